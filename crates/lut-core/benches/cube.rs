@@ -1,0 +1,2 @@
+//! Cube renderer benchmarks (placeholder).
+fn main() {}

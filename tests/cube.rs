@@ -1,0 +1,1 @@
+//! Cube panorama tests (filled in below).
