@@ -1,0 +1,736 @@
+//! The event loop: winit window, softbuffer surface, egui input and panel, lut-core
+//! renders, background loads. Event-driven: a frame is drawn only when input arrives,
+//! egui asks for one (its `repaint_delay`, never the `RedrawRequested` echo), something
+//! animates, or the full-quality frame after fast motion is due.
+
+use super::input::{key_action, wheel_notches, Controller, Held, KeyAction, Look, Turn, TURN_KEYS};
+use super::paint::{Compositor, SceneRect};
+use super::ui::{self, LoadStatus, PanelModel, Readouts};
+use super::OpenArgs;
+use anyhow::{anyhow, Result};
+use lut_core::{EnvMap, IndexStep, LutChoice, Projection, Renderer, RendererKind, Sampler};
+use std::collections::VecDeque;
+use std::io::Read;
+use std::num::NonZeroU32;
+use std::path::PathBuf;
+use std::rc::Rc;
+use std::time::{Duration, Instant};
+use winit::application::ApplicationHandler;
+use winit::event::WindowEvent;
+use winit::event_loop::{
+    ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy, OwnedDisplayHandle,
+};
+use winit::window::{Fullscreen, Window, WindowId};
+
+/// Where a panorama comes from.
+#[derive(Debug, Clone, PartialEq)]
+enum Source {
+    Sample,
+    File(PathBuf),
+}
+
+impl Source {
+    fn name(&self) -> String {
+        match self {
+            Source::Sample => crate::assets::SAMPLE_NAME.to_string(),
+            Source::File(p) => p.display().to_string(),
+        }
+    }
+}
+
+/// A loaded panorama with its renderer (tables built on the loading thread).
+struct Loaded {
+    map: EnvMap,
+    renderer: Renderer,
+    source: Source,
+    projection: Option<Projection>,
+}
+
+/// Messages from the loading thread.
+enum UserEvent {
+    Progress {
+        id: u64,
+        done: u64,
+        total: u64,
+    },
+    Decoding {
+        id: u64,
+    },
+    Done {
+        id: u64,
+        result: Result<Box<Loaded>, String>,
+    },
+}
+
+/// Read `path` in chunks, reporting progress, so a large file never looks frozen.
+fn read_with_progress(
+    path: &std::path::Path,
+    mut progress: impl FnMut(u64, u64),
+) -> Result<Vec<u8>, String> {
+    let name = path.display();
+    let mut f = std::fs::File::open(path).map_err(|e| format!("{name}: cannot open: {e}"))?;
+    let total = f.metadata().map(|m| m.len()).unwrap_or(0);
+    let cap = usize::try_from(total).unwrap_or(0);
+    let mut bytes = Vec::with_capacity(cap);
+    let mut chunk = vec![0u8; 1 << 20];
+    loop {
+        let n = f
+            .read(&mut chunk)
+            .map_err(|e| format!("{name}: cannot read: {e}"))?;
+        if n == 0 {
+            break;
+        }
+        bytes.extend_from_slice(&chunk[..n]);
+        progress(bytes.len() as u64, total);
+    }
+    Ok(bytes)
+}
+
+/// The loading thread's work: read, decode, build tables.
+fn load(
+    proxy: &EventLoopProxy<UserEvent>,
+    id: u64,
+    source: Source,
+    projection: Option<Projection>,
+) -> Result<Box<Loaded>, String> {
+    let map = match &source {
+        Source::Sample => {
+            let _ = proxy.send_event(UserEvent::Decoding { id });
+            crate::cli_common::load_panorama(None, projection).map_err(|e| format!("{e:#}"))?
+        }
+        Source::File(p) => {
+            let bytes = read_with_progress(p, |done, total| {
+                let _ = proxy.send_event(UserEvent::Progress { id, done, total });
+            })?;
+            let _ = proxy.send_event(UserEvent::Decoding { id });
+            // The same decoding as `EnvMap::load` (and so as `viewer render`).
+            EnvMap::decode(&bytes, &p.display().to_string(), projection)
+                .map_err(|e| e.to_string())?
+        }
+    };
+    let renderer = Renderer::new(&map);
+    Ok(Box::new(Loaded {
+        map,
+        renderer,
+        source,
+        projection,
+    }))
+}
+
+/// What a cached scene was rendered from: when it matches, the scene is reused.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SceneKey {
+    look: Look,
+    size: (u32, u32),
+    renderer: RendererKind,
+    sampler: Sampler,
+    index_step: IndexStep,
+    lut: LutChoice,
+    map_generation: u64,
+}
+
+/// Window, surface and egui-winit state: they exist between `resumed` and exit.
+struct Gfx {
+    window: Rc<Window>,
+    surface: softbuffer::Surface<OwnedDisplayHandle, Rc<Window>>,
+    egui_winit: egui_winit::State,
+    surface_size: (u32, u32),
+}
+
+/// Things the UI pass asks the app to do after it.
+#[derive(Default)]
+struct FrameRequests {
+    keys: Vec<KeyAction>,
+    held: Held,
+    panel: ui::PanelOutput,
+    scene_rect: Option<SceneRect>,
+}
+
+struct App {
+    print_view: bool,
+    initial_size: (u32, u32),
+    proxy: EventLoopProxy<UserEvent>,
+    softbuffer: softbuffer::Context<OwnedDisplayHandle>,
+    start: Instant,
+    gfx: Option<Gfx>,
+    egui_ctx: egui::Context,
+    compositor: Compositor,
+    ctl: Controller,
+    current: Option<Box<Loaded>>,
+    map_generation: u64,
+    /// Projection chosen in the panel for the current (or failed) file.
+    projection: Option<Projection>,
+    /// The source the projection choice applies to: the current one, or a failed one.
+    projection_source: Option<Source>,
+    loading: Option<(u64, Source, LoadStatus)>,
+    next_load_id: u64,
+    error: Option<String>,
+    show_panel: bool,
+    scene: Vec<u32>,
+    scene_key: Option<SceneKey>,
+    readouts: Readouts,
+    next_frame_at: Option<Instant>,
+    frame_times: VecDeque<Instant>,
+    fatal: Option<anyhow::Error>,
+}
+
+/// Open the window and run until it is closed.
+pub fn run(args: OpenArgs, projection: Option<Projection>) -> Result<()> {
+    let event_loop = create_event_loop()?;
+    let softbuffer = softbuffer::Context::new(event_loop.owned_display_handle())
+        .map_err(|e| anyhow!("cannot use the display for software drawing: {e}"))?;
+    let proxy = event_loop.create_proxy();
+    let mut app = App {
+        print_view: args.print_view,
+        initial_size: args.size,
+        proxy,
+        softbuffer,
+        start: Instant::now(),
+        gfx: None,
+        egui_ctx: egui::Context::default(),
+        compositor: Compositor::new(),
+        ctl: Controller::default(),
+        current: None,
+        map_generation: 0,
+        projection,
+        projection_source: None,
+        loading: None,
+        next_load_id: 0,
+        error: None,
+        show_panel: true,
+        scene: Vec::new(),
+        scene_key: None,
+        readouts: Readouts::default(),
+        next_frame_at: None,
+        frame_times: VecDeque::new(),
+        fatal: None,
+    };
+    let source = args.panorama.map_or(Source::Sample, Source::File);
+    app.start_load(source, projection);
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
+    match app.fatal {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// Create the event loop, turning a missing display (an error, or a panic deep in a
+/// platform backend) into a clear error.
+fn create_event_loop() -> Result<EventLoop<UserEvent>> {
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let built = std::panic::catch_unwind(|| EventLoop::<UserEvent>::with_user_event().build());
+    std::panic::set_hook(hook);
+    let no_display = "cannot open a window: no usable display (is DISPLAY or WAYLAND_DISPLAY set \
+                      and the X11/Wayland libraries installed? `viewer render` works without one)";
+    match built {
+        Ok(Ok(el)) => Ok(el),
+        Ok(Err(e)) => Err(anyhow!("{no_display}: {e}")),
+        Err(p) => {
+            let why = p
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            Err(anyhow!("{no_display}: {why}"))
+        }
+    }
+}
+
+impl App {
+    fn request_redraw(&self) {
+        if let Some(g) = &self.gfx {
+            g.window.request_redraw();
+        }
+    }
+
+    /// Load `source` on a background thread; the current panorama stays until it is done.
+    fn start_load(&mut self, source: Source, projection: Option<Projection>) {
+        self.next_load_id += 1;
+        let id = self.next_load_id;
+        let name = source.name();
+        let status = match source {
+            Source::Sample => LoadStatus::Decoding { name },
+            Source::File(_) => LoadStatus::Reading {
+                name,
+                done: 0,
+                total: 0,
+            },
+        };
+        self.loading = Some((id, source.clone(), status));
+        let proxy = self.proxy.clone();
+        let spawned = std::thread::Builder::new()
+            .name("viewer-load".into())
+            .spawn(move || {
+                let result = load(&proxy, id, source, projection);
+                let _ = proxy.send_event(UserEvent::Done { id, result });
+            });
+        if let Err(e) = spawned {
+            self.loading = None;
+            self.error = Some(format!("cannot start loading: {e}"));
+        }
+        self.request_redraw();
+    }
+
+    fn on_load_event(&mut self, ev: UserEvent) {
+        let current_id = self.loading.as_ref().map(|l| l.0);
+        match ev {
+            UserEvent::Progress { id, done, total } if Some(id) == current_id => {
+                if let Some((_, src, st)) = &mut self.loading {
+                    *st = LoadStatus::Reading {
+                        name: src.name(),
+                        done,
+                        total,
+                    };
+                }
+            }
+            UserEvent::Decoding { id } if Some(id) == current_id => {
+                if let Some((_, src, st)) = &mut self.loading {
+                    *st = LoadStatus::Decoding { name: src.name() };
+                }
+            }
+            UserEvent::Done { id, result } if Some(id) == current_id => {
+                let source = self.loading.take().map(|l| l.1);
+                match result {
+                    Ok(loaded) => {
+                        if self.print_view {
+                            println!(
+                                "loaded {} {}x{} {}",
+                                loaded.source.name(),
+                                loaded.map.width(),
+                                loaded.map.height(),
+                                loaded.map.projection().name()
+                            );
+                        }
+                        self.readouts.map = format!(
+                            "{} ({}×{}, {})",
+                            short_name(&loaded.source),
+                            loaded.map.width(),
+                            loaded.map.height(),
+                            loaded.map.projection().name()
+                        );
+                        if let Some(g) = &self.gfx {
+                            g.window
+                                .set_title(&format!("viewer: {}", short_name(&loaded.source)));
+                        }
+                        self.projection = loaded.projection;
+                        self.projection_source = Some(loaded.source.clone());
+                        self.current = Some(loaded);
+                        self.map_generation += 1;
+                        self.error = None;
+                    }
+                    Err(e) => {
+                        eprintln!("viewer: {e}");
+                        self.error = Some(e);
+                        self.show_panel = true;
+                        // A projection chosen next retries this file.
+                        self.projection_source = source;
+                        if self.current.is_none() {
+                            // Nothing to keep showing: fall back to the bundled sample.
+                            self.start_load(Source::Sample, None);
+                        }
+                    }
+                }
+            }
+            _ => {} // from a superseded load
+        }
+        self.request_redraw();
+    }
+
+    /// Build this frame's UI and collect what the user did.
+    fn build_ui(&mut self, ui: &mut egui::Ui, t: f64, win: (u32, u32)) -> FrameRequests {
+        let mut req = FrameRequests::default();
+        let ppp = ui.ctx().pixels_per_point();
+        if !ui.ctx().egui_wants_keyboard_input() {
+            ui.input(|i| {
+                for ev in &i.events {
+                    if let egui::Event::Key {
+                        key,
+                        pressed: true,
+                        repeat,
+                        modifiers,
+                        ..
+                    } = ev
+                    {
+                        match key_action(*key, *modifiers) {
+                            Some(KeyAction::Turn(_)) | None => {}
+                            Some(a @ (KeyAction::ZoomIn | KeyAction::ZoomOut)) => req.keys.push(a),
+                            Some(a) if !repeat => req.keys.push(a),
+                            Some(_) => {}
+                        }
+                    }
+                }
+                let plain = !(i.modifiers.ctrl || i.modifiers.command);
+                for k in TURN_KEYS {
+                    if plain && i.key_down(k) {
+                        match key_action(k, egui::Modifiers::NONE) {
+                            Some(KeyAction::Turn(Turn::Left)) => req.held.left = true,
+                            Some(KeyAction::Turn(Turn::Right)) => req.held.right = true,
+                            Some(KeyAction::Turn(Turn::Up)) => req.held.up = true,
+                            Some(KeyAction::Turn(Turn::Down)) => req.held.down = true,
+                            _ => {}
+                        }
+                    }
+                }
+            });
+        }
+        if self.show_panel {
+            let loading = self.loading.as_ref().map(|l| &l.2);
+            let look = self.ctl.look();
+            req.panel = ui::side_panel(
+                ui,
+                PanelModel {
+                    settings: &mut self.ctl.settings,
+                    projection: &mut self.projection,
+                    look,
+                    readouts: &self.readouts,
+                    loading,
+                    error: self.error.as_deref(),
+                },
+            );
+        }
+        // The scene: everything the panel leaves. Drags and wheel go through egui so a
+        // click on the panel is never taken for a drag (hit-testing is egui's).
+        let rect = ui.available_rect_before_wrap();
+        let resp = ui.interact(rect, egui::Id::new("scene"), egui::Sense::drag());
+        req.scene_rect = SceneRect::from_points(rect, ppp, win.0, win.1);
+        let Some(sr) = req.scene_rect else {
+            return req;
+        };
+        let size = (sr.w, sr.h);
+        let to_px = |p: egui::Pos2| {
+            (
+                f64::from(p.x * ppp) - f64::from(sr.x),
+                f64::from(p.y * ppp) - f64::from(sr.y),
+            )
+        };
+        let primary = egui::PointerButton::Primary;
+        if resp.drag_started_by(primary) {
+            let origin = ui
+                .input(|i| i.pointer.press_origin())
+                .or(resp.interact_pointer_pos());
+            if let Some(o) = origin {
+                self.ctl.press(to_px(o), size, t);
+            }
+        }
+        if self.ctl.dragging() {
+            match resp.interact_pointer_pos() {
+                Some(p) if resp.dragged_by(primary) => self.ctl.drag_to(to_px(p), size, t),
+                // Released, or the drag ended some other way (pointer gone): never leave
+                // a QTVR turn running.
+                _ => self.ctl.release(t),
+            }
+        }
+        if resp.contains_pointer() {
+            let notches: f64 = ui.input(|i| {
+                i.events
+                    .iter()
+                    .map(|e| match e {
+                        egui::Event::MouseWheel { unit, delta, .. } => {
+                            wheel_notches(*unit, delta.y)
+                        }
+                        _ => 0.0,
+                    })
+                    .sum()
+            });
+            if notches != 0.0 {
+                let cursor = resp.hover_pos().map(to_px);
+                self.ctl.wheel(notches, cursor, size);
+                if let Some(p) = resp.interact_pointer_pos().filter(|_| self.ctl.dragging()) {
+                    // Keep a grab in progress consistent with the new zoom.
+                    self.ctl.press(to_px(p), size, t);
+                }
+            }
+        }
+        req
+    }
+
+    fn apply_requests(&mut self, req: &FrameRequests, t: f64, el: &ActiveEventLoop) {
+        self.ctl.set_held(req.held.or(req.panel.held), t);
+        if req.panel.reset {
+            self.ctl.key(KeyAction::Reset);
+        }
+        if req.panel.dismiss_error {
+            self.error = None;
+        }
+        if req.panel.projection_changed {
+            let source = self
+                .projection_source
+                .clone()
+                .or_else(|| self.current.as_ref().map(|c| c.source.clone()));
+            if let Some(s) = source {
+                self.start_load(s, self.projection);
+            }
+        }
+        for &a in &req.keys {
+            match a {
+                KeyAction::TogglePanel => self.show_panel = !self.show_panel,
+                KeyAction::Quit => el.exit(),
+                KeyAction::ToggleFullscreen => {
+                    if let Some(g) = &self.gfx {
+                        let full = g.window.fullscreen().is_some();
+                        g.window
+                            .set_fullscreen((!full).then_some(Fullscreen::Borderless(None)));
+                    }
+                }
+                KeyAction::LeaveFullscreen => {
+                    if let Some(g) = &self.gfx {
+                        g.window.set_fullscreen(None);
+                    }
+                }
+                other => self.ctl.key(other),
+            }
+        }
+    }
+
+    /// Render the scene for `rect` unless the cached one already shows it.
+    fn render_scene(&mut self, rect: SceneRect, look: Look, fast: bool) {
+        let Some(cur) = self.current.as_mut() else {
+            return;
+        };
+        let opts = self.ctl.settings.render_options(fast);
+        let key = SceneKey {
+            look,
+            size: (rect.w, rect.h),
+            renderer: opts.renderer,
+            sampler: opts.sampler,
+            index_step: opts.index_step,
+            lut: opts.lut,
+            map_generation: self.map_generation,
+        };
+        if self.scene_key == Some(key) {
+            return;
+        }
+        self.scene.resize(rect.w as usize * rect.h as usize, 0);
+        let t0 = Instant::now();
+        let result = cur.renderer.render(
+            &cur.map,
+            look.view(),
+            &opts,
+            &mut self.scene,
+            rect.w,
+            rect.h,
+        );
+        self.readouts.render_ms = t0.elapsed().as_secs_f64() * 1e3;
+        match result {
+            Ok(report) => {
+                self.readouts.path = Some(report.path);
+                self.readouts.table_bytes = report.table_bytes;
+                self.readouts.exact_pixels = report.exact_pixels;
+                self.readouts.pixels = report.pixels;
+                self.readouts.scene = (rect.w, rect.h);
+                self.scene_key = Some(key);
+                if self.print_view {
+                    println!(
+                        "view yaw={:.4} pitch={:.4} hfov={:.4} path={:?} sampler={} fast={} size={}x{}",
+                        look.yaw,
+                        look.pitch,
+                        look.hfov,
+                        report.path,
+                        opts.sampler.name(),
+                        fast,
+                        rect.w,
+                        rect.h
+                    );
+                }
+            }
+            Err(e) => {
+                self.error = Some(format!("render failed: {e}"));
+                self.scene_key = None;
+            }
+        }
+    }
+
+    fn redraw(&mut self, el: &ActiveEventLoop) -> Result<()> {
+        let Some(g) = self.gfx.as_mut() else {
+            return Ok(());
+        };
+        let size = g.window.inner_size();
+        let (w, h) = (size.width, size.height);
+        let (Some(nw), Some(nh)) = (NonZeroU32::new(w), NonZeroU32::new(h)) else {
+            // Minimized (0×0): draw nothing, and run no UI pass whose texture updates
+            // would be lost.
+            return Ok(());
+        };
+        let t = self.start.elapsed().as_secs_f64();
+        let ui_t0 = Instant::now();
+        let raw = g.egui_winit.take_egui_input(&g.window);
+        let ctx = self.egui_ctx.clone();
+        let look_before = self.ctl.look();
+        let mut req = FrameRequests::default();
+        let full = ctx.run_ui(raw, |ui| req = self.build_ui(ui, t, (w, h)));
+        self.apply_requests(&req, t, el);
+        let frame = self.ctl.frame(t);
+        let mut ui_ms = ui_t0.elapsed().as_secs_f64() * 1e3;
+        if let Some(r) = req.scene_rect {
+            self.render_scene(r, frame.look, frame.fast);
+        }
+        let Some(g) = self.gfx.as_mut() else {
+            return Ok(());
+        };
+        g.egui_winit
+            .handle_platform_output(&g.window, full.platform_output);
+        let t1 = Instant::now();
+        let prims = ctx.tessellate(full.shapes, full.pixels_per_point);
+        if g.surface_size != (w, h) {
+            g.surface
+                .resize(nw, nh)
+                .map_err(|e| anyhow!("cannot resize the drawing surface to {w}x{h}: {e}"))?;
+            g.surface_size = (w, h);
+        }
+        let mut buffer = g
+            .surface
+            .buffer_mut()
+            .map_err(|e| anyhow!("cannot get the drawing buffer: {e}"))?;
+        let scene = match (req.scene_rect, self.scene_key) {
+            (Some(r), Some(k)) if k.size == (r.w, r.h) => Some((self.scene.as_slice(), r)),
+            _ => None,
+        };
+        self.compositor.compose(
+            &mut buffer,
+            w,
+            h,
+            scene,
+            &prims,
+            &full.textures_delta,
+            full.pixels_per_point,
+        );
+        ui_ms += t1.elapsed().as_secs_f64() * 1e3;
+        buffer
+            .present()
+            .map_err(|e| anyhow!("cannot show the frame: {e}"))?;
+        self.readouts.ui_ms = ui_ms;
+
+        let now = Instant::now();
+        self.frame_times.push_back(now);
+        while self
+            .frame_times
+            .front()
+            .is_some_and(|&f| now.duration_since(f) > Duration::from_secs(1))
+        {
+            self.frame_times.pop_front();
+        }
+        self.readouts.fps = match (self.frame_times.front(), self.frame_times.len()) {
+            (Some(&f), n) if n >= 2 => (n - 1) as f64 / now.duration_since(f).as_secs_f64(),
+            _ => 0.0,
+        };
+
+        // When is the next frame due?
+        let mut next: Option<Instant> = None;
+        let mut want = |at: Instant| next = Some(next.map_or(at, |n: Instant| n.min(at)));
+        let delay = full
+            .viewport_output
+            .get(&egui::ViewportId::ROOT)
+            .map_or(Duration::MAX, |v| v.repaint_delay);
+        if delay < Duration::from_secs(3600) {
+            want(now + delay);
+        }
+        if let Some(at) = self.ctl.wake_at() {
+            want(self.start + Duration::from_secs_f64(at.max(0.0)));
+        }
+        if self.ctl.look() != look_before && self.show_panel {
+            // The readouts were drawn before this frame's input moved the view.
+            want(now);
+        }
+        self.next_frame_at = next;
+        Ok(())
+    }
+}
+
+fn short_name(s: &Source) -> String {
+    match s {
+        Source::Sample => "courtyard (bundled sample)".into(),
+        Source::File(p) => p.file_name().map_or_else(
+            || p.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        ),
+    }
+}
+
+impl ApplicationHandler<UserEvent> for App {
+    fn resumed(&mut self, el: &ActiveEventLoop) {
+        if self.gfx.is_some() {
+            return;
+        }
+        let (w, h) = self.initial_size;
+        let attrs = Window::default_attributes()
+            .with_title("viewer")
+            .with_inner_size(winit::dpi::LogicalSize::new(f64::from(w), f64::from(h)));
+        let window = match el.create_window(attrs) {
+            Ok(w) => Rc::new(w),
+            Err(e) => {
+                self.fatal = Some(anyhow!("cannot create a window: {e}"));
+                el.exit();
+                return;
+            }
+        };
+        let surface = match softbuffer::Surface::new(&self.softbuffer, window.clone()) {
+            Ok(s) => s,
+            Err(e) => {
+                self.fatal = Some(anyhow!("cannot draw into the window: {e}"));
+                el.exit();
+                return;
+            }
+        };
+        let egui_winit = egui_winit::State::new(
+            self.egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            window.theme(),
+            None,
+        );
+        window.request_redraw();
+        self.gfx = Some(Gfx {
+            window,
+            surface,
+            egui_winit,
+            surface_size: (0, 0),
+        });
+    }
+
+    fn user_event(&mut self, _el: &ActiveEventLoop, ev: UserEvent) {
+        self.on_load_event(ev);
+    }
+
+    fn window_event(&mut self, el: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(g) = self.gfx.as_mut() else {
+            return;
+        };
+        let response = g.egui_winit.on_window_event(&g.window, &event);
+        match event {
+            WindowEvent::CloseRequested => el.exit(),
+            WindowEvent::RedrawRequested => {
+                // egui-winit answers "repaint" to this very event: ignore that, or the idle
+                // viewer would redraw forever.
+                if let Err(e) = self.redraw(el) {
+                    self.fatal = Some(e);
+                    el.exit();
+                }
+            }
+            WindowEvent::DroppedFile(path) => self.start_load(Source::File(path), None),
+            WindowEvent::Resized(_) | WindowEvent::ScaleFactorChanged { .. } => {
+                g.window.request_redraw()
+            }
+            _ => {
+                if response.repaint {
+                    g.window.request_redraw();
+                }
+            }
+        }
+    }
+
+    fn about_to_wait(&mut self, el: &ActiveEventLoop) {
+        match self.next_frame_at {
+            Some(at) if at <= Instant::now() => {
+                self.next_frame_at = None;
+                self.request_redraw();
+                el.set_control_flow(ControlFlow::Wait);
+            }
+            Some(at) => el.set_control_flow(ControlFlow::WaitUntil(at)),
+            None => el.set_control_flow(ControlFlow::Wait),
+        }
+    }
+}
