@@ -1,0 +1,567 @@
+//! Lighting a rendered panorama frame with goniometric luminaires.
+//!
+//! The panorama is taken as the albedo of a box-shaped room around the camera (for a cube
+//! panorama, the cube is the room). For every output pixel: the scene point is the camera
+//! ray ∩ the room box; for each luminaire, the direction and distance from the light give
+//! E = I(direction) · cos(incidence) / d² (through the distance series of [`LightTable`]);
+//! the shaded colour is albedo · (ambient + exposure · ΣE), computed on linear light
+//! (sRGB decoded, multiplied, encoded again).
+//!
+//! World frame (conventions.md): X right, Y up, Z forward at yaw 0, in metres, with the
+//! origin on the floor below the camera: the room spans x ∈ [−W/2, W/2], y ∈ [0, H],
+//! z ∈ [−D/2, D/2] and the camera sits at (0, camera height, 0). The walls are convex
+//! around every light inside, so there are no shadows to trace.
+
+use super::table::LightTable;
+use super::{LightError, PhotometricType};
+use crate::camera::Camera;
+use glam::DVec3;
+use rayon::prelude::*;
+use std::sync::{Arc, OnceLock};
+
+/// A box-shaped room around the camera, in metres.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Room {
+    width: f64,
+    depth: f64,
+    height: f64,
+    camera_height: f64,
+}
+
+impl Room {
+    /// A room `width` (along X) × `depth` (along Z) × `height` (along Y), with the camera
+    /// at the horizontal centre, `camera_height` above the floor.
+    ///
+    /// # Errors
+    /// [`LightError::BadOption`] when a size is not a positive finite number or the camera
+    /// is not strictly between floor and ceiling.
+    pub fn new(
+        width: f64,
+        depth: f64,
+        height: f64,
+        camera_height: f64,
+    ) -> Result<Room, LightError> {
+        for (name, value) in [
+            ("room width", width),
+            ("room depth", depth),
+            ("room height", height),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(LightError::BadOption {
+                    name,
+                    expected: "a positive number of metres",
+                    value,
+                });
+            }
+        }
+        if !(camera_height > 0.0 && camera_height < height) {
+            return Err(LightError::BadOption {
+                name: "camera height",
+                expected: "strictly between the floor (0) and the ceiling",
+                value: camera_height,
+            });
+        }
+        Ok(Room {
+            width,
+            depth,
+            height,
+            camera_height,
+        })
+    }
+
+    /// A cube room of side `size` (a cube panorama's room), camera at `camera_height`.
+    ///
+    /// # Errors
+    /// As [`Room::new`].
+    pub fn cube(size: f64, camera_height: f64) -> Result<Room, LightError> {
+        Room::new(size, size, size, camera_height)
+    }
+
+    /// Width along X in metres.
+    pub fn width(&self) -> f64 {
+        self.width
+    }
+    /// Depth along Z in metres.
+    pub fn depth(&self) -> f64 {
+        self.depth
+    }
+    /// Height along Y in metres.
+    pub fn height(&self) -> f64 {
+        self.height
+    }
+    /// Camera height above the floor in metres.
+    pub fn camera_height(&self) -> f64 {
+        self.camera_height
+    }
+
+    /// The camera's position in the world frame.
+    pub fn camera_position(&self) -> DVec3 {
+        DVec3::new(0.0, self.camera_height, 0.0)
+    }
+
+    /// Whether a point lies in the closed box (with a 1 µm tolerance).
+    pub fn contains(&self, p: DVec3) -> bool {
+        let e = 1e-6;
+        p.x.abs() <= self.width / 2.0 + e
+            && p.z.abs() <= self.depth / 2.0 + e
+            && p.y >= -e
+            && p.y <= self.height + e
+    }
+
+    /// Where the ray from `origin` (inside the box) along `dir` (any length, not zero)
+    /// leaves the box, and the inward unit normal of the face it hits.
+    #[inline]
+    pub fn hit(&self, origin: DVec3, dir: DVec3) -> (DVec3, DVec3) {
+        let lo = DVec3::new(-self.width / 2.0, 0.0, -self.depth / 2.0);
+        let hi = DVec3::new(self.width / 2.0, self.height, self.depth / 2.0);
+        let mut t = f64::INFINITY;
+        let mut n = DVec3::ZERO;
+        for axis in 0..3 {
+            let d = dir[axis];
+            if d == 0.0 {
+                continue;
+            }
+            let (plane, normal) = if d > 0.0 {
+                (hi[axis], -1.0)
+            } else {
+                (lo[axis], 1.0)
+            };
+            let ta = (plane - origin[axis]) / d;
+            if ta < t {
+                t = ta;
+                n = DVec3::ZERO;
+                n[axis] = normal;
+            }
+        }
+        if !t.is_finite() {
+            return (origin, DVec3::Y);
+        }
+        let mut p = origin + dir * t.max(0.0);
+        // Put the hit exactly on its face (no drift off the wall from rounding).
+        let axis = if n.x != 0.0 {
+            0
+        } else if n.y != 0.0 {
+            1
+        } else {
+            2
+        };
+        p[axis] = if n[axis] < 0.0 { hi[axis] } else { lo[axis] };
+        (p, n)
+    }
+}
+
+/// One luminaire placed in the room.
+#[derive(Debug, Clone)]
+pub struct Luminaire {
+    /// Its intensity distribution.
+    pub table: Arc<LightTable>,
+    /// Position in metres, world frame.
+    pub position: DVec3,
+    /// Aim yaw in degrees (the camera's sense: positive turns right).
+    pub yaw_deg: f64,
+    /// Aim pitch in degrees (positive up; −90 = straight down), clamped to [−90, 90].
+    pub pitch_deg: f64,
+    /// Multiplies the intensity (e.g. several lamps, dimming).
+    pub multiplier: f64,
+}
+
+impl Luminaire {
+    /// A luminaire at `position`, aimed straight down, multiplier 1.
+    pub fn new(table: Arc<LightTable>, position: DVec3) -> Luminaire {
+        Luminaire {
+            table,
+            position,
+            yaw_deg: 0.0,
+            pitch_deg: -90.0,
+            multiplier: 1.0,
+        }
+    }
+
+    /// The light's frame (right, up, aim) as unit world vectors: the camera's rotation,
+    /// pitch about X then yaw about Y. Aimed down at yaw 0, "up" points along +Z.
+    pub fn frame(&self) -> (DVec3, DVec3, DVec3) {
+        let (sp, cp) = self.pitch_deg.clamp(-90.0, 90.0).to_radians().sin_cos();
+        let (sy, cy) = self.yaw_deg.to_radians().sin_cos();
+        let rot = |v: DVec3| {
+            let y1 = v.y * cp + v.z * sp;
+            let z1 = v.z * cp - v.y * sp;
+            DVec3::new(v.x * cy + z1 * sy, y1, z1 * cy - v.x * sy)
+        };
+        (rot(DVec3::X), rot(DVec3::Y), rot(DVec3::Z))
+    }
+
+    /// The lamp's tilt in degrees: for type C the angle between the aim and straight
+    /// down, for types A/B the angle between the aim and the horizontal.
+    pub fn tilt_deg(&self) -> f64 {
+        let (_, _, f) = self.frame();
+        match self.table.photometric_type() {
+            PhotometricType::C => (-f.y).clamp(-1.0, 1.0).acos().to_degrees(),
+            _ => f.y.clamp(-1.0, 1.0).asin().to_degrees().abs(),
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Placed {
+    table: Arc<LightTable>,
+    pos: DVec3,
+    right: DVec3,
+    up: DVec3,
+    aim: DVec3,
+    /// multiplier × tilt factor.
+    scale: f64,
+}
+
+/// Luminaires in a room: what [`shade_frame`] and [`lux_at`] light.
+#[derive(Debug, Clone)]
+pub struct LightScene {
+    room: Room,
+    lights: Vec<Luminaire>,
+    placed: Vec<Placed>,
+}
+
+impl LightScene {
+    /// Place the luminaires in the room.
+    ///
+    /// # Errors
+    /// [`LightError::LightOutsideRoom`] for a light outside the box,
+    /// [`LightError::BadOption`] for a non-finite position or angle or a negative or
+    /// non-finite multiplier.
+    pub fn new(room: Room, lights: Vec<Luminaire>) -> Result<LightScene, LightError> {
+        let mut placed = Vec::with_capacity(lights.len());
+        for (index, l) in lights.iter().enumerate() {
+            for (name, value) in [
+                ("light position x", l.position.x),
+                ("light position y", l.position.y),
+                ("light position z", l.position.z),
+                ("light yaw", l.yaw_deg),
+                ("light pitch", l.pitch_deg),
+            ] {
+                if !value.is_finite() {
+                    return Err(LightError::BadOption {
+                        name,
+                        expected: "a finite number",
+                        value,
+                    });
+                }
+            }
+            if !(l.multiplier.is_finite() && l.multiplier >= 0.0) {
+                return Err(LightError::BadOption {
+                    name: "light multiplier",
+                    expected: "a finite number ≥ 0",
+                    value: l.multiplier,
+                });
+            }
+            if !room.contains(l.position) {
+                return Err(LightError::LightOutsideRoom {
+                    index,
+                    x: l.position.x,
+                    y: l.position.y,
+                    z: l.position.z,
+                    half_width: room.width / 2.0,
+                    height: room.height,
+                    half_depth: room.depth / 2.0,
+                });
+            }
+            let (right, up, aim) = l.frame();
+            let tilt = l.table.tilt().map_or(1.0, |t| t.factor_at(l.tilt_deg()));
+            placed.push(Placed {
+                table: l.table.clone(),
+                pos: l.position,
+                right,
+                up,
+                aim,
+                scale: l.multiplier * tilt,
+            });
+        }
+        Ok(LightScene {
+            room,
+            lights,
+            placed,
+        })
+    }
+
+    /// The room.
+    pub fn room(&self) -> &Room {
+        &self.room
+    }
+
+    /// The luminaires.
+    pub fn luminaires(&self) -> &[Luminaire] {
+        &self.lights
+    }
+
+    /// Illuminance in lux at surface point `p` with unit normal `n` (facing into the
+    /// room): Σ multiplier · tilt factor · I(direction) · cos(incidence) / d².
+    #[inline]
+    pub fn illuminance(&self, p: DVec3, n: DVec3) -> f64 {
+        let mut e = 0.0;
+        for l in &self.placed {
+            let to_light = l.pos - p;
+            let d2 = to_light.length_squared();
+            if d2 < 1e-18 {
+                continue;
+            }
+            let d = d2.sqrt();
+            let cos_i = n.dot(to_light) / d;
+            if cos_i <= 0.0 {
+                continue;
+            }
+            // Direction from the light to the point, in the light's frame.
+            let w = -to_light / d;
+            let local = DVec3::new(w.dot(l.right), w.dot(l.up), w.dot(l.aim));
+            e += l.scale * l.table.illuminance_normal(local, d) * cos_i;
+        }
+        e
+    }
+
+    /// The scene point and inward normal seen along world direction `dir` from the camera.
+    pub fn scene_point(&self, dir: DVec3) -> (DVec3, DVec3) {
+        self.room.hit(self.room.camera_position(), dir)
+    }
+}
+
+/// How [`shade_frame`] turns illuminance into colour.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadeOptions {
+    /// Light factor everywhere, lights or not (1 = the panorama as photographed).
+    pub ambient: f64,
+    /// Light factor per lux (so 1 / exposure lux look like the photograph).
+    pub exposure: f64,
+    /// Replace the shading by a false-colour illuminance map blended over it.
+    pub false_color: bool,
+    /// Illuminance at the top (red) of the false-colour scale; the scale is logarithmic
+    /// over three decades below it.
+    pub false_color_max_lux: f64,
+}
+
+impl Default for ShadeOptions {
+    fn default() -> Self {
+        ShadeOptions {
+            ambient: 0.15,
+            exposure: 1.0 / 300.0,
+            false_color: false,
+            false_color_max_lux: 1000.0,
+        }
+    }
+}
+
+/// sRGB 8-bit → linear.
+fn decode_lut() -> &'static [f32; 256] {
+    static LUT: OnceLock<[f32; 256]> = OnceLock::new();
+    LUT.get_or_init(|| {
+        let mut t = [0.0f32; 256];
+        for (i, v) in t.iter_mut().enumerate() {
+            let c = i as f64 / 255.0;
+            *v = if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            } as f32;
+        }
+        t
+    })
+}
+
+const ENC_N: usize = 4096;
+
+/// Linear [0, 1] in 4096 steps → sRGB 8-bit.
+fn encode_lut() -> &'static [u8; ENC_N] {
+    static LUT: OnceLock<[u8; ENC_N]> = OnceLock::new();
+    LUT.get_or_init(|| {
+        let mut t = [0u8; ENC_N];
+        for (i, v) in t.iter_mut().enumerate() {
+            let l = i as f64 / (ENC_N - 1) as f64;
+            let s = if l <= 0.003_130_8 {
+                l * 12.92
+            } else {
+                1.055 * l.powf(1.0 / 2.4) - 0.055
+            };
+            *v = (s * 255.0).round().clamp(0.0, 255.0) as u8;
+        }
+        t
+    })
+}
+
+#[inline]
+fn encode(l: f32, enc: &[u8; ENC_N]) -> u32 {
+    let i = (l.clamp(0.0, 1.0) * (ENC_N - 1) as f32 + 0.5) as usize;
+    enc[i.min(ENC_N - 1)] as u32
+}
+
+/// The false-colour ramp at `t` in [0, 1]: dark blue, blue, green, yellow, red.
+pub fn false_color(t: f64) -> u32 {
+    const STOPS: [(f64, [f64; 3]); 5] = [
+        (0.0, [0.0, 0.0, 96.0]),
+        (0.25, [0.0, 96.0, 255.0]),
+        (0.5, [0.0, 200.0, 80.0]),
+        (0.75, [255.0, 220.0, 0.0]),
+        (1.0, [255.0, 32.0, 0.0]),
+    ];
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+    let k = STOPS.iter().rposition(|s| s.0 <= t).unwrap_or(0).min(3);
+    let (t0, c0) = STOPS[k];
+    let (t1, c1) = STOPS[k + 1];
+    let f = (t - t0) / (t1 - t0);
+    let ch = |i: usize| ((c0[i] + (c1[i] - c0[i]) * f).round().clamp(0.0, 255.0)) as u32;
+    (ch(0) << 16) | (ch(1) << 8) | ch(2)
+}
+
+/// Position on the false-colour scale of `lux` for a scale topping at `max_lux`.
+fn scale_pos(lux: f64, max_lux: f64) -> f64 {
+    if lux.is_nan() || lux <= 0.0 {
+        return 0.0;
+    }
+    ((lux / max_lux).log10() / 3.0 + 1.0).clamp(0.0, 1.0)
+}
+
+/// Shade one pixel of albedo `p` with light factor `k`.
+#[inline]
+fn shade_pixel(p: u32, k: f32, dec: &[f32; 256], enc: &[u8; ENC_N]) -> u32 {
+    let r = encode(dec[((p >> 16) & 0xff) as usize] * k, enc);
+    let g = encode(dec[((p >> 8) & 0xff) as usize] * k, enc);
+    let b = encode(dec[(p & 0xff) as usize] * k, enc);
+    (r << 16) | (g << 8) | b
+}
+
+/// Light a rendered frame in place: each pixel's colour is taken as the albedo of the
+/// room surface its camera ray hits. Rows run in parallel; the result does not depend
+/// on the number of threads.
+///
+/// # Errors
+/// [`LightError::BufferSize`] when `frame` does not hold `w × h` pixels (or the camera
+/// was made for another size); [`LightError::BadOption`] for non-finite or negative
+/// ambient/exposure or a non-positive false-colour maximum.
+pub fn shade_frame(
+    scene: &LightScene,
+    cam: &Camera,
+    frame: &mut [u32],
+    w: u32,
+    h: u32,
+    opts: &ShadeOptions,
+) -> Result<(), LightError> {
+    let needed = w as usize * h as usize;
+    if frame.len() != needed || cam.width != w || cam.height != h {
+        return Err(LightError::BufferSize {
+            len: frame.len(),
+            width: w,
+            height: h,
+            needed,
+        });
+    }
+    for (name, value) in [("ambient", opts.ambient), ("exposure", opts.exposure)] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(LightError::BadOption {
+                name,
+                expected: "a finite number ≥ 0",
+                value,
+            });
+        }
+    }
+    if opts.false_color && !(opts.false_color_max_lux.is_finite() && opts.false_color_max_lux > 0.0)
+    {
+        return Err(LightError::BadOption {
+            name: "false-colour maximum",
+            expected: "a positive number of lux",
+            value: opts.false_color_max_lux,
+        });
+    }
+    if needed == 0 {
+        return Ok(());
+    }
+    let dec = decode_lut();
+    let enc = encode_lut();
+    let origin = scene.room.camera_position();
+    frame
+        .par_chunks_mut(w as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let py = y as f64 + 0.5;
+            for (x, px) in row.iter_mut().enumerate() {
+                let dir = cam.world_ray(x as f64 + 0.5, py);
+                let (p, n) = scene.room.hit(origin, dir);
+                let e = scene.illuminance(p, n);
+                let k = (opts.ambient + opts.exposure * e) as f32;
+                let shaded = shade_pixel(*px, k, dec, enc);
+                *px = if opts.false_color {
+                    blend(
+                        false_color(scale_pos(e, opts.false_color_max_lux)),
+                        shaded,
+                        0.65,
+                    )
+                } else {
+                    shaded
+                };
+            }
+        });
+    Ok(())
+}
+
+/// a · t + b · (1 − t) per channel.
+fn blend(a: u32, b: u32, t: f32) -> u32 {
+    let ch = |s: u32| {
+        let x = ((a >> s) & 0xff) as f32;
+        let y = ((b >> s) & 0xff) as f32;
+        ((x * t + y * (1.0 - t)).round() as u32).min(255) << s
+    };
+    ch(16) | ch(8) | ch(0)
+}
+
+/// Illuminance in lux (lights only, no ambient) at the room surface seen through image
+/// point (px, py) (pixel coordinates, centres at +0.5) of `cam`.
+pub fn lux_at(scene: &LightScene, cam: &Camera, px: f64, py: f64) -> f64 {
+    let (p, n) = scene.scene_point(cam.world_ray(px, py));
+    scene.illuminance(p, n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hit_faces_and_normals() {
+        let r = Room::new(4.0, 6.0, 3.0, 1.5).unwrap();
+        let o = r.camera_position();
+        let (p, n) = r.hit(o, DVec3::new(0.0, -1.0, 0.0));
+        assert_eq!((p, n), (DVec3::new(0.0, 0.0, 0.0), DVec3::Y));
+        let (p, n) = r.hit(o, DVec3::new(1.0, 0.0, 0.0));
+        assert_eq!((p, n), (DVec3::new(2.0, 1.5, 0.0), -DVec3::X));
+        let (p, n) = r.hit(o, DVec3::new(0.0, 1.0, -1.0));
+        assert_eq!(n, DVec3::NEG_Y);
+        assert!((p - DVec3::new(0.0, 3.0, -1.5)).length() < 1e-12);
+    }
+
+    #[test]
+    fn light_frame_down_has_up_along_z() {
+        let t = Arc::new(
+            LightTable::from_ies(
+                &crate::light::IesFile::parse("TILT=NONE\n1 -1 1 1 1 1 2 0 0 0 1 1 1 0 0 1\n", "t")
+                    .unwrap(),
+                &Default::default(),
+            )
+            .unwrap(),
+        );
+        let l = Luminaire::new(t, DVec3::ZERO);
+        let (r, u, f) = l.frame();
+        assert!((r - DVec3::X).length() < 1e-12);
+        assert!((u - DVec3::Z).length() < 1e-12);
+        assert!((f - DVec3::NEG_Y).length() < 1e-12);
+        assert!(l.tilt_deg().abs() < 1e-9);
+    }
+
+    #[test]
+    fn srgb_luts_round_trip() {
+        let (d, e) = (decode_lut(), encode_lut());
+        for i in 0..=255u32 {
+            assert_eq!(encode(d[i as usize], e), i);
+        }
+    }
+
+    #[test]
+    fn false_color_ends() {
+        assert_eq!(false_color(0.0), 0x000060);
+        assert_eq!(false_color(1.0), 0xff2000);
+        assert_eq!(scale_pos(1000.0, 1000.0), 1.0);
+        assert_eq!(scale_pos(1.0, 1000.0), 0.0);
+    }
+}
