@@ -1,0 +1,148 @@
+//! The exact renderer: per output pixel, f64 ray → (λ, φ) → (u, v) → sample.
+//!
+//! Plain and obviously right on purpose: it is the yardstick every fast path is measured
+//! against. It shares only the sampler with the LUT renderer (so image differences are
+//! geometry differences).
+
+use crate::camera::{check_size, dir_to_lat_long, Camera, View};
+use crate::envmap::{EnvMap, Sampler};
+use crate::error::ViewError;
+use crate::fixed::to_fx;
+use crate::projection::Projection;
+use rayon::prelude::*;
+
+/// Exact map position of the center of output pixel (x, y), or `None` when the map does
+/// not cover that direction.
+#[inline]
+pub fn exact_uv(cam: &Camera, projection: Projection, map_w: f64, map_h: f64, x: u32, y: u32) -> Option<(f64, f64)> {
+    let (lambda, phi) = dir_to_lat_long(cam.world_ray(x as f64 + 0.5, y as f64 + 0.5));
+    projection.uv(lambda, phi, map_w, map_h)
+}
+
+/// Exact map position of an arbitrary image-plane point (used for supersampling).
+#[inline]
+pub fn exact_uv_at(cam: &Camera, projection: Projection, map_w: f64, map_h: f64, px: f64, py: f64) -> Option<(f64, f64)> {
+    let (lambda, phi) = dir_to_lat_long(cam.world_ray(px, py));
+    projection.uv(lambda, phi, map_w, map_h)
+}
+
+/// Sample `map` at an f64 position, wrapping u for 360° maps (background if uncovered).
+#[inline]
+pub fn sample_at(map: &EnvMap, sampler: Sampler, uv: Option<(f64, f64)>) -> u32 {
+    match uv {
+        None => map.background(),
+        Some((u, v)) => {
+            let w = map.width() as f64;
+            let u = if map.projection().wraps() {
+                let r = u.rem_euclid(w);
+                if r >= w {
+                    0.0
+                } else {
+                    r
+                }
+            } else {
+                u
+            };
+            map.sample(sampler, to_fx(u), to_fx(v))
+        }
+    }
+}
+
+/// Render `view` of `map` into `out` (row-major 0RGB, `width × height`), exactly.
+///
+/// `threads`: split rows across the rayon pool when true; output is identical either way.
+///
+/// # Errors
+/// [`ViewError`] for a bad size or buffer length.
+pub fn render_exact(
+    map: &EnvMap,
+    view: View,
+    sampler: Sampler,
+    out: &mut [u32],
+    width: u32,
+    height: u32,
+    threads: bool,
+) -> Result<(), ViewError> {
+    check_size(width, height)?;
+    check_buffer(out, width, height)?;
+    let cam = Camera::new(view, width, height);
+    let (mw, mh) = (map.width() as f64, map.height() as f64);
+    let proj = map.projection();
+    let row = |(y, line): (usize, &mut [u32])| {
+        for (x, px) in line.iter_mut().enumerate() {
+            *px = sample_at(map, sampler, exact_uv(&cam, proj, mw, mh, x as u32, y as u32));
+        }
+    };
+    if threads {
+        out.par_chunks_mut(width as usize).enumerate().for_each(row);
+    } else {
+        out.chunks_mut(width as usize).enumerate().for_each(row);
+    }
+    Ok(())
+}
+
+/// Render `view` supersampled `n × n` per output pixel (exact geometry, box filter over
+/// the sub-samples, in 8-bit sRGB as stored): the reference for minification quality.
+///
+/// # Errors
+/// [`ViewError`] for a bad size or buffer length.
+#[allow(clippy::too_many_arguments)]
+pub fn render_exact_supersampled(
+    map: &EnvMap,
+    view: View,
+    sampler: Sampler,
+    n: u32,
+    out: &mut [u32],
+    width: u32,
+    height: u32,
+    threads: bool,
+) -> Result<(), ViewError> {
+    check_size(width, height)?;
+    check_buffer(out, width, height)?;
+    let n = n.max(1);
+    let cam = Camera::new(view, width, height);
+    let (mw, mh) = (map.width() as f64, map.height() as f64);
+    let proj = map.projection();
+    let inv = 1.0 / n as f64;
+    let row = |(y, line): (usize, &mut [u32])| {
+        for (x, px) in line.iter_mut().enumerate() {
+            let (mut r, mut g, mut b) = (0u32, 0u32, 0u32);
+            for sy in 0..n {
+                for sx in 0..n {
+                    let pxf = x as f64 + (sx as f64 + 0.5) * inv;
+                    let pyf = y as f64 + (sy as f64 + 0.5) * inv;
+                    let c = sample_at(map, sampler, exact_uv_at(&cam, proj, mw, mh, pxf, pyf));
+                    r += c >> 16 & 0xFF;
+                    g += c >> 8 & 0xFF;
+                    b += c & 0xFF;
+                }
+            }
+            let nn = n * n;
+            let half = nn / 2;
+            *px = ((r + half) / nn) << 16 | ((g + half) / nn) << 8 | (b + half) / nn;
+        }
+    };
+    if threads {
+        out.par_chunks_mut(width as usize).enumerate().for_each(row);
+    } else {
+        out.chunks_mut(width as usize).enumerate().for_each(row);
+    }
+    Ok(())
+}
+
+/// Check that `out` holds exactly `width × height` pixels.
+///
+/// # Errors
+/// [`ViewError::BufferSize`].
+pub fn check_buffer(out: &[u32], width: u32, height: u32) -> Result<(), ViewError> {
+    let needed = width as usize * height as usize;
+    if out.len() != needed {
+        return Err(ViewError::BufferSize {
+            len: out.len(),
+            width,
+            height,
+            needed,
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,56 @@
+//! `viewer`: the CPU panorama viewer.
+//!
+//! * `viewer [PANORAMA]` opens the interactive window (see `window`).
+//! * `viewer render ...` renders one view to a PNG (headless).
+//! * `viewer convert ...` converts between equirectangular and cube maps.
+//! * `viewer ies ...` summarizes and samples an IES photometric file.
+//! * `viewer bench ...` measures speed against error.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+mod assets;
+mod cli_common;
+mod convert_cmd;
+mod cube_cmd;
+mod ies_cmd;
+mod render_cmd;
+mod window;
+
+/// CPU panorama viewer: scanline-coherent LUT rendering (US 5,748,194).
+#[derive(Parser, Debug)]
+#[command(name = "viewer", version, about, args_conflicts_with_subcommands = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Open the window (the default when no subcommand is given).
+    #[command(flatten)]
+    open: window::OpenArgs,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render one view of a panorama to a PNG file.
+    Render(render_cmd::RenderArgs),
+    /// Convert equirect <-> cube maps.
+    Convert(convert_cmd::ConvertArgs),
+    /// Summarize an IES LM-63 file and sample its candela distribution.
+    Ies(ies_cmd::IesArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Render(a)) => render_cmd::run(a),
+        Some(Command::Convert(a)) => convert_cmd::run(a),
+        Some(Command::Ies(a)) => ies_cmd::run(a),
+        None => window::run(cli.open),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("viewer: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,159 @@
+//! `viewer render`: one view of a panorama to a PNG, headless.
+
+use crate::cli_common::{load_panorama, parse_angle, parse_projection, parse_size, write_png_atomic};
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use lut_core::lut::Surface;
+use lut_core::{IndexStep, LutChoice, Projection, RenderOptions, Renderer, RendererKind, Sampler, View};
+use std::path::PathBuf;
+
+/// Which renderer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RendererArg {
+    /// The scanline-coherent LUT renderer.
+    Lut,
+    /// The exact per-pixel renderer.
+    Exact,
+}
+
+/// Pixel interpolation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SamplerArg {
+    /// Nearest source pixel.
+    Nearest,
+    /// Bilinear.
+    Bilinear,
+}
+
+/// Table choice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LutArg {
+    /// Wide above 60 degrees hfov, high-resolution at or below.
+    Auto,
+    /// The wide-FOV table.
+    Wide,
+    /// The high-resolution table.
+    High,
+}
+
+/// Table surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SurfaceArg {
+    /// Cylinder (FIGS. 5-7).
+    Cylinder,
+    /// Plane (FIG. 8A).
+    Plane,
+}
+
+/// Arguments of `viewer render`.
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Panorama image (JPEG, PNG, ...). The bundled sample when omitted.
+    pub panorama: Option<PathBuf>,
+    /// Output PNG, written atomically.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Yaw in degrees (any value, taken modulo 360; positive turns right).
+    #[arg(long, default_value = "0", value_parser = parse_angle, allow_hyphen_values = true)]
+    pub yaw: f64,
+    /// Pitch in degrees (positive looks up; clamped to [-90, 90]).
+    #[arg(long, default_value = "0", value_parser = parse_angle, allow_hyphen_values = true)]
+    pub pitch: f64,
+    /// Horizontal field of view in degrees, in (0, 180).
+    #[arg(long, default_value = "90", value_parser = parse_angle, allow_hyphen_values = true)]
+    pub hfov: f64,
+    /// Output size WIDTHxHEIGHT (each side 1..=16384).
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Map projection: auto (2:1 is equirect), equirect, cylinder, sine, elliptical, diamond.
+    #[arg(long, default_value = "auto", value_parser = parse_projection)]
+    pub projection: Option<Projection>,
+    /// Renderer.
+    #[arg(long, value_enum, default_value_t = RendererArg::Lut)]
+    pub renderer: RendererArg,
+    /// Pixel interpolation.
+    #[arg(long, value_enum, default_value_t = SamplerArg::Bilinear)]
+    pub sampler: SamplerArg,
+    /// Index interpolation step: 1, 2, 4, 8, 16, or "adaptive".
+    #[arg(long, default_value = "4", value_parser = parse_step)]
+    pub index_step: IndexStep,
+    /// Which look-up table.
+    #[arg(long, value_enum, default_value_t = LutArg::Auto)]
+    pub lut: LutArg,
+    /// Surface the look-up table is built on.
+    #[arg(long, value_enum, default_value_t = SurfaceArg::Cylinder)]
+    pub lut_surface: SurfaceArg,
+    /// Render on one thread.
+    #[arg(long)]
+    pub single_thread: bool,
+    /// Print which path rendered and the table size.
+    #[arg(long, short)]
+    pub verbose: bool,
+}
+
+/// Parse an index step.
+pub fn parse_step(s: &str) -> Result<IndexStep, String> {
+    if s == "adaptive" {
+        return Ok(IndexStep::Adaptive);
+    }
+    match s.parse::<u32>() {
+        Ok(n @ (1 | 2 | 4 | 8 | 16)) => Ok(IndexStep::Fixed(n)),
+        _ => Err(format!("index step '{s}' must be 1, 2, 4, 8, 16 or adaptive")),
+    }
+}
+
+impl RenderArgs {
+    /// The render options these arguments select.
+    pub fn options(&self) -> RenderOptions {
+        RenderOptions {
+            renderer: match self.renderer {
+                RendererArg::Lut => RendererKind::Lut,
+                RendererArg::Exact => RendererKind::Exact,
+            },
+            sampler: match self.sampler {
+                SamplerArg::Nearest => Sampler::Nearest,
+                SamplerArg::Bilinear => Sampler::Bilinear,
+            },
+            index_step: self.index_step,
+            lut: match self.lut {
+                LutArg::Auto => LutChoice::Auto,
+                LutArg::Wide => LutChoice::Wide,
+                LutArg::High => LutChoice::High,
+            },
+            surface: match self.lut_surface {
+                SurfaceArg::Cylinder => Surface::Cylinder,
+                SurfaceArg::Plane => Surface::Plane,
+            },
+            threads: !self.single_thread,
+        }
+    }
+}
+
+/// Run `viewer render`.
+pub fn run(a: RenderArgs) -> Result<()> {
+    let view = View::new(a.yaw, a.pitch, a.hfov).context("invalid view")?;
+    let (w, h) = a.size;
+    let map = load_panorama(a.panorama.as_deref(), a.projection)?;
+    let opts = a.options();
+    let mut renderer = Renderer::new(&map);
+    let mut out = vec![0u32; w as usize * h as usize];
+    let report = renderer.render(&map, view, &opts, &mut out, w, h)?;
+    write_png_atomic(&a.output, &out, w, h)?;
+    if a.verbose {
+        eprintln!(
+            "rendered {}x{} from {}x{} {} map: path {}, table {} bytes, {} of {} pixels exact, index step {}..{}",
+            w,
+            h,
+            map.width(),
+            map.height(),
+            map.projection(),
+            report.path.name(),
+            report.table_bytes,
+            report.exact_pixels,
+            report.pixels,
+            report.min_step,
+            report.max_step
+        );
+    }
+    Ok(())
+}

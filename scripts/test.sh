@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# The whole test suite: formatting, lints, unit/integration/golden/property tests, and the
+# real window under Xvfb. Works on a fresh machine with the Rust toolchain: it installs the
+# Debian packages the window test needs when they are missing (as root, via apt-get).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+need_pkgs=()
+command -v Xvfb >/dev/null || need_pkgs+=(xvfb)
+command -v xdotool >/dev/null || need_pkgs+=(xdotool)
+[ -x /usr/bin/import ] || need_pkgs+=(imagemagick)
+command -v xwininfo >/dev/null || need_pkgs+=(x11-utils)
+ldconfig -p | grep -q libxkbcommon-x11 || need_pkgs+=(libxkbcommon-x11-0)
+ldconfig -p | grep -q libXcursor || need_pkgs+=(libxcursor1)
+ldconfig -p | grep -q libXi.so || need_pkgs+=(libxi6)
+if [ ${#need_pkgs[@]} -gt 0 ]; then
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+    echo "== installing ${need_pkgs[*]}"
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq xvfb xdotool x11-utils x11-apps imagemagick \
+      libx11-6 libx11-xcb1 libxcursor1 libxi6 libxkbcommon-x11-0 libxkbcommon0 libxcb1 libxcb-xkb1 >/dev/null
+  else
+    echo "missing packages for the window test: ${need_pkgs[*]} (install them, or run as root)" >&2
+    exit 1
+  fi
+fi
+
+echo "== cargo fmt --check"
+cargo fmt --all -- --check
+echo "== cargo clippy"
+cargo clippy --workspace --all-targets --profile ci -- -D warnings
+echo "== cargo test (profile ci: optimized, overflow checks on)"
+cargo test --workspace --profile ci
+if [ -f scripts/window-smoke.sh ]; then
+  echo "== window smoke test under Xvfb"
+  bash scripts/window-smoke.sh
+fi
+echo "== all tests passed"
