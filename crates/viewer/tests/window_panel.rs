@@ -16,7 +16,7 @@ mod ui;
 
 use input::{Look, Settings};
 use paint::{Compositor, SceneRect, BACKGROUND};
-use ui::{LoadStatus, PanelModel, Readouts, PANEL_WIDTH};
+use ui::{LoadStatus, PanelModel, Readouts, BUTTON_LABELS, PANEL_WIDTH};
 
 const W: u32 = 800;
 const H: u32 = 500;
@@ -182,4 +182,20 @@ fn load_progress_and_errors_show_in_the_panel() {
     assert_eq!(plain.iter().filter(|p| reddish(p)).count(), 0);
     assert!(busy.iter().filter(|p| reddish(p)).count() > 30);
     assert_ne!(plain, busy);
+}
+
+#[test]
+fn button_labels_have_glyphs_in_the_default_fonts() {
+    let ctx = egui::Context::default();
+    // One pass loads the fonts.
+    let _ = ctx.run_ui(egui::RawInput::default(), |ui| {
+        ui.label("x");
+    });
+    let font = egui::FontId::proportional(14.0);
+    for label in BUTTON_LABELS {
+        assert!(
+            ctx.fonts_mut(|f| f.has_glyphs(&font, label)),
+            "no glyph for button label {label:?}"
+        );
+    }
 }

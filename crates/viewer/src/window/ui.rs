@@ -8,6 +8,10 @@ use lut_core::{IndexStep, LutChoice, Projection, RenderPath, RendererKind, Sampl
 /// Width of the panel, in points.
 pub const PANEL_WIDTH: f32 = 230.0;
 
+/// Labels of the turn and zoom buttons: up, left, reset, right, down, zoom in, zoom out.
+/// (Glyphs the default egui fonts have: a test checks.)
+pub const BUTTON_LABELS: [&str; 7] = ["⬆", "⬅", "R", "➡", "⬇", "+", "−"];
+
 /// Numbers shown under "Readouts".
 #[derive(Debug, Clone, Default)]
 pub struct Readouts {
@@ -157,21 +161,46 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
     };
     egui::Grid::new("turn").spacing([4.0, 4.0]).show(ui, |ui| {
         ui.label("");
-        out.held.up = held_btn(ui, "▲", "Look up (hold)");
+        out.held.up = held_btn(ui, BUTTON_LABELS[0], "Look up (hold)");
         ui.label("");
-        out.held.zoom_in = held_btn(ui, "+", "Zoom in (hold)");
+        out.held.zoom_in = held_btn(ui, BUTTON_LABELS[5], "Zoom in (hold)");
         ui.end_row();
-        out.held.left = held_btn(ui, "◀", "Turn left (hold)");
+        out.held.left = held_btn(ui, BUTTON_LABELS[1], "Turn left (hold)");
         out.reset = ui
-            .add_sized([44.0, 28.0], egui::Button::new("R"))
+            .add_sized([44.0, 28.0], egui::Button::new(BUTTON_LABELS[2]))
             .on_hover_text("Reset the view")
             .clicked();
-        out.held.right = held_btn(ui, "▶", "Turn right (hold)");
-        out.held.zoom_out = held_btn(ui, "−", "Zoom out (hold)");
+        out.held.right = held_btn(ui, BUTTON_LABELS[3], "Turn right (hold)");
+        out.held.zoom_out = held_btn(ui, BUTTON_LABELS[6], "Zoom out (hold)");
         ui.end_row();
         ui.label("");
-        out.held.down = held_btn(ui, "▼", "Look down (hold)");
+        out.held.down = held_btn(ui, BUTTON_LABELS[4], "Look down (hold)");
         ui.end_row();
+    });
+
+    ui.separator();
+    let r = m.readouts;
+    egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
+        let mut row = |k: &str, v: String| {
+            ui.label(k);
+            ui.monospace(v);
+            ui.end_row();
+        };
+        row("yaw", format!("{:8.2}°", m.look.yaw));
+        row("pitch", format!("{:8.2}°", m.look.pitch));
+        row("hfov", format!("{:8.2}°", m.look.hfov));
+        row("in use", path_label(r.path).into());
+        row("table", kib(r.table_bytes));
+        if r.pixels > 0 && r.exact_pixels > 0 {
+            row(
+                "exact px",
+                format!("{:.1}%", 100.0 * r.exact_pixels as f64 / r.pixels as f64),
+            );
+        }
+        row("scene", format!("{}×{}", r.scene.0, r.scene.1));
+        row("render", format!("{:6.2} ms", r.render_ms));
+        row("UI", format!("{:6.2} ms", r.ui_ms));
+        row("fps", format!("{:6.1}", r.fps));
     });
 
     ui.separator();
@@ -262,31 +291,6 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
             .on_hover_text("How the image maps the sphere; auto takes 2:1 images as equirect");
         out.projection_changed = *m.projection != before;
         ui.end_row();
-    });
-
-    ui.separator();
-    let r = m.readouts;
-    egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
-        let mut row = |k: &str, v: String| {
-            ui.label(k);
-            ui.monospace(v);
-            ui.end_row();
-        };
-        row("yaw", format!("{:8.2}°", m.look.yaw));
-        row("pitch", format!("{:8.2}°", m.look.pitch));
-        row("hfov", format!("{:8.2}°", m.look.hfov));
-        row("in use", path_label(r.path).into());
-        row("table", kib(r.table_bytes));
-        if r.pixels > 0 && r.exact_pixels > 0 {
-            row(
-                "exact px",
-                format!("{:.1}%", 100.0 * r.exact_pixels as f64 / r.pixels as f64),
-            );
-        }
-        row("scene", format!("{}×{}", r.scene.0, r.scene.1));
-        row("render", format!("{:6.2} ms", r.render_ms));
-        row("UI", format!("{:6.2} ms", r.ui_ms));
-        row("fps", format!("{:6.1}", r.fps));
     });
 
     ui.separator();
