@@ -244,9 +244,9 @@ fn check_mirrors(t: &LightTable, f: &IesFile, mirrors: &dyn Fn(f64) -> Vec<f64>)
             let stored = f.candela[ih * nv + iv] * f.candela_multiplier;
             for m in mirrors(h) {
                 let got = t.candela(v, m);
-                // f32 storage: 1e-6 relative.
+                // f64 storage, normalized by 1/d_ref² and back: 1e-12 relative.
                 assert!(
-                    close(got, stored, 1e-6),
+                    close(got, stored, 1e-12),
                     "h {h} mirrored {m} v {v}: {got} vs {stored}"
                 );
             }
@@ -308,7 +308,7 @@ fn no_symmetry_wraps_around_360() {
     check_mirrors(&t, &f, &|c| vec![c, c + 360.0, c - 360.0]);
     // Between 330 and 360 (= 0) the value interpolates linearly across the wrap.
     let (a, b) = (pattern(330.0, 90.0), pattern(0.0, 90.0));
-    assert!(close(t.candela(90.0, 340.0), a + (b - a) / 3.0, 1e-6));
+    assert!(close(t.candela(90.0, 340.0), a + (b - a) / 3.0, 1e-12));
 }
 
 #[test]
@@ -339,7 +339,7 @@ fn direction_angles_follow_the_documented_frames() {
     assert!(close(
         t.candela_dir(DVec3::new(1.0, 0.0, 0.0)),
         pattern(270.0, 90.0),
-        1e-6
+        1e-12
     ));
     // Type B: H is left-right (asin x), V is up-down (plane angle about the lateral axis).
     let b = table(&IesFile::load(&data("type_b_full.ies")).unwrap());
@@ -361,7 +361,7 @@ fn interpolation_is_exact_at_measured_angles_and_linear_between() {
     let t = table(&f);
     for &hh in &h {
         for &vv in &v {
-            assert!(close(t.candela(vv, hh), pattern(hh, vv), 1e-6));
+            assert!(close(t.candela(vv, hh), pattern(hh, vv), 1e-12));
         }
     }
     for (i, j, fv, fh) in [(0, 0, 0.5, 0.0), (1, 0, 0.2, 0.7), (2, 1, 0.9, 0.25)] {
@@ -374,7 +374,7 @@ fn interpolation_is_exact_at_measured_angles_and_linear_between() {
         let a = c00 + (c01 - c00) * fv;
         let b = c10 + (c11 - c10) * fv;
         let want = a + (b - a) * fh;
-        assert!(close(t.candela(vv, hh), want, 1e-6), "({vv}, {hh})");
+        assert!(close(t.candela(vv, hh), want, 1e-12), "({vv}, {hh})");
     }
 }
 
@@ -386,7 +386,7 @@ fn sample_file_interpolates_between_measured_angles() {
     assert!(close(
         t.candela(3.75, 0.0),
         1.5 * (2000.2 + 1950.0) / 2.0,
-        1e-6
+        1e-12
     ));
     // Zero outside the measured vertical range 0..90.
     assert_eq!(t.candela(95.0, 0.0), 0.0);
@@ -430,7 +430,7 @@ fn constant_ranges_are_not_stored_and_are_substituted() {
                     val(0.0, lo + 10.0) + (val(90.0, lo + 10.0) - val(0.0, lo + 10.0)) * hf / 90.0;
                 a + (b - a) * (vv - lo) / 10.0
             };
-            assert!(close(t.candela(vv, hh), want, 1e-6), "({vv}, {hh})");
+            assert!(close(t.candela(vv, hh), want, 1e-12), "({vv}, {hh})");
         }
     }
 }
@@ -504,8 +504,8 @@ fn distance_series_tends_to_the_far_field_table_for_smooth_light() {
         for &g in angles {
             let want = 1000.0 + 500.0 * g.to_radians().cos() * damp;
             let got = t.level_candela(k, g, 0.0).unwrap();
-            // f32 storage: 1e-6 relative.
-            assert!(close(got, want, 1e-6), "level {k} γ {g}: {got} vs {want}");
+            // f64 storage, normalized by 1/d_ref² and back: 1e-12 relative.
+            assert!(close(got, want, 1e-12), "level {k} γ {g}: {got} vs {want}");
         }
         if k < 3 {
             damp *= (1.0 + (5.0 * 2f64.powi(k as i32)).to_radians().cos()) / 2.0;
@@ -618,7 +618,7 @@ fn downlight_distribution_is_read_through_the_aim() {
     .unwrap();
     let cam = Camera::new(View::new(0.0, -90.0, 90.0).unwrap(), 101, 101);
     let e = lux_at(&scene, &cam, 50.5, 50.5);
-    assert!(close(e, 3300.0 / (2.7 * 2.7), 1e-6), "{e}");
+    assert!(close(e, 3300.0 / (2.7 * 2.7), 1e-12), "{e}");
     // The upper hemisphere gets nothing: the ceiling is dark.
     let up = Camera::new(View::new(0.0, 90.0, 90.0).unwrap(), 11, 11);
     assert_eq!(lux_at(&scene, &up, 5.5, 5.5), 0.0);
@@ -628,7 +628,7 @@ fn downlight_distribution_is_read_through_the_aim() {
     let scene = LightScene::new(room, vec![l]).unwrap();
     assert_eq!(lux_at(&scene, &cam, 50.5, 50.5), 0.0);
     let e = lux_at(&scene, &up, 5.5, 5.5);
-    assert!(close(e, 3300.0 / (0.7 * 0.7), 1e-6), "{e}");
+    assert!(close(e, 3300.0 / (0.7 * 0.7), 1e-12), "{e}");
 }
 
 #[test]

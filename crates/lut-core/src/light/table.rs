@@ -142,12 +142,12 @@ struct Level {
     /// The stored vertical subset (constant ranges removed).
     v: Axis,
     /// Horizontal-major: values[ih * nv + iv], lux at d_ref.
-    values: Vec<f32>,
+    values: Vec<f64>,
     /// The measured vertical range; zero outside.
     v_measured: (f64, f64),
     /// Constant below / above the stored vertical subset.
-    below: f32,
-    above: f32,
+    below: f64,
+    above: f64,
     /// Type C without symmetry whose last angle is short of 360°: wrap to the first.
     wrap: bool,
     /// Type A/B: zero outside the measured horizontal range.
@@ -157,7 +157,7 @@ struct Level {
 impl Level {
     /// The value at (folded) horizontal angle h and vertical angle v.
     #[inline]
-    fn sample(&self, h: f64, v: f64) -> f32 {
+    fn sample(&self, h: f64, v: f64) -> f64 {
         if !(v >= self.v_measured.0 && v <= self.v_measured.1) {
             return 0.0;
         }
@@ -188,7 +188,6 @@ impl Level {
         };
         let (iv, tv) = self.v.locate(v);
         let iv1 = (iv + 1).min(nv - 1);
-        let (tv, th) = (tv as f32, th as f32);
         let row0 = &self.values[ih0 * nv..ih0 * nv + nv];
         let row1 = &self.values[ih1 * nv..ih1 * nv + nv];
         let a = row0[iv] + (row0[iv1] - row0[iv]) * tv;
@@ -291,7 +290,7 @@ impl Grid {
         Some(g)
     }
 
-    /// Cut constant leading/trailing vertical ranges and normalize to f32 lux at d_ref.
+    /// Cut constant leading/trailing vertical ranges and normalize to lux at d_ref.
     fn to_level(&self, scale: f64, wrap: bool, h_bounded: bool) -> Level {
         let nv = self.v.len();
         let row_const = |iv: usize| -> Option<f64> {
@@ -321,15 +320,15 @@ impl Grid {
         let stored = end - start + 1;
         let mut values = Vec::with_capacity(self.h.len() * stored);
         for row in self.vals.chunks_exact(nv) {
-            values.extend(row[start..=end].iter().map(|&c| (c * scale) as f32));
+            values.extend(row[start..=end].iter().map(|&c| c * scale));
         }
         Level {
             h: Axis::new(self.h.clone()),
             v: Axis::new(self.v[start..=end].to_vec()),
             values,
             v_measured: (self.v[0], self.v[nv - 1]),
-            below: (below * scale) as f32,
-            above: (above * scale) as f32,
+            below: below * scale,
+            above: above * scale,
             wrap,
             h_bounded,
         }
@@ -554,7 +553,7 @@ impl LightTable {
     /// series.
     pub fn level_candela(&self, k: usize, vertical: f64, horizontal: f64) -> Option<f64> {
         let l = self.levels.get(k)?;
-        Some(l.sample(self.fold_horizontal(horizontal), vertical) as f64 * self.d_ref2)
+        Some(l.sample(self.fold_horizontal(horizontal), vertical) * self.d_ref2)
     }
 
     /// Interpolated candela (file value × multiplier) at photometric angles in degrees:
@@ -604,16 +603,16 @@ impl LightTable {
         let inv_sq = self.d_ref2 / (dist * dist);
         let top = self.levels.len() - 1;
         if dist <= self.d_ref || top == 0 {
-            return self.levels[0].sample(h, v) as f64 * inv_sq;
+            return self.levels[0].sample(h, v) * inv_sq;
         }
         let big_d = (dist / self.d_ref).log2().min(top as f64);
         let i = (big_d as usize).min(top);
         let t = big_d - i as f64;
-        let a = self.levels[i].sample(h, v) as f64;
+        let a = self.levels[i].sample(h, v);
         if i == top || t == 0.0 {
             return a * inv_sq;
         }
-        let b = self.levels[i + 1].sample(h, v) as f64;
+        let b = self.levels[i + 1].sample(h, v);
         (a + (b - a) * t) * inv_sq
     }
 
