@@ -127,6 +127,7 @@ fn equirect_cube_view_matches_equirect_view() {
         render_exact(&map, view, Sampler::Bilinear, &mut reference, w as u32, h as u32, true).unwrap();
         let got = render(&cube, view, Sampler::Bilinear, CubeRenderer::Accelerated, w as u32, h as u32, true);
         let p = psnr(&got, &reference);
+        eprintln!("equirect→cube→view ({yaw}, {pitch}, {hfov}): {p:.2} dB");
         assert!(p >= 40.0, "view ({yaw}, {pitch}, {hfov}): PSNR {p:.2} dB < 40");
     }
 }
@@ -207,14 +208,15 @@ fn accelerated_renderer_really_runs_segments() {
 
 #[test]
 fn edges_and_corners_show_no_seam_nan_or_bad_read() {
-    // Faces of 8² texels of a smooth function of direction, magnified: bilinear reading
+    const TOL: u32 = 8;
+    // Faces of 4² texels of a smooth function of direction, magnified: bilinear reading
     // across faces stays within interpolation error of the analytic color everywhere;
     // a cube that clamps at face edges (the seam) does not.
-    let n = 8;
+    let n = 4;
     let cube = cube_from_fn(n, smooth);
     let clamped = cube.with_clamped_borders();
     let (w, h) = (96u32, 96u32);
-    let mut worst_clamped = 0;
+    let (mut worst, mut worst_clamped) = (0, 0);
     for &(yaw, pitch) in EDGE_VIEWS {
         for hfov in [30.0, 100.0] {
             let view = View::new(yaw, pitch, hfov).unwrap();
@@ -227,8 +229,10 @@ fn edges_and_corners_show_no_seam_nan_or_bad_read() {
                     let want = smooth(d.normalize());
                     let i = (y * w + x) as usize;
                     let e = max_channel_diff(got[i], want);
-                    // Bilinear of a linear-in-direction function over 11°-wide texels.
-                    assert!(e <= 6, "({yaw}, {pitch}, {hfov}) pixel ({x},{y}): off by {e}");
+                    worst = worst.max(e);
+                    // Bilinear interpolation error of `smooth` over 14°–27°-wide texels (7
+                    // measured; clamping at face edges instead of reading across: 15).
+                    assert!(e <= TOL, "({yaw}, {pitch}, {hfov}) pixel ({x},{y}): off by {e}");
                     worst_clamped = worst_clamped.max(max_channel_diff(bad[i], want));
                     // Face coordinates finite and on the face.
                     let face = cube::face_of(d);
@@ -248,7 +252,8 @@ fn edges_and_corners_show_no_seam_nan_or_bad_read() {
             }
         }
     }
-    assert!(worst_clamped > 6, "the seam check must catch clamping (worst {worst_clamped})");
+    eprintln!("seam check: worst error {worst}, with clamped borders {worst_clamped}");
+    assert!(worst_clamped >= TOL + 5, "the seam check must catch clamping (worst {worst_clamped})");
 }
 
 #[test]
@@ -352,6 +357,7 @@ fn edge_mismatch(cube: &CubeMap) -> (f64, f64) {
 fn skybox_orientation_by_edge_continuity() {
     let cube = cube::load_cube(&[skybox_dir()], None, None).unwrap();
     let (worst, inner) = edge_mismatch(&cube);
+    eprintln!("sky box edges: worst {worst:.2}, inside {inner:.2}");
     assert!(
         worst <= 2.0 * inner + 3.0,
         "sky box (cube2 naming): an edge does not join: worst edge {worst:.2} vs {inner:.2} inside"
@@ -359,6 +365,7 @@ fn skybox_orientation_by_edge_continuity() {
     // Taken as conventions naming instead, the same files do not join: the check can fail.
     let wrong = cube::load_cube(&[skybox_dir()], None, Some(Naming::Conventions)).unwrap();
     let (worst_wrong, _) = edge_mismatch(&wrong);
+    eprintln!("sky box as conventions naming: worst edge {worst_wrong:.2}");
     assert!(worst_wrong > 2.0 * inner + 3.0, "wrong naming not detected ({worst_wrong:.2})");
     // A procedural cube from the conventions camera joins everywhere (sanity of the check).
     let (w, i) = edge_mismatch(&cube_from_fn(32, smooth));
@@ -379,6 +386,7 @@ fn skybox_against_converted_equirect() {
         render_exact(&map, view, Sampler::Bilinear, &mut reference, 80, 60, false).unwrap();
         let got = render(&cube, view, Sampler::Bilinear, CubeRenderer::Basic, 80, 60, false);
         let p = psnr(&got, &reference);
+        eprintln!("sky box vs its equirect ({yaw}, {pitch}): {p:.1} dB");
         assert!(p > 35.0, "({yaw}, {pitch}): {p:.1} dB");
     }
 }
@@ -418,7 +426,7 @@ fn every_layout_and_naming_loads_the_same_cube() {
         write_png(&words.join(format!("{}.png", face.name())), &px, n, n);
         write_png(&axes.join(format!("sky_{}.png", axis_name(face))), &px, n, n);
     }
-    check("words folder", cube::load_cube(&[words.clone()], None, None));
+    check("words folder", cube::load_cube(std::slice::from_ref(&words), None, None));
     check("axes folder", cube::load_cube(&[axes], None, None));
 
     // Irrlicht naming: files made by undoing the Irrlicht placement load back.
@@ -433,7 +441,8 @@ fn every_layout_and_naming_loads_the_same_cube() {
     check("irrlicht", cube::load_cube(&[irr], None, Some(Naming::Irrlicht)));
 
     // Single images, assembled here from the documented cell positions.
-    let cells: [(&str, u32, u32, [(Face, u32, u32); 6]); 3] = [
+    type Cells = [(Face, u32, u32); 6];
+    let cells: [(&str, u32, u32, Cells); 3] = [
         ("cross", 4, 3, [
             (Face::Up, 1, 0), (Face::Left, 0, 1), (Face::Front, 1, 1),
             (Face::Right, 2, 1), (Face::Back, 3, 1), (Face::Down, 1, 2),
@@ -460,9 +469,9 @@ fn every_layout_and_naming_loads_the_same_cube() {
         }
         let path = dir.join(format!("layout_{name}.png"));
         write_png(&path, &img, w, h);
-        check(name, cube::load_cube(&[path.clone()], None, None));
+        check(name, cube::load_cube(std::slice::from_ref(&path), None, None));
         let layout: Layout = name.parse().unwrap();
-        check(name, cube::load_cube(&[path.clone()], Some(layout), None));
+        check(name, cube::load_cube(std::slice::from_ref(&path), Some(layout), None));
         // and the library's own writer produces the same image
         let (lw, lh, lpx) = reference.to_layout(layout).unwrap();
         assert_eq!((lw, lh), (w, h));
@@ -488,7 +497,7 @@ fn malformed_inputs_give_clear_errors() {
     // Five faces.
     let five = mk("five", ok);
     std::fs::remove_file(five.join("down.png")).unwrap();
-    let e = cube::load_cube(&[five.clone()], None, None).unwrap_err();
+    let e = cube::load_cube(std::slice::from_ref(&five), None, None).unwrap_err();
     assert!(matches!(e, CubeError::Faces { .. }), "{e:?}");
     let msg = e.to_string();
     assert!(msg.contains("missing: down") && msg.contains("five"), "{msg}");
@@ -516,7 +525,7 @@ fn malformed_inputs_give_clear_errors() {
     // Unreadable: garbage bytes, and a file that does not exist.
     let bad = mk("garbage", ok);
     std::fs::write(bad.join("back.png"), b"not an image at all").unwrap();
-    let e = cube::load_cube(&[bad.clone()], None, None).unwrap_err();
+    let e = cube::load_cube(std::slice::from_ref(&bad), None, None).unwrap_err();
     assert!(matches!(&e, CubeError::Read { path, .. } if path.ends_with("back.png")), "{e:?}");
     let mut list: Vec<PathBuf> = Face::ALL.iter().map(|f| bad.join(format!("{}.png", f.name()))).collect();
     list[0] = dir.join("missing/front.png");
@@ -540,8 +549,8 @@ fn malformed_inputs_give_clear_errors() {
     assert!(matches!(e, CubeError::Layout { .. }) && e.to_string().contains("4:3"), "{e}");
     let cross = dir.join("cross.png");
     write_png(&cross, &vec![0; 64 * 48], 64, 48);
-    assert!(cube::load_cube(&[cross.clone()], None, None).is_ok());
-    let e = cube::load_cube(&[cross.clone()], Some(Layout::Strip), None).unwrap_err();
+    assert!(cube::load_cube(std::slice::from_ref(&cross), None, None).is_ok());
+    let e = cube::load_cube(std::slice::from_ref(&cross), Some(Layout::Strip), None).unwrap_err();
     assert!(matches!(e, CubeError::Layout { .. }), "{e:?}");
     let e = cube::load_cube(&[cross], Some(Layout::Files), None).unwrap_err();
     assert!(matches!(e, CubeError::Usage(_)), "{e:?}");

@@ -275,8 +275,11 @@ fn is_image(path: &Path) -> bool {
         .unwrap_or(false)
 }
 
+/// A decoded image: width, height, 0RGB pixels.
+type Decoded = (u32, u32, Vec<u32>);
+
 /// Decode an image file to 0RGB, checking its size from the header first.
-fn read_image(path: &Path, check: impl Fn(u32, u32) -> Result<(), CubeError>) -> Result<(u32, u32, Vec<u32>), CubeError> {
+fn read_image(path: &Path, check: impl Fn(u32, u32) -> Result<(), CubeError>) -> Result<Decoded, CubeError> {
     let err = |reason: String| CubeError::Read {
         path: path.to_path_buf(),
         reason,
@@ -431,7 +434,7 @@ pub fn load_face_files(what: &str, files: &[PathBuf], naming: Option<Naming>) ->
             check_face_size(&path.display().to_string(), w)
         }
     };
-    let decoded: Vec<Result<(u32, u32, Vec<u32>), CubeError>> = slots
+    let decoded: Vec<Result<Decoded, CubeError>> = slots
         .par_iter()
         .map(|s| {
             let (p, _) = s.expect("all six checked above");
@@ -482,7 +485,7 @@ pub fn load_layout_image(path: &Path, layout: Option<Layout>) -> Result<CubeMap,
             })?,
         };
         let (c, r) = l.grid().unwrap_or((1, 1));
-        if w % c != 0 || h % r != 0 || w / c != h / r {
+        if !w.is_multiple_of(c) || !h.is_multiple_of(r) || w / c != h / r {
             return Err(CubeError::Layout {
                 path: path.to_path_buf(),
                 reason: format!(
