@@ -4,8 +4,8 @@
 # Starts the release binary on the bundled sample in a virtual X display, takes a
 # screenshot, drags with the mouse, scrolls the wheel, takes another, checks that the
 # view changed in the expected direction (from the view the viewer prints with
-# --print-view), checks that an idle window renders nothing, closes the window with
-# Ctrl+Q and requires exit code 0.
+# --print-view), checks that an idle window renders nothing, resets with R, closes the
+# window with Ctrl+Q and requires exit code 0.
 #
 # Screenshots and logs: target/window-smoke/. Also writes docs/screenshot.png.
 #
@@ -132,7 +132,6 @@ YAW0=$(field yaw); PITCH0=$(field pitch); HFOV0=$(field hfov); PATH0=$(field pat
 SCENE=$(field size); SW=${SCENE%x*}; SH=${SCENE#*x}
 log "start: yaw=$YAW0 pitch=$PITCH0 hfov=$HFOV0 $PATH0 scene ${SW}x${SH}"
 $IMPORT -window root "$OUT/1-start.png"
-$IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$ROOT/docs/screenshot.png"
 
 # Idle: no frame is rendered while nothing changes.
 N=$(lines)
@@ -187,13 +186,29 @@ log "pixels changed: $DIFF"
 awk -v d="$DIFF" -v n="$((SW * SH))" 'BEGIN { exit !(d + 0 > n / 4) }' ||
   fail "the screenshots barely differ ($DIFF pixels)"
 
-# Close with Ctrl+Q and require a clean exit.
-# No window manager gives the window the keyboard: focus it, then press Ctrl+Q through
-# XTEST as a user would (held keys, so the press is not lost in one burst).
-close_keys() {
+# No window manager gives the window the keyboard: focus it, then type through XTEST as
+# a user would (held keys, so a press is not lost in one burst).
+focus() {
   xdotool mousemove "$CX" "$CY"
   xdotool windowfocus "$WID" 2>/dev/null || true
   sleep 0.3
+}
+
+# R resets the view (the paper's RESIZE). The README screenshot is taken now, with the
+# tables warm, so its render time is a typical one.
+focus
+xdotool keydown r; sleep 0.1; xdotool keyup r
+settle
+log "after R: yaw=$(field yaw) pitch=$(field pitch) hfov=$(field hfov)"
+[ "$(field yaw)" = 0.0000 ] && [ "$(field pitch)" = 0.0000 ] && [ "$(field hfov)" = 90.0000 ] ||
+  fail "R should reset the view to yaw 0, pitch 0, hfov 90"
+sleep 0.3 # the readouts' follow-up frame
+$IMPORT -window root "$OUT/4-reset.png"
+$IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$ROOT/docs/screenshot.png"
+
+# Close with Ctrl+Q and require a clean exit.
+close_keys() {
+  focus
   xdotool keydown ctrl; sleep 0.1; xdotool key q; sleep 0.1; xdotool keyup ctrl
 }
 close_keys
