@@ -58,7 +58,7 @@ fn bench_lights(c: &mut Criterion) {
     let mut group = c.benchmark_group("lights_1920x1080");
     group.throughput(Throughput::Elements(u64::from(w * h)));
     group.sample_size(10);
-    for n in [1usize, 8] {
+    for n in [0usize, 1, 8] {
         let lights: Vec<Luminaire> = (0..n)
             .map(|i| {
                 let a = i as f64 / n as f64 * std::f64::consts::TAU;

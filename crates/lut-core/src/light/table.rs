@@ -155,17 +155,26 @@ struct Level {
 }
 
 impl Level {
+    /// The value at vertical angle v when it lies in a range that is not stored (zero
+    /// outside the measured range, or a constant range); `None` inside the stored rows.
+    #[inline]
+    fn constant_at(&self, v: f64) -> Option<f64> {
+        if !(v >= self.v_measured.0 && v <= self.v_measured.1) {
+            Some(0.0)
+        } else if v < self.v.first() {
+            Some(self.below)
+        } else if v > self.v.last() {
+            Some(self.above)
+        } else {
+            None
+        }
+    }
+
     /// The value at (folded) horizontal angle h and vertical angle v.
     #[inline]
     fn sample(&self, h: f64, v: f64) -> f64 {
-        if !(v >= self.v_measured.0 && v <= self.v_measured.1) {
-            return 0.0;
-        }
-        if v < self.v.first() {
-            return self.below;
-        }
-        if v > self.v.last() {
-            return self.above;
+        if let Some(c) = self.constant_at(v) {
+            return c;
         }
         let nv = self.v.a.len();
         let nh = self.h.a.len();
@@ -567,20 +576,34 @@ impl LightTable {
     /// light's frame (x right, y up, z along the aim); see the module docs.
     #[inline]
     pub fn angles_of(&self, d: DVec3) -> (f64, f64) {
+        (self.vertical_of(d), self.horizontal_of(d))
+    }
+
+    /// The vertical photometric angle in degrees (first, so constant ranges can be
+    /// recognised before the horizontal angle is computed).
+    #[inline]
+    fn vertical_of(&self, d: DVec3) -> f64 {
+        match self.photometric_type {
+            PhotometricType::C => d.z.clamp(-1.0, 1.0).acos().to_degrees(),
+            PhotometricType::A => d.y.clamp(-1.0, 1.0).asin().to_degrees(),
+            PhotometricType::B => d.y.atan2(d.z).to_degrees(),
+        }
+    }
+
+    /// The horizontal photometric angle in degrees (type C in [0, 360)).
+    #[inline]
+    fn horizontal_of(&self, d: DVec3) -> f64 {
         match self.photometric_type {
             PhotometricType::C => {
-                let g = d.z.clamp(-1.0, 1.0).acos().to_degrees();
                 let c = (-d.x).atan2(d.y).to_degrees();
-                (g, if c < 0.0 { c + 360.0 } else { c })
+                if c < 0.0 {
+                    c + 360.0
+                } else {
+                    c
+                }
             }
-            PhotometricType::A => (
-                d.y.clamp(-1.0, 1.0).asin().to_degrees(),
-                d.x.atan2(d.z).to_degrees(),
-            ),
-            PhotometricType::B => (
-                d.y.atan2(d.z).to_degrees(),
-                d.x.clamp(-1.0, 1.0).asin().to_degrees(),
-            ),
+            PhotometricType::A => d.x.atan2(d.z).to_degrees(),
+            PhotometricType::B => d.x.clamp(-1.0, 1.0).asin().to_degrees(),
         }
     }
 
@@ -598,21 +621,33 @@ impl LightTable {
         if dist.is_nan() || dist <= 0.0 {
             return 0.0;
         }
-        let (v, h) = self.angles_of(d);
-        let h = self.fold_horizontal(h);
+        let v = self.vertical_of(d);
         let inv_sq = self.d_ref2 / (dist * dist);
         let top = self.levels.len() - 1;
-        if dist <= self.d_ref || top == 0 {
-            return self.levels[0].sample(h, v) * inv_sq;
+        // Distance index D: integer part picks the table, fraction blends with the next.
+        let (i, t) = if dist <= self.d_ref || top == 0 {
+            (0, 0.0)
+        } else {
+            let big_d = (dist / self.d_ref).log2().min(top as f64);
+            let i = (big_d as usize).min(top);
+            (i, if i == top { 0.0 } else { big_d - i as f64 })
+        };
+        let a_const = self.levels[i].constant_at(v);
+        let b_const = if t > 0.0 {
+            self.levels[i + 1].constant_at(v)
+        } else {
+            a_const
+        };
+        // In a constant range (beyond a cut-off, say) no horizontal angle is needed.
+        if let (Some(a), Some(b)) = (a_const, b_const) {
+            return (a + (b - a) * t) * inv_sq;
         }
-        let big_d = (dist / self.d_ref).log2().min(top as f64);
-        let i = (big_d as usize).min(top);
-        let t = big_d - i as f64;
-        let a = self.levels[i].sample(h, v);
-        if i == top || t == 0.0 {
+        let h = self.fold_horizontal(self.horizontal_of(d));
+        let a = a_const.unwrap_or_else(|| self.levels[i].sample(h, v));
+        if t == 0.0 {
             return a * inv_sq;
         }
-        let b = self.levels[i + 1].sample(h, v);
+        let b = b_const.unwrap_or_else(|| self.levels[i + 1].sample(h, v));
         (a + (b - a) * t) * inv_sq
     }
 
