@@ -752,3 +752,56 @@ fn shading_is_identical_on_one_and_many_threads() {
     assert_eq!(run(1, true), run(3, true));
     assert_ne!(run(1, false), run(1, true));
 }
+
+#[test]
+fn series_lookup_matches_the_tables_inside_and_outside_constant_ranges() {
+    // A cut-off at 60° (zero beyond, not stored) and a measured range ending at 150°:
+    // the series lookup, which skips the horizontal angle in constant ranges, must equal
+    // the blend of the two tables' own lookups everywhere.
+    let v: Vec<f64> = (0..=30).map(|i| i as f64 * 5.0).collect();
+    let h: Vec<f64> = (0..=8).map(|i| i as f64 * 45.0).collect();
+    let f = synth(
+        1,
+        &v,
+        &h,
+        |hh, g| {
+            if g >= 60.0 {
+                0.0
+            } else {
+                500.0 + 3.0 * hh - 4.0 * g
+            }
+        },
+        1.0,
+    );
+    let t = LightTable::from_ies(
+        &f,
+        &TableOptions {
+            reference_distance: 1.0,
+            max_levels: 3,
+        },
+    )
+    .unwrap();
+    assert!(t.level_size(0).unwrap().1 < v.len());
+    let mut n = 0;
+    for i in 0..40 {
+        let th = (i as f64 * 4.7).to_radians();
+        let ph = (i as f64 * 37.0).to_radians();
+        let dir = DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+        let (vv, hh) = t.angles_of(dir);
+        for d in [0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 9.0] {
+            let big_d = f64::log2(f64::max(d, 1.0)).min(2.0);
+            let k = big_d.floor() as usize;
+            let frac = big_d - k as f64;
+            let a = t.level_candela(k, vv, hh).unwrap();
+            let b = t.level_candela((k + 1).min(2), vv, hh).unwrap();
+            let want = (a + (b - a) * frac) / (d * d);
+            let got = t.illuminance_normal(dir, d);
+            assert!(
+                close(got, want, 1e-12),
+                "γ {vv} C {hh} d {d}: {got} vs {want}"
+            );
+            n += (vv > 150.0 || a == 0.0) as usize;
+        }
+    }
+    assert!(n > 0, "no direction fell in a constant range");
+}
