@@ -385,6 +385,10 @@ impl<'a> Parser<'a> {
 
     fn parse(mut self) -> Result<IesFile, IesError> {
         // --- header: format line, keywords, up to TILT= ---
+        // A UTF-8 byte-order mark would hide the format line.
+        if let Some(l) = self.lines.first_mut() {
+            *l = l.trim_start_matches('\u{feff}');
+        }
         let first = self.lines.first().map_or("", |l| l.trim());
         let upper = first.to_ascii_uppercase();
         let (format, header_start) = if upper.starts_with("IESNA91") {
@@ -616,6 +620,12 @@ mod tests {
         assert_eq!(f.lumens_per_lamp, None);
         let f = IesFile::parse(&format!("IESNA91\n[TEST] a\n{body}"), "x").unwrap();
         assert_eq!(f.format, IesFormat::Lm63_1991);
+    }
+
+    #[test]
+    fn byte_order_mark_is_ignored() {
+        let f = IesFile::parse(&format!("\u{feff}{MINIMAL}"), "bom.ies").unwrap();
+        assert_eq!(f.format, IesFormat::Lm63_2002);
     }
 
     #[test]
