@@ -45,7 +45,7 @@ pub use render::{render, scanline_runs, CubeRenderer};
 
 use crate::camera::{lat_long_to_dir, View};
 use crate::envmap::{lerp_px, EnvMap, Sampler};
-use crate::fixed::{to_fx, FX_BITS, FX_HALF};
+use crate::fixed::{to_fx, FX_BITS, FX_HALF, FX_ONE};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -430,11 +430,11 @@ impl CubeMap {
     /// Nearest: the texel containing (u, v), clamped into the face.
     #[inline(always)]
     pub fn nearest(&self, face: Face, u: f64, v: f64) -> u32 {
-        let n = self.size as i64;
-        // `as` maps NaN to 0 and saturates, and the clamp keeps the index in the face.
-        let x = (u.floor() as i64).clamp(0, n - 1) as usize;
-        let y = (v.floor() as i64).clamp(0, n - 1) as usize;
-        self.faces[face.index()][(y + 1) * (n as usize + 2) + x + 1]
+        let n = self.size as usize;
+        // Clamp first (NaN → 0): then `as` truncation is floor, with no libm call.
+        let x = (u.max(0.0) as usize).min(n - 1);
+        let y = (v.max(0.0) as usize).min(n - 1);
+        self.faces[face.index()][(y + 1) * (n + 2) + x + 1]
     }
 
     /// Bilinear over the four texel centers around (u − ½, v − ½), 8-bit weights, reading
@@ -444,8 +444,10 @@ impl CubeMap {
         let n = self.size as f64;
         // In [0, n] (NaN → 0): with the +1 border offset and −½ for centers, the top-left
         // texel index is in [0, n] and its right/lower neighbour in [1, n + 1].
-        let uu = to_fx(u.max(0.0).min(n)) + FX_HALF;
-        let vv = to_fx(v.max(0.0).min(n)) + FX_HALF;
+        // Q.16 rounded half up: the coordinates are non-negative here, so `+ ½, as` is
+        // `round` without the libm call `f64::round` costs on baseline x86-64.
+        let uu = (u.max(0.0).min(n) * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
+        let vv = (v.max(0.0).min(n) * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
         let x0 = (uu >> FX_BITS) as usize;
         let y0 = (vv >> FX_BITS) as usize;
         let fx = ((uu >> (FX_BITS - 8)) & 0xFF) as u32;

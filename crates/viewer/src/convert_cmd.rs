@@ -1,0 +1,144 @@
+//! `viewer convert INPUT... OUTPUT --to cube|equirect`: equirect → cube faces (six files in
+//! a folder, or one layout image) and cube → equirect. Every file is written atomically.
+use crate::cli_common::{parse_projection, parse_size, write_image_atomic, write_png_atomic};
+use anyhow::{anyhow, bail, Context, Result};
+use clap::{Args, ValueEnum};
+use lut_core::cube::{CubeMap, Face, Layout};
+use lut_core::{EnvMap, Projection, Sampler};
+use std::path::{Path, PathBuf};
+
+/// What to convert to.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Target {
+    /// Six cube faces (a folder of files, or one layout image with --layout).
+    Cube,
+    /// One equirectangular (2:1) image.
+    Equirect,
+}
+
+/// Arguments of `viewer convert`.
+#[derive(Args, Debug)]
+pub struct ConvertArgs {
+    /// The input(s), then the output. `--to cube`: one panorama, then a folder (layout
+    /// files) or an image file (cross/strip/3x2). `--to equirect`: a cube map (a folder,
+    /// six face files or one layout image), then the output image.
+    #[arg(required = true, num_args = 2.., value_name = "INPUT... OUTPUT")]
+    pub paths: Vec<PathBuf>,
+    /// Target format.
+    #[arg(long)]
+    pub to: Target,
+    /// Cube face side in pixels (`--to cube`; default: input width / 4).
+    #[arg(long)]
+    pub face_size: Option<u32>,
+    /// `--to cube`: the output layout (files, cross, strip, 3x2; default files).
+    /// `--to equirect`: the input's layout, overriding detection.
+    #[arg(long)]
+    pub layout: Option<String>,
+    /// Output size WxH (`--to equirect`; default 4N x 2N for faces of side N).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Orientation of named face files (conventions, cube2, irrlicht; default from the
+    /// names: cube2 for ft/rt/bk/lf/up/dn, conventions otherwise). See docs/cube.md.
+    #[arg(long)]
+    pub naming: Option<String>,
+    /// Projection of the input panorama for `--to cube` (auto = 2:1 equirect).
+    #[arg(long, default_value = "auto")]
+    pub projection: String,
+    /// Resampling filter.
+    #[arg(long, default_value = "bilinear", value_parser = |s: &str| s.parse::<Sampler>())]
+    pub sampler: Sampler,
+}
+
+/// Run `viewer convert`.
+pub fn run(a: ConvertArgs) -> Result<()> {
+    let (output, inputs) = a
+        .paths
+        .split_last()
+        .ok_or_else(|| anyhow!("convert needs INPUT... OUTPUT"))?;
+    match a.to {
+        Target::Cube => to_cube(&a, inputs, output),
+        Target::Equirect => to_equirect(&a, inputs, output),
+    }
+}
+
+fn to_cube(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()> {
+    let [input] = inputs else {
+        bail!("--to cube takes one input panorama, got {}", inputs.len());
+    };
+    if a.size.is_some() {
+        bail!("--size is for --to equirect; use --face-size for cube faces");
+    }
+    let layout = match &a.layout {
+        Some(s) => s.parse::<Layout>().map_err(anyhow::Error::msg)?,
+        None => Layout::Files,
+    };
+    let projection: Option<Projection> = parse_projection(&a.projection).map_err(anyhow::Error::msg)?;
+    let map = EnvMap::load(input, projection)?;
+    let face_size = a.face_size.unwrap_or((map.width() / 4).max(1));
+    let cube = CubeMap::from_envmap(&map, face_size, a.sampler)?;
+    write_cube(&cube, layout, output)
+}
+
+/// Write a cube map: six `<face>.png` files into folder `output` (created if missing) for
+/// [`Layout::Files`], else one layout image (PNG or JPEG by extension). Atomic per file.
+pub fn write_cube(cube: &CubeMap, layout: Layout, output: &Path) -> Result<()> {
+    let n = cube.face_size();
+    if layout == Layout::Files {
+        if output.extension().is_some_and(|e| image_format(e).is_some()) && !output.is_dir() {
+            bail!(
+                "{}: layout files writes six images into a folder; give a folder, or --layout cross|strip|3x2 for one image",
+                output.display()
+            );
+        }
+        std::fs::create_dir_all(output)
+            .with_context(|| format!("{}: cannot create folder", output.display()))?;
+        for face in Face::ALL {
+            let path = output.join(format!("{}.png", face.name()));
+            write_png_atomic(&path, &cube.face_pixels(face), n, n)?;
+        }
+        return Ok(());
+    }
+    let (w, h, px) = cube.to_layout(layout)?;
+    write_any(output, &px, w, h)
+}
+
+fn to_equirect(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()> {
+    if a.face_size.is_some() {
+        bail!("--face-size is for --to cube; use --size WxH for the equirect");
+    }
+    let cube = crate::cube_cmd::load_cube(inputs, a.layout.as_deref(), a.naming.as_deref())?;
+    let n = cube.face_size();
+    let (w, h) = a.size.unwrap_or((4 * n, 2 * n));
+    let px = cube.to_equirect(w, h, a.sampler)?;
+    write_any(output, &px, w, h)
+}
+
+fn image_format(ext: &std::ffi::OsStr) -> Option<image::ImageFormat> {
+    match ext.to_str()?.to_ascii_lowercase().as_str() {
+        "png" => Some(image::ImageFormat::Png),
+        "jpg" | "jpeg" => Some(image::ImageFormat::Jpeg),
+        _ => None,
+    }
+}
+
+/// Write 0RGB pixels as PNG or JPEG (quality 95), chosen by the extension, atomically.
+fn write_any(out: &Path, px: &[u32], w: u32, h: u32) -> Result<()> {
+    match out.extension().and_then(image_format) {
+        Some(image::ImageFormat::Png) => write_png_atomic(out, px, w, h),
+        Some(_) => {
+            let mut rgb = Vec::with_capacity(px.len() * 3);
+            for p in px {
+                rgb.extend_from_slice(&[(p >> 16) as u8, (p >> 8) as u8, *p as u8]);
+            }
+            write_image_atomic(out, |f| {
+                image::codecs::jpeg::JpegEncoder::new_with_quality(f, 95)
+                    .encode(&rgb, w, h, image::ExtendedColorType::Rgb8)
+                    .map_err(|e| anyhow!("{}: cannot encode JPEG: {e}", out.display()))
+            })
+        }
+        None => bail!(
+            "{}: output must end in .png, .jpg or .jpeg",
+            out.display()
+        ),
+    }
+}

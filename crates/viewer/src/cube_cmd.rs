@@ -1,0 +1,86 @@
+//! Cube-map inputs for the viewer: loading from the command line or a dropped folder, and
+//! rendering a view (the entry points `render --projection cube` and the window use).
+
+#![allow(dead_code)] // entry points for render_cmd / window, wired by their owners
+
+use anyhow::{Context, Result};
+use lut_core::cube::{self, CubeMap, CubeRenderer, Layout, Naming};
+use lut_core::{Sampler, View};
+use std::path::{Path, PathBuf};
+
+/// Load a cube map from `inputs` (a folder, six face files, or one layout image).
+///
+/// `layout`: `files`, `cross`, `strip`, `3x2` or `None` to detect it (a folder or six
+/// files are `files`; one image is recognized by its aspect ratio). `naming`:
+/// `conventions`, `cube2`, `irrlicht` or `None` for the default the file names imply (see
+/// `docs/cube.md`).
+///
+/// # Errors
+/// Unknown layout or naming names, and every [`cube::CubeError`], with the file named.
+pub fn load_cube(inputs: &[PathBuf], layout: Option<&str>, naming: Option<&str>) -> Result<CubeMap> {
+    let layout = layout
+        .map(|s| s.parse::<Layout>().map_err(anyhow::Error::msg))
+        .transpose()?;
+    let naming = naming
+        .map(|s| s.parse::<Naming>().map_err(anyhow::Error::msg))
+        .transpose()?;
+    Ok(cube::load_cube(inputs, layout, naming)?)
+}
+
+/// True when `inputs` look like a cube map rather than one panorama image: a folder, six
+/// or more files, or one image whose aspect ratio is a cube layout (4:3, 6:1, 3:2). For
+/// the window's drop handler and `render`'s auto projection.
+pub fn looks_like_cube(inputs: &[PathBuf]) -> bool {
+    match inputs {
+        [one] if one.is_dir() => true,
+        [one] => image::ImageReader::open(one)
+            .ok()
+            .and_then(|r| r.with_guessed_format().ok())
+            .and_then(|r| r.into_dimensions().ok())
+            .map(|(w, h)| Layout::detect(w, h).is_some())
+            .unwrap_or(false),
+        many => many.len() >= 6,
+    }
+}
+
+/// Render one view of `cube` into a new `width × height` 0RGB buffer (accelerated
+/// renderer, rows across threads).
+///
+/// # Errors
+/// A bad size.
+pub fn render_view(cube: &CubeMap, view: View, sampler: Sampler, width: u32, height: u32) -> Result<Vec<u32>> {
+    let mut out = vec![0u32; width as usize * height as usize];
+    cube::render(
+        cube,
+        view,
+        sampler,
+        CubeRenderer::Accelerated,
+        &mut out,
+        width,
+        height,
+        true,
+    )?;
+    Ok(out)
+}
+
+/// Render one view of a cube map given on the command line to a PNG, atomically: what
+/// `viewer render --projection cube FACES... --out OUT` does.
+///
+/// # Errors
+/// Loading, rendering or writing failures, naming the file.
+#[allow(clippy::too_many_arguments)]
+pub fn render_to_png(
+    inputs: &[PathBuf],
+    layout: Option<&str>,
+    naming: Option<&str>,
+    view: View,
+    sampler: Sampler,
+    width: u32,
+    height: u32,
+    out: &Path,
+) -> Result<()> {
+    let cube = load_cube(inputs, layout, naming)?;
+    let px = render_view(&cube, view, sampler, width, height)?;
+    crate::cli_common::write_png_atomic(out, &px, width, height)
+        .with_context(|| format!("writing {}", out.display()))
+}
