@@ -165,6 +165,8 @@ struct App {
     loading: Option<(u64, Source, LoadStatus)>,
     next_load_id: u64,
     error: Option<String>,
+    /// The running load is the fallback after a failed one: its success keeps the error.
+    keep_error: bool,
     show_panel: bool,
     scene: Vec<u32>,
     scene_key: Option<SceneKey>,
@@ -197,6 +199,7 @@ pub fn run(args: OpenArgs, projection: Option<Projection>) -> Result<()> {
         loading: None,
         next_load_id: 0,
         error: None,
+        keep_error: false,
         show_panel: true,
         scene: Vec::new(),
         scene_key: None,
@@ -260,6 +263,7 @@ impl App {
             },
         };
         self.loading = Some((id, source.clone(), status));
+        self.keep_error = false;
         let proxy = self.proxy.clone();
         let spawned = std::thread::Builder::new()
             .name("viewer-load".into())
@@ -315,11 +319,13 @@ impl App {
                             g.window
                                 .set_title(&format!("viewer: {}", short_name(&loaded.source)));
                         }
-                        self.projection = loaded.projection;
-                        self.projection_source = Some(loaded.source.clone());
+                        if !std::mem::take(&mut self.keep_error) {
+                            self.error = None;
+                            self.projection = loaded.projection;
+                            self.projection_source = Some(loaded.source.clone());
+                        }
                         self.current = Some(loaded);
                         self.map_generation += 1;
-                        self.error = None;
                     }
                     Err(e) => {
                         eprintln!("viewer: {e}");
@@ -330,6 +336,7 @@ impl App {
                         if self.current.is_none() {
                             // Nothing to keep showing: fall back to the bundled sample.
                             self.start_load(Source::Sample, None);
+                            self.keep_error = true;
                         }
                     }
                 }
@@ -454,6 +461,8 @@ impl App {
         }
         if req.panel.dismiss_error {
             self.error = None;
+            self.projection_source = self.current.as_ref().map(|c| c.source.clone());
+            self.projection = self.current.as_ref().and_then(|c| c.projection);
         }
         if req.panel.projection_changed {
             let source = self
