@@ -3,9 +3,10 @@
 //!
 //! Each image is checked two ways:
 //! 1. **against the exact renderer** rendered in the same test (independent geometry):
-//!    bilinear images may differ by at most 16 levels per channel at any pixel (a 0.05 px
-//!    position error on a hard black/white grid line moves the blend by ≤ 13 levels, plus
-//!    weight rounding) and by at most 0.5 level on average; nearest images may differ in at
+//!    bilinear images may differ by at most 20 levels per channel at any pixel (a 0.05 px
+//!    position error across a hard edge of contrast 255 in both axes moves the blend by at
+//!    most 0.05·255·√2 ≈ 18 levels, plus up to 2 levels of 8-bit weight truncation) and by
+//!    at most 0.5 level on average; nearest images may differ in at
 //!    most 2 % of pixels (nearest flips at pixel boundaries, magnified at hfov 1);
 //! 2. **against the stored truth** in `tests/truth/` (regressions): identical bytes
 //!    required. `REGENERATE=1 cargo test --test golden` rewrites truths after an intended
@@ -29,7 +30,9 @@ fn to_rgb(px: &[u32], w: u32, h: u32) -> image::RgbImage {
 fn compare_to_truth(name: &str, px: &[u32], w: u32, h: u32) {
     let path = root().join("tests/truth").join(format!("{name}.png"));
     let img = to_rgb(px, w, h);
-    if std::env::var_os("REGENERATE").is_some() || !path.exists() && std::env::var_os("CI").is_none() {
+    if std::env::var_os("REGENERATE").is_some()
+        || !path.exists() && std::env::var_os("CI").is_none()
+    {
         img.save(&path).unwrap();
         return;
     }
@@ -92,7 +95,10 @@ fn golden_every_projection() {
                 let n = (w * h) as usize;
                 let mut lut = vec![0u32; n];
                 let mut ex = vec![0u32; n];
-                let opts = RenderOptions { sampler, ..RenderOptions::default() };
+                let opts = RenderOptions {
+                    sampler,
+                    ..RenderOptions::default()
+                };
                 r.render(&map, view, &opts, &mut lut, w, h).unwrap();
                 render_exact(&map, view, sampler, &mut ex, w, h, false).unwrap();
                 let name = format!("{p}_{}_{case}", sampler.name());
@@ -109,7 +115,7 @@ fn golden_every_projection() {
                 let mean = sum as f64 / n as f64;
                 match sampler {
                     Sampler::Bilinear => assert!(
-                        worst <= 16 && mean <= 0.5,
+                        worst <= 20 && mean <= 0.5,
                         "{name}: LUT vs exact worst {worst} mean {mean:.3}"
                     ),
                     Sampler::Nearest => assert!(

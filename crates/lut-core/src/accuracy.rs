@@ -14,24 +14,46 @@ use crate::projection::Projection;
 
 /// Angular-metric position error of `got` against `exact` at latitude `phi`.
 #[inline]
-pub fn position_error(p: Projection, w: f64, _h: f64, phi: f64, exact: (f64, f64), got: (f64, f64)) -> f64 {
-    let mut du = got.0 - exact.0;
-    if p.wraps() {
-        du -= (du / w).round() * w;
-    }
+pub fn position_error(
+    p: Projection,
+    w: f64,
+    _h: f64,
+    phi: f64,
+    exact: (f64, f64),
+    got: (f64, f64),
+) -> f64 {
     let s = p.row_scale(phi);
-    let scale = if s > 1e-9 { (phi.cos() / s).min(2.0) } else { 1.0 };
+    let du = wrap_du(p, w, s, got.0 - exact.0);
+    let scale = if s > 1e-9 {
+        (phi.cos() / s).min(2.0)
+    } else {
+        1.0
+    };
     let dv = got.1 - exact.1;
     ((du * scale).powi(2) + dv * dv).sqrt()
 }
 
+/// A u difference reduced around the row's wrap: W for 360° maps, s(φ)·W for elliptical
+/// and diamond rows (λ = −π and λ = +π are the same direction at opposite row ends).
+#[inline]
+fn wrap_du(p: Projection, w: f64, s: f64, du: f64) -> f64 {
+    let period = if p.wraps() {
+        w
+    } else if p.scaled_rows() {
+        s * w
+    } else {
+        return du;
+    };
+    if period <= 0.0 {
+        return 0.0; // the pole row of a scaled map is a single point
+    }
+    du - (du / period).round() * period
+}
+
 /// Raw (unscaled) position error, wrap-aware.
 #[inline]
-pub fn raw_error(p: Projection, w: f64, exact: (f64, f64), got: (f64, f64)) -> f64 {
-    let mut du = got.0 - exact.0;
-    if p.wraps() {
-        du -= (du / w).round() * w;
-    }
+pub fn raw_error(p: Projection, w: f64, phi: f64, exact: (f64, f64), got: (f64, f64)) -> f64 {
+    let du = wrap_du(p, w, p.row_scale(phi), got.0 - exact.0);
     let dv = got.1 - exact.1;
     (du * du + dv * dv).sqrt()
 }
@@ -93,7 +115,7 @@ pub fn compare_positions(
                 (Some(e), Some(g)) => {
                     let (_, phi) = cam.pixel_lat_long(x, y);
                     let err = position_error(p, w, h, phi, e, g);
-                    let raw = raw_error(p, w, e, g);
+                    let raw = raw_error(p, w, phi, e, g);
                     st.count += 1;
                     sum += err;
                     if err > st.max || !err.is_finite() {

@@ -86,7 +86,9 @@ impl TableSpec {
     /// the angular metric), clamped to [0.0005, 0.01]; the high table halves it.
     pub fn default_for(surface: Surface, kind: TableKind, map_w: u32) -> TableSpec {
         let w = map_w.max(2) as f64;
-        let base = (8.0 * TABLE_ERROR_BUDGET * 0.15 * TAU / w).sqrt().clamp(0.0005, 0.01);
+        let base = (8.0 * TABLE_ERROR_BUDGET * 0.15 * TAU / w)
+            .sqrt()
+            .clamp(0.0005, 0.01);
         let (step, hfov_max) = match kind {
             TableKind::Wide => (base, 150f64),
             TableKind::High => (base * 0.5, 62.0),
@@ -166,7 +168,14 @@ fn surface_dir(surface: Surface, row: f64, col: f64) -> (f64, f64, f64) {
 
 /// Exact (Λ, V, φ) of a surface point, in map pixels, before fixed-point rounding.
 #[inline]
-fn exact_entry(surface: Surface, p: Projection, w: f64, h: f64, row: f64, col: f64) -> (f64, f64, f64) {
+fn exact_entry(
+    surface: Surface,
+    p: Projection,
+    w: f64,
+    h: f64,
+    row: f64,
+    col: f64,
+) -> (f64, f64, f64) {
     let (x, y, z) = surface_dir(surface, row, col);
     let lambda = x.atan2(z);
     let phi = y.atan2((x * x + z * z).sqrt());
@@ -185,7 +194,11 @@ impl LutTable {
         // Use exactly `step` so node r is at r*step; the last node may pass row_max a bit.
         let step = spec.step;
         let (w, h) = (map_w as f64, map_h as f64);
-        let q = |x: f64| (x * 65536.0).round().clamp(i32::MIN as f64, i32::MAX as f64) as i32;
+        let q = |x: f64| {
+            (x * 65536.0)
+                .round()
+                .clamp(i32::MIN as f64, i32::MAX as f64) as i32
+        };
         let mut entries = vec![[0i32; 2]; rows * cols];
         entries
             .par_chunks_mut(cols)
@@ -193,7 +206,8 @@ impl LutTable {
             .for_each(|(r, line)| {
                 let row = r as f64 * step;
                 for (k, e) in line.iter_mut().enumerate() {
-                    let (l, v, _) = exact_entry(spec.surface, projection, w, h, row, k as f64 * step);
+                    let (l, v, _) =
+                        exact_entry(spec.surface, projection, w, h, row, k as f64 * step);
                     *e = [q(l), q(v)];
                 }
             });
@@ -234,7 +248,13 @@ impl LutTable {
                     };
                     let (e00, e01, e10, e11) = (n(b, k), n(b, k + 1), n(b + 1, k), n(b + 1, k + 1));
                     let mut cell = 0.0f64;
-                    for (fr, fc) in [(0.5, 0.5), (0.0, 0.5), (0.5, 0.0), (0.25, 0.75), (0.75, 0.25)] {
+                    for (fr, fc) in [
+                        (0.5, 0.5),
+                        (0.0, 0.5),
+                        (0.5, 0.0),
+                        (0.25, 0.75),
+                        (0.75, 0.25),
+                    ] {
                         let row = (b as f64 + fr) * step;
                         let col = (k as f64 + fc) * step;
                         let (el, ev, phi) = exact_entry(surface, p, w, h, row, col);
@@ -360,8 +380,16 @@ fn entry_error(p: Projection, w: f64, h: f64, exact: (f64, f64, f64), got: (f64,
             return f64::INFINITY;
         }
     }
-    let ue = w * 0.5 + p.row_scale(phi) * el;
-    let ui = w * 0.5 + p.row_scale_at_v(vi, h) * il;
+    let se = p.row_scale(phi);
+    let ue = w * 0.5 + se * el;
+    let ui = if p.scaled_rows() {
+        // After unfolding and yaw, |Λ| can be anything up to W/2, so an error in the row
+        // scale (through v) counts at its worst: u = W/2 + s·Λ, |Λ| ≤ W/2.
+        let ds = (p.row_scale_at_v(vi, h) - se).abs();
+        ue + se * (il - el).abs() + w * 0.5 * ds
+    } else {
+        w * 0.5 + il
+    };
     crate::accuracy::position_error(p, w, h, phi, (ue, ve), (ui, vi))
 }
 
@@ -377,7 +405,14 @@ mod tests {
         for (r, k) in [(0usize, 0usize), (10, 20), (100, 3)] {
             let (b, wa) = t.row_position(r as f64 * step);
             let (l, v) = t.lookup(b, wa, k as f64 * step);
-            let (el, ev, _) = exact_entry(Surface::Cylinder, Projection::Equirect, 2048.0, 1024.0, r as f64 * step, k as f64 * step);
+            let (el, ev, _) = exact_entry(
+                Surface::Cylinder,
+                Projection::Equirect,
+                2048.0,
+                1024.0,
+                r as f64 * step,
+                k as f64 * step,
+            );
             assert!((l as f64 / 65536.0 - el).abs() < 1e-3, "{r} {k}");
             assert!((v as f64 / 65536.0 - ev).abs() < 1e-3, "{r} {k}");
         }

@@ -181,7 +181,8 @@ pub struct Renderer {
     tables: Vec<(Surface, TableKind, LutTable)>,
     geometry: Option<(u32, u32, Projection)>,
     scans: Vec<Scan>,
-    /// Row scale per map row (Q.16), for elliptical and diamond maps.
+    /// Row scale per map row (Q.30: multiplied by Λ up to W/2, so Q.16 would lose up to
+    /// 0.06 px), for elliptical and diamond maps.
     row_scale: Vec<i64>,
 }
 
@@ -254,7 +255,7 @@ impl Renderer {
         self.row_scale.clear();
         if p.scaled_rows() {
             self.row_scale = (0..=h)
-                .map(|j| to_fx(p.row_scale_at_v(j as f64, h as f64)))
+                .map(|j| (p.row_scale_at_v(j as f64, h as f64) * ROW_SCALE_ONE).round() as i64)
                 .collect();
         }
     }
@@ -389,7 +390,13 @@ impl Renderer {
     }
 
     /// Per-frame setup: one [`Scan`] per output row.
-    fn prepare(&mut self, view: View, opts: &RenderOptions, width: u32, height: u32) -> (Frame, RenderReport) {
+    fn prepare(
+        &mut self,
+        view: View,
+        opts: &RenderOptions,
+        width: u32,
+        height: u32,
+    ) -> (Frame, RenderReport) {
         let kind = Self::table_kind(view, opts);
         let (mw, mh, proj) = self.geometry.expect("geometry set");
         self.table(opts.surface, kind);
@@ -711,7 +718,15 @@ fn lut_run<S: Sink>(
 
 /// Emit `m` pixels from `x` on, starting at (Λ, V) and stepping by (dΛ, dV).
 #[inline(always)]
-fn emit<S: Sink>(fr: &Frame, row_scale: &[i64], x: i64, m: i64, start: (Fx, Fx), step: (Fx, Fx), sink: &mut S) {
+fn emit<S: Sink>(
+    fr: &Frame,
+    row_scale: &[i64],
+    x: i64,
+    m: i64,
+    start: (Fx, Fx),
+    step: (Fx, Fx),
+    sink: &mut S,
+) {
     let (l, vv) = start;
     let (dl, dvv) = step;
     // v = H/2 − V
@@ -722,13 +737,13 @@ fn emit<S: Sink>(fr: &Frame, row_scale: &[i64], x: i64, m: i64, start: (Fx, Fx),
     if fr.scaled {
         let mut lw = l + fr.yaw_fx;
         for i in 0..m {
-            // wrap Λ + yaw into [−W/2, W/2)
+            // wrap Λ + yaw into (−W/2, W/2], as λ into (−π, π]
             let mut a = lw;
-            if a >= fr.half_map_w_fx || a < -fr.half_map_w_fx {
-                a = (a + fr.half_map_w_fx).rem_euclid(fr.map_w_fx) - fr.half_map_w_fx;
+            if a > fr.half_map_w_fx || a <= -fr.half_map_w_fx {
+                a = fr.half_map_w_fx - (fr.half_map_w_fx - a).rem_euclid(fr.map_w_fx);
             }
             let s = row_scale_at(row_scale, v, fr.mh as usize);
-            let u = fr.half_map_w_fx + ((s * a) >> FX_BITS);
+            let u = fr.half_map_w_fx + ((s * a) >> ROW_SCALE_BITS);
             sink.put(x + i, u, v);
             lw += dl;
             v += dv;
@@ -776,7 +791,11 @@ fn wrap_u(u: Fx, w: Fx) -> Fx {
     }
 }
 
-/// Row scale s(v) (Q.16), linear between map rows.
+/// Fractional bits of the row scale s.
+const ROW_SCALE_BITS: u32 = 30;
+const ROW_SCALE_ONE: f64 = (1u64 << ROW_SCALE_BITS) as f64;
+
+/// Row scale s(v) (Q.30), linear between map rows.
 #[inline(always)]
 fn row_scale_at(rs: &[i64], v: Fx, h: usize) -> i64 {
     let vi = (v >> FX_BITS).clamp(0, h as i64 - 1) as usize;
