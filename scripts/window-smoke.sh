@@ -117,8 +117,17 @@ settle() {
 }
 
 log "starting the viewer on the bundled sample"
-"$BIN" --size 800x500 --print-view >"$VIEWLOG" 2>"$ERRLOG" &
-VIEWER_PID=$!
+for attempt in 1 2; do
+  "$BIN" --size 800x500 --print-view >"$VIEWLOG" 2>"$ERRLOG" &
+  VIEWER_PID=$!
+  sleep 1
+  # A display that answered xdpyinfo once refused the viewer in one run out of many:
+  # retry once, then give up (the message is in $ERRLOG).
+  if kill -0 "$VIEWER_PID" 2>/dev/null || ! grep -q 'cannot open a window' "$ERRLOG"; then break; fi
+  log "the viewer could not connect (attempt $attempt): $(cat "$ERRLOG")"
+  kill -0 "$XVFB_PID" 2>/dev/null || fail "Xvfb died (see $OUT/xvfb.log)"
+  sleep 1
+done
 wait_for '^loaded ' 0 60
 wait_for '^view .*fast=false' 0 60
 settle
