@@ -15,7 +15,11 @@ fn repo() -> PathBuf {
 }
 
 fn courtyard() -> EnvMap {
-    EnvMap::load(&repo().join("assets/courtyard.jpg"), Some(Projection::Equirect)).expect("courtyard")
+    EnvMap::load(
+        &repo().join("assets/courtyard.jpg"),
+        Some(Projection::Equirect),
+    )
+    .expect("courtyard")
 }
 
 /// The sample sky box (Sauerbraten naming), downscaled copy committed in tests/data/cube.
@@ -52,7 +56,11 @@ fn cube_from_fn(n: u32, f: impl Fn(DVec3) -> u32) -> CubeMap {
         .map(|face| {
             let cam = Camera::new(face.view(), n, n);
             (0..n * n)
-                .map(|i| f(cam.world_ray((i % n) as f64 + 0.5, (i / n) as f64 + 0.5).normalize()))
+                .map(|i| {
+                    f(cam
+                        .world_ray((i % n) as f64 + 0.5, (i / n) as f64 + 0.5)
+                        .normalize())
+                })
                 .collect()
         })
         .collect();
@@ -85,7 +93,15 @@ fn noise_cube(n: u32) -> CubeMap {
     CubeMap::from_faces(n, refs).unwrap()
 }
 
-fn render(cube: &CubeMap, view: View, s: Sampler, r: CubeRenderer, w: u32, h: u32, threads: bool) -> Vec<u32> {
+fn render(
+    cube: &CubeMap,
+    view: View,
+    s: Sampler,
+    r: CubeRenderer,
+    w: u32,
+    h: u32,
+    threads: bool,
+) -> Vec<u32> {
     let mut out = vec![0u32; (w * h) as usize];
     cube::render(cube, view, s, r, &mut out, w, h, threads).unwrap();
     out
@@ -124,11 +140,31 @@ fn equirect_cube_view_matches_equirect_view() {
     ] {
         let view = View::new(yaw, pitch, hfov).unwrap();
         let mut reference = vec![0u32; w * h];
-        render_exact(&map, view, Sampler::Bilinear, &mut reference, w as u32, h as u32, true).unwrap();
-        let got = render(&cube, view, Sampler::Bilinear, CubeRenderer::Accelerated, w as u32, h as u32, true);
+        render_exact(
+            &map,
+            view,
+            Sampler::Bilinear,
+            &mut reference,
+            w as u32,
+            h as u32,
+            true,
+        )
+        .unwrap();
+        let got = render(
+            &cube,
+            view,
+            Sampler::Bilinear,
+            CubeRenderer::Accelerated,
+            w as u32,
+            h as u32,
+            true,
+        );
         let p = psnr(&got, &reference);
         eprintln!("equirect→cube→view ({yaw}, {pitch}, {hfov}): {p:.2} dB");
-        assert!(p >= 40.0, "view ({yaw}, {pitch}, {hfov}): PSNR {p:.2} dB < 40");
+        assert!(
+            p >= 40.0,
+            "view ({yaw}, {pitch}, {hfov}): PSNR {p:.2} dB < 40"
+        );
     }
 }
 
@@ -137,7 +173,9 @@ fn renderers_are_byte_identical_over_a_sweep() {
     let cube = noise_cube(24);
     let mut yaws: Vec<f64> = (-12..=12).map(|i| i as f64 * 15.0).collect();
     yaws.extend([45.0, -45.0, 135.0, -135.0, 0.001, 89.999, 33.3]);
-    let pitches = [-90.0, -75.0, -45.0, -35.26, -10.0, 0.0, 20.0, 35.26, 45.0, 60.0, 89.9, 90.0];
+    let pitches = [
+        -90.0, -75.0, -45.0, -35.26, -10.0, 0.0, 20.0, 35.26, 45.0, 60.0, 89.9, 90.0,
+    ];
     let hfovs = [5.0, 60.0, 90.0, 125.0, 170.0];
     let sizes = [(1, 1), (2, 1), (1, 3), (17, 13), (40, 31)];
     let mut renders = 0;
@@ -149,7 +187,10 @@ fn renderers_are_byte_identical_over_a_sweep() {
                 for s in [Sampler::Nearest, Sampler::Bilinear] {
                     let a = render(&cube, view, s, CubeRenderer::Basic, w, h, false);
                     let b = render(&cube, view, s, CubeRenderer::Accelerated, w, h, false);
-                    assert!(a == b, "view ({yaw}, {pitch}, {hfov}) {w}x{h} {s:?}: renderers differ");
+                    assert!(
+                        a == b,
+                        "view ({yaw}, {pitch}, {hfov}) {w}x{h} {s:?}: renderers differ"
+                    );
                 }
                 renders += 1;
             }
@@ -160,11 +201,46 @@ fn renderers_are_byte_identical_over_a_sweep() {
         for hfov in [90.0, 150.0] {
             let view = View::new(yaw, pitch, hfov).unwrap();
             for (w, h) in [(160, 121), (161, 90)] {
-                let a = render(&cube, view, Sampler::Bilinear, CubeRenderer::Basic, w, h, false);
-                let b = render(&cube, view, Sampler::Bilinear, CubeRenderer::Accelerated, w, h, false);
-                let c = render(&cube, view, Sampler::Bilinear, CubeRenderer::Accelerated, w, h, true);
-                let d = render(&cube, view, Sampler::Bilinear, CubeRenderer::Basic, w, h, true);
-                assert!(a == b && b == c && c == d, "view ({yaw}, {pitch}, {hfov}) {w}x{h}");
+                let a = render(
+                    &cube,
+                    view,
+                    Sampler::Bilinear,
+                    CubeRenderer::Basic,
+                    w,
+                    h,
+                    false,
+                );
+                let b = render(
+                    &cube,
+                    view,
+                    Sampler::Bilinear,
+                    CubeRenderer::Accelerated,
+                    w,
+                    h,
+                    false,
+                );
+                let c = render(
+                    &cube,
+                    view,
+                    Sampler::Bilinear,
+                    CubeRenderer::Accelerated,
+                    w,
+                    h,
+                    true,
+                );
+                let d = render(
+                    &cube,
+                    view,
+                    Sampler::Bilinear,
+                    CubeRenderer::Basic,
+                    w,
+                    h,
+                    true,
+                );
+                assert!(
+                    a == b && b == c && c == d,
+                    "view ({yaw}, {pitch}, {hfov}) {w}x{h}"
+                );
             }
         }
     }
@@ -175,7 +251,12 @@ fn accelerated_renderer_really_runs_segments() {
     // The equality above would hold trivially if the accelerated path fell back to per
     // pixel everywhere: check it proves almost every pixel's face from its run's ends.
     let (w, h) = (320u32, 181u32);
-    for &(yaw, pitch, hfov) in &[(0.0, 0.0, 90.0), (45.0, 35.26, 120.0), (20.0, 80.0, 100.0), (45.0, 90.0, 150.0)] {
+    for &(yaw, pitch, hfov) in &[
+        (0.0, 0.0, 90.0),
+        (45.0, 35.26, 120.0),
+        (20.0, 80.0, 100.0),
+        (45.0, 90.0, 150.0),
+    ] {
         let view = View::new(yaw, pitch, hfov).unwrap();
         let (mut proven, mut total, mut runs) = (0u32, 0u32, 0u32);
         for y in 0..h {
@@ -201,8 +282,10 @@ fn accelerated_renderer_really_runs_segments() {
     }
     // Straight at a corner: rows split into several faces.
     let view = View::new(45.0, 35.26, 90.0).unwrap();
-    let faces: std::collections::BTreeSet<Face> =
-        (0..h).flat_map(|y| cube::scanline_runs(view, w, h, 64, y)).map(|r| r.2).collect();
+    let faces: std::collections::BTreeSet<Face> = (0..h)
+        .flat_map(|y| cube::scanline_runs(view, w, h, 64, y))
+        .map(|r| r.2)
+        .collect();
     assert_eq!(faces.len(), 3, "a corner view shows three faces: {faces:?}");
 }
 
@@ -221,8 +304,24 @@ fn edges_and_corners_show_no_seam_nan_or_bad_read() {
         for hfov in [30.0, 100.0] {
             let view = View::new(yaw, pitch, hfov).unwrap();
             let cam = Camera::new(view, w, h);
-            let got = render(&cube, view, Sampler::Bilinear, CubeRenderer::Accelerated, w, h, false);
-            let bad = render(&clamped, view, Sampler::Bilinear, CubeRenderer::Accelerated, w, h, false);
+            let got = render(
+                &cube,
+                view,
+                Sampler::Bilinear,
+                CubeRenderer::Accelerated,
+                w,
+                h,
+                false,
+            );
+            let bad = render(
+                &clamped,
+                view,
+                Sampler::Bilinear,
+                CubeRenderer::Accelerated,
+                w,
+                h,
+                false,
+            );
             for y in 0..h {
                 for x in 0..w {
                     let d = cam.world_ray(x as f64 + 0.5, y as f64 + 0.5);
@@ -232,7 +331,10 @@ fn edges_and_corners_show_no_seam_nan_or_bad_read() {
                     worst = worst.max(e);
                     // Bilinear interpolation error of `smooth` over 14°–27°-wide texels (7
                     // measured; clamping at face edges instead of reading across: 15).
-                    assert!(e <= TOL, "({yaw}, {pitch}, {hfov}) pixel ({x},{y}): off by {e}");
+                    assert!(
+                        e <= TOL,
+                        "({yaw}, {pitch}, {hfov}) pixel ({x},{y}): off by {e}"
+                    );
                     worst_clamped = worst_clamped.max(max_channel_diff(bad[i], want));
                     // Face coordinates finite and on the face.
                     let face = cube::face_of(d);
@@ -253,7 +355,10 @@ fn edges_and_corners_show_no_seam_nan_or_bad_read() {
         }
     }
     eprintln!("seam check: worst error {worst}, with clamped borders {worst_clamped}");
-    assert!(worst_clamped >= TOL + 5, "the seam check must catch clamping (worst {worst_clamped})");
+    assert!(
+        worst_clamped >= TOL + 5,
+        "the seam check must catch clamping (worst {worst_clamped})"
+    );
 }
 
 #[test]
@@ -286,7 +391,10 @@ fn write_png(path: &Path, px: &[u32], w: u32, h: u32) {
     for p in px {
         rgb.extend_from_slice(&[(p >> 16) as u8, (p >> 8) as u8, *p as u8]);
     }
-    image::RgbImage::from_raw(w, h, rgb).unwrap().save(path).unwrap();
+    image::RgbImage::from_raw(w, h, rgb)
+        .unwrap()
+        .save(path)
+        .unwrap();
 }
 
 fn skybox_files() -> Vec<PathBuf> {
@@ -302,7 +410,10 @@ fn skybox_files() -> Vec<PathBuf> {
 /// the faces) so a joined edge can be told from a broken one.
 fn edge_mismatch(cube: &CubeMap) -> (f64, f64) {
     let n = cube.face_size();
-    let cams: Vec<Camera> = Face::ALL.iter().map(|f| Camera::new(f.view(), n, n)).collect();
+    let cams: Vec<Camera> = Face::ALL
+        .iter()
+        .map(|f| Camera::new(f.view(), n, n))
+        .collect();
     let diff = |a: u32, b: u32| {
         [0, 8, 16]
             .iter()
@@ -366,7 +477,10 @@ fn skybox_orientation_by_edge_continuity() {
     let wrong = cube::load_cube(&[skybox_dir()], None, Some(Naming::Conventions)).unwrap();
     let (worst_wrong, _) = edge_mismatch(&wrong);
     eprintln!("sky box as conventions naming: worst edge {worst_wrong:.2}");
-    assert!(worst_wrong > 2.0 * inner + 3.0, "wrong naming not detected ({worst_wrong:.2})");
+    assert!(
+        worst_wrong > 2.0 * inner + 3.0,
+        "wrong naming not detected ({worst_wrong:.2})"
+    );
     // A procedural cube from the conventions camera joins everywhere (sanity of the check).
     let (w, i) = edge_mismatch(&cube_from_fn(32, smooth));
     assert!(w <= 2.0 * i + 3.0);
@@ -384,7 +498,15 @@ fn skybox_against_converted_equirect() {
         let view = View::new(yaw, pitch, 70.0).unwrap();
         let mut reference = vec![0u32; 80 * 60];
         render_exact(&map, view, Sampler::Bilinear, &mut reference, 80, 60, false).unwrap();
-        let got = render(&cube, view, Sampler::Bilinear, CubeRenderer::Basic, 80, 60, false);
+        let got = render(
+            &cube,
+            view,
+            Sampler::Bilinear,
+            CubeRenderer::Basic,
+            80,
+            60,
+            false,
+        );
         let p = psnr(&got, &reference);
         eprintln!("sky box vs its equirect ({yaw}, {pitch}): {p:.1} dB");
         assert!(p > 35.0, "({yaw}, {pitch}): {p:.1} dB");
@@ -406,7 +528,10 @@ fn every_layout_and_naming_loads_the_same_cube() {
     let mut files = skybox_files();
     check("list", cube::load_cube(&files, None, None));
     files.reverse();
-    check("reversed list", cube::load_cube(&files, Some(Layout::Files), Some(Naming::Cube2)));
+    check(
+        "reversed list",
+        cube::load_cube(&files, Some(Layout::Files), Some(Naming::Cube2)),
+    );
 
     // Word names and axis names, written in conventions orientation.
     let words = dir.join("words");
@@ -424,9 +549,17 @@ fn every_layout_and_naming_loads_the_same_cube() {
     for face in Face::ALL {
         let px = reference.face_pixels(face);
         write_png(&words.join(format!("{}.png", face.name())), &px, n, n);
-        write_png(&axes.join(format!("sky_{}.png", axis_name(face))), &px, n, n);
+        write_png(
+            &axes.join(format!("sky_{}.png", axis_name(face))),
+            &px,
+            n,
+            n,
+        );
     }
-    check("words folder", cube::load_cube(std::slice::from_ref(&words), None, None));
+    check(
+        "words folder",
+        cube::load_cube(std::slice::from_ref(&words), None, None),
+    );
     check("axes folder", cube::load_cube(&[axes], None, None));
 
     // Irrlicht naming: files made by undoing the Irrlicht placement load back.
@@ -436,25 +569,60 @@ fn every_layout_and_naming_loads_the_same_cube() {
         let (face, t) = Naming::Irrlicht.place(named);
         let inverse = Transform::cw((4 - t.quarter_turns) % 4);
         let short = ["ft", "rt", "bk", "lf", "up", "dn"][named.index()];
-        write_png(&irr.join(format!("x_{short}.png")), &inverse.apply(&reference.face_pixels(face), n), n, n);
+        write_png(
+            &irr.join(format!("x_{short}.png")),
+            &inverse.apply(&reference.face_pixels(face), n),
+            n,
+            n,
+        );
     }
-    check("irrlicht", cube::load_cube(&[irr], None, Some(Naming::Irrlicht)));
+    check(
+        "irrlicht",
+        cube::load_cube(&[irr], None, Some(Naming::Irrlicht)),
+    );
 
     // Single images, assembled here from the documented cell positions.
     type Cells = [(Face, u32, u32); 6];
     let cells: [(&str, u32, u32, Cells); 3] = [
-        ("cross", 4, 3, [
-            (Face::Up, 1, 0), (Face::Left, 0, 1), (Face::Front, 1, 1),
-            (Face::Right, 2, 1), (Face::Back, 3, 1), (Face::Down, 1, 2),
-        ]),
-        ("strip", 6, 1, [
-            (Face::Right, 0, 0), (Face::Left, 1, 0), (Face::Up, 2, 0),
-            (Face::Down, 3, 0), (Face::Front, 4, 0), (Face::Back, 5, 0),
-        ]),
-        ("3x2", 3, 2, [
-            (Face::Right, 0, 0), (Face::Left, 1, 0), (Face::Up, 2, 0),
-            (Face::Down, 0, 1), (Face::Front, 1, 1), (Face::Back, 2, 1),
-        ]),
+        (
+            "cross",
+            4,
+            3,
+            [
+                (Face::Up, 1, 0),
+                (Face::Left, 0, 1),
+                (Face::Front, 1, 1),
+                (Face::Right, 2, 1),
+                (Face::Back, 3, 1),
+                (Face::Down, 1, 2),
+            ],
+        ),
+        (
+            "strip",
+            6,
+            1,
+            [
+                (Face::Right, 0, 0),
+                (Face::Left, 1, 0),
+                (Face::Up, 2, 0),
+                (Face::Down, 3, 0),
+                (Face::Front, 4, 0),
+                (Face::Back, 5, 0),
+            ],
+        ),
+        (
+            "3x2",
+            3,
+            2,
+            [
+                (Face::Right, 0, 0),
+                (Face::Left, 1, 0),
+                (Face::Up, 2, 0),
+                (Face::Down, 0, 1),
+                (Face::Front, 1, 1),
+                (Face::Back, 2, 1),
+            ],
+        ),
     ];
     for (name, cols, rows, places) in cells {
         let (w, h) = (cols * n, rows * n);
@@ -469,13 +637,22 @@ fn every_layout_and_naming_loads_the_same_cube() {
         }
         let path = dir.join(format!("layout_{name}.png"));
         write_png(&path, &img, w, h);
-        check(name, cube::load_cube(std::slice::from_ref(&path), None, None));
+        check(
+            name,
+            cube::load_cube(std::slice::from_ref(&path), None, None),
+        );
         let layout: Layout = name.parse().unwrap();
-        check(name, cube::load_cube(std::slice::from_ref(&path), Some(layout), None));
+        check(
+            name,
+            cube::load_cube(std::slice::from_ref(&path), Some(layout), None),
+        );
         // and the library's own writer produces the same image
         let (lw, lh, lpx) = reference.to_layout(layout).unwrap();
         assert_eq!((lw, lh), (w, h));
-        assert!(lpx == img, "{name}: to_layout differs from the documented cells");
+        assert!(
+            lpx == img,
+            "{name}: to_layout differs from the documented cells"
+        );
     }
 }
 
@@ -488,7 +665,12 @@ fn malformed_inputs_give_clear_errors() {
         let d = dir.join(sub);
         std::fs::create_dir_all(&d).unwrap();
         for (face, (w, h)) in Face::ALL.iter().zip(sizes) {
-            write_png(&d.join(format!("{}.png", face.name())), &vec![0x445566; (w * h) as usize], w, h);
+            write_png(
+                &d.join(format!("{}.png", face.name())),
+                &vec![0x445566; (w * h) as usize],
+                w,
+                h,
+            );
         }
         d
     };
@@ -500,7 +682,10 @@ fn malformed_inputs_give_clear_errors() {
     let e = cube::load_cube(std::slice::from_ref(&five), None, None).unwrap_err();
     assert!(matches!(e, CubeError::Faces { .. }), "{e:?}");
     let msg = e.to_string();
-    assert!(msg.contains("missing: down") && msg.contains("five"), "{msg}");
+    assert!(
+        msg.contains("missing: down") && msg.contains("five"),
+        "{msg}"
+    );
     let list: Vec<PathBuf> = ["front", "right", "back", "left", "up"]
         .iter()
         .map(|f| five.join(format!("{f}.png")))
@@ -512,32 +697,65 @@ fn malformed_inputs_give_clear_errors() {
     let mut sizes = ok;
     sizes[3] = (8, 8);
     let e = cube::load_cube(&[mk("unequal", sizes)], None, None).unwrap_err();
-    assert!(matches!(e, CubeError::UnequalSizes { size: 8, first_size: 16, .. }), "{e:?}");
+    assert!(
+        matches!(
+            e,
+            CubeError::UnequalSizes {
+                size: 8,
+                first_size: 16,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
     assert!(e.to_string().contains("left.png"), "{e}");
 
     // Not square.
     let mut sizes = ok;
     sizes[4] = (16, 12);
     let e = cube::load_cube(&[mk("nonsquare", sizes)], None, None).unwrap_err();
-    assert!(matches!(e, CubeError::NotSquare { width: 16, height: 12, .. }), "{e:?}");
+    assert!(
+        matches!(
+            e,
+            CubeError::NotSquare {
+                width: 16,
+                height: 12,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
     assert!(e.to_string().contains("up.png"), "{e}");
 
     // Unreadable: garbage bytes, and a file that does not exist.
     let bad = mk("garbage", ok);
     std::fs::write(bad.join("back.png"), b"not an image at all").unwrap();
     let e = cube::load_cube(std::slice::from_ref(&bad), None, None).unwrap_err();
-    assert!(matches!(&e, CubeError::Read { path, .. } if path.ends_with("back.png")), "{e:?}");
-    let mut list: Vec<PathBuf> = Face::ALL.iter().map(|f| bad.join(format!("{}.png", f.name()))).collect();
+    assert!(
+        matches!(&e, CubeError::Read { path, .. } if path.ends_with("back.png")),
+        "{e:?}"
+    );
+    let mut list: Vec<PathBuf> = Face::ALL
+        .iter()
+        .map(|f| bad.join(format!("{}.png", f.name())))
+        .collect();
     list[0] = dir.join("missing/front.png");
     let e = cube::load_cube(&list, None, None).unwrap_err();
-    assert!(matches!(&e, CubeError::Read { path, .. } if path.ends_with("front.png")), "{e:?}");
+    assert!(
+        matches!(&e, CubeError::Read { path, .. } if path.ends_with("front.png")),
+        "{e:?}"
+    );
 
     // Two files for one face, a name that says no face, an empty folder.
     let dup = mk("dup", ok);
     write_png(&dup.join("ft.png"), &square, 16, 16);
     let e = cube::load_cube(&[dup], None, None).unwrap_err();
-    assert!(e.to_string().contains("two files for the front face"), "{e}");
-    let e = cube::load_cube(&[dir.join("five/front.png"), dir.join("x.png")], None, None).unwrap_err();
+    assert!(
+        e.to_string().contains("two files for the front face"),
+        "{e}"
+    );
+    let e =
+        cube::load_cube(&[dir.join("five/front.png"), dir.join("x.png")], None, None).unwrap_err();
     assert!(matches!(e, CubeError::Faces { .. }), "{e:?}");
     std::fs::create_dir_all(dir.join("empty")).unwrap();
     assert!(cube::load_cube(&[dir.join("empty")], None, None).is_err());
@@ -546,7 +764,10 @@ fn malformed_inputs_give_clear_errors() {
     let odd = dir.join("odd.png");
     write_png(&odd, &vec![0; 50 * 20], 50, 20);
     let e = cube::load_cube(&[odd], None, None).unwrap_err();
-    assert!(matches!(e, CubeError::Layout { .. }) && e.to_string().contains("4:3"), "{e}");
+    assert!(
+        matches!(e, CubeError::Layout { .. }) && e.to_string().contains("4:3"),
+        "{e}"
+    );
     let cross = dir.join("cross.png");
     write_png(&cross, &vec![0; 64 * 48], 64, 48);
     assert!(cube::load_cube(std::slice::from_ref(&cross), None, None).is_ok());
@@ -554,5 +775,8 @@ fn malformed_inputs_give_clear_errors() {
     assert!(matches!(e, CubeError::Layout { .. }), "{e:?}");
     let e = cube::load_cube(&[cross], Some(Layout::Files), None).unwrap_err();
     assert!(matches!(e, CubeError::Usage(_)), "{e:?}");
-    assert!(matches!(cube::load_cube(&[], None, None), Err(CubeError::Usage(_))));
+    assert!(matches!(
+        cube::load_cube(&[], None, None),
+        Err(CubeError::Usage(_))
+    ));
 }

@@ -72,7 +72,8 @@ fn to_cube(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()> {
         Some(s) => s.parse::<Layout>().map_err(anyhow::Error::msg)?,
         None => Layout::Files,
     };
-    let projection: Option<Projection> = parse_projection(&a.projection).map_err(anyhow::Error::msg)?;
+    let projection: Option<Projection> =
+        parse_projection(&a.projection).map_err(anyhow::Error::msg)?;
     let map = EnvMap::load(input, projection)?;
     let face_size = a.face_size.unwrap_or((map.width() / 4).max(1));
     let cube = CubeMap::from_envmap(&map, face_size, a.sampler)?;
@@ -84,7 +85,11 @@ fn to_cube(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()> {
 pub fn write_cube(cube: &CubeMap, layout: Layout, output: &Path) -> Result<()> {
     let n = cube.face_size();
     if layout == Layout::Files {
-        if output.extension().is_some_and(|e| image_format(e).is_some()) && !output.is_dir() {
+        if output
+            .extension()
+            .is_some_and(|e| image_format(e).is_some())
+            && !output.is_dir()
+        {
             bail!(
                 "{}: layout files writes six images into a folder; give a folder, or --layout cross|strip|3x2 for one image",
                 output.display()
@@ -136,9 +141,6 @@ fn write_any(out: &Path, px: &[u32], w: u32, h: u32) -> Result<()> {
                     .map_err(|e| anyhow!("{}: cannot encode JPEG: {e}", out.display()))
             })
         }
-        None => bail!(
-            "{}: output must end in .png, .jpg or .jpeg",
-            out.display()
-        ),
+        None => bail!("{}: output must end in .png, .jpg or .jpeg", out.display()),
     }
 }

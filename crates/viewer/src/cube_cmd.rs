@@ -17,7 +17,11 @@ use std::path::{Path, PathBuf};
 ///
 /// # Errors
 /// Unknown layout or naming names, and every [`cube::CubeError`], with the file named.
-pub fn load_cube(inputs: &[PathBuf], layout: Option<&str>, naming: Option<&str>) -> Result<CubeMap> {
+pub fn load_cube(
+    inputs: &[PathBuf],
+    layout: Option<&str>,
+    naming: Option<&str>,
+) -> Result<CubeMap> {
     let layout = layout
         .map(|s| s.parse::<Layout>().map_err(anyhow::Error::msg))
         .transpose()?;
@@ -48,7 +52,13 @@ pub fn looks_like_cube(inputs: &[PathBuf]) -> bool {
 ///
 /// # Errors
 /// A bad size.
-pub fn render_view(cube: &CubeMap, view: View, sampler: Sampler, width: u32, height: u32) -> Result<Vec<u32>> {
+pub fn render_view(
+    cube: &CubeMap,
+    view: View,
+    sampler: Sampler,
+    width: u32,
+    height: u32,
+) -> Result<Vec<u32>> {
     let mut out = vec![0u32; width as usize * height as usize];
     cube::render(
         cube,

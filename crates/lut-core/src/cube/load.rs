@@ -102,7 +102,9 @@ impl std::str::FromStr for Layout {
             "cross" => Ok(Layout::Cross),
             "strip" => Ok(Layout::Strip),
             "3x2" => Ok(Layout::Grid3x2),
-            o => Err(format!("unknown layout '{o}' (expected files, cross, strip or 3x2)")),
+            o => Err(format!(
+                "unknown layout '{o}' (expected files, cross, strip or 3x2)"
+            )),
         }
     }
 }
@@ -265,7 +267,8 @@ fn classify(path: &Path) -> Option<(Face, NameKind)> {
 }
 
 const IMAGE_EXTENSIONS: &[&str] = &[
-    "jpg", "jpeg", "png", "bmp", "tga", "tif", "tiff", "webp", "exr", "hdr", "gif", "ppm", "pnm", "qoi",
+    "jpg", "jpeg", "png", "bmp", "tga", "tif", "tiff", "webp", "exr", "hdr", "gif", "ppm", "pnm",
+    "qoi",
 ];
 
 fn is_image(path: &Path) -> bool {
@@ -279,7 +282,10 @@ fn is_image(path: &Path) -> bool {
 type Decoded = (u32, u32, Vec<u32>);
 
 /// Decode an image file to 0RGB, checking its size from the header first.
-fn read_image(path: &Path, check: impl Fn(u32, u32) -> Result<(), CubeError>) -> Result<Decoded, CubeError> {
+fn read_image(
+    path: &Path,
+    check: impl Fn(u32, u32) -> Result<(), CubeError>,
+) -> Result<Decoded, CubeError> {
     let err = |reason: String| CubeError::Read {
         path: path.to_path_buf(),
         reason,
@@ -317,7 +323,11 @@ fn read_image(path: &Path, check: impl Fn(u32, u32) -> Result<(), CubeError>) ->
 /// [`CubeError`] naming the file or folder and the reason: unreadable or undecodable
 /// files, faces missing, repeated or unrecognized, non-square or unequal faces, an image
 /// that fits no layout, or a layout that does not fit the inputs.
-pub fn load_cube(inputs: &[PathBuf], layout: Option<Layout>, naming: Option<Naming>) -> Result<CubeMap, CubeError> {
+pub fn load_cube(
+    inputs: &[PathBuf],
+    layout: Option<Layout>,
+    naming: Option<Naming>,
+) -> Result<CubeMap, CubeError> {
     match inputs {
         [] => Err(CubeError::Usage("no cube map input given".into())),
         [one] if one.is_dir() => {
@@ -379,7 +389,11 @@ pub fn load_cube(inputs: &[PathBuf], layout: Option<Layout>, naming: Option<Nami
 ///
 /// # Errors
 /// As [`load_cube`].
-pub fn load_face_files(what: &str, files: &[PathBuf], naming: Option<Naming>) -> Result<CubeMap, CubeError> {
+pub fn load_face_files(
+    what: &str,
+    files: &[PathBuf],
+    naming: Option<Naming>,
+) -> Result<CubeMap, CubeError> {
     let mut slots: [Option<(&PathBuf, NameKind)>; 6] = [None; 6];
     for f in files {
         let Some((face, kind)) = classify(f) else {
@@ -419,7 +433,11 @@ pub fn load_face_files(what: &str, files: &[PathBuf], naming: Option<Naming>) ->
         });
     }
     let sky = slots.iter().flatten().any(|(_, k)| *k == NameKind::SkyBox);
-    let naming = naming.unwrap_or(if sky { Naming::Cube2 } else { Naming::Conventions });
+    let naming = naming.unwrap_or(if sky {
+        Naming::Cube2
+    } else {
+        Naming::Conventions
+    });
 
     let check_square = |path: &Path| {
         let path = path.to_path_buf();
@@ -522,8 +540,12 @@ impl CubeMap {
     /// # Errors
     /// [`CubeError::Usage`] for [`Layout::Files`], which is not one image.
     pub fn to_layout(&self, layout: Layout) -> Result<(u32, u32, Vec<u32>), CubeError> {
-        let (Some((w, h)), Some(cells)) = (layout_dimensions(layout, self.face_size()), layout.cells()) else {
-            return Err(CubeError::Usage("layout files is six images, not one".into()));
+        let (Some((w, h)), Some(cells)) =
+            (layout_dimensions(layout, self.face_size()), layout.cells())
+        else {
+            return Err(CubeError::Usage(
+                "layout files is six images, not one".into(),
+            ));
         };
         let n = self.face_size() as usize;
         let mut out = vec![0u32; w as usize * h as usize];

@@ -362,14 +362,26 @@ impl CubeMap {
     ///
     /// # Errors
     /// [`CubeError::FaceSize`] for a bad `face_size`.
-    pub fn from_envmap(map: &EnvMap, face_size: u32, sampler: Sampler) -> Result<CubeMap, CubeError> {
+    pub fn from_envmap(
+        map: &EnvMap,
+        face_size: u32,
+        sampler: Sampler,
+    ) -> Result<CubeMap, CubeError> {
         check_face_size("cube map", face_size)?;
         let n = face_size as usize;
         let mut faces: [Vec<u32>; 6] = Default::default();
         for (k, face) in Face::ALL.iter().enumerate() {
             let mut buf = vec![0u32; n * n];
-            crate::exact::render_exact(map, face.view(), sampler, &mut buf, face_size, face_size, true)
-                .map_err(|e| CubeError::Usage(format!("cannot render {} face: {e}", face.name())))?;
+            crate::exact::render_exact(
+                map,
+                face.view(),
+                sampler,
+                &mut buf,
+                face_size,
+                face_size,
+                true,
+            )
+            .map_err(|e| CubeError::Usage(format!("cannot render {} face: {e}", face.name())))?;
             faces[k] = buf;
         }
         let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
@@ -457,7 +469,11 @@ impl CubeMap {
         let i = y0 * stride + x0;
         let row0 = &data[i..i + 2];
         let row1 = &data[i + stride..i + stride + 2];
-        lerp_px(lerp_px(row0[0], row0[1], fx), lerp_px(row1[0], row1[1], fx), fy)
+        lerp_px(
+            lerp_px(row0[0], row0[1], fx),
+            lerp_px(row1[0], row1[1], fx),
+            fy,
+        )
     }
 
     /// Resample to an equirectangular `width × height` image (row-major 0RGB): each pixel
@@ -465,14 +481,21 @@ impl CubeMap {
     ///
     /// # Errors
     /// [`CubeError::Usage`] for an empty or oversized output.
-    pub fn to_equirect(&self, width: u32, height: u32, sampler: Sampler) -> Result<Vec<u32>, CubeError> {
+    pub fn to_equirect(
+        &self,
+        width: u32,
+        height: u32,
+        sampler: Sampler,
+    ) -> Result<Vec<u32>, CubeError> {
         crate::camera::check_size(width, height).map_err(|e| CubeError::Usage(e.to_string()))?;
         let (w, h) = (width as usize, height as usize);
         let mut out = vec![0u32; w * h];
         out.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
-            let phi = std::f64::consts::FRAC_PI_2 - (j as f64 + 0.5) / h as f64 * std::f64::consts::PI;
+            let phi =
+                std::f64::consts::FRAC_PI_2 - (j as f64 + 0.5) / h as f64 * std::f64::consts::PI;
             for (i, px) in row.iter_mut().enumerate() {
-                let lambda = (i as f64 + 0.5) / w as f64 * std::f64::consts::TAU - std::f64::consts::PI;
+                let lambda =
+                    (i as f64 + 0.5) / w as f64 * std::f64::consts::TAU - std::f64::consts::PI;
                 *px = self.sample_dir(sampler, lat_long_to_dir(lambda, phi));
             }
         });
@@ -501,7 +524,8 @@ impl CubeMap {
     /// Apply a transform to every face (used by tests and by namings): a new cube map
     /// whose face `k` is `faces[k]` of `self` transformed.
     pub fn map_faces(&self, f: impl Fn(Face, Vec<u32>) -> Vec<u32>) -> Result<CubeMap, CubeError> {
-        let faces: [Vec<u32>; 6] = std::array::from_fn(|k| f(Face::ALL[k], self.face_pixels(Face::ALL[k])));
+        let faces: [Vec<u32>; 6] =
+            std::array::from_fn(|k| f(Face::ALL[k], self.face_pixels(Face::ALL[k])));
         let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
         CubeMap::from_faces(self.size, refs)
     }
@@ -552,9 +576,17 @@ mod tests {
         let front = cube.bordered_face(Face::Front);
         let stride = 6;
         assert_eq!(front[stride * 2], 0x10 * 4, "left border of front is left");
-        assert_eq!(front[stride * 2 + 5], 0x10 * 2, "right border of front is right");
+        assert_eq!(
+            front[stride * 2 + 5],
+            0x10 * 2,
+            "right border of front is right"
+        );
         assert_eq!(front[2], 0x10 * 5, "top border of front is up");
-        assert_eq!(front[5 * stride + 2], 0x10 * 6, "bottom border of front is down");
+        assert_eq!(
+            front[5 * stride + 2],
+            0x10 * 6,
+            "bottom border of front is down"
+        );
         let up = cube.bordered_face(Face::Up);
         assert_eq!(up[5 * stride + 2], 0x10, "bottom border of up is front");
         assert_eq!(up[2], 0x30, "top border of up is back");
@@ -565,7 +597,10 @@ mod tests {
         let a = vec![0u32; 16];
         let b = vec![0u32; 15];
         let refs: [&[u32]; 6] = [&a, &a, &a, &a, &a, &b];
-        assert!(matches!(CubeMap::from_faces(4, refs), Err(CubeError::Buffer { .. })));
+        assert!(matches!(
+            CubeMap::from_faces(4, refs),
+            Err(CubeError::Buffer { .. })
+        ));
         assert!(matches!(
             CubeMap::from_faces(0, [&[][..]; 6]),
             Err(CubeError::FaceSize { .. })

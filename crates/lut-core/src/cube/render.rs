@@ -61,7 +61,9 @@ impl std::str::FromStr for CubeRenderer {
         match s {
             "basic" => Ok(CubeRenderer::Basic),
             "accelerated" | "accel" => Ok(CubeRenderer::Accelerated),
-            o => Err(format!("unknown cube renderer '{o}' (expected basic or accelerated)")),
+            o => Err(format!(
+                "unknown cube renderer '{o}' (expected basic or accelerated)"
+            )),
         }
     }
 }
@@ -209,7 +211,9 @@ fn render_with<S: Fetch>(
         }
     };
     if threads {
-        out.par_chunks_mut(w * rows_per_band).enumerate().for_each(band);
+        out.par_chunks_mut(w * rows_per_band)
+            .enumerate()
+            .for_each(band);
     } else {
         out.chunks_mut(w * rows_per_band).enumerate().for_each(band);
     }
@@ -217,7 +221,15 @@ fn render_with<S: Fetch>(
 
 /// The per-pixel kernel over `line[x0..x1]` of row `y`: full ray, face choice, coordinates.
 #[inline(always)]
-fn per_pixel<S: Fetch>(cube: &CubeMap, frame: &Frame, s: S, y: usize, line: &mut [u32], x0: usize, x1: usize) {
+fn per_pixel<S: Fetch>(
+    cube: &CubeMap,
+    frame: &Frame,
+    s: S,
+    y: usize,
+    line: &mut [u32],
+    x0: usize,
+    x1: usize,
+) {
     let dy = frame.dy(y);
     for (x, px) in line.iter_mut().enumerate().take(x1).skip(x0) {
         // The whole rotation per pixel; bit-identical to the accelerated path's ray.
@@ -251,7 +263,14 @@ fn push_seg(segs: &mut Vec<Seg>, start: usize, end: usize, face: Face) {
 }
 
 /// Binary search for face changes between pixels `lo` and `hi` whose faces are known.
-fn split(face_at: &impl Fn(usize) -> Face, lo: usize, hi: usize, flo: Face, fhi: Face, segs: &mut Vec<Seg>) {
+fn split(
+    face_at: &impl Fn(usize) -> Face,
+    lo: usize,
+    hi: usize,
+    flo: Face,
+    fhi: Face,
+    segs: &mut Vec<Seg>,
+) {
     if flo == fhi {
         push_seg(segs, lo, hi, flo);
         return;
@@ -274,7 +293,14 @@ fn margin(face: Face, d: DVec3) -> f64 {
     (m - a.abs()).min(m - b.abs())
 }
 
-fn accel_row<S: Fetch>(cube: &CubeMap, frame: &Frame, s: S, y: usize, line: &mut [u32], segs: &mut Vec<Seg>) {
+fn accel_row<S: Fetch>(
+    cube: &CubeMap,
+    frame: &Frame,
+    s: S,
+    y: usize,
+    line: &mut [u32],
+    segs: &mut Vec<Seg>,
+) {
     let w = line.len();
     let p = frame.row(frame.dy(y));
     let b = frame.b;
@@ -284,7 +310,7 @@ fn accel_row<S: Fetch>(cube: &CubeMap, frame: &Frame, s: S, y: usize, line: &mut
     for seg in segs.iter() {
         let ok = |x: usize| margin(seg.face, ray(p, b, frame.dx(x))) > frame.delta;
         let (mut a, mut e) = (seg.start, seg.end + 1); // half-open [a, e)
-        // Peel at most two unproven pixels from each end.
+                                                       // Peel at most two unproven pixels from each end.
         for _ in 0..2 {
             if a < e && !ok(a) {
                 per_pixel(cube, frame, s, y, line, a, a + 1);
@@ -317,7 +343,15 @@ fn accel_row<S: Fetch>(cube: &CubeMap, frame: &Frame, s: S, y: usize, line: &mut
 /// A verified run on face `F`: step the ray along the scanline, no face choice.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn run<const F: usize, S: Fetch>(cube: &CubeMap, frame: &Frame, s: S, p: DVec3, line: &mut [u32], a: usize, e: usize) {
+fn run<const F: usize, S: Fetch>(
+    cube: &CubeMap,
+    frame: &Frame,
+    s: S,
+    p: DVec3,
+    line: &mut [u32],
+    a: usize,
+    e: usize,
+) {
     let face = Face::from_index(F);
     let b = frame.b;
     let half = frame.half_face;
@@ -331,7 +365,13 @@ fn run<const F: usize, S: Fetch>(cube: &CubeMap, frame: &Frame, s: S, p: DVec3, 
 /// How the accelerated renderer splits row `y` of a `width × height` view: the runs
 /// `(start, end_exclusive, face, verified)` in order, where unverified runs (and peeled
 /// single pixels) were rendered per pixel. For tests and the docs' statistics.
-pub fn scanline_runs(view: View, width: u32, height: u32, face_size: u32, y: u32) -> Vec<(u32, u32, Face, bool)> {
+pub fn scanline_runs(
+    view: View,
+    width: u32,
+    height: u32,
+    face_size: u32,
+    y: u32,
+) -> Vec<(u32, u32, Face, bool)> {
     let frame = Frame::new(view, width, height, face_size);
     let w = width as usize;
     let p = frame.row(frame.dy(y as usize));
