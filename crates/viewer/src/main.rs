@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod assets;
+mod bench_cmd;
 mod cli_common;
 mod convert_cmd;
 mod cube_cmd;
@@ -19,7 +20,12 @@ mod window;
 
 /// CPU panorama viewer: scanline-coherent LUT rendering (US 5,748,194).
 #[derive(Parser, Debug)]
-#[command(name = "viewer", version, about, args_conflicts_with_subcommands = true)]
+#[command(
+    name = "viewer",
+    version,
+    about,
+    args_conflicts_with_subcommands = true
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -36,6 +42,8 @@ enum Command {
     Convert(convert_cmd::ConvertArgs),
     /// Summarize an IES LM-63 file and sample its candela distribution.
     Ies(ies_cmd::IesArgs),
+    /// Measure speed against error for every renderer configuration.
+    Bench(bench_cmd::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +52,7 @@ fn main() -> ExitCode {
         Some(Command::Render(a)) => render_cmd::run(a),
         Some(Command::Convert(a)) => convert_cmd::run(a),
         Some(Command::Ies(a)) => ies_cmd::run(a),
+        Some(Command::Bench(a)) => bench_cmd::run(a),
         None => window::run(cli.open),
     };
     match result {
