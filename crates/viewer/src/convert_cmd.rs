@@ -144,3 +144,57 @@ fn write_any(out: &Path, px: &[u32], w: u32, h: u32) -> Result<()> {
         None => bail!("{}: output must end in .png, .jpg or .jpeg", out.display()),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample_cube() -> CubeMap {
+        let n = 8u32;
+        let faces: Vec<Vec<u32>> = (0..6u32)
+            .map(|k| {
+                (0..n * n)
+                    .map(|i| (k * 40) << 16 | (i * 3) << 8 | (i % n) * 20)
+                    .collect()
+            })
+            .collect();
+        let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
+        CubeMap::from_faces(n, refs).unwrap()
+    }
+
+    #[test]
+    fn written_cubes_load_back_identically() {
+        let tmp = tempfile::tempdir().unwrap();
+        let cube = sample_cube();
+        let dir = tmp.path().join("faces");
+        write_cube(&cube, Layout::Files, &dir).unwrap();
+        let back = crate::cube_cmd::load_cube(std::slice::from_ref(&dir), None, None).unwrap();
+        assert!(back == cube, "files");
+        for (layout, name) in [
+            (Layout::Cross, "c.png"),
+            (Layout::Strip, "s.png"),
+            (Layout::Grid3x2, "g.png"),
+        ] {
+            let path = tmp.path().join(name);
+            write_cube(&cube, layout, &path).unwrap();
+            let back = crate::cube_cmd::load_cube(std::slice::from_ref(&path), None, None).unwrap();
+            assert!(back == cube, "{name}");
+        }
+    }
+
+    #[test]
+    fn failed_writes_leave_nothing() {
+        let tmp = tempfile::tempdir().unwrap();
+        let cube = sample_cube();
+        let out = tmp.path().join("missing/c.png");
+        assert!(write_cube(&cube, Layout::Cross, &out).is_err());
+        assert!(!out.exists());
+        let bad = tmp.path().join("c.bmp");
+        assert!(write_cube(&cube, Layout::Cross, &bad).is_err());
+        assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 0);
+        // layout files into something named like an image is refused, not a folder made
+        let img = tmp.path().join("faces.png");
+        assert!(write_cube(&cube, Layout::Files, &img).is_err());
+        assert!(!img.exists());
+    }
+}
