@@ -154,7 +154,7 @@ mod tests {
         let faces: Vec<Vec<u32>> = (0..6u32)
             .map(|k| {
                 (0..n * n)
-                    .map(|i| (k * 40) << 16 | (i * 3) << 8 | (i % n) * 20)
+                    .map(|i| ((k * 40) << 16) | ((i * 3) << 8) | ((i % n) * 20))
                     .collect()
             })
             .collect();
