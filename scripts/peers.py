@@ -1,0 +1,269 @@
+#!/usr/bin/env python3
+"""Peers measured side by side with our LUT renderer, in one run.
+
+    python3 scripts/peers.py [--size 1920x1080] [--threads 2] [--out /tmp/peers]
+                             [--viewer target/release/viewer] [--no-install] [--no-ffmpeg]
+
+1. Installs the peers with the ordinary tools if missing: `pip install
+   opencv-python-headless numpy`, `apt-get install -y ffmpeg`.
+2. Runs `viewer bench --json --export-maps OUT` (our numbers, hfov-90 view set, the
+   generated 8192x4096 grid map, same thread count) which also exports the source map,
+   the exact sampling maps (OpenCV convention: u - 0.5, v - 0.5) and our exact renders.
+3. Renders the same views with
+   * OpenCV `remap`, maps precomputed: float32 maps, and fixed point (`convertMaps` to
+     CV_16SC2; the conversion is timed separately as map building), bilinear and nearest;
+   * OpenCV with the map built per view in numpy (float64 math, float32 maps), + remap;
+   * ffmpeg `v360` (equirect -> flat), which builds its whole table for each view: timed
+     as (ffmpeg run with v360) - (the same run with a plain crop instead), per view.
+   All with the same thread count (`cv2.setNumThreads`, ffmpeg `-filter_threads`).
+4. Prints a table: median ms per frame, our time as a ratio to theirs, and their PSNR
+   against our exact render (same sampler). Writes OUT/peers.json.
+
+The source map is padded by one wrapped column on each side so OpenCV's
+BORDER_REPLICATE clamps vertically and wraps horizontally, as our convention does.
+"""
+
+import argparse
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def install(no_install):
+    try:
+        import cv2  # noqa: F401
+        import numpy  # noqa: F401
+    except ImportError:
+        if no_install:
+            sys.exit("peers: opencv-python-headless and numpy are missing (pip install them)")
+        subprocess.run([sys.executable, "-m", "pip", "install", "-q",
+                        "opencv-python-headless", "numpy"], check=True)
+    if shutil.which("ffmpeg") is None and not no_install:
+        env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+        subprocess.run(["apt-get", "update", "-q"], check=True, env=env)
+        subprocess.run(["apt-get", "install", "-y", "-q", "ffmpeg"], check=True, env=env)
+
+
+def psnr(a, b):
+    import numpy as np
+    d = a.astype(np.float64) - b.astype(np.float64)
+    mse = float(np.mean(d * d))
+    return float("inf") if mse == 0 else 10.0 * np.log10(255.0 ** 2 / mse)
+
+
+def pooled_psnr(pairs):
+    import numpy as np
+    sse, n = 0.0, 0
+    for a, b in pairs:
+        d = a.astype(np.float64) - b.astype(np.float64)
+        sse += float(np.sum(d * d))
+        n += d.size
+    return float("inf") if sse == 0 else 10.0 * np.log10(255.0 ** 2 / (sse / n))
+
+
+def numpy_maps(yaw, pitch, hfov, w, h, mw, mh):
+    """The exact equirect sampling map of conventions.md, in numpy (OpenCV centers)."""
+    import numpy as np
+    f = (w / 2) / np.tan(np.radians(hfov) / 2)
+    x = np.arange(w, dtype=np.float64) + 0.5 - w / 2
+    y = h / 2 - (np.arange(h, dtype=np.float64) + 0.5)
+    X, Y = np.meshgrid(x, y)
+    Z = np.full_like(X, f)
+    p, q = np.radians(pitch), np.radians(yaw)
+    # pitch about X (Z toward +Y), then yaw about Y (Z toward +X)
+    Y1 = Y * np.cos(p) + Z * np.sin(p)
+    Z1 = -Y * np.sin(p) + Z * np.cos(p)
+    X2 = X * np.cos(q) + Z1 * np.sin(q)
+    Z2 = -X * np.sin(q) + Z1 * np.cos(q)
+    lam = np.arctan2(X2, Z2)
+    phi = np.arctan2(Y1, np.hypot(X2, Z2))
+    u = (lam + np.pi) / (2 * np.pi) * mw
+    v = (np.pi / 2 - phi) / np.pi * mh
+    return (u - 0.5).astype(np.float32), (v - 0.5).astype(np.float32)
+
+
+def median_ms(times):
+    return statistics.median(times) * 1e3
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--size", default="1920x1080")
+    ap.add_argument("--threads", type=int, default=os.cpu_count())
+    ap.add_argument("--out", default="/tmp/peers")
+    ap.add_argument("--viewer", default=os.path.join(REPO, "target/release/viewer"))
+    ap.add_argument("--reps", type=int, default=3, help="timed repetitions per view")
+    ap.add_argument("--no-install", action="store_true")
+    ap.add_argument("--no-ffmpeg", action="store_true")
+    ap.add_argument("--bench-args", default="", help="extra arguments for viewer bench")
+    a = ap.parse_args()
+    install(a.no_install)
+    import cv2
+    import numpy as np
+
+    if not os.path.exists(a.viewer):
+        sys.exit(f"peers: {a.viewer} not found (cargo build --release -p viewer)")
+    os.makedirs(a.out, exist_ok=True)
+    ours_path = os.path.join(a.out, "ours.json")
+    cmd = [a.viewer, "bench", "--size", a.size, "--threads", str(a.threads),
+           "--export-maps", a.out, "--json"] + a.bench_args.split()
+    print("peers: running", " ".join(cmd), file=sys.stderr)
+    with open(ours_path, "w") as fo:
+        subprocess.run(cmd, check=True, stdout=fo)
+    ours = json.load(open(ours_path))
+    meta = json.load(open(os.path.join(a.out, "views.json")))
+    w, h, mw, mh = meta["width"], meta["height"], meta["map_width"], meta["map_height"]
+    n = a.threads
+    cv2.setNumThreads(n)
+
+    src = np.fromfile(os.path.join(a.out, meta["map"]), dtype=np.uint8).reshape(mh, mw, 3)
+    srcp = np.ascontiguousarray(np.concatenate([src[:, -1:], src, src[:, :1]], axis=1))
+
+    res = {k: [] for k in ["cv_float_bil", "cv_fixed_bil", "cv_float_nn", "cv_fixed_nn",
+                           "cv_convert", "np_build", "np_build_remap", "ff_v360"]}
+    imgs = {k: [] for k in ["cv_float_bil", "cv_fixed_bil", "cv_float_nn", "cv_fixed_nn",
+                            "np_build_remap", "ff_v360"]}
+    np_map_err = 0.0
+    for i, v in enumerate(meta["views"]):
+        rd = lambda name, dt: np.fromfile(os.path.join(a.out, v[name]), dtype=dt)  # noqa: E731
+        mx = rd("mapx", np.float32).reshape(h, w) + 1.0  # +1: the padding column
+        my = rd("mapy", np.float32).reshape(h, w)
+        ex_bil = rd("exact_bilinear", np.uint8).reshape(h, w, 3)
+        ex_nn = rd("exact_nearest", np.uint8).reshape(h, w, 3)
+
+        def timed(key, fn, reps=a.reps):
+            out = None
+            for _ in range(reps + 1):  # +1 warm-up
+                t = time.perf_counter()
+                out = fn()
+                dt = time.perf_counter() - t
+                if _ > 0:
+                    res[key].append(dt)
+            return out
+
+        bil, nn, rep = cv2.INTER_LINEAR, cv2.INTER_NEAREST, cv2.BORDER_REPLICATE
+        o = timed("cv_float_bil", lambda: cv2.remap(srcp, mx, my, bil, borderMode=rep))
+        imgs["cv_float_bil"].append((o, ex_bil))
+        m1, m2 = timed("cv_convert", lambda: cv2.convertMaps(mx, my, cv2.CV_16SC2))
+        o = timed("cv_fixed_bil", lambda: cv2.remap(srcp, m1, m2, bil, borderMode=rep))
+        imgs["cv_fixed_bil"].append((o, ex_bil))
+        # Nearest: OpenCV rounds to the nearest integer center, ours takes the pixel
+        # containing (u, v): the same choice, up to ties.
+        o = timed("cv_float_nn", lambda: cv2.remap(srcp, mx, my, nn, borderMode=rep))
+        imgs["cv_float_nn"].append((o, ex_nn))
+        n1, _ = cv2.convertMaps(mx, my, cv2.CV_16SC2, nninterpolation=True)
+        o = timed("cv_fixed_nn", lambda: cv2.remap(srcp, n1, None, nn, borderMode=rep))
+        imgs["cv_fixed_nn"].append((o, ex_nn))
+
+        # Per view: build the map in numpy, then remap (float maps).
+        def per_view():
+            t = time.perf_counter()
+            bx, by = numpy_maps(v["yaw"], v["pitch"], v["hfov"], w, h, mw, mh)
+            res["np_build"].append(time.perf_counter() - t)
+            return cv2.remap(srcp, bx + 1.0, by, bil, borderMode=rep), bx, by
+        o, bx, by = timed("np_build_remap", per_view, reps=1)
+        imgs["np_build_remap"].append((o, ex_bil))
+        np_map_err = max(np_map_err, float(np.max(np.abs(bx + 1.0 - mx))),
+                         float(np.max(np.abs(by - my))))
+        print(f"peers: opencv view {i + 1}/{len(meta['views'])}", file=sys.stderr)
+
+    if not a.no_ffmpeg and shutil.which("ffmpeg"):
+        mapfile = os.path.join(a.out, meta["map"])
+        outfile = os.path.join(a.out, "ff.rgb")
+        vfov = lambda hf: 2 * np.degrees(np.arctan(np.tan(np.radians(hf) / 2) * h / w))  # noqa: E731
+
+        def ff(vf):
+            cmd = ["ffmpeg", "-v", "error", "-y", "-threads", str(n), "-filter_threads", str(n),
+                   "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{mw}x{mh}", "-i", mapfile,
+                   "-vf", vf, "-frames:v", "1", "-f", "rawvideo", "-pix_fmt", "rgb24", outfile]
+            t = time.perf_counter()
+            subprocess.run(cmd, check=True)
+            return time.perf_counter() - t
+
+        base = [ff(f"format=gbrp,crop={w}:{h}:0:0") for _ in range(a.reps + 1)][1:]
+        base_s = statistics.median(base)
+        for i, v in enumerate(meta["views"]):
+            ex_bil = np.fromfile(os.path.join(a.out, v["exact_bilinear"]),
+                                 dtype=np.uint8).reshape(h, w, 3)
+            # Mapping to our conventions: v360's yaw and pitch have our signs (checked by
+            # PSNR: the opposite signs give a different picture); its yaw range is
+            # [-180, 180], so yaw is wrapped; h_fov/v_fov are the full angles of the flat
+            # output, v_fov from our square-pixel aspect.
+            yaw = (v["yaw"] + 180.0) % 360.0 - 180.0
+            vf = (f"format=gbrp,v360=input=e:output=flat:yaw={yaw}:pitch={v['pitch']}:"
+                  f"h_fov={v['hfov']}:v_fov={vfov(v['hfov'])}:w={w}:h={h}:interp=linear")
+            times = [ff(vf) for _ in range(a.reps)]
+            res["ff_v360"].extend(max(t - base_s, 0.0) for t in times)
+            o = np.fromfile(outfile, dtype=np.uint8).reshape(h, w, 3)
+            imgs["ff_v360"].append((o, ex_bil))
+            print(f"peers: ffmpeg view {i + 1}/{len(meta['views'])}", file=sys.stderr)
+        res["ff_base"] = base
+
+    def our(sampler, step):
+        for r in ours:
+            if (r["renderer"] == "lut" and r["sampler"] == sampler and r["lut"] == "wide"
+                    and r["index_step"] == step and r["hfov"] == 90.0):
+                return r["ms_median"]
+        return None
+
+    def ours_of(name, sampler):
+        for r in ours:
+            if r["renderer"] == name and r["sampler"] == sampler and r["hfov"] == 90.0:
+                return r["ms_median"]
+        return None
+
+    lut_bil, lut_nn = our("bilinear", 4), our("nearest", 4)
+    lut_bil_ad = our("bilinear", "adaptive")
+    rows = []
+
+    def add(name, key, ours_ms, what, extra=None):
+        if not res.get(key):
+            return
+        ms = median_ms(res[key])
+        if extra:
+            ms += median_ms(res[extra])
+        p = pooled_psnr(imgs[key]) if key in imgs and imgs[key] else None
+        rows.append({"peer": name, "key": key, "ms_median": ms, "ours_ms": ours_ms,
+                     "ours": what, "ratio_ours_over_theirs": ours_ms / ms if ours_ms and ms > 0 else None,
+                     "psnr_db_vs_exact": p})
+
+    add("OpenCV remap, float maps, bilinear", "cv_float_bil", lut_bil, "lut bilinear step 4")
+    add("OpenCV remap, fixed-point maps, bilinear", "cv_fixed_bil", lut_bil, "lut bilinear step 4")
+    add("OpenCV remap, float maps, nearest", "cv_float_nn", lut_nn, "lut nearest step 4")
+    add("OpenCV remap, fixed-point maps, nearest", "cv_fixed_nn", lut_nn, "lut nearest step 4")
+    add("OpenCV convertMaps (map building only)", "cv_convert", None, "-")
+    add("numpy map build per view (float64)", "np_build", None, "-")
+    add("OpenCV per view: numpy map + remap", "np_build_remap", lut_bil, "lut bilinear step 4")
+    add("ffmpeg v360 per view (table build + 1 frame)", "ff_v360", lut_bil, "lut bilinear step 4")
+    add("our plain gather (precomputed indices)", "cv_fixed_nn", ours_of("gather", "nearest"),
+        "gather")
+    rows[-1]["peer"] = "OpenCV fixed nearest vs our plain gather"
+
+    summary = {"threads": n, "width": w, "height": h, "map_width": mw, "map_height": mh,
+               "views": len(meta["views"]), "reps": a.reps,
+               "ours_lut_bilinear_step4_ms": lut_bil, "ours_lut_bilinear_adaptive_ms": lut_bil_ad,
+               "ours_lut_nearest_step4_ms": lut_nn,
+               "numpy_map_max_diff_px": np_map_err,
+               "ffmpeg_baseline_ms": median_ms(res["ff_base"]) if res.get("ff_base") else None,
+               "rows": rows}
+    json.dump(summary, open(os.path.join(a.out, "peers.json"), "w"), indent=2)
+    print(f"peers: {w}x{h} from {mw}x{mh}, {n} threads, {len(meta['views'])} views x {a.reps} reps")
+    print(f"| peer | their ms (median) | ours | our ms | ours/theirs | their PSNR vs our exact |")
+    print("|---|---:|---|---:|---:|---:|")
+    for r in rows:
+        ratio = f"{r['ratio_ours_over_theirs']:.3f}" if r["ratio_ours_over_theirs"] else "-"
+        om = f"{r['ours_ms']:.2f}" if r["ours_ms"] else "-"
+        p = r["psnr_db_vs_exact"]
+        ps = "-" if p is None else ("identical" if p == float("inf") else f"{p:.1f} dB")
+        print(f"| {r['peer']} | {r['ms_median']:.2f} | {r['ours']} | {om} | {ratio} | {ps} |")
+    print(f"numpy-built maps vs our exported exact maps: max |diff| {np_map_err:.2e} px")
+
+
+if __name__ == "__main__":
+    main()
