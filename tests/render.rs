@@ -13,12 +13,23 @@ use std::sync::{Mutex, OnceLock};
 
 const BOUND: f64 = 0.05;
 
-fn renderers() -> &'static Mutex<HashMap<(u32, u32, Projection), Renderer>> {
-    static R: OnceLock<Mutex<HashMap<(u32, u32, Projection), Renderer>>> = OnceLock::new();
+type Cache = Mutex<HashMap<(u32, u32, Projection), Renderer>>;
+
+/// Renderers (and their tables) kept across cases, one per map geometry.
+fn renderers() -> &'static Cache {
+    static R: OnceLock<Cache> = OnceLock::new();
     R.get_or_init(|| Mutex::new(HashMap::new()))
 }
 
-fn measure(mw: u32, mh: u32, p: Projection, view: View, opts: RenderOptions, w: u32, h: u32) -> ErrorStats {
+fn measure(
+    mw: u32,
+    mh: u32,
+    p: Projection,
+    view: View,
+    opts: RenderOptions,
+    w: u32,
+    h: u32,
+) -> ErrorStats {
     let mut guard = renderers().lock().unwrap_or_else(|e| e.into_inner());
     let r = guard.entry((mw, mh, p)).or_default();
     let (pos, _) = r.positions(mw, mh, p, view, &opts, w, h).unwrap();
@@ -75,8 +86,20 @@ fn hard_views_within_bound_every_projection() {
         let (mw, mh) = geometry(p, true);
         for &(y, pi, hf) in &views {
             let view = View::new(y, pi, hf).unwrap();
-            for step in [IndexStep::Fixed(4), IndexStep::Fixed(16), IndexStep::Adaptive] {
-                let st = measure(mw, mh, p, view, opts(step, LutChoice::Auto, Surface::Cylinder), 160, 90);
+            for step in [
+                IndexStep::Fixed(4),
+                IndexStep::Fixed(16),
+                IndexStep::Adaptive,
+            ] {
+                let st = measure(
+                    mw,
+                    mh,
+                    p,
+                    view,
+                    opts(step, LutChoice::Auto, Surface::Cylinder),
+                    160,
+                    90,
+                );
                 check(&format!("{p} yaw {y} pitch {pi} hfov {hf} {step:?}"), &st);
             }
         }
@@ -86,11 +109,24 @@ fn hard_views_within_bound_every_projection() {
 #[test]
 fn both_tables_and_the_plane_within_bound() {
     let (mw, mh) = (8192, 4096);
-    for (y, pi, hf) in [(0.0, 0.0, 45.0), (100.0, 70.0, 59.0), (-30.0, -20.0, 90.0), (0.0, 89.0, 50.0)] {
+    for (y, pi, hf) in [
+        (0.0, 0.0, 45.0),
+        (100.0, 70.0, 59.0),
+        (-30.0, -20.0, 90.0),
+        (0.0, 89.0, 50.0),
+    ] {
         let view = View::new(y, pi, hf).unwrap();
         for lut in [LutChoice::Wide, LutChoice::High] {
             for surface in [Surface::Cylinder, Surface::Plane] {
-                let st = measure(mw, mh, Projection::Equirect, view, opts(IndexStep::Fixed(8), lut, surface), 128, 96);
+                let st = measure(
+                    mw,
+                    mh,
+                    Projection::Equirect,
+                    view,
+                    opts(IndexStep::Fixed(8), lut, surface),
+                    128,
+                    96,
+                );
                 check(&format!("{lut:?} {surface:?} view {y},{pi},{hf}"), &st);
             }
         }
@@ -100,9 +136,21 @@ fn both_tables_and_the_plane_within_bound() {
 /// Widest map supported (65536 wide): fixed-point ranges and the bound hold.
 #[test]
 fn widest_map_supported() {
-    for (y, pi, hf) in [(179.99, 10.0, 20.0), (0.0, 89.95, 90.0), (-91.0, -30.0, 2.0)] {
+    for (y, pi, hf) in [
+        (179.99, 10.0, 20.0),
+        (0.0, 89.95, 90.0),
+        (-91.0, -30.0, 2.0),
+    ] {
         let view = View::new(y, pi, hf).unwrap();
-        let st = measure(65536, 32768, Projection::Equirect, view, RenderOptions::default(), 96, 64);
+        let st = measure(
+            65536,
+            32768,
+            Projection::Equirect,
+            view,
+            RenderOptions::default(),
+            96,
+            64,
+        );
         check(&format!("65536-wide view {y},{pi},{hf}"), &st);
     }
 }
@@ -143,11 +191,22 @@ fn threads_are_byte_identical() {
             let (w, h) = (333, 211);
             let mut a = vec![0u32; (w * h) as usize];
             let mut b = vec![1u32; (w * h) as usize];
-            let o1 = RenderOptions { sampler, threads: false, ..RenderOptions::default() };
-            let o2 = RenderOptions { sampler, threads: true, ..RenderOptions::default() };
+            let o1 = RenderOptions {
+                sampler,
+                threads: false,
+                ..RenderOptions::default()
+            };
+            let o2 = RenderOptions {
+                sampler,
+                threads: true,
+                ..RenderOptions::default()
+            };
             r.render(&map, view, &o1, &mut a, w, h).unwrap();
             r.render(&map, view, &o2, &mut b, w, h).unwrap();
-            assert!(a == b, "threads changed the output at view {y},{pi},{hf} {sampler:?}");
+            assert!(
+                a == b,
+                "threads changed the output at view {y},{pi},{hf} {sampler:?}"
+            );
         }
     }
 }
@@ -161,8 +220,17 @@ fn odd_and_tiny_sizes() {
     for (w, h) in [(1, 1), (1, 7), (7, 1), (3, 3), (17, 5), (257, 1), (1, 300)] {
         let view = View::new(33.0, 12.0, 75.0).unwrap();
         let mut out = vec![0u32; (w * h) as usize];
-        r.render(&map, view, &RenderOptions::default(), &mut out, w, h).unwrap();
-        let st = measure(512, 256, Projection::Equirect, view, RenderOptions::default(), w, h);
+        r.render(&map, view, &RenderOptions::default(), &mut out, w, h)
+            .unwrap();
+        let st = measure(
+            512,
+            256,
+            Projection::Equirect,
+            view,
+            RenderOptions::default(),
+            w,
+            h,
+        );
         check(&format!("size {w}x{h}"), &st);
     }
 }
@@ -173,9 +241,16 @@ fn bad_requests_are_errors_not_panics() {
     let mut r = Renderer::new(&map);
     let view = View::default();
     let mut out = vec![0u32; 10];
-    assert!(r.render(&map, view, &RenderOptions::default(), &mut out, 0, 10).is_err());
-    assert!(r.render(&map, view, &RenderOptions::default(), &mut out, 3, 3).is_err());
-    let bad = RenderOptions { index_step: IndexStep::Fixed(3), ..RenderOptions::default() };
+    assert!(r
+        .render(&map, view, &RenderOptions::default(), &mut out, 0, 10)
+        .is_err());
+    assert!(r
+        .render(&map, view, &RenderOptions::default(), &mut out, 3, 3)
+        .is_err());
+    let bad = RenderOptions {
+        index_step: IndexStep::Fixed(3),
+        ..RenderOptions::default()
+    };
     assert!(r.render(&map, view, &bad, &mut out, 5, 2).is_err());
 }
 
@@ -186,13 +261,29 @@ fn report_names_the_path() {
     let mut r = Renderer::new(&map);
     let mut out = vec![0u32; 64 * 48];
     let rep = |r: &mut Renderer, out: &mut Vec<u32>, hf: f64| {
-        r.render(&map, View::new(0.0, 0.0, hf).unwrap(), &RenderOptions::default(), out, 64, 48)
-            .unwrap()
+        r.render(
+            &map,
+            View::new(0.0, 0.0, hf).unwrap(),
+            &RenderOptions::default(),
+            out,
+            64,
+            48,
+        )
+        .unwrap()
     };
-    assert_eq!(rep(&mut r, &mut out, 90.0).path, lut_core::RenderPath::LutWide);
-    assert_eq!(rep(&mut r, &mut out, 60.0).path, lut_core::RenderPath::LutHigh);
+    assert_eq!(
+        rep(&mut r, &mut out, 90.0).path,
+        lut_core::RenderPath::LutWide
+    );
+    assert_eq!(
+        rep(&mut r, &mut out, 60.0).path,
+        lut_core::RenderPath::LutHigh
+    );
     let wide = rep(&mut r, &mut out, 179.0);
     assert_eq!(wide.path, lut_core::RenderPath::LutWide);
-    assert!(wide.exact_pixels > 0, "beyond 150 degrees the fallback must render the edges");
+    assert!(
+        wide.exact_pixels > 0,
+        "beyond 150 degrees the fallback must render the edges"
+    );
     assert_eq!(rep(&mut r, &mut out, 90.0).exact_pixels, 0);
 }

@@ -14,14 +14,28 @@ use rayon::prelude::*;
 /// Exact map position of the center of output pixel (x, y), or `None` when the map does
 /// not cover that direction.
 #[inline]
-pub fn exact_uv(cam: &Camera, projection: Projection, map_w: f64, map_h: f64, x: u32, y: u32) -> Option<(f64, f64)> {
+pub fn exact_uv(
+    cam: &Camera,
+    projection: Projection,
+    map_w: f64,
+    map_h: f64,
+    x: u32,
+    y: u32,
+) -> Option<(f64, f64)> {
     let (lambda, phi) = dir_to_lat_long(cam.world_ray(x as f64 + 0.5, y as f64 + 0.5));
     projection.uv(lambda, phi, map_w, map_h)
 }
 
 /// Exact map position of an arbitrary image-plane point (used for supersampling).
 #[inline]
-pub fn exact_uv_at(cam: &Camera, projection: Projection, map_w: f64, map_h: f64, px: f64, py: f64) -> Option<(f64, f64)> {
+pub fn exact_uv_at(
+    cam: &Camera,
+    projection: Projection,
+    map_w: f64,
+    map_h: f64,
+    px: f64,
+    py: f64,
+) -> Option<(f64, f64)> {
     let (lambda, phi) = dir_to_lat_long(cam.world_ray(px, py));
     projection.uv(lambda, phi, map_w, map_h)
 }
@@ -70,7 +84,11 @@ pub fn render_exact(
     let proj = map.projection();
     let row = |(y, line): (usize, &mut [u32])| {
         for (x, px) in line.iter_mut().enumerate() {
-            *px = sample_at(map, sampler, exact_uv(&cam, proj, mw, mh, x as u32, y as u32));
+            *px = sample_at(
+                map,
+                sampler,
+                exact_uv(&cam, proj, mw, mh, x as u32, y as u32),
+            );
         }
     };
     if threads {
@@ -119,7 +137,7 @@ pub fn render_exact_supersampled(
             }
             let nn = n * n;
             let half = nn / 2;
-            *px = ((r + half) / nn) << 16 | ((g + half) / nn) << 8 | (b + half) / nn;
+            *px = (((r + half) / nn) << 16) | (((g + half) / nn) << 8) | ((b + half) / nn);
         }
     };
     if threads {

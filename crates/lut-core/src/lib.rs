@@ -40,22 +40,24 @@
 
 #![warn(missing_docs)]
 
+pub mod accuracy;
 pub mod camera;
+pub mod cube;
 pub mod envmap;
 pub mod error;
 pub mod exact;
 pub mod fixed;
+pub mod light;
 pub mod lut;
 pub mod projection;
 pub mod raster;
 pub mod synth;
-pub mod accuracy;
-pub mod cube;
-pub mod light;
 
 pub use camera::{Camera, View, MAX_OUTPUT_SIDE};
 pub use envmap::{EnvMap, Sampler, MAX_MAP_PIXELS, MAX_MAP_WIDTH};
 pub use error::{MapError, ViewError};
 pub use exact::{render_exact, render_exact_supersampled};
 pub use projection::Projection;
-pub use raster::{IndexStep, LutChoice, RenderOptions, RenderPath, RenderReport, Renderer, RendererKind};
+pub use raster::{
+    IndexStep, LutChoice, RenderOptions, RenderPath, RenderReport, Renderer, RendererKind,
+};

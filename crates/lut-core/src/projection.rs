@@ -133,9 +133,7 @@ impl Projection {
         }
         let big_v = h * 0.5 - v;
         let phi = match self {
-            Projection::Equirect | Projection::Elliptical | Projection::Diamond => {
-                big_v / h * PI
-            }
+            Projection::Equirect | Projection::Elliptical | Projection::Diamond => big_v / h * PI,
             Projection::Cylinder => (big_v / (w / TAU)).atan(),
             Projection::Sine => (big_v / (h * 0.5)).clamp(-1.0, 1.0).asin(),
         };

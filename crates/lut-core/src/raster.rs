@@ -132,6 +132,9 @@ pub struct RenderReport {
     pub min_step: u32,
 }
 
+/// Sampling positions of a frame, row-major; `None` where the background shows.
+pub type Positions = Vec<Option<(f64, f64)>>;
+
 /// Per-scanline setup, computed once per frame.
 #[derive(Debug, Clone, Copy, Default)]
 struct Scan {
@@ -353,6 +356,7 @@ impl Renderer {
     ///
     /// # Errors
     /// As [`Renderer::render`].
+    #[allow(clippy::too_many_arguments)]
     pub fn positions(
         &mut self,
         map_w: u32,
@@ -362,7 +366,7 @@ impl Renderer {
         opts: &RenderOptions,
         width: u32,
         height: u32,
-    ) -> Result<(Vec<Option<(f64, f64)>>, RenderReport), ViewError> {
+    ) -> Result<(Positions, RenderReport), ViewError> {
         check_size(width, height)?;
         check_step(opts.index_step)?;
         self.set_geometry(map_w, map_h, projection);

@@ -46,13 +46,15 @@ pub fn grid_map(w: u32, h: u32, projection: Projection) -> Result<EnvMap, MapErr
     crate::envmap::check_map_size("generated map", w, h)?;
     let (wf, hf) = (w as f64, h as f64);
     let mut px = vec![0u32; w as usize * h as usize];
-    px.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
-        for (x, p) in row.iter_mut().enumerate() {
-            *p = match projection.direction(x as f64 + 0.5, y as f64 + 0.5, wf, hf) {
-                Some((l, ph)) => scene_color(l, ph),
-                None => 0,
-            };
-        }
-    });
+    px.par_chunks_mut(w as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, p) in row.iter_mut().enumerate() {
+                *p = match projection.direction(x as f64 + 0.5, y as f64 + 0.5, wf, hf) {
+                    Some((l, ph)) => scene_color(l, ph),
+                    None => 0,
+                };
+            }
+        });
     EnvMap::from_pixels(w, h, &px, projection)
 }

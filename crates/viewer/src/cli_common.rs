@@ -98,6 +98,14 @@ pub fn write_image_atomic(
         bw.flush()
             .with_context(|| format!("{}: cannot write", out.display()))?;
     }
+    // tempfile creates 0600 files; a rendered image is an ordinary file.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = tmp
+            .as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644));
+    }
     tmp.persist(out)
         .map_err(|e| anyhow!("{}: cannot write: {}", out.display(), e.error))?;
     Ok(())

@@ -1,12 +1,10 @@
 //! Cube-map inputs for the viewer: loading from the command line or a dropped folder, and
 //! rendering a view (the entry points `render --projection cube` and the window use).
 
-#![allow(dead_code)] // entry points for render_cmd / window, wired by their owners
-
-use anyhow::{Context, Result};
+use anyhow::Result;
 use lut_core::cube::{self, CubeMap, CubeRenderer, Layout, Naming};
 use lut_core::{Sampler, View};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Load a cube map from `inputs` (a folder, six face files, or one layout image).
 ///
@@ -34,6 +32,7 @@ pub fn load_cube(
 /// True when `inputs` look like a cube map rather than one panorama image: a folder, six
 /// or more files, or one image whose aspect ratio is a cube layout (4:3, 6:1, 3:2). For
 /// the window's drop handler and `render`'s auto projection.
+#[allow(dead_code)] // the window's drop handler (wired with the window's cube support)
 pub fn looks_like_cube(inputs: &[PathBuf]) -> bool {
     match inputs {
         [one] if one.is_dir() => true,
@@ -52,6 +51,7 @@ pub fn looks_like_cube(inputs: &[PathBuf]) -> bool {
 ///
 /// # Errors
 /// A bad size.
+#[allow(dead_code)] // the window's cube support
 pub fn render_view(
     cube: &CubeMap,
     view: View,
@@ -71,26 +71,4 @@ pub fn render_view(
         true,
     )?;
     Ok(out)
-}
-
-/// Render one view of a cube map given on the command line to a PNG, atomically: what
-/// `viewer render --projection cube FACES... --out OUT` does.
-///
-/// # Errors
-/// Loading, rendering or writing failures, naming the file.
-#[allow(clippy::too_many_arguments)]
-pub fn render_to_png(
-    inputs: &[PathBuf],
-    layout: Option<&str>,
-    naming: Option<&str>,
-    view: View,
-    sampler: Sampler,
-    width: u32,
-    height: u32,
-    out: &Path,
-) -> Result<()> {
-    let cube = load_cube(inputs, layout, naming)?;
-    let px = render_view(&cube, view, sampler, width, height)?;
-    crate::cli_common::write_png_atomic(out, &px, width, height)
-        .with_context(|| format!("writing {}", out.display()))
 }

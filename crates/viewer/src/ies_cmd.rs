@@ -221,7 +221,6 @@ fn parse_room(s: &str) -> Result<(f64, f64, f64), String> {
 ///
 /// # Errors
 /// An unreadable or malformed IES file, a light outside the room, a bad room size.
-#[allow(dead_code)] // called by `viewer render` (and the window) once wired
 pub fn build_scene(args: &LightArgs) -> Result<Option<LightScene>> {
     if args.lights.is_empty() {
         return Ok(None);
@@ -253,7 +252,6 @@ pub fn build_scene(args: &LightArgs) -> Result<Option<LightScene>> {
 ///
 /// # Errors
 /// A non-positive `--exposure-lux`.
-#[allow(dead_code)] // called by `viewer render` (and the window) once wired
 pub fn shade_options(args: &LightArgs) -> Result<ShadeOptions> {
     let lux = args.exposure_lux.unwrap_or(300.0);
     if !(lux.is_finite() && lux > 0.0) {
@@ -274,7 +272,6 @@ pub fn shade_options(args: &LightArgs) -> Result<ShadeOptions> {
 ///
 /// # Errors
 /// As [`build_scene`] and [`shade_options`], or a frame that is not `w × h`.
-#[allow(dead_code)] // called by `viewer render` (and the window) once wired
 pub fn apply_lights(args: &LightArgs, view: View, frame: &mut [u32], w: u32, h: u32) -> Result<()> {
     let Some(scene) = build_scene(args)? else {
         return Ok(());

@@ -1,10 +1,12 @@
 //! `viewer render`: one view of a panorama to a PNG, headless.
 
-use crate::cli_common::{load_panorama, parse_angle, parse_projection, parse_size, write_png_atomic};
+use crate::cli_common::{load_panorama, parse_angle, parse_size, write_png_atomic};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use lut_core::lut::Surface;
-use lut_core::{IndexStep, LutChoice, Projection, RenderOptions, Renderer, RendererKind, Sampler, View};
+use lut_core::{
+    IndexStep, LutChoice, Projection, RenderOptions, Renderer, RendererKind, Sampler, View,
+};
 use std::path::PathBuf;
 
 /// Which renderer.
@@ -45,11 +47,44 @@ pub enum SurfaceArg {
     Plane,
 }
 
+/// The `--projection` choice: auto, one of the map projections, or a cube map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProjectionArg {
+    /// 2:1 images are equirectangular; a folder or several files are a cube map.
+    Auto,
+    /// A map on a surface of revolution.
+    Map(Projection),
+    /// A cube map (six faces or one layout image).
+    Cube,
+}
+
+/// Parse `--projection`.
+pub fn parse_projection_arg(s: &str) -> Result<ProjectionArg, String> {
+    match s {
+        "auto" => Ok(ProjectionArg::Auto),
+        "cube" => Ok(ProjectionArg::Cube),
+        other => other
+            .parse()
+            .map(ProjectionArg::Map)
+            .map_err(|e: String| format!("{e}, or cube")),
+    }
+}
+
+/// Cube renderer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CubeRendererArg {
+    /// Per pixel: face by the largest coordinate.
+    Basic,
+    /// Per scanline: face segments split by binary search.
+    Scanline,
+}
+
 /// Arguments of `viewer render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Panorama image (JPEG, PNG, ...). The bundled sample when omitted.
-    pub panorama: Option<PathBuf>,
+    /// Panorama image (JPEG, PNG, ...), or a cube map: a folder, six face files, or one
+    /// layout image with --projection cube. The bundled sample when omitted.
+    pub panorama: Vec<PathBuf>,
     /// Output PNG, written atomically.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -65,9 +100,19 @@ pub struct RenderArgs {
     /// Output size WIDTHxHEIGHT (each side 1..=16384).
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Map projection: auto (2:1 is equirect), equirect, cylinder, sine, elliptical, diamond.
-    #[arg(long, default_value = "auto", value_parser = parse_projection)]
-    pub projection: Option<Projection>,
+    /// Map projection: auto (2:1 is equirect; a folder or several files are a cube),
+    /// equirect, cylinder, sine, elliptical, diamond, cube.
+    #[arg(long, default_value = "auto", value_parser = parse_projection_arg)]
+    pub projection: ProjectionArg,
+    /// Cube input layout: files, cross, strip, 3x2 (detected when omitted).
+    #[arg(long)]
+    pub layout: Option<String>,
+    /// Cube face naming/orientation: conventions, cube2, irrlicht (see docs/cube.md).
+    #[arg(long)]
+    pub naming: Option<String>,
+    /// Cube renderer.
+    #[arg(long, value_enum, default_value_t = CubeRendererArg::Scanline)]
+    pub cube_renderer: CubeRendererArg,
     /// Renderer.
     #[arg(long, value_enum, default_value_t = RendererArg::Lut)]
     pub renderer: RendererArg,
@@ -89,6 +134,9 @@ pub struct RenderArgs {
     /// Print which path rendered and the table size.
     #[arg(long, short)]
     pub verbose: bool,
+    /// Luminaires lighting the scene.
+    #[command(flatten)]
+    pub lights: crate::ies_cmd::LightArgs,
 }
 
 /// Parse an index step.
@@ -98,7 +146,9 @@ pub fn parse_step(s: &str) -> Result<IndexStep, String> {
     }
     match s.parse::<u32>() {
         Ok(n @ (1 | 2 | 4 | 8 | 16)) => Ok(IndexStep::Fixed(n)),
-        _ => Err(format!("index step '{s}' must be 1, 2, 4, 8, 16 or adaptive")),
+        _ => Err(format!(
+            "index step '{s}' must be 1, 2, 4, 8, 16 or adaptive"
+        )),
     }
 }
 
@@ -133,27 +183,62 @@ impl RenderArgs {
 pub fn run(a: RenderArgs) -> Result<()> {
     let view = View::new(a.yaw, a.pitch, a.hfov).context("invalid view")?;
     let (w, h) = a.size;
-    let map = load_panorama(a.panorama.as_deref(), a.projection)?;
-    let opts = a.options();
-    let mut renderer = Renderer::new(&map);
+    let cube = match a.projection {
+        ProjectionArg::Cube => true,
+        ProjectionArg::Auto => {
+            a.panorama.len() > 1 || a.panorama.first().is_some_and(|p| p.is_dir())
+        }
+        ProjectionArg::Map(_) => false,
+    };
     let mut out = vec![0u32; w as usize * h as usize];
-    let report = renderer.render(&map, view, &opts, &mut out, w, h)?;
-    write_png_atomic(&a.output, &out, w, h)?;
-    if a.verbose {
-        eprintln!(
-            "rendered {}x{} from {}x{} {} map: path {}, table {} bytes, {} of {} pixels exact, index step {}..{}",
-            w,
-            h,
-            map.width(),
-            map.height(),
-            map.projection(),
-            report.path.name(),
-            report.table_bytes,
-            report.exact_pixels,
-            report.pixels,
-            report.min_step,
-            report.max_step
-        );
+    let sampler = a.options().sampler;
+    if cube {
+        let cube =
+            crate::cube_cmd::load_cube(&a.panorama, a.layout.as_deref(), a.naming.as_deref())?;
+        let kind = match a.cube_renderer {
+            CubeRendererArg::Basic => lut_core::cube::CubeRenderer::Basic,
+            CubeRendererArg::Scanline => lut_core::cube::CubeRenderer::Accelerated,
+        };
+        lut_core::cube::render(&cube, view, sampler, kind, &mut out, w, h, !a.single_thread)?;
+        if a.verbose {
+            eprintln!(
+                "rendered {w}x{h} from a cube map of {}px faces",
+                cube.face_size()
+            );
+        }
+    } else {
+        if a.panorama.len() > 1 {
+            anyhow::bail!(
+                "{} files given: a single panorama takes one file (use --projection cube for six faces)",
+                a.panorama.len()
+            );
+        }
+        let projection = match a.projection {
+            ProjectionArg::Map(p) => Some(p),
+            _ => None,
+        };
+        let map = load_panorama(a.panorama.first().map(|p| p.as_path()), projection)?;
+        let opts = a.options();
+        let mut renderer = Renderer::new(&map);
+        let report = renderer.render(&map, view, &opts, &mut out, w, h)?;
+        if a.verbose {
+            eprintln!(
+                "rendered {}x{} from {}x{} {} map: path {}, table {} bytes, {} of {} pixels exact, index step {}..{}",
+                w,
+                h,
+                map.width(),
+                map.height(),
+                map.projection(),
+                report.path.name(),
+                report.table_bytes,
+                report.exact_pixels,
+                report.pixels,
+                report.min_step,
+                report.max_step
+            );
+        }
     }
+    crate::ies_cmd::apply_lights(&a.lights, view, &mut out, w, h)?;
+    write_png_atomic(&a.output, &out, w, h)?;
     Ok(())
 }
