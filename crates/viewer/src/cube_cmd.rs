@@ -32,7 +32,6 @@ pub fn load_cube(
 /// True when `inputs` look like a cube map rather than one panorama image: a folder, six
 /// or more files, or one image whose aspect ratio is a cube layout (4:3, 6:1, 3:2). For
 /// the window's drop handler and `render`'s auto projection.
-#[allow(dead_code)] // the window's drop handler (wired with the window's cube support)
 pub fn looks_like_cube(inputs: &[PathBuf]) -> bool {
     match inputs {
         [one] if one.is_dir() => true,

@@ -8,6 +8,9 @@
 #[path = "../src/window/input.rs"]
 mod input;
 #[allow(dead_code)]
+#[path = "../src/window/lights.rs"]
+mod lights;
+#[allow(dead_code)]
 #[path = "../src/window/paint.rs"]
 mod paint;
 #[allow(dead_code)]
@@ -39,6 +42,7 @@ fn paint_panel(
     let mut compositor = Compositor::new();
     let mut settings = Settings::default();
     let mut projection = None;
+    let mut lights = lights::LightsState::default();
     let readouts = Readouts {
         map: "test map (256×128, equirect)".into(),
         render_ms: 3.5,
@@ -68,6 +72,7 @@ fn paint_panel(
                     readouts: &readouts,
                     loading,
                     error,
+                    lights: &mut lights,
                 },
             );
             scene = SceneRect::from_points(ui.available_rect_before_wrap(), ppp, W, H);

@@ -4,11 +4,14 @@
 //! animates, or the full-quality frame after fast motion is due.
 
 use super::input::{key_action, wheel_notches, Controller, Held, KeyAction, Look, Turn, TURN_KEYS};
+use super::lights::{LightsKey, LightsState};
 use super::paint::{Compositor, SceneRect};
 use super::ui::{self, LoadStatus, PanelModel, Readouts};
 use super::OpenArgs;
+use crate::render_cmd::{CubeRendererArg, ProjectionArg};
 use anyhow::{anyhow, Result};
-use lut_core::{EnvMap, IndexStep, LutChoice, Projection, Renderer, RendererKind, Sampler};
+use lut_core::cube::{CubeMap, CubeRenderer};
+use lut_core::{Camera, EnvMap, IndexStep, LutChoice, Projection, Renderer, RendererKind, Sampler};
 use std::collections::VecDeque;
 use std::io::Read;
 use std::num::NonZeroU32;
@@ -27,6 +30,11 @@ use winit::window::{Fullscreen, Window, WindowId};
 enum Source {
     Sample,
     File(PathBuf),
+    /// A cube map: a folder, face files or one layout image, with the layout if given.
+    Cube {
+        paths: Vec<PathBuf>,
+        layout: Option<String>,
+    },
 }
 
 impl Source {
@@ -34,16 +42,53 @@ impl Source {
         match self {
             Source::Sample => crate::assets::SAMPLE_NAME.to_string(),
             Source::File(p) => p.display().to_string(),
+            Source::Cube { paths, .. } => match paths.as_slice() {
+                [one] => one.display().to_string(),
+                many => format!(
+                    "{} cube faces in {}",
+                    many.len(),
+                    many.first()
+                        .and_then(|p| p.parent())
+                        .map_or_else(|| ".".into(), |d| d.display().to_string())
+                ),
+            },
+        }
+    }
+
+    /// The source that opens what `paths` were dropped or given as: a folder or several
+    /// files are a cube map; one image is a cube map when its aspect ratio is a cube
+    /// layout's (4:3, 6:1, 3:2) or a layout is forced.
+    fn of_paths(paths: Vec<PathBuf>, cube: bool, layout: Option<String>) -> Option<Source> {
+        let cube = cube || layout.is_some() || crate::cube_cmd::looks_like_cube(&paths);
+        match paths.as_slice() {
+            [] => None,
+            [one] if !cube => Some(Source::File(one.clone())),
+            _ => Some(Source::Cube { paths, layout }),
         }
     }
 }
 
+/// What is shown: a map on a surface of revolution with its LUT renderer, or a cube map.
+enum Scene {
+    Map { map: EnvMap, renderer: Renderer },
+    Cube(CubeMap),
+}
+
 /// A loaded panorama with its renderer (tables built on the loading thread).
 struct Loaded {
-    map: EnvMap,
-    renderer: Renderer,
+    scene: Scene,
     source: Source,
     projection: Option<Projection>,
+}
+
+impl Loaded {
+    /// Size and projection for the readout and `--print-view`: "W×H projection".
+    fn describe(&self) -> (u32, u32, &'static str) {
+        match &self.scene {
+            Scene::Map { map, .. } => (map.width(), map.height(), map.projection().name()),
+            Scene::Cube(c) => (c.face_size(), c.face_size(), "cube"),
+        }
+    }
 }
 
 /// Messages from the loading thread.
@@ -92,8 +137,19 @@ fn load(
     id: u64,
     source: Source,
     projection: Option<Projection>,
+    naming: Option<&str>,
 ) -> Result<Box<Loaded>, String> {
     let map = match &source {
+        Source::Cube { paths, layout } => {
+            let _ = proxy.send_event(UserEvent::Decoding { id });
+            let cube = crate::cube_cmd::load_cube(paths, layout.as_deref(), naming)
+                .map_err(|e| format!("{e:#}"))?;
+            return Ok(Box::new(Loaded {
+                scene: Scene::Cube(cube),
+                source,
+                projection,
+            }));
+        }
         Source::Sample => {
             let _ = proxy.send_event(UserEvent::Decoding { id });
             crate::cli_common::load_panorama(None, projection).map_err(|e| format!("{e:#}"))?
@@ -110,15 +166,14 @@ fn load(
     };
     let renderer = Renderer::new(&map);
     Ok(Box::new(Loaded {
-        map,
-        renderer,
+        scene: Scene::Map { map, renderer },
         source,
         projection,
     }))
 }
 
 /// What a cached scene was rendered from: when it matches, the scene is reused.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 struct SceneKey {
     look: Look,
     size: (u32, u32),
@@ -126,7 +181,9 @@ struct SceneKey {
     sampler: Sampler,
     index_step: IndexStep,
     lut: LutChoice,
+    cube_renderer: CubeRenderer,
     map_generation: u64,
+    lights: LightsKey,
 }
 
 /// Window, surface and egui-winit state: they exist between `resumed` and exit.
@@ -144,6 +201,8 @@ struct FrameRequests {
     held: Held,
     panel: ui::PanelOutput,
     scene_rect: Option<SceneRect>,
+    /// The pointer over the scene, in scene pixels.
+    cursor: Option<(f64, f64)>,
 }
 
 struct App {
@@ -174,10 +233,21 @@ struct App {
     next_frame_at: Option<Instant>,
     frame_times: VecDeque<Instant>,
     fatal: Option<anyhow::Error>,
+    /// Cube face naming from the command line (for every cube opened).
+    naming: Option<String>,
+    /// The luminaires (panel state).
+    lights: LightsState,
+    /// Paths dropped since the last event batch: one drop of several items arrives as one
+    /// event per item, and they open together (six face files are one cube map).
+    pending_drops: Vec<PathBuf>,
 }
 
 /// Open the window and run until it is closed.
-pub fn run(args: OpenArgs, projection: Option<Projection>) -> Result<()> {
+pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
+    let projection = match args.projection {
+        ProjectionArg::Map(p) => Some(p),
+        ProjectionArg::Auto | ProjectionArg::Cube => None,
+    };
     let event_loop = create_event_loop()?;
     let softbuffer = softbuffer::Context::new(event_loop.owned_display_handle())
         .map_err(|e| anyhow!("cannot use the display for software drawing: {e}"))?;
@@ -207,9 +277,27 @@ pub fn run(args: OpenArgs, projection: Option<Projection>) -> Result<()> {
         next_frame_at: None,
         frame_times: VecDeque::new(),
         fatal: None,
+        naming: args.naming.clone(),
+        lights,
+        pending_drops: Vec::new(),
     };
-    let source = args.panorama.map_or(Source::Sample, Source::File);
-    app.start_load(source, projection);
+    app.ctl.settings.cube_renderer = match args.cube_renderer {
+        CubeRendererArg::Basic => CubeRenderer::Basic,
+        CubeRendererArg::Scanline => CubeRenderer::Accelerated,
+    };
+    let cube = match args.projection {
+        ProjectionArg::Cube => true,
+        ProjectionArg::Map(_) => false,
+        ProjectionArg::Auto => args.panorama.len() > 1 || args.panorama.iter().any(|p| p.is_dir()),
+    };
+    // One image in auto is a map (as `viewer render` takes it); `--projection cube` or
+    // `--layout` makes it a cube.
+    let source = if cube || args.layout.is_some() {
+        Source::of_paths(args.panorama, true, args.layout)
+    } else {
+        args.panorama.first().cloned().map(Source::File)
+    };
+    app.start_load(source.unwrap_or(Source::Sample), projection);
     event_loop
         .run_app(&mut app)
         .map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
@@ -255,7 +343,7 @@ impl App {
         let id = self.next_load_id;
         let name = source.name();
         let status = match source {
-            Source::Sample => LoadStatus::Decoding { name },
+            Source::Sample | Source::Cube { .. } => LoadStatus::Decoding { name },
             Source::File(_) => LoadStatus::Reading {
                 name,
                 done: 0,
@@ -265,10 +353,11 @@ impl App {
         self.loading = Some((id, source.clone(), status));
         self.keep_error = false;
         let proxy = self.proxy.clone();
+        let naming = self.naming.clone();
         let spawned = std::thread::Builder::new()
             .name("viewer-load".into())
             .spawn(move || {
-                let result = load(&proxy, id, source, projection);
+                let result = load(&proxy, id, source, projection, naming.as_deref());
                 let _ = proxy.send_event(UserEvent::Done { id, result });
             });
         if let Err(e) = spawned {
@@ -299,22 +388,18 @@ impl App {
                 let source = self.loading.take().map(|l| l.1);
                 match result {
                     Ok(loaded) => {
+                        let (mw, mh, proj) = loaded.describe();
                         if self.print_view {
-                            println!(
-                                "loaded {} {}x{} {}",
-                                loaded.source.name(),
-                                loaded.map.width(),
-                                loaded.map.height(),
-                                loaded.map.projection().name()
-                            );
+                            println!("loaded {} {mw}x{mh} {proj}", loaded.source.name());
                         }
-                        self.readouts.map = format!(
-                            "{} ({}×{}, {})",
-                            short_name(&loaded.source),
-                            loaded.map.width(),
-                            loaded.map.height(),
-                            loaded.map.projection().name()
-                        );
+                        self.readouts.map = match loaded.scene {
+                            Scene::Cube(_) => {
+                                format!("{} (cube, {mw}px faces)", short_name(&loaded.source))
+                            }
+                            Scene::Map { .. } => {
+                                format!("{} ({mw}×{mh}, {proj})", short_name(&loaded.source))
+                            }
+                        };
                         if let Some(g) = &self.gfx {
                             g.window
                                 .set_title(&format!("viewer: {}", short_name(&loaded.source)));
@@ -342,6 +427,22 @@ impl App {
                 }
             }
             _ => {} // from a superseded load
+        }
+        self.request_redraw();
+    }
+
+    /// Open what was dropped: `.ies` files add lights, the rest is one panorama or cube.
+    fn open_dropped(&mut self) {
+        let (ies, rest): (Vec<PathBuf>, Vec<PathBuf>) = std::mem::take(&mut self.pending_drops)
+            .into_iter()
+            .partition(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("ies")));
+        for p in &ies {
+            // The error (if any) is shown in the Lights section.
+            let _ = self.lights.load_and_add(p);
+            self.show_panel = true;
+        }
+        if let Some(source) = Source::of_paths(rest, false, None) {
+            self.start_load(source, None);
         }
         self.request_redraw();
     }
@@ -395,6 +496,7 @@ impl App {
                     readouts: &self.readouts,
                     loading,
                     error: self.error.as_deref(),
+                    lights: &mut self.lights,
                 },
             );
         }
@@ -413,6 +515,7 @@ impl App {
                 f64::from(p.y * ppp) - f64::from(sr.y),
             )
         };
+        req.cursor = resp.hover_pos().map(to_px);
         let primary = egui::PointerButton::Primary;
         if resp.drag_started_by(primary) {
             let origin = ui
@@ -469,6 +572,13 @@ impl App {
                 .projection_source
                 .clone()
                 .or_else(|| self.current.as_ref().map(|c| c.source.clone()));
+            // A projection chosen for a cube's single layout image opens it as a map.
+            let source = source.map(|s| match s {
+                Source::Cube { paths, .. } if paths.len() == 1 && !paths[0].is_dir() => {
+                    Source::File(paths[0].clone())
+                }
+                other => other,
+            });
             if let Some(s) = source {
                 self.start_load(s, self.projection);
             }
@@ -494,7 +604,8 @@ impl App {
         }
     }
 
-    /// Render the scene for `rect` unless the cached one already shows it.
+    /// Render the scene for `rect` unless the cached one already shows it, then light it
+    /// when there are luminaires.
     fn render_scene(&mut self, rect: SceneRect, look: Look, fast: bool) {
         let Some(cur) = self.current.as_mut() else {
             return;
@@ -507,41 +618,69 @@ impl App {
             sampler: opts.sampler,
             index_step: opts.index_step,
             lut: opts.lut,
+            cube_renderer: self.ctl.settings.cube_renderer,
             map_generation: self.map_generation,
+            lights: self.lights.key(),
         };
-        if self.scene_key == Some(key) {
+        if self.scene_key.as_ref() == Some(&key) {
             return;
         }
         self.scene.resize(rect.w as usize * rect.h as usize, 0);
         let t0 = Instant::now();
-        let result = cur.renderer.render(
-            &cur.map,
-            look.view(),
-            &opts,
-            &mut self.scene,
-            rect.w,
-            rect.h,
-        );
-        self.readouts.render_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let view = look.view();
+        let result = match &mut cur.scene {
+            Scene::Map { map, renderer } => renderer
+                .render(map, view, &opts, &mut self.scene, rect.w, rect.h)
+                .map(|report| {
+                    self.readouts.path = Some(report.path);
+                    self.readouts.table_bytes = report.table_bytes;
+                    self.readouts.exact_pixels = report.exact_pixels;
+                    self.readouts.pixels = report.pixels;
+                    self.readouts.cube = None;
+                    format!("{:?}", report.path)
+                }),
+            Scene::Cube(cube) => {
+                let kind = self.ctl.settings.cube_renderer;
+                lut_core::cube::render(
+                    cube,
+                    view,
+                    opts.sampler,
+                    kind,
+                    &mut self.scene,
+                    rect.w,
+                    rect.h,
+                    true,
+                )
+                .map(|()| {
+                    self.readouts.path = None;
+                    self.readouts.table_bytes = cube.bytes();
+                    self.readouts.exact_pixels = 0;
+                    self.readouts.pixels = u64::from(rect.w) * u64::from(rect.h);
+                    self.readouts.cube = Some(kind);
+                    match kind {
+                        CubeRenderer::Basic => "CubeBasic".to_string(),
+                        CubeRenderer::Accelerated => "CubeScanline".to_string(),
+                    }
+                })
+            }
+        };
         match result {
-            Ok(report) => {
-                self.readouts.path = Some(report.path);
-                self.readouts.table_bytes = report.table_bytes;
-                self.readouts.exact_pixels = report.exact_pixels;
-                self.readouts.pixels = report.pixels;
+            Ok(path) => {
+                self.light_scene(view, rect);
+                self.readouts.render_ms = t0.elapsed().as_secs_f64() * 1e3;
                 self.readouts.scene = (rect.w, rect.h);
                 self.scene_key = Some(key);
                 if self.print_view {
                     println!(
-                        "view yaw={:.4} pitch={:.4} hfov={:.4} path={:?} sampler={} fast={} size={}x{}",
+                        "view yaw={:.4} pitch={:.4} hfov={:.4} path={path} sampler={} fast={} size={}x{} lights={}",
                         look.yaw,
                         look.pitch,
                         look.hfov,
-                        report.path,
                         opts.sampler.name(),
                         fast,
                         rect.w,
-                        rect.h
+                        rect.h,
+                        self.lights.lights.len()
                     );
                 }
             }
@@ -550,6 +689,43 @@ impl App {
                 self.scene_key = None;
             }
         }
+    }
+
+    /// Light the freshly rendered scene (as `viewer render --light ...` does); a scene
+    /// that cannot be built (a light outside the room) is reported in the panel and the
+    /// frame is left unlit.
+    fn light_scene(&mut self, view: lut_core::View, rect: SceneRect) {
+        let result = self.lights.scene().and_then(|scene| match scene {
+            None => Ok(()),
+            Some(scene) => lut_core::light::shade_frame(
+                &scene,
+                &Camera::new(view, rect.w, rect.h),
+                &mut self.scene,
+                rect.w,
+                rect.h,
+                &self.lights.shade_options(),
+            )
+            .map_err(|e| e.to_string()),
+        });
+        self.lights.scene_error = result.err();
+    }
+
+    /// The illuminance at the pointer for the readout; true when it changed.
+    fn update_lux(
+        &mut self,
+        cursor: Option<(f64, f64)>,
+        rect: Option<SceneRect>,
+        look: Look,
+    ) -> bool {
+        let lux = match (cursor, rect, self.lights.scene()) {
+            (Some((x, y)), Some(r), Ok(Some(scene))) if r.w > 0 && r.h > 0 => Some(
+                lut_core::light::lux_at(&scene, &Camera::new(look.view(), r.w, r.h), x, y),
+            ),
+            _ => None,
+        };
+        let changed = lux.map(f64::to_bits) != self.lights.lux_at_cursor.map(f64::to_bits);
+        self.lights.lux_at_cursor = lux;
+        changed
     }
 
     fn redraw(&mut self, el: &ActiveEventLoop) -> Result<()> {
@@ -576,6 +752,7 @@ impl App {
         if let Some(r) = req.scene_rect {
             self.render_scene(r, frame.look, frame.fast);
         }
+        let lux_changed = self.update_lux(req.cursor, req.scene_rect, frame.look);
         let Some(g) = self.gfx.as_mut() else {
             return Ok(());
         };
@@ -593,7 +770,7 @@ impl App {
             .surface
             .buffer_mut()
             .map_err(|e| anyhow!("cannot get the drawing buffer: {e}"))?;
-        let scene = match (req.scene_rect, self.scene_key) {
+        let scene = match (req.scene_rect, &self.scene_key) {
             (Some(r), Some(k)) if k.size == (r.w, r.h) => Some((self.scene.as_slice(), r)),
             _ => None,
         };
@@ -639,7 +816,7 @@ impl App {
         if let Some(at) = self.ctl.wake_at() {
             want(self.start + Duration::from_secs_f64(at.max(0.0)));
         }
-        if self.ctl.look() != look_before && self.show_panel {
+        if (self.ctl.look() != look_before || lux_changed) && self.show_panel {
             // The readouts were drawn before this frame's input moved the view.
             want(now);
         }
@@ -655,6 +832,13 @@ fn short_name(s: &Source) -> String {
             || p.display().to_string(),
             |n| n.to_string_lossy().into_owned(),
         ),
+        Source::Cube { paths, .. } => match paths.as_slice() {
+            [one] => one.file_name().map_or_else(
+                || one.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            ),
+            many => format!("{} cube faces", many.len()),
+        },
     }
 }
 
@@ -719,7 +903,7 @@ impl ApplicationHandler<UserEvent> for App {
                     el.exit();
                 }
             }
-            WindowEvent::DroppedFile(path) => self.start_load(Source::File(path), None),
+            WindowEvent::DroppedFile(path) => self.pending_drops.push(path),
             WindowEvent::Resized(_) | WindowEvent::ScaleFactorChanged { .. } => {
                 g.window.request_redraw()
             }
@@ -732,6 +916,9 @@ impl ApplicationHandler<UserEvent> for App {
     }
 
     fn about_to_wait(&mut self, el: &ActiveEventLoop) {
+        if !self.pending_drops.is_empty() {
+            self.open_dropped();
+        }
         match self.next_frame_at {
             Some(at) if at <= Instant::now() => {
                 self.next_frame_at = None;

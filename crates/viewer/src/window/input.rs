@@ -20,6 +20,7 @@
 
 use glam::DVec3;
 use lut_core::camera::{dir_to_lat_long, wrap_deg};
+use lut_core::cube::CubeRenderer;
 use lut_core::{Camera, IndexStep, LutChoice, RenderOptions, RendererKind, Sampler, View};
 
 /// Narrowest horizontal field of view the wheel and keys reach, degrees.
@@ -138,6 +139,8 @@ pub struct Settings {
     pub renderer: RendererKind,
     /// Which LUT (auto by hfov, or forced).
     pub lut: LutChoice,
+    /// Cube maps: the paper's basic (per pixel) or accelerated (per scanline) renderer.
+    pub cube_renderer: CubeRenderer,
 }
 
 impl Default for Settings {
@@ -151,6 +154,7 @@ impl Default for Settings {
             index_step: o.index_step,
             renderer: o.renderer,
             lut: o.lut,
+            cube_renderer: CubeRenderer::Accelerated,
         }
     }
 }

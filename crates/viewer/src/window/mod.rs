@@ -10,32 +10,43 @@
 
 mod app;
 pub mod input;
+pub mod lights;
 pub mod paint;
 pub mod ui;
 
+use crate::render_cmd::{CubeRendererArg, ProjectionArg};
 use clap::Args;
-use lut_core::Projection;
-
-/// `Option<Projection>` under another name, so clap takes the value parser's result
-/// as-is (`auto` parses to `None`).
-type ProjectionArg = Option<Projection>;
+use std::path::PathBuf;
 
 /// Arguments of the default command: open the window.
 #[derive(Args, Debug)]
 pub struct OpenArgs {
-    /// Panorama to open (the bundled sample when omitted). Any image `viewer render`
-    /// reads; drop another file on the window to open it.
-    pub panorama: Option<std::path::PathBuf>,
-    /// Map projection of the panorama: auto (2:1 images are equirect), equirect,
-    /// cylinder, sine, elliptical or diamond.
-    #[arg(long, value_name = "NAME", default_value = "auto", value_parser = crate::cli_common::parse_projection)]
+    /// Panorama to open (the bundled sample when omitted): any image `viewer render`
+    /// reads, or a cube map (a folder, six face files, or one layout image with
+    /// --projection cube). Drop another file or folder on the window to open it.
+    pub panorama: Vec<PathBuf>,
+    /// Projection: auto (2:1 images are equirect; a folder or several files are a cube),
+    /// equirect, cylinder, sine, elliptical, diamond or cube.
+    #[arg(long, value_name = "NAME", default_value = "auto", value_parser = crate::render_cmd::parse_projection_arg)]
     pub projection: ProjectionArg,
+    /// Cube input layout: files, cross, strip, 3x2 (detected when omitted).
+    #[arg(long)]
+    pub layout: Option<String>,
+    /// Cube face naming/orientation: conventions, cube2, irrlicht (see docs/cube.md).
+    #[arg(long)]
+    pub naming: Option<String>,
+    /// Cube renderer (also chosen in the panel).
+    #[arg(long, value_enum, default_value_t = CubeRendererArg::Scanline)]
+    pub cube_renderer: CubeRendererArg,
     /// Initial window size in logical pixels, WIDTHxHEIGHT.
     #[arg(long, value_name = "WxH", default_value = "1024x640", value_parser = crate::cli_common::parse_size)]
     pub size: (u32, u32),
     /// Print the view of every rendered frame to stdout (for scripts and tests).
     #[arg(long)]
     pub print_view: bool,
+    /// Luminaires lighting the scene (also added, moved and removed in the panel).
+    #[command(flatten)]
+    pub lights: crate::ies_cmd::LightArgs,
 }
 
 /// Open the window on the panorama (or the sample) and run until it is closed.
@@ -44,11 +55,20 @@ pub struct OpenArgs {
 /// A missing panorama file, or no display to open a window on (a clear message; the
 /// process exits nonzero, it does not panic).
 pub fn run(a: OpenArgs) -> anyhow::Result<()> {
-    if let Some(p) = &a.panorama {
+    for p in &a.panorama {
         // Fail before opening a window for a path that is not there at all; a file that
         // exists but does not decode is reported in the window instead.
         std::fs::metadata(p).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
     }
+    if a.panorama.len() > 1 && matches!(a.projection, ProjectionArg::Map(_)) {
+        anyhow::bail!(
+            "{} files given: a single panorama takes one file (six faces are a cube map)",
+            a.panorama.len()
+        );
+    }
+    // Lights given on the command line: loaded now, so a bad file or position is
+    // reported before any window opens (as `viewer render` reports it).
+    let lights = lights_from_args(&a.lights)?;
     let has_display = ["DISPLAY", "WAYLAND_DISPLAY"]
         .iter()
         .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()));
@@ -58,6 +78,36 @@ pub fn run(a: OpenArgs) -> anyhow::Result<()> {
              `viewer render` draws a view to a PNG without one"
         );
     }
-    let projection = a.projection;
-    app::run(a, projection)
+    app::run(a, lights)
+}
+
+/// The panel's light state for `--light ...` and the other light options.
+///
+/// # Errors
+/// As `ies_cmd::build_scene`: an unreadable IES file, a light outside the room.
+fn lights_from_args(a: &crate::ies_cmd::LightArgs) -> anyhow::Result<lights::LightsState> {
+    let opts = crate::ies_cmd::shade_options(a)?;
+    let scene = crate::ies_cmd::build_scene(a)?;
+    let mut st = lights::LightsState {
+        room: a.room.unwrap_or(lights::DEFAULT_ROOM),
+        camera_height: a.camera_height.unwrap_or(lights::DEFAULT_CAMERA_HEIGHT),
+        multiplier: a.light_multiplier.unwrap_or(1.0),
+        exposure_lux: a.exposure_lux.unwrap_or(lights::DEFAULT_EXPOSURE_LUX),
+        ambient: opts.ambient,
+        false_color: opts.false_color,
+        false_color_max: opts.false_color_max_lux,
+        ..lights::LightsState::default()
+    };
+    if let Some(scene) = scene {
+        for (spec, l) in a.lights.iter().zip(scene.luminaires()) {
+            st.lights.push(lights::LightEntry {
+                path: spec.file.clone(),
+                table: l.table.clone(),
+                position: spec.position,
+                yaw: spec.aim.0,
+                pitch: spec.aim.1,
+            });
+        }
+    }
+    Ok(st)
 }

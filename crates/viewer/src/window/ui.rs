@@ -3,6 +3,8 @@
 //! so a test can paint it offscreen without a window.
 
 use super::input::{AaMode, DragStyle, Held, Look, Settings};
+use super::lights::{format_lux, LightsState};
+use lut_core::cube::CubeRenderer;
 use lut_core::{IndexStep, LutChoice, Projection, RenderPath, RendererKind, Sampler};
 
 /// Width of the panel, in points.
@@ -33,6 +35,8 @@ pub struct Readouts {
     pub scene: (u32, u32),
     /// Panorama description: name, size, projection.
     pub map: String,
+    /// The scene is a cube map, rendered by this renderer (`None`: a LUT-rendered map).
+    pub cube: Option<CubeRenderer>,
 }
 
 /// A background load in progress.
@@ -68,6 +72,8 @@ pub struct PanelModel<'a> {
     pub loading: Option<&'a LoadStatus>,
     /// The last load error.
     pub error: Option<&'a str>,
+    /// The luminaires and their shading; the "Lights" section edits them.
+    pub lights: &'a mut LightsState,
 }
 
 /// What the user did in the panel this frame.
@@ -81,6 +87,22 @@ pub struct PanelOutput {
     pub projection_changed: bool,
     /// The error was dismissed.
     pub dismiss_error: bool,
+}
+
+/// The "in use" readout: the cube renderer for a cube map, else the LUT path.
+pub fn in_use_label(r: &Readouts) -> &'static str {
+    match r.cube {
+        Some(k) => cube_label(k),
+        None => path_label(r.path),
+    }
+}
+
+/// Name of a cube renderer (the panel's choice and the "in use" readout).
+pub fn cube_label(k: CubeRenderer) -> &'static str {
+    match k {
+        CubeRenderer::Basic => "cube (basic)",
+        CubeRenderer::Accelerated => "cube (scanline)",
+    }
 }
 
 /// Name of a renderer path for the readout.
@@ -189,7 +211,7 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
         row("yaw", format!("{:8.2}°", m.look.yaw));
         row("pitch", format!("{:8.2}°", m.look.pitch));
         row("hfov", format!("{:8.2}°", m.look.hfov));
-        row("in use", path_label(r.path).into());
+        row("in use", in_use_label(r).into());
         row("table", kib(r.table_bytes));
         if r.pixels > 0 && r.exact_pixels > 0 {
             row(
@@ -267,6 +289,18 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
             });
         ui.end_row();
 
+        ui.label("Cube");
+        egui::ComboBox::from_id_salt("cube_renderer")
+            .selected_text(cube_label(s.cube_renderer))
+            .show_ui(ui, |ui| {
+                for k in [CubeRenderer::Basic, CubeRenderer::Accelerated] {
+                    ui.selectable_value(&mut s.cube_renderer, k, cube_label(k));
+                }
+            })
+            .response
+            .on_hover_text("Renderer for cube maps: basic (per pixel) or scanline");
+        ui.end_row();
+
         ui.label("LUT");
         egui::ComboBox::from_id_salt("lut")
             .selected_text(lut_label(s.lut))
@@ -294,7 +328,125 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
     });
 
     ui.separator();
-    ui.small("Drag to look, wheel to zoom. Keys: arrows/WASD turn, +/− zoom, R reset, F fullscreen, Esc leave it, H/Tab panel. Drop an image to open it.");
+    lights_section(ui, m.lights);
+
+    ui.separator();
+    ui.small("Drag to look, wheel to zoom. Keys: arrows/WASD turn, +/− zoom, R reset, F fullscreen, Esc leave it, H/Tab panel. Drop an image or a cube folder to open it, an .ies file to add a light.");
+}
+
+/// The "Lights" section: add, place, aim and remove luminaires; multiplier, exposure,
+/// false colour; the lux at the pointer.
+fn lights_section(ui: &mut egui::Ui, l: &mut LightsState) {
+    egui::CollapsingHeader::new(format!("Lights ({})", l.lights.len()))
+        .id_salt("lights")
+        .default_open(!l.lights.is_empty())
+        .show(ui, |ui| {
+            ui.horizontal(|ui| {
+                ui.label("lux at cursor");
+                ui.monospace(format_lux(l.lux_at_cursor));
+            });
+            ui.horizontal(|ui| {
+                let field = ui.add(
+                    egui::TextEdit::singleline(&mut l.path_input)
+                        .hint_text("file.ies")
+                        .desired_width(130.0),
+                );
+                let enter = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                if (ui.button("Add light").clicked() || enter) && !l.path_input.trim().is_empty() {
+                    let path = std::path::PathBuf::from(l.path_input.trim());
+                    if l.load_and_add(&path).is_ok() {
+                        l.path_input.clear();
+                    }
+                }
+            });
+            for e in [&l.error, &l.scene_error].into_iter().flatten() {
+                ui.colored_label(egui::Color32::from_rgb(255, 120, 100), e);
+            }
+            let mut remove = None;
+            for (i, light) in l.lights.iter_mut().enumerate() {
+                ui.push_id(("light", i), |ui| {
+                    ui.horizontal(|ui| {
+                        ui.label(format!("{}. {}", i + 1, light.name()));
+                        if ui.small_button("✖").on_hover_text("Remove").clicked() {
+                            remove = Some(i);
+                        }
+                    });
+                    ui.horizontal(|ui| {
+                        for (axis, v) in ["X", "Y", "Z"].iter().zip(light.position.iter_mut()) {
+                            ui.label(*axis);
+                            ui.add(egui::DragValue::new(v).speed(0.02).max_decimals(2));
+                        }
+                    });
+                    ui.horizontal(|ui| {
+                        ui.label("yaw");
+                        ui.add(
+                            egui::DragValue::new(&mut light.yaw)
+                                .speed(1.0)
+                                .range(-180.0..=180.0)
+                                .suffix("°"),
+                        );
+                        ui.label("pitch");
+                        ui.add(
+                            egui::DragValue::new(&mut light.pitch)
+                                .speed(1.0)
+                                .range(-90.0..=90.0)
+                                .suffix("°"),
+                        );
+                    });
+                });
+            }
+            if let Some(i) = remove {
+                l.lights.remove(i);
+            }
+            egui::Grid::new("light_opts").num_columns(2).show(ui, |ui| {
+                ui.label("Multiplier");
+                ui.add(egui::Slider::new(&mut l.multiplier, 0.0..=10.0).logarithmic(true));
+                ui.end_row();
+                ui.label("Exposure");
+                ui.add(
+                    egui::Slider::new(&mut l.exposure_lux, 10.0..=5000.0)
+                        .logarithmic(true)
+                        .suffix(" lx"),
+                )
+                .on_hover_text("Illuminance that looks as bright as the photograph");
+                ui.end_row();
+                ui.label("Ambient");
+                ui.add(egui::Slider::new(&mut l.ambient, 0.0..=1.0));
+                ui.end_row();
+                ui.label("False colour");
+                ui.checkbox(&mut l.false_color, "illuminance");
+                ui.end_row();
+                if l.false_color {
+                    ui.label("Scale top");
+                    ui.add(
+                        egui::Slider::new(&mut l.false_color_max, 10.0..=10000.0)
+                            .logarithmic(true)
+                            .suffix(" lx"),
+                    );
+                    ui.end_row();
+                }
+                ui.label("Room W×D×H");
+                ui.horizontal(|ui| {
+                    for v in [&mut l.room.0, &mut l.room.1, &mut l.room.2] {
+                        ui.add(
+                            egui::DragValue::new(v)
+                                .speed(0.05)
+                                .range(0.5..=100.0)
+                                .max_decimals(2),
+                        );
+                    }
+                });
+                ui.end_row();
+                ui.label("Camera height");
+                ui.add(
+                    egui::DragValue::new(&mut l.camera_height)
+                        .speed(0.02)
+                        .range(0.05..=100.0)
+                        .suffix(" m"),
+                );
+                ui.end_row();
+            });
+        });
 }
 
 fn lut_label(l: LutChoice) -> &'static str {

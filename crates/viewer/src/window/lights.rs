@@ -1,0 +1,339 @@
+//! The window's luminaires: what the panel's "Lights" section edits, turned into the
+//! `lut_core::light` scene and shading options `viewer render --light ...` uses. Pure
+//! data (no window), so the conversions are unit-tested.
+
+use lut_core::light::{LightScene, LightTable, Luminaire, Room, ShadeOptions};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Default room (width × depth × height, metres) and camera height: as `viewer render`.
+pub const DEFAULT_ROOM: (f64, f64, f64) = (5.0, 5.0, 2.7);
+/// Default camera height above the floor in metres.
+pub const DEFAULT_CAMERA_HEIGHT: f64 = 1.6;
+/// Default exposure: the illuminance that reproduces the photograph's brightness.
+pub const DEFAULT_EXPOSURE_LUX: f64 = 300.0;
+
+/// One luminaire in the panel.
+#[derive(Debug, Clone)]
+pub struct LightEntry {
+    /// The IES file it was loaded from.
+    pub path: PathBuf,
+    /// Its intensity distribution (shared by entries of the same file).
+    pub table: Arc<LightTable>,
+    /// Position in metres (world frame: X right, Y up from the floor, Z forward).
+    pub position: [f64; 3],
+    /// Aim yaw in degrees.
+    pub yaw: f64,
+    /// Aim pitch in degrees (−90 = straight down).
+    pub pitch: f64,
+}
+
+impl LightEntry {
+    /// The file name for the list.
+    pub fn name(&self) -> String {
+        self.path.file_name().map_or_else(
+            || self.path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        )
+    }
+}
+
+/// Everything the "Lights" section shows and edits.
+#[derive(Debug, Clone)]
+pub struct LightsState {
+    /// The luminaires.
+    pub lights: Vec<LightEntry>,
+    /// The "IES file" text field.
+    pub path_input: String,
+    /// Room width (X), depth (Z), height (Y) in metres.
+    pub room: (f64, f64, f64),
+    /// Camera height above the floor in metres.
+    pub camera_height: f64,
+    /// Multiplies every luminaire's intensity.
+    pub multiplier: f64,
+    /// Illuminance in lux that reproduces the panorama's own brightness.
+    pub exposure_lux: f64,
+    /// Light factor with no luminaire.
+    pub ambient: f64,
+    /// Overlay the false-colour illuminance map.
+    pub false_color: bool,
+    /// Top of the false-colour scale in lux.
+    pub false_color_max: f64,
+    /// The last IES file that did not load.
+    pub error: Option<String>,
+    /// Why the lights cannot light the scene (a light outside the room), if so.
+    pub scene_error: Option<String>,
+    /// Illuminance at the pointer (lights only), when the pointer is over the scene.
+    pub lux_at_cursor: Option<f64>,
+}
+
+impl Default for LightsState {
+    fn default() -> Self {
+        let d = ShadeOptions::default();
+        LightsState {
+            lights: Vec::new(),
+            path_input: String::new(),
+            room: DEFAULT_ROOM,
+            camera_height: DEFAULT_CAMERA_HEIGHT,
+            multiplier: 1.0,
+            exposure_lux: DEFAULT_EXPOSURE_LUX,
+            ambient: d.ambient,
+            false_color: false,
+            false_color_max: d.false_color_max_lux,
+            error: None,
+            scene_error: None,
+            lux_at_cursor: None,
+        }
+    }
+}
+
+/// What a lit frame depends on: when it is unchanged, the cached scene stays valid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightsKey {
+    lights: Vec<(usize, [f64; 3], f64, f64)>,
+    room: (f64, f64, f64),
+    camera_height: f64,
+    multiplier: f64,
+    shade: Option<ShadeOptions>,
+}
+
+impl LightsState {
+    /// Add a luminaire with `table`, hung below the ceiling and aimed straight down;
+    /// each new one is moved along X so they do not stack (kept inside the room).
+    pub fn add(&mut self, path: PathBuf, table: Arc<LightTable>) {
+        let (w, _, h) = self.room;
+        let n = self.lights.len() as f64;
+        // 0, +0.5, −0.5, +1, −1, ... metres, within the walls.
+        let step = ((n + 1.0) / 2.0).floor() * 0.5;
+        let x = if self.lights.len() % 2 == 1 {
+            step
+        } else {
+            -step
+        };
+        let half = (w / 2.0 - 0.05).max(0.0);
+        let y = (h - 0.05).max(h * 0.5);
+        self.lights.push(LightEntry {
+            path,
+            table,
+            position: [x.clamp(-half, half), y, 0.0],
+            yaw: 0.0,
+            pitch: -90.0,
+        });
+    }
+
+    /// Load `path` (an IES file) and add a luminaire with it; the table is shared with
+    /// lights of the same file. The error (named file, line, what was expected) is kept
+    /// in [`LightsState::error`] and returned.
+    ///
+    /// # Errors
+    /// An unreadable or malformed IES file.
+    pub fn load_and_add(&mut self, path: &Path) -> Result<(), String> {
+        let existing = self
+            .lights
+            .iter()
+            .find(|l| l.path == path)
+            .map(|l| l.table.clone());
+        let table = match existing {
+            Some(t) => t,
+            None => match LightTable::load(path) {
+                Ok(t) => Arc::new(t),
+                Err(e) => {
+                    let msg = format!("{}: {e}", path.display());
+                    self.error = Some(msg.clone());
+                    return Err(msg);
+                }
+            },
+        };
+        self.error = None;
+        self.add(path.to_path_buf(), table);
+        Ok(())
+    }
+
+    /// The scene to light, `None` with no luminaire.
+    ///
+    /// # Errors
+    /// A bad room or camera height, a light outside the room, a non-finite value.
+    pub fn scene(&self) -> Result<Option<LightScene>, String> {
+        if self.lights.is_empty() {
+            return Ok(None);
+        }
+        let (w, d, h) = self.room;
+        let room = Room::new(w, d, h, self.camera_height).map_err(|e| e.to_string())?;
+        let lights = self
+            .lights
+            .iter()
+            .map(|l| {
+                let mut lum = Luminaire::new(l.table.clone(), l.position.into());
+                lum.yaw_deg = l.yaw;
+                lum.pitch_deg = l.pitch;
+                lum.multiplier = self.multiplier;
+                lum
+            })
+            .collect();
+        LightScene::new(room, lights)
+            .map(Some)
+            .map_err(|e| e.to_string())
+    }
+
+    /// How the lit frame is shaded.
+    pub fn shade_options(&self) -> ShadeOptions {
+        ShadeOptions {
+            ambient: self.ambient,
+            exposure: if self.exposure_lux > 0.0 {
+                1.0 / self.exposure_lux
+            } else {
+                0.0
+            },
+            false_color: self.false_color,
+            false_color_max_lux: self.false_color_max,
+        }
+    }
+
+    /// What the lit frame depends on.
+    pub fn key(&self) -> LightsKey {
+        LightsKey {
+            lights: self
+                .lights
+                .iter()
+                .map(|l| (Arc::as_ptr(&l.table) as usize, l.position, l.yaw, l.pitch))
+                .collect(),
+            room: self.room,
+            camera_height: self.camera_height,
+            multiplier: self.multiplier,
+            shade: (!self.lights.is_empty()).then(|| self.shade_options()),
+        }
+    }
+}
+
+/// The "lux at cursor" readout: `—` off the scene or with no light, else the value with
+/// precision that suits its size.
+pub fn format_lux(lux: Option<f64>) -> String {
+    match lux {
+        Some(l) if l.is_finite() && l >= 0.0 => {
+            if l >= 100.0 {
+                format!("{l:.0} lx")
+            } else if l >= 1.0 {
+                format!("{l:.1} lx")
+            } else {
+                format!("{l:.3} lx")
+            }
+        }
+        _ => "—".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lut_core::{Camera, View};
+
+    fn sample_path() -> PathBuf {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/ies/type_b_full.ies")
+    }
+
+    #[test]
+    fn no_light_no_scene() {
+        let s = LightsState::default();
+        assert!(s.scene().unwrap().is_none());
+        assert_eq!(s.key().shade, None);
+    }
+
+    #[test]
+    fn panel_state_becomes_the_scene() {
+        let mut s = LightsState::default();
+        s.load_and_add(&sample_path()).unwrap();
+        s.load_and_add(&sample_path()).unwrap();
+        s.lights[1].position = [1.0, 2.0, -1.5];
+        s.lights[1].yaw = 30.0;
+        s.lights[1].pitch = -45.0;
+        s.multiplier = 2.5;
+        let scene = s.scene().unwrap().unwrap();
+        let l = scene.luminaires();
+        assert_eq!(l.len(), 2);
+        // Same file: one shared table.
+        assert!(Arc::ptr_eq(&l[0].table, &l[1].table));
+        assert_eq!(l[0].pitch_deg, -90.0);
+        assert_eq!(l[1].position, glam::DVec3::new(1.0, 2.0, -1.5));
+        assert_eq!((l[1].yaw_deg, l[1].pitch_deg), (30.0, -45.0));
+        assert!(l.iter().all(|x| x.multiplier == 2.5));
+        // New lights are spread along X and hang inside the room.
+        assert_ne!(s.lights[0].position, [1.0, 2.0, -1.5]);
+        assert!(s.lights[0].position[1] < s.room.2);
+    }
+
+    #[test]
+    fn the_same_state_lights_like_viewer_render() {
+        // The window's lux readout is lux_at over the scene viewer render builds from the
+        // same numbers: check one against the other at the image centre.
+        let mut s = LightsState::default();
+        s.load_and_add(&sample_path()).unwrap();
+        let scene = s.scene().unwrap().unwrap();
+        let cam = Camera::new(View::new(0.0, -90.0, 90.0).unwrap(), 64, 64);
+        let lux = lut_core::light::lux_at(&scene, &cam, 32.0, 32.0);
+        let direct = scene.illuminance(glam::DVec3::new(0.0, 0.0, 0.0), glam::DVec3::Y);
+        assert!(
+            (lux - direct).abs() <= 1e-9 * direct.max(1.0),
+            "{lux} {direct}"
+        );
+        assert!(lux > 0.0);
+    }
+
+    #[test]
+    fn bad_file_and_outside_light_are_errors_not_panics() {
+        let mut s = LightsState::default();
+        let e = s.load_and_add(Path::new("/no/such/lamp.ies")).unwrap_err();
+        assert!(e.contains("lamp.ies"), "{e}");
+        assert_eq!(s.error.as_deref(), Some(e.as_str()));
+        assert!(s.lights.is_empty());
+        s.load_and_add(&sample_path()).unwrap();
+        assert!(s.error.is_none());
+        s.lights[0].position = [0.0, 9.0, 0.0];
+        assert!(s.scene().is_err());
+        s.lights[0].position = [0.0, 2.0, 0.0];
+        s.camera_height = 3.0; // above the ceiling
+        assert!(s.scene().is_err());
+    }
+
+    #[test]
+    fn key_follows_every_edit() {
+        let mut s = LightsState::default();
+        s.load_and_add(&sample_path()).unwrap();
+        let k = s.key();
+        assert_eq!(k, s.key());
+        let mut t = s.clone();
+        t.lights[0].yaw += 1.0;
+        assert_ne!(k, t.key());
+        let mut t = s.clone();
+        t.false_color = true;
+        assert_ne!(k, t.key());
+        let mut t = s.clone();
+        t.exposure_lux = 100.0;
+        assert_ne!(k, t.key());
+        let mut t = s.clone();
+        t.lights.clear();
+        assert_ne!(k, t.key());
+        // The text field does not change the picture.
+        let mut t = s.clone();
+        t.path_input = "x".into();
+        assert_eq!(k, t.key());
+    }
+
+    #[test]
+    fn exposure_becomes_a_factor() {
+        let mut s = LightsState::default();
+        s.exposure_lux = 250.0;
+        assert!((s.shade_options().exposure - 1.0 / 250.0).abs() < 1e-15);
+        s.exposure_lux = 0.0;
+        assert_eq!(s.shade_options().exposure, 0.0);
+    }
+
+    #[test]
+    fn lux_readout() {
+        assert_eq!(format_lux(None), "—");
+        assert_eq!(format_lux(Some(f64::NAN)), "—");
+        assert_eq!(format_lux(Some(1234.4)), "1234 lx");
+        assert_eq!(format_lux(Some(12.34)), "12.3 lx");
+        assert_eq!(format_lux(Some(0.01234)), "0.012 lx");
+        assert_eq!(format_lux(Some(0.0)), "0.000 lx");
+    }
+}
