@@ -320,8 +320,10 @@ mod tests {
 
     #[test]
     fn exposure_becomes_a_factor() {
-        let mut s = LightsState::default();
-        s.exposure_lux = 250.0;
+        let mut s = LightsState {
+            exposure_lux: 250.0,
+            ..LightsState::default()
+        };
         assert!((s.shade_options().exposure - 1.0 / 250.0).abs() < 1e-15);
         s.exposure_lux = 0.0;
         assert_eq!(s.shade_options().exposure, 0.0);
