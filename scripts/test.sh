@@ -33,6 +33,7 @@ echo "== cargo test (profile ci: optimized, overflow checks on)"
 cargo test --workspace --profile ci
 if [ -f scripts/window-smoke.sh ]; then
   echo "== window smoke test under Xvfb"
-  bash scripts/window-smoke.sh
+  # the binary the test run just built (optimized, overflow checks on): no second build
+  VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-smoke.sh
 fi
 echo "== all tests passed"
