@@ -349,7 +349,7 @@ fn lights_section(ui: &mut egui::Ui, l: &mut LightsState) {
                 let field = ui.add(
                     egui::TextEdit::singleline(&mut l.path_input)
                         .hint_text("file.ies")
-                        .desired_width(130.0),
+                        .desired_width(110.0),
                 );
                 let enter = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
                 if (ui.button("Add light").clicked() || enter) && !l.path_input.trim().is_empty() {
@@ -398,6 +398,8 @@ fn lights_section(ui: &mut egui::Ui, l: &mut LightsState) {
             if let Some(i) = remove {
                 l.lights.remove(i);
             }
+            // Sliders narrow enough that their value fields fit the fixed-width panel.
+            ui.spacing_mut().slider_width = 64.0;
             egui::Grid::new("light_opts").num_columns(2).show(ui, |ui| {
                 ui.label("Multiplier");
                 ui.add(egui::Slider::new(&mut l.multiplier, 0.0..=10.0).logarithmic(true));
@@ -425,18 +427,20 @@ fn lights_section(ui: &mut egui::Ui, l: &mut LightsState) {
                     );
                     ui.end_row();
                 }
-                ui.label("Room W×D×H");
-                ui.horizontal(|ui| {
-                    for v in [&mut l.room.0, &mut l.room.1, &mut l.room.2] {
-                        ui.add(
-                            egui::DragValue::new(v)
-                                .speed(0.05)
-                                .range(0.5..=100.0)
-                                .max_decimals(2),
-                        );
-                    }
-                });
-                ui.end_row();
+            });
+            ui.horizontal(|ui| {
+                ui.label("Room");
+                for v in [&mut l.room.0, &mut l.room.1, &mut l.room.2] {
+                    ui.add(
+                        egui::DragValue::new(v)
+                            .speed(0.05)
+                            .range(0.5..=100.0)
+                            .max_decimals(2),
+                    )
+                    .on_hover_text("Width (X) × depth (Z) × height (Y), metres");
+                }
+            });
+            ui.horizontal(|ui| {
                 ui.label("Camera height");
                 ui.add(
                     egui::DragValue::new(&mut l.camera_height)
@@ -444,7 +448,6 @@ fn lights_section(ui: &mut egui::Ui, l: &mut LightsState) {
                         .range(0.05..=100.0)
                         .suffix(" m"),
                 );
-                ui.end_row();
             });
         });
 }
