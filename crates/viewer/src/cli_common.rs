@@ -64,9 +64,14 @@ pub fn write_png_atomic(out: &Path, pixels: &[u32], width: u32, height: u32) -> 
     }
     let img = image::RgbImage::from_raw(width, height, rgb)
         .ok_or_else(|| anyhow!("internal: pixel buffer does not match {width}x{height}"))?;
+    // The format follows the extension (PNG unless it names another encoder we have).
+    let format = match image::ImageFormat::from_path(out) {
+        Ok(f @ (image::ImageFormat::Jpeg | image::ImageFormat::Png)) => f,
+        _ => image::ImageFormat::Png,
+    };
     write_image_atomic(out, |tmp| {
-        img.write_to(tmp, image::ImageFormat::Png)
-            .map_err(|e| anyhow!("{}: cannot encode PNG: {e}", out.display()))
+        img.write_to(tmp, format)
+            .map_err(|e| anyhow!("{}: cannot encode the image: {e}", out.display()))
     })
 }
 
