@@ -10,6 +10,7 @@ use lut_core::{IndexStep, Projection, RenderOptions, Renderer, View};
 
 const BOUND: f64 = 0.05;
 
+#[allow(clippy::too_many_arguments)] // a test helper: one case per call
 fn check(
     r: &mut Renderer,
     mw: u32,
