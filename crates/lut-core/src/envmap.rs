@@ -145,7 +145,8 @@ impl EnvMap {
         })
     }
 
-    /// Build a map from a decoded image (any colour type; converted to 8-bit RGB).
+    /// Build a map from a decoded image (any colour type; converted to 8-bit RGB; HDR
+    /// images through the default [`Tone`]).
     ///
     /// # Errors
     /// As [`EnvMap::from_pixels`].
@@ -153,13 +154,40 @@ impl EnvMap {
         img: &image::DynamicImage,
         projection: Projection,
     ) -> Result<EnvMap, MapError> {
-        let rgb = img.to_rgb8();
-        let (w, h) = rgb.dimensions();
+        Self::from_image_toned(img, projection, Tone::default())
+    }
+
+    /// As [`EnvMap::from_image`], with HDR (floating-point) images shown through `tone`:
+    /// exposure, the tone curve `x / (1 + x)`, then sRGB encoding. Negative and NaN values
+    /// are clamped to 0 (and +∞ to white), never propagated. 8-bit images are used as
+    /// stored.
+    ///
+    /// # Errors
+    /// As [`EnvMap::from_pixels`].
+    pub fn from_image_toned(
+        img: &image::DynamicImage,
+        projection: Projection,
+        tone: Tone,
+    ) -> Result<EnvMap, MapError> {
+        let (w, h) = (img.width(), img.height());
         check_map_size("image", w, h)?;
-        let px: Vec<u32> = rgb
-            .pixels()
-            .map(|p| (p[0] as u32) << 16 | (p[1] as u32) << 8 | p[2] as u32)
-            .collect();
+        let px: Vec<u32> = match img {
+            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_) => {
+                let k = 2f32.powf(tone.exposure_ev as f32);
+                img.to_rgb32f()
+                    .pixels()
+                    .map(|p| {
+                        let c = |x: f32| tone_map(x * k) as u32;
+                        (c(p[0]) << 16) | (c(p[1]) << 8) | c(p[2])
+                    })
+                    .collect()
+            }
+            _ => img
+                .to_rgb8()
+                .pixels()
+                .map(|p| ((p[0] as u32) << 16) | ((p[1] as u32) << 8) | p[2] as u32)
+                .collect(),
+        };
         EnvMap::from_pixels(w, h, &px, projection)
     }
 
@@ -188,6 +216,20 @@ impl EnvMap {
         what: &str,
         projection: Option<Projection>,
     ) -> Result<EnvMap, MapError> {
+        Self::decode_toned(bytes, what, projection, Tone::default())
+    }
+
+    /// As [`EnvMap::decode`], showing HDR images through `tone` (see
+    /// [`EnvMap::from_image_toned`]).
+    ///
+    /// # Errors
+    /// [`MapError`] naming `what` and the reason.
+    pub fn decode_toned(
+        bytes: &[u8],
+        what: &str,
+        projection: Option<Projection>,
+        tone: Tone,
+    ) -> Result<EnvMap, MapError> {
         let decode_err = |reason: String| MapError::Decode {
             path: what.into(),
             reason,
@@ -212,7 +254,7 @@ impl EnvMap {
         limits.max_alloc = Some(MAX_MAP_PIXELS * 16);
         reader.limits(limits);
         let img = reader.decode().map_err(|e| decode_err(e.to_string()))?;
-        EnvMap::from_image(&img, projection)
+        EnvMap::from_image_toned(&img, projection, tone)
     }
 
     /// Width in pixels.
@@ -317,6 +359,32 @@ impl EnvMap {
     }
 }
 
+/// How HDR (floating-point) images become 8-bit display pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Tone {
+    /// Exposure in stops: linear values are multiplied by 2^EV before the tone curve.
+    pub exposure_ev: f64,
+}
+
+/// One linear HDR value → 8-bit sRGB: clamp (negative, NaN → 0; +∞ → 1), the curve
+/// x/(1+x), then the sRGB transfer function.
+#[inline]
+pub fn tone_map(x: f32) -> u8 {
+    let y = if x.is_nan() || x <= 0.0 {
+        0.0
+    } else if x.is_infinite() {
+        1.0
+    } else {
+        x / (1.0 + x)
+    };
+    let s = if y <= 0.003_130_8 {
+        12.92 * y
+    } else {
+        1.055 * y.powf(1.0 / 2.4) - 0.055
+    };
+    (s.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+}
+
 /// Pick the projection for an image: explicit, or auto (2:1 → equirect, else an error).
 ///
 /// # Errors
@@ -394,6 +462,36 @@ mod tests {
         let m = ramp(16, 8, Projection::Elliptical);
         assert_eq!(m.bilinear(to_fx(0.1), to_fx(0.1)), m.pixel(0, 0));
         assert_eq!(m.bilinear(to_fx(15.9), to_fx(7.9)), m.pixel(15, 7));
+    }
+
+    #[test]
+    fn tone_map_clamps_and_curves() {
+        assert_eq!(tone_map(f32::NAN), 0);
+        assert_eq!(tone_map(-3.0), 0);
+        assert_eq!(tone_map(f32::NEG_INFINITY), 0);
+        assert_eq!(tone_map(f32::INFINITY), 255);
+        assert_eq!(tone_map(0.0), 0);
+        // 1 -> 0.5 linear -> sRGB 0.7354 -> 188
+        assert_eq!(tone_map(1.0), 188);
+        assert!(tone_map(2.0) > tone_map(1.0));
+    }
+
+    #[test]
+    fn hdr_images_are_toned_and_clamped() {
+        let mut img = image::Rgb32FImage::new(4, 2);
+        for (i, p) in img.pixels_mut().enumerate() {
+            let v = [f32::NAN, -1.0, 1.0, f32::INFINITY, 0.5, 2.0, 0.0, 1e9][i];
+            *p = image::Rgb([v, v, v]);
+        }
+        let dynimg = image::DynamicImage::ImageRgb32F(img);
+        let m = EnvMap::from_image(&dynimg, Projection::Equirect).unwrap();
+        let g = |x, y| m.pixel(x, y) & 0xFF;
+        assert_eq!((g(0, 0), g(1, 0), g(2, 0), g(3, 0)), (0, 0, 188, 255));
+        let brighter =
+            EnvMap::from_image_toned(&dynimg, Projection::Equirect, Tone { exposure_ev: 1.0 })
+                .unwrap();
+        // +1 EV on 0.5 is 1.0
+        assert_eq!(brighter.pixel(0, 1) & 0xFF, 188);
     }
 
     #[test]

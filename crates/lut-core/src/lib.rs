@@ -54,7 +54,7 @@ pub mod raster;
 pub mod synth;
 
 pub use camera::{Camera, View, MAX_OUTPUT_SIDE};
-pub use envmap::{EnvMap, Sampler, MAX_MAP_PIXELS, MAX_MAP_WIDTH};
+pub use envmap::{EnvMap, Sampler, Tone, MAX_MAP_PIXELS, MAX_MAP_WIDTH};
 pub use error::{MapError, ViewError};
 pub use exact::{render_exact, render_exact_supersampled};
 pub use projection::Projection;

@@ -45,12 +45,31 @@ pub fn parse_projection(s: &str) -> Result<Option<Projection>, String> {
 
 /// Load the panorama at `path`, or the bundled sample when `None`.
 pub fn load_panorama(path: Option<&Path>, projection: Option<Projection>) -> Result<EnvMap> {
+    load_panorama_toned(path, projection, lut_core::Tone::default())
+}
+
+/// As [`load_panorama`], showing HDR files (.hdr, .exr) through `tone`.
+pub fn load_panorama_toned(
+    path: Option<&Path>,
+    projection: Option<Projection>,
+    tone: lut_core::Tone,
+) -> Result<EnvMap> {
     match path {
-        Some(p) => Ok(EnvMap::load(p, projection)?),
-        None => Ok(EnvMap::decode(
+        Some(p) => {
+            let bytes =
+                std::fs::read(p).with_context(|| format!("{}: cannot read", p.display()))?;
+            Ok(EnvMap::decode_toned(
+                &bytes,
+                &p.display().to_string(),
+                projection,
+                tone,
+            )?)
+        }
+        None => Ok(EnvMap::decode_toned(
             crate::assets::SAMPLE_JPEG,
             crate::assets::SAMPLE_NAME,
             projection,
+            tone,
         )?),
     }
 }

@@ -1,6 +1,6 @@
 //! `viewer render`: one view of a panorama to a PNG, headless.
 
-use crate::cli_common::{load_panorama, parse_angle, parse_size, write_png_atomic};
+use crate::cli_common::{load_panorama_toned, parse_angle, parse_size, write_png_atomic};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use lut_core::lut::Surface;
@@ -128,6 +128,10 @@ pub struct RenderArgs {
     /// Surface the look-up table is built on.
     #[arg(long, value_enum, default_value_t = SurfaceArg::Cylinder)]
     pub lut_surface: SurfaceArg,
+    /// Exposure in stops for HDR maps (.hdr, .exr): values times 2^EV, then the tone
+    /// curve x/(1+x) and sRGB. 8-bit images are shown as stored.
+    #[arg(long, default_value = "0", value_parser = parse_stops, allow_hyphen_values = true)]
+    pub exposure: f64,
     /// Render on one thread.
     #[arg(long)]
     pub single_thread: bool,
@@ -137,6 +141,14 @@ pub struct RenderArgs {
     /// Luminaires lighting the scene.
     #[command(flatten)]
     pub lights: crate::ies_cmd::LightArgs,
+}
+
+/// Parse an exposure in stops (a finite number).
+pub fn parse_stops(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("exposure '{s}' is not a finite number of stops")),
+    }
 }
 
 /// Parse an index step.
@@ -217,7 +229,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
             ProjectionArg::Map(p) => Some(p),
             _ => None,
         };
-        let map = load_panorama(a.panorama.first().map(|p| p.as_path()), projection)?;
+        let tone = lut_core::Tone {
+            exposure_ev: a.exposure,
+        };
+        let map = load_panorama_toned(a.panorama.first().map(|p| p.as_path()), projection, tone)?;
         let opts = a.options();
         let mut renderer = Renderer::new(&map);
         let report = renderer.render(&map, view, &opts, &mut out, w, h)?;

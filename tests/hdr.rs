@@ -1,0 +1,70 @@
+//! HDR environment maps: the sample EXRs (DWAB-compressed; lossy float16 with negative
+//! values) decode, and every value is clamped and tone-mapped, never propagated.
+
+use lut_core::envmap::tone_map;
+use lut_core::{EnvMap, Projection, RenderOptions, Renderer, Tone, View};
+use std::path::PathBuf;
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data/hdr")
+        .join(name)
+}
+
+#[test]
+fn sample_exrs_load_clamped_and_toned() {
+    for name in ["interior.exr", "venice.exr"] {
+        let path = data(name);
+        let raw = image::open(&path).unwrap().to_rgb32f();
+        let map = EnvMap::load(&path, None).unwrap();
+        assert_eq!((map.width(), map.height()), raw.dimensions(), "{name}");
+        assert_eq!(map.projection(), Projection::Equirect);
+        let mut negatives = 0;
+        for (x, y, p) in raw.enumerate_pixels() {
+            let got = map.pixel(x, y);
+            for c in 0..3 {
+                let v = p[c];
+                if v < 0.0 || v.is_nan() {
+                    negatives += 1;
+                }
+                let want = tone_map(v) as u32;
+                assert_eq!(
+                    (got >> (16 - 8 * c)) & 0xFF,
+                    want,
+                    "{name} ({x},{y}) channel {c} value {v}"
+                );
+            }
+        }
+        if name == "venice.exr" {
+            assert!(negatives > 0, "venice.exr is known to hold negative values");
+        }
+        // Renders without trouble.
+        let mut r = Renderer::new(&map);
+        let mut out = vec![0u32; 64 * 32];
+        r.render(
+            &map,
+            View::new(10.0, 5.0, 90.0).unwrap(),
+            &RenderOptions::default(),
+            &mut out,
+            64,
+            32,
+        )
+        .unwrap();
+    }
+}
+
+#[test]
+fn exposure_brightens() {
+    let bytes = std::fs::read(data("interior.exr")).unwrap();
+    let dark =
+        EnvMap::decode_toned(&bytes, "interior.exr", None, Tone { exposure_ev: -2.0 }).unwrap();
+    let bright =
+        EnvMap::decode_toned(&bytes, "interior.exr", None, Tone { exposure_ev: 2.0 }).unwrap();
+    let sum = |m: &EnvMap| -> u64 {
+        (0..m.height())
+            .flat_map(|y| (0..m.width()).map(move |x| (x, y)))
+            .map(|(x, y)| (m.pixel(x, y) & 0xFF) as u64)
+            .sum()
+    };
+    assert!(sum(&bright) > sum(&dark) * 2);
+}
