@@ -3,7 +3,10 @@
 //! egui asks for one (its `repaint_delay`, never the `RedrawRequested` echo), something
 //! animates, or the full-quality frame after fast motion is due.
 
-use super::input::{key_action, wheel_notches, Controller, Held, KeyAction, Look, Turn, TURN_KEYS};
+use super::input::{
+    key_action, wheel_notches, Controller, Held, KeyAction, Look, Turn, EXPOSURE_KEY_STEP_EV,
+    TURN_KEYS,
+};
 use super::lights::{LightsKey, LightsState};
 use super::paint::{Compositor, SceneRect};
 use super::ui::{self, LoadStatus, PanelModel, Readouts};
@@ -11,7 +14,9 @@ use super::OpenArgs;
 use crate::render_cmd::{CubeRendererArg, ProjectionArg};
 use anyhow::{anyhow, Result};
 use lut_core::cube::{CubeMap, CubeRenderer};
-use lut_core::{Camera, EnvMap, IndexStep, LutChoice, Projection, Renderer, RendererKind, Sampler};
+use lut_core::{
+    Camera, EnvMap, IndexStep, LutChoice, Projection, Renderer, RendererKind, Sampler, Tone,
+};
 use std::collections::VecDeque;
 use std::io::Read;
 use std::num::NonZeroU32;
@@ -79,6 +84,10 @@ struct Loaded {
     scene: Scene,
     source: Source,
     projection: Option<Projection>,
+    /// An HDR file (`.hdr`, `.exr`): shown through the panel's exposure.
+    hdr: bool,
+    /// The exposure it was decoded with (stops).
+    exposure_ev: f64,
 }
 
 impl Loaded {
@@ -138,7 +147,9 @@ fn load(
     source: Source,
     projection: Option<Projection>,
     naming: Option<&str>,
+    tone: Tone,
 ) -> Result<Box<Loaded>, String> {
+    let hdr = matches!(&source, Source::File(p) if super::export::is_hdr_path(p));
     let map = match &source {
         Source::Cube { paths, layout } => {
             let _ = proxy.send_event(UserEvent::Decoding { id });
@@ -148,6 +159,8 @@ fn load(
                 scene: Scene::Cube(cube),
                 source,
                 projection,
+                hdr: false,
+                exposure_ev: tone.exposure_ev,
             }));
         }
         Source::Sample => {
@@ -159,8 +172,9 @@ fn load(
                 let _ = proxy.send_event(UserEvent::Progress { id, done, total });
             })?;
             let _ = proxy.send_event(UserEvent::Decoding { id });
-            // The same decoding as `EnvMap::load` (and so as `viewer render`).
-            EnvMap::decode(&bytes, &p.display().to_string(), projection)
+            // The same decoding as `EnvMap::load` (and so as `viewer render
+            // --exposure`); 8-bit images ignore the tone.
+            EnvMap::decode_toned(&bytes, &p.display().to_string(), projection, tone)
                 .map_err(|e| e.to_string())?
         }
     };
@@ -169,6 +183,8 @@ fn load(
         scene: Scene::Map { map, renderer },
         source,
         projection,
+        hdr,
+        exposure_ev: tone.exposure_ev,
     }))
 }
 
@@ -354,10 +370,13 @@ impl App {
         self.keep_error = false;
         let proxy = self.proxy.clone();
         let naming = self.naming.clone();
+        let tone = Tone {
+            exposure_ev: self.ctl.settings.exposure_ev,
+        };
         let spawned = std::thread::Builder::new()
             .name("viewer-load".into())
             .spawn(move || {
-                let result = load(&proxy, id, source, projection, naming.as_deref());
+                let result = load(&proxy, id, source, projection, naming.as_deref(), tone);
                 let _ = proxy.send_event(UserEvent::Done { id, result });
             });
         if let Err(e) = spawned {
@@ -409,6 +428,7 @@ impl App {
                             self.projection = loaded.projection;
                             self.projection_source = Some(loaded.source.clone());
                         }
+                        self.readouts.hdr = loaded.hdr;
                         self.current = Some(loaded);
                         self.map_generation += 1;
                     }
@@ -583,8 +603,28 @@ impl App {
                 self.start_load(s, self.projection);
             }
         }
+        if req.panel.exposure_commit {
+            self.reload_exposure();
+        }
+        if req.panel.save_view {
+            self.save_view();
+        }
         for &a in &req.keys {
             match a {
+                KeyAction::ExposureDown | KeyAction::ExposureUp => {
+                    let d = if a == KeyAction::ExposureUp {
+                        EXPOSURE_KEY_STEP_EV
+                    } else {
+                        -EXPOSURE_KEY_STEP_EV
+                    };
+                    let s = &mut self.ctl.settings;
+                    let ev = super::export::step_exposure(s.exposure_ev, d);
+                    if ev != s.exposure_ev && self.readouts.hdr {
+                        s.exposure_ev = ev;
+                        self.reload_exposure();
+                    }
+                }
+                KeyAction::SaveView => self.save_view(),
                 KeyAction::TogglePanel => self.show_panel = !self.show_panel,
                 KeyAction::Quit => el.exit(),
                 KeyAction::ToggleFullscreen => {
@@ -602,6 +642,93 @@ impl App {
                 other => self.ctl.key(other),
             }
         }
+    }
+
+    /// Decode the current HDR file again with the panel's exposure (on the loading
+    /// thread; the view and the current picture stay until it is ready).
+    fn reload_exposure(&mut self) {
+        let Some(cur) = self.current.as_ref().filter(|c| c.hdr) else {
+            return;
+        };
+        if cur.exposure_ev == self.ctl.settings.exposure_ev && self.loading.is_none() {
+            return;
+        }
+        let (source, projection) = (cur.source.clone(), cur.projection);
+        self.start_load(source, projection);
+    }
+
+    /// "Save view…" / P: render the current view at the scene's size times the export
+    /// scale, full quality (the chosen sampler, bilinear by default, never the fast
+    /// nearest), lit as shown, and write it to `view-N.png` in the current directory.
+    fn save_view(&mut self) {
+        let scene = match self.readouts.scene {
+            (w, h) if w > 0 && h > 0 => (w, h),
+            _ => self.gfx.as_ref().map_or((1024, 640), |g| {
+                let s = g.window.inner_size();
+                (s.width, s.height)
+            }),
+        };
+        let (w, h) = super::export::export_size(scene, self.ctl.settings.export_scale);
+        let status = match self.render_export(w, h) {
+            Ok(pixels) => {
+                let path = super::export::next_view_path(std::path::Path::new("."), |p| p.exists());
+                match crate::cli_common::write_png_atomic(&path, &pixels, w, h) {
+                    Ok(()) => format!("saved {} ({w}×{h})", path.display()),
+                    Err(e) => format!("save failed: {e:#}"),
+                }
+            }
+            Err(e) => format!("save failed: {e}"),
+        };
+        if self.print_view {
+            println!("{status}");
+        }
+        self.readouts.export_status = Some(status);
+        self.show_panel = true;
+        self.request_redraw();
+    }
+
+    /// The current view rendered into a new `w`×`h` buffer with the window's renderer
+    /// and options at full quality, then lit as the scene is.
+    fn render_export(&mut self, w: u32, h: u32) -> Result<Vec<u32>, String> {
+        let cur = self
+            .current
+            .as_mut()
+            .ok_or_else(|| "no panorama loaded".to_string())?;
+        let opts = lut_core::RenderOptions {
+            sampler: self.ctl.settings.sampler,
+            ..self.ctl.settings.render_options(false)
+        };
+        let view = self.ctl.look().view();
+        let mut buf = vec![0u32; w as usize * h as usize];
+        match &mut cur.scene {
+            Scene::Map { map, renderer } => renderer
+                .render(map, view, &opts, &mut buf, w, h)
+                .map(|_| ())
+                .map_err(|e| e.to_string())?,
+            Scene::Cube(cube) => lut_core::cube::render(
+                cube,
+                view,
+                opts.sampler,
+                self.ctl.settings.cube_renderer,
+                &mut buf,
+                w,
+                h,
+                true,
+            )
+            .map_err(|e| e.to_string())?,
+        }
+        if let Some(scene) = self.lights.scene()? {
+            lut_core::light::shade_frame(
+                &scene,
+                &Camera::new(view, w, h),
+                &mut buf,
+                w,
+                h,
+                &self.lights.shade_options(),
+            )
+            .map_err(|e| e.to_string())?;
+        }
+        Ok(buf)
     }
 
     /// Render the scene for `rect` unless the cached one already shows it, then light it

@@ -141,6 +141,10 @@ pub struct Settings {
     pub lut: LutChoice,
     /// Cube maps: the paper's basic (per pixel) or accelerated (per scanline) renderer.
     pub cube_renderer: CubeRenderer,
+    /// HDR panoramas (`.hdr`, `.exr`): exposure in stops (`lut_core::Tone`).
+    pub exposure_ev: f64,
+    /// "Save view…": the export is the scene's size times this (1, 2 or 4).
+    pub export_scale: u32,
 }
 
 impl Default for Settings {
@@ -155,6 +159,8 @@ impl Default for Settings {
             renderer: o.renderer,
             lut: o.lut,
             cube_renderer: CubeRenderer::Accelerated,
+            exposure_ev: 0.0,
+            export_scale: 1,
         }
     }
 }
@@ -251,11 +257,27 @@ pub enum KeyAction {
     TogglePanel,
     /// Close the window (Ctrl+Q or Ctrl+W).
     Quit,
+    /// HDR panoramas: exposure down [`EXPOSURE_KEY_STEP_EV`] stops (`[`).
+    ExposureDown,
+    /// HDR panoramas: exposure up [`EXPOSURE_KEY_STEP_EV`] stops (`]`).
+    ExposureUp,
+    /// Save the current view as a PNG (`P`).
+    SaveView,
 }
+
+/// Stops the `[` and `]` keys change the exposure of an HDR panorama by.
+pub const EXPOSURE_KEY_STEP_EV: f64 = 0.5;
+
+/// Exposure range of the panel slider and the `[` `]` keys, in stops.
+pub const EXPOSURE_RANGE_EV: (f64, f64) = (-8.0, 8.0);
+
+/// Scale factors the export offers: the scene's size times this.
+pub const EXPORT_SCALES: [u32; 3] = [1, 2, 4];
 
 /// The key bindings: arrows and WASD turn, + and − zoom (= too, so + works without
 /// Shift), R resets, F toggles fullscreen, Esc leaves it, H or Tab toggles the panel,
-/// Ctrl+Q or Ctrl+W closes the window. Other Ctrl/Cmd combinations do nothing.
+/// Ctrl+Q or Ctrl+W closes the window, `[` and `]` change an HDR panorama's exposure by
+/// half a stop, P saves the view as a PNG. Other Ctrl/Cmd combinations do nothing.
 pub fn key_action(key: egui::Key, modifiers: egui::Modifiers) -> Option<KeyAction> {
     use egui::Key as K;
     if modifiers.command || modifiers.ctrl {
@@ -272,6 +294,9 @@ pub fn key_action(key: egui::Key, modifiers: egui::Modifiers) -> Option<KeyActio
         K::F => KeyAction::ToggleFullscreen,
         K::Escape => KeyAction::LeaveFullscreen,
         K::H | K::Tab => KeyAction::TogglePanel,
+        K::OpenBracket => KeyAction::ExposureDown,
+        K::CloseBracket => KeyAction::ExposureUp,
+        K::P => KeyAction::SaveView,
         _ => return None,
     })
 }
@@ -957,6 +982,9 @@ mod tests {
             (K::Escape, KeyAction::LeaveFullscreen),
             (K::H, KeyAction::TogglePanel),
             (K::Tab, KeyAction::TogglePanel),
+            (K::OpenBracket, KeyAction::ExposureDown),
+            (K::CloseBracket, KeyAction::ExposureUp),
+            (K::P, KeyAction::SaveView),
         ];
         let none = egui::Modifiers::NONE;
         for (k, a) in cases {

@@ -3,12 +3,14 @@
 //! * [`input`]: drag, wheel, keys and held buttons → the view (pure, unit-tested).
 //! * [`ui`]: the egui panel (pure immediate-mode drawing from plain data).
 //! * [`paint`]: the scene and the panel composed on the CPU into one 0RGB buffer.
+//! * [`export`]: HDR exposure steps and the "Save view…" size and file name (pure).
 //! * `app`: the winit event loop, softbuffer surface and background loading.
 //!
 //! Every frame's scene is rendered by `lut_core::Renderer::render`, the same call with the
 //! same options `viewer render` makes, so the window shows what `viewer render` writes.
 
 mod app;
+pub mod export;
 pub mod input;
 pub mod lights;
 pub mod paint;

@@ -37,6 +37,10 @@ pub struct Readouts {
     pub map: String,
     /// The scene is a cube map, rendered by this renderer (`None`: a LUT-rendered map).
     pub cube: Option<CubeRenderer>,
+    /// The panorama is an HDR file (`.hdr`, `.exr`): the exposure slider is enabled.
+    pub hdr: bool,
+    /// The last "Save view…": "saved PATH" or the error.
+    pub export_status: Option<String>,
 }
 
 /// A background load in progress.
@@ -87,6 +91,10 @@ pub struct PanelOutput {
     pub projection_changed: bool,
     /// The error was dismissed.
     pub dismiss_error: bool,
+    /// The exposure slider was released (or typed into) with a new value: re-decode.
+    pub exposure_commit: bool,
+    /// "Save view…" was pressed.
+    pub save_view: bool,
 }
 
 /// The "in use" readout: the cube renderer for a cube map, else the LUT path.
@@ -325,13 +333,50 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
             .on_hover_text("How the image maps the sphere; auto takes 2:1 images as equirect");
         out.projection_changed = *m.projection != before;
         ui.end_row();
+
+        ui.label("Exposure (EV)");
+        ui.spacing_mut().slider_width = 64.0;
+        let (lo, hi) = super::input::EXPOSURE_RANGE_EV;
+        let slider = ui
+            .add_enabled(
+                m.readouts.hdr,
+                egui::Slider::new(&mut s.exposure_ev, lo..=hi)
+                    .step_by(0.1)
+                    .max_decimals(1),
+            )
+            .on_hover_text("HDR panoramas (.hdr, .exr): stops of exposure; keys [ and ]")
+            .on_disabled_hover_text("Only for HDR panoramas (.hdr, .exr)");
+        out.exposure_commit =
+            slider.drag_stopped() || (slider.changed() && !slider.is_pointer_button_down_on());
+        ui.end_row();
+
+        ui.label("Export scale");
+        egui::ComboBox::from_id_salt("export_scale")
+            .selected_text(format!("{}x", s.export_scale))
+            .show_ui(ui, |ui| {
+                for k in super::input::EXPORT_SCALES {
+                    ui.selectable_value(&mut s.export_scale, k, format!("{k}x"));
+                }
+            })
+            .response
+            .on_hover_text("Size of the saved view: the scene's size times this");
+        ui.end_row();
     });
+    ui.horizontal(|ui| {
+        out.save_view = ui
+            .button("Save view…")
+            .on_hover_text("Write the view to view-N.png in the current directory (key P)")
+            .clicked();
+    });
+    if let Some(st) = &m.readouts.export_status {
+        ui.label(st);
+    }
 
     ui.separator();
     lights_section(ui, m.lights);
 
     ui.separator();
-    ui.small("Drag to look, wheel to zoom. Keys: arrows/WASD turn, +/− zoom, R reset, F fullscreen, Esc leave it, H/Tab panel. Drop an image or a cube folder to open it, an .ies file to add a light.");
+    ui.small("Drag to look, wheel to zoom. Keys: arrows/WASD turn, +/− zoom, R reset, [ ] exposure (HDR), P save view, F fullscreen, Esc leave it, H/Tab panel. Drop an image or a cube folder to open it, an .ies file to add a light.");
 }
 
 /// The "Lights" section: add, place, aim and remove luminaires; multiplier, exposure,
