@@ -9,7 +9,7 @@ use crate::envmap::{EnvMap, Sampler};
 use crate::error::ViewError;
 use crate::fixed::to_fx;
 use crate::projection::Projection;
-use rayon::prelude::*;
+use crate::rows::for_each_row;
 
 /// Exact map position of the center of output pixel (x, y), or `None` when the map does
 /// not cover that direction.
@@ -82,7 +82,7 @@ pub fn render_exact(
     let cam = Camera::new(view, width, height);
     let (mw, mh) = (map.width() as f64, map.height() as f64);
     let proj = map.projection();
-    let row = |(y, line): (usize, &mut [u32])| {
+    for_each_row(out, width as usize, threads, |y, line| {
         for (x, px) in line.iter_mut().enumerate() {
             *px = sample_at(
                 map,
@@ -90,12 +90,7 @@ pub fn render_exact(
                 exact_uv(&cam, proj, mw, mh, x as u32, y as u32),
             );
         }
-    };
-    if threads {
-        out.par_chunks_mut(width as usize).enumerate().for_each(row);
-    } else {
-        out.chunks_mut(width as usize).enumerate().for_each(row);
-    }
+    });
     Ok(())
 }
 
@@ -122,7 +117,7 @@ pub fn render_exact_supersampled(
     let (mw, mh) = (map.width() as f64, map.height() as f64);
     let proj = map.projection();
     let inv = 1.0 / n as f64;
-    let row = |(y, line): (usize, &mut [u32])| {
+    for_each_row(out, width as usize, threads, |y, line| {
         for (x, px) in line.iter_mut().enumerate() {
             let (mut r, mut g, mut b) = (0u32, 0u32, 0u32);
             for sy in 0..n {
@@ -139,12 +134,7 @@ pub fn render_exact_supersampled(
             let half = nn / 2;
             *px = (((r + half) / nn) << 16) | (((g + half) / nn) << 8) | ((b + half) / nn);
         }
-    };
-    if threads {
-        out.par_chunks_mut(width as usize).enumerate().for_each(row);
-    } else {
-        out.chunks_mut(width as usize).enumerate().for_each(row);
-    }
+    });
     Ok(())
 }
 

@@ -51,6 +51,7 @@ pub mod light;
 pub mod lut;
 pub mod projection;
 pub mod raster;
+mod rows;
 pub mod synth;
 
 pub use camera::{Camera, View, MAX_OUTPUT_SIDE};

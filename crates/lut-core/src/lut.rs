@@ -107,7 +107,7 @@ impl TableSpec {
                     TableKind::Wide => 60f64.to_radians(),
                     TableKind::High => 45f64.to_radians(),
                 };
-                let t_max = t_max.min(120f64.to_radians().mul_add(0.5, 0.0).tan());
+                let t_max = t_max.min(60f64.to_radians().tan()); // hfov <= 120
                 TableSpec {
                     surface,
                     step,

@@ -18,7 +18,7 @@ use crate::exact::{check_buffer, render_exact};
 use crate::fixed::{to_fx, Fx, FX_BITS};
 use crate::lut::{LutTable, Surface, TableKind, TableSpec};
 use crate::projection::Projection;
-use rayon::prelude::*;
+use crate::rows::for_each_row;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
@@ -329,7 +329,7 @@ impl Renderer {
         let row_scale = &self.row_scale[..];
         let w = width as usize;
         let bilinear = opts.sampler == Sampler::Bilinear;
-        let body = |(y, row): (usize, &mut [u32])| {
+        for_each_row(out, w, opts.threads, |y, row| {
             let scan = &scans[y];
             if bilinear {
                 let mut s = PixelSink::<true> { row, map };
@@ -338,15 +338,7 @@ impl Renderer {
                 let mut s = PixelSink::<false> { row, map };
                 render_row(scan, table, &frame, row_scale, &mut s);
             }
-        };
-        if opts.threads && height > 1 {
-            out.par_chunks_mut(w)
-                .enumerate()
-                .with_min_len(rows_per_task(w))
-                .for_each(body);
-        } else {
-            out.chunks_mut(w).enumerate().for_each(body);
-        }
+        });
         Ok(report)
     }
 
@@ -375,12 +367,10 @@ impl Renderer {
         let mut out = vec![None; width as usize * height as usize];
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
-        out.par_chunks_mut(width as usize)
-            .enumerate()
-            .for_each(|(y, row)| {
-                let mut s = PosSink { row };
-                render_row(&scans[y], table, &frame, row_scale, &mut s);
-            });
+        for_each_row(&mut out, width as usize, true, |y, row| {
+            let mut s = PosSink { row };
+            render_row(&scans[y], table, &frame, row_scale, &mut s);
+        });
         Ok((out, report))
     }
 
@@ -529,11 +519,6 @@ impl Renderer {
         };
         (frame, report)
     }
-}
-
-/// Rows per rayon task: at least ~16k pixels per task.
-fn rows_per_task(w: usize) -> usize {
-    (16384 / w.max(1)).max(1)
 }
 
 fn check_step(s: IndexStep) -> Result<(), ViewError> {

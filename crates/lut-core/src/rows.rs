@@ -1,0 +1,28 @@
+//! Running a per-row function over an image, on one thread or in row bands on rayon.
+
+use rayon::prelude::*;
+
+/// Minimum pixels per rayon task, so small frames stay on one thread.
+const MIN_PIXELS_PER_TASK: usize = 16384;
+
+/// Call `f(y, row)` for every `width`-long row of `out`, in parallel row bands when
+/// `threads` is true. `f` sees the same rows either way, so the output does not depend on
+/// the split.
+pub(crate) fn for_each_row<T: Send>(
+    out: &mut [T],
+    width: usize,
+    threads: bool,
+    f: impl Fn(usize, &mut [T]) + Sync + Send,
+) {
+    let width = width.max(1);
+    if threads && out.len() > width {
+        out.par_chunks_mut(width)
+            .enumerate()
+            .with_min_len((MIN_PIXELS_PER_TASK / width).max(1))
+            .for_each(|(y, row)| f(y, row));
+    } else {
+        out.chunks_mut(width)
+            .enumerate()
+            .for_each(|(y, row)| f(y, row));
+    }
+}
