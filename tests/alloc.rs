@@ -1,0 +1,75 @@
+//! The LUT renderer allocates nothing per frame after the first (single-threaded; with
+//! threads the only allocations are rayon's own job bookkeeping).
+
+use lut_core::{Projection, RenderOptions, Renderer, View};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator unchanged; only counts calls.
+#[allow(unsafe_code)]
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(p, l) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn no_allocation_per_frame_after_the_first() {
+    let map = lut_core::synth::grid_map(1024, 512, Projection::Equirect).unwrap();
+    let mut r = Renderer::new(&map);
+    let (w, h) = (320u32, 200u32);
+    let mut out = vec![0u32; (w * h) as usize];
+    let opts = RenderOptions {
+        threads: false,
+        ..RenderOptions::default()
+    };
+    // First frames build the tables (both kinds) and size the scratch.
+    for hfov in [90.0, 40.0] {
+        r.render(
+            &map,
+            View::new(0.0, 0.0, hfov).unwrap(),
+            &opts,
+            &mut out,
+            w,
+            h,
+        )
+        .unwrap();
+    }
+    let before = ALLOCS.load(Ordering::Relaxed);
+    // Turning, zooming across the table switch, looking at the poles and the seam.
+    for (yaw, pitch, hfov) in [
+        (30.0, 10.0, 90.0),
+        (180.0, 90.0, 120.0),
+        (-170.0, -89.9, 40.0),
+        (1e6, 45.0, 59.0),
+    ] {
+        r.render(
+            &map,
+            View::new(yaw, pitch, hfov).unwrap(),
+            &opts,
+            &mut out,
+            w,
+            h,
+        )
+        .unwrap();
+    }
+    let after = ALLOCS.load(Ordering::Relaxed);
+    assert_eq!(
+        after - before,
+        0,
+        "the renderer allocated {} times in 4 frames",
+        after - before
+    );
+}
