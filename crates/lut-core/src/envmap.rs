@@ -7,7 +7,7 @@
 //! `H − 1` (vertical clamp).
 
 use crate::error::MapError;
-use crate::fixed::{Fx, FX_BITS, FX_HALF};
+use crate::fixed::{Fx, FX_BITS, FX_HALF, FX_ONE};
 use crate::projection::Projection;
 use std::path::Path;
 
@@ -302,6 +302,96 @@ impl EnvMap {
         match sampler {
             Sampler::Nearest => self.nearest(u, v),
             Sampler::Bilinear => self.bilinear(u, v),
+        }
+    }
+
+    /// Sample a run of positions stepping linearly: `out[i]` = the `BILINEAR` (else
+    /// nearest) sample at (u + i·du, v + i·dv). Identical to calling [`EnvMap::bilinear`]
+    /// / [`EnvMap::nearest`] per pixel with u wrapped into [0, W) for 360° maps.
+    ///
+    /// This is the LUT renderer's inner loop. When the whole run stays inside the map
+    /// (after one wrap of its start), the loop has no clamps and no wrap tests: the
+    /// padding column and row make x + 1 and y + 1 readable at the last column and row.
+    /// Otherwise it falls back to the per-pixel functions.
+    #[inline]
+    pub fn sample_span<const BILINEAR: bool>(&self, out: &mut [u32], u: Fx, v: Fx, du: Fx, dv: Fx) {
+        let m = out.len() as i64;
+        if m == 0 {
+            return;
+        }
+        let wfx = (self.width as i64) << FX_BITS;
+        let hfx = (self.height as i64) << FX_BITS;
+        // Bilinear reads the pixel centres around (u − ½, v − ½).
+        let bias = if BILINEAR { FX_HALF } else { 0 };
+        let wraps = self.projection.wraps();
+        let mut uu = u - bias;
+        if wraps && !(0..wfx).contains(&uu) {
+            // One period off at most on the renderer's path; a division otherwise.
+            uu += if uu < 0 { wfx } else { -wfx };
+            if !(0..wfx).contains(&uu) {
+                uu = uu.rem_euclid(wfx);
+            }
+        }
+        let mut vv = v - bias;
+        let (u_end, v_end) = (uu + du * (m - 1), vv + dv * (m - 1));
+        // Nearest may read column W and row H (padding equal to the clamped pixel);
+        // bilinear needs x0, y0 ≤ W − 1, H − 1 so that x0 + 1, y0 + 1 are the padding.
+        let (u_lim, v_lim) = if BILINEAR {
+            (wfx, hfx)
+        } else {
+            (wfx + FX_ONE, hfx + FX_ONE)
+        };
+        let inside = |a: Fx, lim: Fx| a >= 0 && a < lim;
+        if !(inside(uu, u_lim) && inside(u_end, u_lim) && inside(vv, v_lim) && inside(v_end, v_lim))
+        {
+            self.sample_span_slow::<BILINEAR>(out, u, v, du, dv);
+            return;
+        }
+        let stride = self.width as usize + 1;
+        let data = &self.data[..];
+        if BILINEAR {
+            for o in out.iter_mut() {
+                let x0 = (uu >> FX_BITS) as usize;
+                let y0 = (vv >> FX_BITS) as usize;
+                let fx = ((uu >> (FX_BITS - 8)) & 0xFF) as u32;
+                let fy = ((vv >> (FX_BITS - 8)) & 0xFF) as u32;
+                let i = y0 * stride + x0;
+                let (r0, r1) = (&data[i..i + 2], &data[i + stride..i + stride + 2]);
+                let top = lerp_px(r0[0], r0[1], fx);
+                let bot = lerp_px(r1[0], r1[1], fx);
+                *o = lerp_px(top, bot, fy);
+                uu += du;
+                vv += dv;
+            }
+        } else {
+            for o in out.iter_mut() {
+                *o = data[(vv >> FX_BITS) as usize * stride + (uu >> FX_BITS) as usize];
+                uu += du;
+                vv += dv;
+            }
+        }
+    }
+
+    #[inline(never)]
+    fn sample_span_slow<const BILINEAR: bool>(
+        &self,
+        out: &mut [u32],
+        mut u: Fx,
+        mut v: Fx,
+        du: Fx,
+        dv: Fx,
+    ) {
+        let wfx = (self.width as i64) << FX_BITS;
+        let wraps = self.projection.wraps();
+        for o in out.iter_mut() {
+            let uu = if wraps { u.rem_euclid(wfx) } else { u };
+            *o = if BILINEAR {
+                self.bilinear(uu, v)
+            } else {
+                self.nearest(uu, v)
+            };
+            u += du;
+            v += dv;
         }
     }
 

@@ -31,6 +31,12 @@ pub const SPAN_ERROR_BUDGET: f64 = 0.02;
 /// Largest step the adaptive mode takes.
 pub const ADAPTIVE_MAX_STEP: u32 = 64;
 
+/// Each scanline is cut into this many regions of |X| (distance from the screen's
+/// centre column), each with its own index step: the curvature of the map coordinates
+/// peaks in one region and is small elsewhere, so a per-region step is several times
+/// longer on average than one step per scanline, at the same error bound.
+const STEP_REGIONS: usize = 8;
+
 /// Which renderer draws the frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum RendererKind {
@@ -151,7 +157,10 @@ struct Scan {
     /// sin and cos of the (unfolded) scanline angle.
     sa: f64,
     ca: f64,
-    shift: u32,
+    /// log2 of the index step per region of |X| (see [`STEP_REGIONS`]).
+    shifts: [u8; STEP_REGIONS],
+    /// Regions per unit of |X|.
+    region_per_x: f64,
     lut_lo: i64,
     lut_hi: i64,
     zone_lo: i64,
@@ -192,6 +201,18 @@ pub struct Renderer {
 /// Where a renderer writes: pixels, or (for measurement) sampling positions.
 trait Sink {
     fn put(&mut self, x: usize, u: Fx, v: Fx);
+    /// `m` pixels from `x` on at (u + i·du, v + i·dv), u wrapped per pixel into [0, W)
+    /// (`w_fx` = W in Q.16); v inside the map.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, w_fx: Fx) {
+        let (mut u, mut v) = (u, v);
+        for i in 0..m {
+            self.put(x + i, wrap_u(u, w_fx), v);
+            u += du;
+            v += dv;
+        }
+    }
     fn background(&mut self, x: usize);
     fn exact(&mut self, x: usize, uv: Option<(f64, f64)>);
 }
@@ -209,6 +230,11 @@ impl<const BILINEAR: bool> Sink for PixelSink<'_, BILINEAR> {
         } else {
             self.map.nearest(u, v)
         };
+    }
+    #[inline(always)]
+    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
+        self.map
+            .sample_span::<BILINEAR>(&mut self.row[x..x + m], u, v, du, dv);
     }
     #[inline(always)]
     fn background(&mut self, x: usize) {
@@ -494,10 +520,16 @@ impl Renderer {
                     scan.zone_hi = zh;
                     t_min = xz * scan.t_per_x;
                 }
-                let n = step_for(&bounds, a.cos().abs(), t_min, scan.t_per_x, nominal);
-                scan.shift = n.trailing_zeros();
-                max_step = max_step.max(n);
-                min_step = min_step.min(n);
+                let (sn, c) = (a.sin().abs(), a.cos().abs());
+                let reg_x = half_w / STEP_REGIONS as f64;
+                scan.region_per_x = 1.0 / reg_x;
+                for (r, shift) in scan.shifts.iter_mut().enumerate() {
+                    let (x_lo, x_hi) = (r as f64 * reg_x, (r + 1) as f64 * reg_x);
+                    let n = step_for(&bounds, (sn, c), t_min, x_lo, x_hi, scan.t_per_x, nominal);
+                    *shift = n.trailing_zeros() as u8;
+                    max_step = max_step.max(n);
+                    min_step = min_step.min(n);
+                }
             }
             exact_pixels += exact_count(&scan, width as i64);
             scans.push(scan);
@@ -562,45 +594,66 @@ struct StepBounds {
     coupling: f64,
 }
 
-/// The longest power-of-two step ≤ `nominal` whose linear-interpolation error along this
-/// scanline is bounded by [`SPAN_ERROR_BUDGET`].
+/// The longest power-of-two step ≤ `nominal` whose linear-interpolation error is bounded
+/// by [`SPAN_ERROR_BUDGET`] for every span that starts at |X| ∈ [x_lo, x_hi] (pixels from
+/// the screen's centre column) on this scanline.
 ///
-/// Along a scanline at folded angle `a` (c = cos a) the direction is (t, sin a, cos a),
-/// λ = atan2(t, c), φ = atan2(sin a, √(t²+c²)), with t = X/ρ linear in the pixel. Over
-/// |t| ≥ t_min: |λ_tt| ≤ 0.6495/c² (its peak, at t = c/√3) or 2tc/(t²+c²)² beyond the
-/// peak; |φ_tt| ≤ 1.125/√(t²+c²); |φ_t| ≤ 1. Linear interpolation over n pixels errs by
-/// at most (n·dt)²/8 · max|f''|. (Both bounds checked numerically; 10 % margin added.)
-fn step_for(b: &StepBounds, c: f64, t_min: f64, dt: f64, nominal: u32) -> u32 {
+/// Along a scanline at folded angle `a` (s = sin a, c = cos a) the direction is
+/// (t, s, c), λ = atan2(t, c), φ = atan2(s, ρ) with ρ = √(t²+c²), and t = X/ρ_screen
+/// linear in the pixel (`dt` per pixel). |λ_tt| = 2|t|c/ρ⁴ exactly: unimodal in |t|
+/// with its peak 0.6495/c² at |t| = c/√3, so its maximum over an interval is at the point
+/// of the interval nearest the peak. φ_t = −s·t/(ρ(1+t²)) and
+/// φ_tt = −s·(c²(1+t²) − 2t²ρ²)/(ρ³(1+t²)²), whose second factor is at most 1/ρ in size
+/// (checked on a dense grid of t and c): |φ_tt| ≤ s/ρ, largest at the smallest |t|, and
+/// |φ_t| ≤ s. Pixels with |t| < `t_min` are evaluated exactly (pole zone) and bound no
+/// span. A span of n pixels from |X| in [x_lo, x_hi] covers |X| ∈ [x_lo − n, x_hi + n];
+/// linear interpolation over it errs by at most (n·dt)²/8 · max|f''| there. (Bounds
+/// checked numerically; 10 % margin added.)
+fn step_for(
+    b: &StepBounds,
+    sc: (f64, f64),
+    t_min: f64,
+    x_lo: f64,
+    x_hi: f64,
+    dt: f64,
+    nominal: u32,
+) -> u32 {
+    let mut n = nominal.max(1);
+    loop {
+        let reach = n as f64;
+        let t_lo = ((x_lo - reach) * dt).max(t_min).max(0.0);
+        let t_hi = ((x_hi + reach) * dt).max(t_lo);
+        let bound = span_bound(b, sc, t_lo, t_hi);
+        let len = reach * dt;
+        if n == 1 || (bound.is_finite() && len * len / 8.0 * bound <= SPAN_ERROR_BUDGET) {
+            return n;
+        }
+        n >>= 1;
+    }
+}
+
+/// Bound on the second derivative (in source pixels per unit t²) of the map position
+/// along a scanline over |t| ∈ [t_lo, t_hi] (see [`step_for`]).
+fn span_bound(b: &StepBounds, (s, c): (f64, f64), t_lo: f64, t_hi: f64) -> f64 {
     let lam_tt = if c <= 0.0 {
-        if t_min > 0.0 {
+        if t_lo > 0.0 {
             0.0
         } else {
             f64::INFINITY
         }
-    } else if t_min <= c / 3f64.sqrt() {
-        0.6495 / (c * c)
     } else {
-        let r2 = t_min * t_min + c * c;
-        2.0 * t_min * c / (r2 * r2)
+        let t = (c / 3f64.sqrt()).clamp(t_lo, t_hi);
+        let r2 = t * t + c * c;
+        2.0 * t * c / (r2 * r2)
     };
-    let rho_min = (t_min * t_min + c * c).sqrt();
+    let rho_min = (t_lo * t_lo + c * c).sqrt();
     let phi_tt = if rho_min > 0.0 {
-        1.125 / rho_min
+        1.125 * s / rho_min
     } else {
         f64::INFINITY
     };
-    let v_tt = b.v1 * phi_tt + b.v2;
-    let bound = 1.1 * (b.lam_px * lam_tt + (1.0 + b.coupling) * v_tt);
-    if !bound.is_finite() {
-        return 1;
-    }
-    // (n dt)^2 / 8 * bound <= budget
-    let n_max = (8.0 * SPAN_ERROR_BUDGET / bound.max(1e-300)).sqrt() / dt;
-    let mut n = nominal.max(1);
-    while n > 1 && n as f64 > n_max {
-        n >>= 1;
-    }
-    n
+    let v_tt = b.v1 * phi_tt + b.v2 * s * s;
+    1.1 * (b.lam_px * lam_tt + (1.0 + b.coupling) * v_tt)
 }
 
 /// Render one scanline into `sink`.
@@ -654,8 +707,8 @@ fn read(scan: &Scan, table: &LutTable, fr: &Frame, x: i64) -> (Fx, Fx) {
     (l, v)
 }
 
-/// LUT evaluation of pixels x0..=x1: table reads every 2^shift pixels, fixed-point steps
-/// between.
+/// LUT evaluation of pixels x0..=x1: table reads every 2^shift pixels (the shift of the
+/// region the span starts in), fixed-point steps between.
 #[inline(always)]
 fn lut_run<S: Sink>(
     scan: &Scan,
@@ -669,10 +722,15 @@ fn lut_run<S: Sink>(
     if x0 > x1 {
         return;
     }
-    let n = 1i64 << scan.shift;
+    let half_w = fr.w_out as f64 * 0.5;
+    let last_region = STEP_REGIONS - 1;
     let mut xs = x0;
     let (mut l0, mut v0) = read(scan, table, fr, xs);
     loop {
+        let big_x = (xs as f64 + 0.5 - half_w).abs();
+        let region = ((big_x * scan.region_per_x) as usize).min(last_region);
+        let shift = scan.shifts[region] as u32;
+        let n = 1i64 << shift;
         let xe = (xs + n).min(x1);
         if xe == xs {
             emit(fr, row_scale, xs, 1, (l0, v0), (0, 0), sink);
@@ -688,7 +746,7 @@ fn lut_run<S: Sink>(
         }
         let m = xe - xs;
         let (dl, dv) = if m == n {
-            ((l1 - l0) >> scan.shift, (v1 - v0) >> scan.shift)
+            ((l1 - l0) >> shift, (v1 - v0) >> shift)
         } else {
             ((l1 - l0) / m, (v1 - v0) / m)
         };
@@ -739,9 +797,11 @@ fn emit<S: Sink>(
         }
         return;
     }
-    let mut u = (l + fr.off_fx).rem_euclid(fr.map_w_fx);
-    let u_end = u + dl * m as i64;
     let wfx = fr.map_w_fx;
+    let mut u = wrap_u(l + fr.off_fx, wfx);
+    if !(0..wfx).contains(&u) {
+        u = u.rem_euclid(wfx);
+    }
     if fr.coverage {
         for i in 0..m {
             let uu = wrap_u(u, wfx);
@@ -753,19 +813,8 @@ fn emit<S: Sink>(
             u += dl;
             v += dv;
         }
-    } else if u_end >= 0 && u_end < wfx {
-        // The whole span stays inside [0, W): no per-pixel wrap.
-        for i in 0..m {
-            sink.put(x + i, u, v);
-            u += dl;
-            v += dv;
-        }
     } else {
-        for i in 0..m {
-            sink.put(x + i, wrap_u(u, wfx), v);
-            u += dl;
-            v += dv;
-        }
+        sink.span(x, m, u, v, dl, dv, wfx);
     }
 }
 
