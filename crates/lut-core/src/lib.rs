@@ -42,23 +42,28 @@
 
 pub mod accuracy;
 pub mod camera;
+pub mod coverage;
 pub mod cube;
 pub mod envmap;
 pub mod error;
 pub mod exact;
 pub mod fixed;
+pub mod gpano;
 pub mod light;
 pub mod lut;
 pub mod projection;
 pub mod raster;
 mod rows;
 pub mod synth;
+pub mod viewlimit;
 
 pub use camera::{Camera, View, MAX_OUTPUT_SIDE};
+pub use coverage::{Coverage, CoverageError, CoverageSource, Crop};
 pub use envmap::{EnvMap, Sampler, Tone, MAX_MAP_PIXELS, MAX_MAP_WIDTH};
 pub use error::{MapError, ViewError};
 pub use exact::{render_exact, render_exact_supersampled};
 pub use projection::Projection;
+pub use viewlimit::limit_view;
 pub use raster::{
     IndexStep, LutChoice, RenderOptions, RenderPath, RenderReport, Renderer, RendererKind,
 };
