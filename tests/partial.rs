@@ -8,8 +8,8 @@ use lut_core::camera::{dir_to_lat_long, Camera};
 use lut_core::exact::exact_uv;
 use lut_core::gpano::{insert_xmp, xmp_packet};
 use lut_core::{
-    limit_view, Coverage, CoverageSource, EnvMap, IndexStep, Projection, RenderOptions,
-    Renderer, RendererKind, Sampler, Tone, View,
+    limit_view, Coverage, CoverageSource, EnvMap, IndexStep, Projection, RenderOptions, Renderer,
+    RendererKind, Sampler, Tone, View,
 };
 
 const FULL_W: u32 = 512;
@@ -31,8 +31,11 @@ fn tagged_jpeg(left: u32, top: u32, w: u32, h: u32, heading: Option<&str>) -> Ve
         image::Rgb(pattern((left + x) % FULL_W, top + y))
     });
     let mut jpeg = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut jpeg), image::ImageFormat::Jpeg)
-        .unwrap();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut jpeg),
+        image::ImageFormat::Jpeg,
+    )
+    .unwrap();
     let (fw, fh, l, t, cw, ch) = (
         FULL_W.to_string(),
         FULL_H.to_string(),
@@ -144,7 +147,10 @@ fn check_case(left: u32, top: u32, cw: u32, ch: u32, views: &[(f64, f64, f64)]) 
     let jpeg = tagged_jpeg(left, top, cw, ch, None);
     let partial = load_partial(&jpeg);
     let crop = partial.crop().expect("a crop");
-    assert_eq!((crop.left(), crop.top(), crop.width(), crop.height()), (left, top, cw, ch));
+    assert_eq!(
+        (crop.left(), crop.top(), crop.width(), crop.height()),
+        (left, top, cw, ch)
+    );
     assert_eq!((partial.width(), partial.height()), (FULL_W, FULL_H));
     // only the covered pixels are stored
     assert!(partial.bytes() <= ((cw + 1) * (ch + 1) * 4) as usize);
@@ -200,7 +206,12 @@ fn gpano_crop_renders_at_its_place() {
         60,
         160,
         100,
-        &[(20.0, 10.0, 90.0), (0.0, 0.0, 150.0), (-60.0, 40.0, 60.0), (170.0, 0.0, 90.0)],
+        &[
+            (20.0, 10.0, 90.0),
+            (0.0, 0.0, 150.0),
+            (-60.0, 40.0, 60.0),
+            (170.0, 0.0, 90.0),
+        ],
     );
 }
 
@@ -212,7 +223,12 @@ fn gpano_crop_straddling_the_seam_renders_at_its_place() {
         30,
         200,
         150,
-        &[(180.0, 0.0, 90.0), (-170.0, 20.0, 60.0), (150.0, -30.0, 120.0), (0.0, 0.0, 100.0)],
+        &[
+            (180.0, 0.0, 90.0),
+            (-170.0, 20.0, 60.0),
+            (150.0, -30.0, 120.0),
+            (0.0, 0.0, 100.0),
+        ],
     );
 }
 
@@ -224,7 +240,12 @@ fn full_width_crop_wraps_and_stops_at_its_rows() {
         32,
         FULL_W,
         128,
-        &[(180.0, 0.0, 90.0), (-179.0, 60.0, 120.0), (90.0, -45.0, 90.0), (0.0, 89.0, 100.0)],
+        &[
+            (180.0, 0.0, 90.0),
+            (-179.0, 60.0, 120.0),
+            (90.0, -45.0, 90.0),
+            (0.0, 89.0, 100.0),
+        ],
     );
 }
 
@@ -237,16 +258,28 @@ fn explicit_coverage_overrides_the_metadata() {
         EnvMap::decode_partial(&jpeg, "t.jpg", None, Some(cov), Tone::default()).unwrap();
     assert_eq!(src, CoverageSource::Explicit);
     let c = m.crop().unwrap();
-    assert_eq!((c.full_width(), c.full_height(), c.left(), c.top()), (512, 256, 200, 60));
+    assert_eq!(
+        (c.full_width(), c.full_height(), c.left(), c.top()),
+        (512, 256, 200, 60)
+    );
     // a different coverage puts it elsewhere and ignores the XMP
     let cov = "360x90+0+0".parse::<Coverage>().unwrap();
     let (m, _) = EnvMap::decode_partial(&jpeg, "t.jpg", None, Some(cov), Tone::default()).unwrap();
     let c = m.crop().unwrap();
-    assert_eq!((c.full_width(), c.full_height(), c.left(), c.top()), (160, 200, 0, 50));
+    assert_eq!(
+        (c.full_width(), c.full_height(), c.left(), c.top()),
+        (160, 200, 0, 50)
+    );
     // the heading comes with the metadata
     assert_eq!(load_partial(&jpeg).pose_heading_deg(), Some(123.5));
     // a coverage for a non-equirect projection is refused
-    let e = EnvMap::decode_partial(&jpeg, "t.jpg", Some(Projection::Cylinder), Some(cov), Tone::default());
+    let e = EnvMap::decode_partial(
+        &jpeg,
+        "t.jpg",
+        Some(Projection::Cylinder),
+        Some(cov),
+        Tone::default(),
+    );
     assert!(e.is_err());
 }
 
@@ -255,8 +288,11 @@ fn bad_metadata_is_a_clear_error_and_coverage_is_the_way_out() {
     // crop runs below the full panorama
     let img = image::RgbImage::from_fn(64, 32, |x, y| image::Rgb(pattern(x, y)));
     let mut jpeg = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut jpeg), image::ImageFormat::Jpeg)
-        .unwrap();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut jpeg),
+        image::ImageFormat::Jpeg,
+    )
+    .unwrap();
     let xmp = xmp_packet(&[
         ("FullPanoWidthPixels", "128"),
         ("FullPanoHeightPixels", "64"),
@@ -312,7 +348,10 @@ fn view_limit_keeps_every_border_ray_inside_at_the_seam() {
         for kind in [RendererKind::Lut, RendererKind::Exact] {
             let img = render(&map, v, kind, Sampler::Nearest);
             let bg = img.iter().filter(|&&p| p == BG).count();
-            assert_eq!(bg, 0, "{kind:?} limited view {v:?} shows {bg} background pixels");
+            assert_eq!(
+                bg, 0,
+                "{kind:?} limited view {v:?} shows {bg} background pixels"
+            );
         }
     }
 }

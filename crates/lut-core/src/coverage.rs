@@ -218,7 +218,9 @@ impl std::str::FromStr for Coverage {
     fn from_str(s: &str) -> Result<Coverage, CoverageError> {
         let syntax = |reason: &str| CoverageError::Syntax {
             text: s.to_string(),
-            reason: format!("{reason}; expected HFOVxVFOV or HFOVxVFOV±YAW±PITCH, e.g. 120x60+30-10"),
+            reason: format!(
+                "{reason}; expected HFOVxVFOV or HFOVxVFOV±YAW±PITCH, e.g. 120x60+30-10"
+            ),
         };
         let t = s.trim();
         let (h, rest) = t
@@ -385,8 +387,7 @@ impl Crop {
             su += wfx;
         }
         let sv = v - ((self.top as i64) << FX_BITS);
-        if su >= (self.width as i64) << FX_BITS || sv < 0 || sv >= (self.height as i64) << FX_BITS
-        {
+        if su >= (self.width as i64) << FX_BITS || sv < 0 || sv >= (self.height as i64) << FX_BITS {
             return None;
         }
         Some((su, sv))
@@ -425,7 +426,9 @@ impl EnvMap {
     /// Set (or clear) the compass heading of longitude 0 (see
     /// [`EnvMap::pose_heading_deg`]). Non-finite values clear it.
     pub fn set_pose_heading_deg(&mut self, heading: Option<f64>) {
-        self.pose_heading = heading.filter(|h| h.is_finite()).map(|h| h.rem_euclid(360.0));
+        self.pose_heading = heading
+            .filter(|h| h.is_finite())
+            .map(|h| h.rem_euclid(360.0));
     }
 
     /// Width of the stored pixels (the crop's width for a partial map, else
@@ -612,7 +615,10 @@ mod tests {
     #[test]
     fn grammar() {
         let c: Coverage = "120x60+30-10".parse().unwrap();
-        assert_eq!((c.hfov(), c.vfov(), c.yaw(), c.pitch()), (120.0, 60.0, 30.0, -10.0));
+        assert_eq!(
+            (c.hfov(), c.vfov(), c.yaw(), c.pitch()),
+            (120.0, 60.0, 30.0, -10.0)
+        );
         let c: Coverage = "360x90".parse().unwrap();
         assert_eq!((c.yaw(), c.pitch()), (0.0, 0.0));
         let c: Coverage = "200.5X100-170+0".parse().unwrap();
@@ -621,9 +627,24 @@ mod tests {
         assert_eq!((c.yaw(), c.pitch()), (0.0, -22.5));
         assert_eq!("10x10+540+0".parse::<Coverage>().unwrap().yaw(), 180.0);
         for bad in [
-            "", "120", "120x", "x60", "120x60+30", "120x60+30-", "120x60 30 10", "1e2x60",
-            "120x60+30-10+5", "0x60", "361x60", "120x181", "120x60+0+80", "-120x60",
-            "120x-60", "nanx60", "1..2x60", "120x60++3+4",
+            "",
+            "120",
+            "120x",
+            "x60",
+            "120x60+30",
+            "120x60+30-",
+            "120x60 30 10",
+            "1e2x60",
+            "120x60+30-10+5",
+            "0x60",
+            "361x60",
+            "120x181",
+            "120x60+0+80",
+            "-120x60",
+            "120x-60",
+            "nanx60",
+            "1..2x60",
+            "120x60++3+4",
         ] {
             let e = bad.parse::<Coverage>();
             assert!(
@@ -682,7 +703,9 @@ mod tests {
 
     fn partial(crop: Crop) -> EnvMap {
         let (w, h) = (crop.width(), crop.height());
-        let px: Vec<u32> = (0..w * h).map(|i| 0x010000 * (i % w) + 0x100 * (i / w) + 1).collect();
+        let px: Vec<u32> = (0..w * h)
+            .map(|i| 0x010000 * (i % w) + 0x100 * (i / w) + 1)
+            .collect();
         let mut m = EnvMap::from_pixels(w, h, &px, Projection::Elliptical)
             .unwrap()
             .into_partial(crop)
@@ -701,7 +724,13 @@ mod tests {
         assert_eq!(at(99.5, 29.5), m.pixel(4, 19));
         assert_eq!(at(0.5, 12.5), m.pixel(5, 2));
         assert_eq!(at(4.99, 12.5), m.pixel(9, 2));
-        for (u, v) in [(5.0, 12.5), (94.99, 12.5), (50.0, 20.0), (97.0, 9.99), (97.0, 30.0)] {
+        for (u, v) in [
+            (5.0, 12.5),
+            (94.99, 12.5),
+            (50.0, 20.0),
+            (97.0, 9.99),
+            (97.0, 30.0),
+        ] {
             assert_eq!(at(u, v), 0xABCDEF, "({u}, {v})");
             assert_eq!(m.bilinear_cropped(to_fx(u), to_fx(v)), 0xABCDEF);
         }
@@ -712,17 +741,29 @@ mod tests {
         assert_eq!(m.bilinear_cropped(to_fx(95.1), to_fx(10.1)), m.pixel(0, 0));
         assert_eq!(m.bilinear_cropped(to_fx(4.9), to_fx(29.9)), m.pixel(9, 19));
         // sample() goes through the crop
-        assert_eq!(m.sample(Sampler::Nearest, to_fx(0.5), to_fx(12.5)), m.pixel(5, 2));
-        assert_eq!(m.sample(Sampler::Bilinear, to_fx(50.0), to_fx(12.5)), 0xABCDEF);
+        assert_eq!(
+            m.sample(Sampler::Nearest, to_fx(0.5), to_fx(12.5)),
+            m.pixel(5, 2)
+        );
+        assert_eq!(
+            m.sample(Sampler::Bilinear, to_fx(50.0), to_fx(12.5)),
+            0xABCDEF
+        );
     }
 
     #[test]
     fn full_width_crop_wraps() {
         let m = partial(Crop::new(16, 20, 0, 5, 16, 6).unwrap());
         let b = m.bilinear_cropped(to_fx(0.0), to_fx(7.5));
-        assert_eq!(b, crate::envmap::lerp_px(m.pixel(15, 2), m.pixel(0, 2), 128));
+        assert_eq!(
+            b,
+            crate::envmap::lerp_px(m.pixel(15, 2), m.pixel(0, 2), 128)
+        );
         let b = m.bilinear_cropped(to_fx(15.9999), to_fx(7.5));
-        assert_eq!(b, crate::envmap::lerp_px(m.pixel(15, 2), m.pixel(0, 2), 128));
+        assert_eq!(
+            b,
+            crate::envmap::lerp_px(m.pixel(15, 2), m.pixel(0, 2), 128)
+        );
         assert_eq!(m.nearest_cropped(to_fx(3.5), to_fx(4.9)), 0xABCDEF);
         assert_eq!(m.nearest_cropped(to_fx(3.5), to_fx(11.0)), 0xABCDEF);
     }
@@ -733,7 +774,10 @@ mod tests {
         assert!(m.crop().is_none());
         assert_eq!(m.coverage(), Coverage::FULL);
         let b = m.bilinear(to_fx(0.0), to_fx(2.5));
-        assert_eq!(b, crate::envmap::lerp_px(m.pixel(15, 2), m.pixel(0, 2), 128));
+        assert_eq!(
+            b,
+            crate::envmap::lerp_px(m.pixel(15, 2), m.pixel(0, 2), 128)
+        );
     }
 
     #[test]

@@ -27,7 +27,7 @@
 //!   `image width / CroppedAreaImageWidthPixels`, provided the height agrees within 1 %;
 //!   otherwise an error.
 
-use crate::coverage::{Crop, CoverageError};
+use crate::coverage::{CoverageError, Crop};
 
 /// The GPano namespace URI.
 pub const GPANO_NS: &str = "http://ns.google.com/photos/1.0/panorama/";
@@ -129,11 +129,7 @@ impl GPano {
             }
             return Ok(());
         }
-        let name = FIELDS
-            .iter()
-            .find(|f| **f == field)
-            .copied()
-            .unwrap_or("?");
+        let name = FIELDS.iter().find(|f| **f == field).copied().unwrap_or("?");
         let heading = field == "PoseHeadingDegrees";
         let value: f64 = text.parse().map_err(|_| GPanoError::Value {
             field: name,
@@ -333,7 +329,9 @@ pub fn read_jpeg(bytes: &[u8]) -> Result<Option<GPano>, GPanoError> {
 /// segment (65502 bytes).
 pub fn insert_xmp(jpeg: &[u8], xmp: &str) -> Result<Vec<u8>, GPanoError> {
     if jpeg.len() < 2 || jpeg[0] != 0xFF || jpeg[1] != 0xD8 {
-        return Err(GPanoError::Inconsistent("not a JPEG (no SOI marker)".into()));
+        return Err(GPanoError::Inconsistent(
+            "not a JPEG (no SOI marker)".into(),
+        ));
     }
     let len = 2 + XMP_SIGNATURE.len() + xmp.len();
     let len = u16::try_from(len)
@@ -411,14 +409,20 @@ mod tests {
         ]);
         let mut jpeg = Vec::new();
         image::RgbImage::new(300, 200)
-            .write_to(&mut std::io::Cursor::new(&mut jpeg), image::ImageFormat::Jpeg)
+            .write_to(
+                &mut std::io::Cursor::new(&mut jpeg),
+                image::ImageFormat::Jpeg,
+            )
             .unwrap();
         let tagged = insert_xmp(&jpeg, &xmp).unwrap();
         let g = read_jpeg(&tagged).unwrap().unwrap();
         assert_eq!(g.cropped_area_left_pixels, Some(100.0));
         assert_eq!(g.pose_heading_degrees, None);
         let c = g.crop_for_image(300, 200).unwrap();
-        assert_eq!((c.left(), c.top(), c.width(), c.height()), (100, 50, 300, 200));
+        assert_eq!(
+            (c.left(), c.top(), c.width(), c.height()),
+            (100, 50, 300, 200)
+        );
         // the image still decodes
         assert!(image::load_from_memory(&tagged).is_ok());
         // untagged JPEG and non-JPEG bytes: nothing
@@ -432,14 +436,20 @@ mod tests {
         let plain = r#"<x:xmpmeta xmlns:x="adobe:ns:meta/"><a xmlns:dc="http://purl.org/dc/elements/1.1/" dc:format="image/jpeg"/></x:xmpmeta>"#;
         assert_eq!(GPano::from_xmp(plain).unwrap(), None);
         // unrelated, broken: nothing (does not stop the file opening)
-        assert_eq!(GPano::from_xmp("<x:xmpmeta><oops></x:xmpmeta>").unwrap(), None);
+        assert_eq!(
+            GPano::from_xmp("<x:xmpmeta><oops></x:xmpmeta>").unwrap(),
+            None
+        );
         // broken and about GPano: an error
         let e = GPano::from_xmp("<a GPano:FullPanoWidthPixels='1'>").unwrap_err();
         assert!(matches!(e, GPanoError::Xml(_)));
         // trailing NULs and padding are fine
         let padded = format!("{}\n   \0\0", xmp_packet(&[("PoseHeadingDegrees", "10")]));
         assert_eq!(
-            GPano::from_xmp(&padded).unwrap().unwrap().pose_heading_degrees,
+            GPano::from_xmp(&padded)
+                .unwrap()
+                .unwrap()
+                .pose_heading_degrees,
             Some(10.0)
         );
     }
