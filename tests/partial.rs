@@ -20,7 +20,11 @@ const BG: u32 = 0xFE01FE;
 /// A recognisable full panorama: red follows longitude, green latitude, blue a 32-px
 /// checker.
 fn pattern(x: u32, y: u32) -> [u8; 3] {
-    let b = if (x / 32 + y / 32) % 2 == 0 { 40 } else { 200 };
+    let b = if (x / 32 + y / 32).is_multiple_of(2) {
+        40
+    } else {
+        200
+    };
     [(x / 2) as u8, y as u8, b]
 }
 

@@ -594,6 +594,25 @@ impl EnvMap {
     }
 }
 
+/// Compass heading (degrees clockwise from north, [0, 360)) of the view centre at `yaw`
+/// for a map whose longitude 0 faces `pose_heading` (GPano `PoseHeadingDegrees`, see
+/// [`EnvMap::pose_heading_deg`]): yaw stays relative to the map; positive yaw turns
+/// right, which is clockwise seen from above, so the heading is the sum.
+pub fn compass_heading(pose_heading: f64, yaw: f64) -> f64 {
+    let h = (pose_heading + yaw).rem_euclid(360.0);
+    if h >= 360.0 {
+        0.0
+    } else {
+        h
+    }
+}
+
+/// The nearest of the eight compass points (N, NE, … NW) to heading `h` in degrees.
+pub fn compass_point(h: f64) -> &'static str {
+    const POINTS: [&str; 8] = ["N", "NE", "E", "SE", "S", "SW", "W", "NW"];
+    POINTS[((h.rem_euclid(360.0) + 22.5) / 45.0) as usize % 8]
+}
+
 /// Image size from the header, without decoding.
 fn image_dimensions(bytes: &[u8], what: &str) -> Result<(u32, u32), MapError> {
     let decode_err = |reason: String| MapError::Decode {
@@ -785,6 +804,18 @@ mod tests {
         let m = EnvMap::from_pixels(4, 4, &[0; 16], Projection::Cylinder).unwrap();
         let e = m.into_partial(Crop::new(100, 50, 0, 0, 5, 4).unwrap());
         assert!(matches!(e, Err(CoverageError::Invalid { .. })));
+    }
+
+    #[test]
+    fn heading_adds_the_pose_and_wraps() {
+        assert_eq!(compass_heading(350.0, 20.0), 10.0);
+        assert_eq!(compass_heading(90.0, -90.0), 0.0);
+        assert_eq!(compass_heading(0.0, 180.0), 180.0);
+        assert_eq!(compass_heading(-45.0, 0.0), 315.0);
+        assert_eq!(compass_point(0.0), "N");
+        assert_eq!(compass_point(350.0), "N");
+        assert_eq!(compass_point(213.0), "SW");
+        assert_eq!(compass_point(-90.0), "W");
     }
 
     #[test]

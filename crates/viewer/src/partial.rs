@@ -2,6 +2,7 @@
 //! the panel and `viewer render -v` show (coverage, compass heading).
 
 use anyhow::{Context, Result};
+use lut_core::coverage::{compass_heading, compass_point};
 use lut_core::{Coverage, CoverageSource, EnvMap, Projection, Tone};
 use std::path::Path;
 
@@ -74,24 +75,6 @@ pub fn coverage_text(map: &EnvMap) -> Option<String> {
     ))
 }
 
-/// Compass heading (degrees clockwise from north, [0, 360)) of the view centre at `yaw`
-/// for a map whose longitude 0 faces `pose_heading` (GPano `PoseHeadingDegrees`): yaw
-/// stays relative to the map, the heading adds the pose.
-pub fn compass_heading(pose_heading: f64, yaw: f64) -> f64 {
-    let h = (pose_heading + yaw).rem_euclid(360.0);
-    if h >= 360.0 {
-        0.0
-    } else {
-        h
-    }
-}
-
-/// The nearest of the eight compass points to heading `h` (degrees).
-pub fn compass_point(h: f64) -> &'static str {
-    const POINTS: [&str; 8] = ["N", "NE", "E", "SE", "S", "SW", "W", "NW"];
-    POINTS[((h.rem_euclid(360.0) + 22.5) / 45.0) as usize % 8]
-}
-
 /// "heading 213° (SW)" for the view centre, when the map knows its heading.
 pub fn heading_text(map: &EnvMap, yaw: f64) -> Option<String> {
     let h = compass_heading(map.pose_heading_deg()?, yaw);
@@ -101,14 +84,6 @@ pub fn heading_text(map: &EnvMap, yaw: f64) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn heading_adds_the_pose_and_wraps() {
-        assert_eq!(compass_heading(350.0, 20.0), 10.0);
-        assert_eq!(compass_heading(90.0, -90.0), 0.0);
-        assert_eq!(compass_heading(0.0, 180.0), 180.0);
-        assert_eq!(compass_heading(-45.0, 0.0), 315.0);
-    }
 
     #[test]
     fn coverage_flag_errors_name_the_text() {

@@ -32,7 +32,11 @@ fn tagged(dir: &Path, xmp_fields: &[(&str, &str)]) -> PathBuf {
         image::Rgb([
             40 + (x / 2) as u8,
             40 + y as u8,
-            if (x / 20 + y / 20) % 2 == 0 { 60 } else { 200 },
+            if (x / 20 + y / 20).is_multiple_of(2) {
+                60
+            } else {
+                200
+            },
         ])
     });
     let mut jpeg = Vec::new();

@@ -224,10 +224,10 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
         row("pitch", format!("{:8.2}°", m.look.pitch));
         row("hfov", format!("{:8.2}°", m.look.hfov));
         if let Some(p) = r.pose_heading {
-            let h = crate::partial::compass_heading(p, m.look.yaw);
+            let h = lut_core::coverage::compass_heading(p, m.look.yaw);
             row(
                 "heading",
-                format!("{h:8.2}° {}", crate::partial::compass_point(h)),
+                format!("{h:8.2}° {}", lut_core::coverage::compass_point(h)),
             );
         }
         row("in use", in_use_label(r).into());
