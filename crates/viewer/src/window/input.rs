@@ -1077,6 +1077,56 @@ mod tests {
     }
 
     #[test]
+    fn view_limit_holds_against_keys_zoom_and_reset() {
+        // 100° x 50° across the seam (yaw 130 to -130), a 200x100 scene
+        let cov = lut_core::Coverage::new(100.0, 50.0, 180.0, 0.0).unwrap();
+        let size = (200, 100);
+        let inside =
+            |c: &Controller| lut_core::viewlimit::view_inside(c.look().view(), 200, 100, &cov);
+        let mut c = Controller::default();
+        c.set_limit(Some((cov, size)));
+        // the home view (yaw 0, hfov 90) cannot fit: pulled in, narrowed
+        assert!(inside(&c), "{:?}", c.look());
+        assert!(c.look().hfov < 90.0);
+        c.frame(0.0);
+        for held in [
+            Held {
+                right: true,
+                ..Held::default()
+            },
+            Held {
+                up: true,
+                ..Held::default()
+            },
+            Held {
+                left: true,
+                down: true,
+                ..Held::default()
+            },
+            Held {
+                zoom_out: true,
+                ..Held::default()
+            },
+        ] {
+            c.set_held(held, 0.0);
+            for i in 1..=300 {
+                c.frame(f64::from(i) / 60.0);
+                assert!(inside(&c), "{held:?} frame {i}: {:?}", c.look());
+            }
+            c.set_held(Held::default(), 5.0);
+            c.frame(0.0);
+        }
+        c.key(KeyAction::Reset);
+        c.frame(6.0);
+        assert!(inside(&c));
+        // switched off: the view may leave
+        c.set_limit(None);
+        c.key(KeyAction::Reset);
+        c.frame(7.0);
+        assert_eq!(c.look(), Look::default());
+    }
+
+    #[test]
     fn held_zoom_buttons_and_clamping() {
         let mut c = Controller::default();
         c.frame(0.0);
