@@ -359,3 +359,37 @@ fn view_limit_keeps_every_border_ray_inside_at_the_seam() {
         }
     }
 }
+
+/// `--coverage` need not give square pixels (e.g. `360x90` on a 1000×500 image makes a
+/// 1000×1000 full panorama). The LUT renderer's sampling positions on such geometries
+/// stay within the project's 0.05 px bound of the exact ones.
+#[test]
+fn non_square_pixel_geometry_keeps_the_lut_bound() {
+    use lut_core::accuracy::compare_positions;
+    for (mw, mh) in [(640u32, 160u32), (400, 400), (300, 600)] {
+        let mut r = Renderer::default();
+        for (yaw, pitch, hfov) in [
+            (0.0, 0.0, 90.0),
+            (179.0, 30.0, 120.0),
+            (-90.0, 85.0, 60.0),
+            (45.0, -89.0, 100.0),
+            (180.0, 10.0, 20.0),
+        ] {
+            let view = View::new(yaw, pitch, hfov).unwrap();
+            let opts = RenderOptions {
+                index_step: IndexStep::Fixed(4),
+                ..RenderOptions::default()
+            };
+            let (pos, _) = r
+                .positions(mw, mh, Projection::Equirect, view, &opts, 160, 90)
+                .unwrap();
+            let st = compare_positions(&pos, view, 160, 90, Projection::Equirect, mw, mh);
+            assert!(
+                st.max <= 0.05 && st.coverage_mismatch == 0,
+                "{mw}x{mh} map, {view:?}: max error {} px at {:?}",
+                st.max,
+                st.worst_pixel
+            );
+        }
+    }
+}
