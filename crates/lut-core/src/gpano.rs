@@ -22,6 +22,9 @@
 //!   `ProjectionType` other than equirectangular, an incomplete set of crop fields, or a
 //!   crop outside the full panorama: an error naming the field;
 //! * `FullPanoHeightPixels` missing: half the full width (a 2:1 panorama);
+//! * `CroppedAreaLeftPixels` at or past the full width: taken modulo the width (longitude
+//!   wraps), and a crop running past the right edge continues at column 0 (it straddles
+//!   the ±180° seam);
 //! * an image whose size differs from `CroppedAreaImage{Width,Height}Pixels` (the usual
 //!   case after resizing a phone panorama): every pixel value is scaled by
 //!   `image width / CroppedAreaImageWidthPixels`, provided the height agrees within 1 %;

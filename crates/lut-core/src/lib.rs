@@ -19,6 +19,11 @@
 //! 5. Nearest or bilinear sampling (FIG. 10) writes 0RGB pixels into the caller's buffer,
 //!    optionally in row bands across threads (byte-identical to one thread).
 //!
+//! Partial panoramas ([`coverage`], [`gpano`], [`viewlimit`]): a map may store only the
+//! pixels of the area it covers plus their place in the full panorama (GPano XMP or an
+//! explicit [`Coverage`]); renderers keep the full geometry and sampling returns the
+//! background outside the crop; [`limit_view`] keeps a view inside the covered area.
+//!
 //! ## Conventions (`conventions.md`, followed exactly)
 //! * yaw ψ positive turns right (toward increasing longitude), any real value, reduced
 //!   mod 360°; pitch θ positive looks up, clamped to [−90°, 90°]; hfov is the horizontal
