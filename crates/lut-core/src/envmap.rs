@@ -54,12 +54,19 @@ impl std::str::FromStr for Sampler {
 /// An environment map: pixels plus the projection that tells how to read them.
 #[derive(Clone)]
 pub struct EnvMap {
-    width: u32,
-    height: u32,
-    projection: Projection,
+    /// Stored width (the crop's width for a partial map).
+    pub(crate) width: u32,
+    /// Stored height.
+    pub(crate) height: u32,
+    pub(crate) projection: Projection,
     /// (width + 1) × (height + 1) pixels, row-major, padded as described in the module docs.
     data: Vec<u32>,
-    background: u32,
+    pub(crate) background: u32,
+    /// For a partial panorama: where the stored pixels sit in the full one (see
+    /// [`crate::coverage`]).
+    pub(crate) crop: Option<crate::coverage::Crop>,
+    /// Compass heading of longitude 0 (GPano `PoseHeadingDegrees`).
+    pub(crate) pose_heading: Option<f64>,
 }
 
 impl std::fmt::Debug for EnvMap {
@@ -68,6 +75,7 @@ impl std::fmt::Debug for EnvMap {
             .field("width", &self.width)
             .field("height", &self.height)
             .field("projection", &self.projection)
+            .field("crop", &self.crop)
             .finish()
     }
 }
@@ -142,6 +150,8 @@ impl EnvMap {
             projection,
             data,
             background: 0,
+            crop: None,
+            pose_heading: None,
         })
     }
 
@@ -257,13 +267,14 @@ impl EnvMap {
         EnvMap::from_image_toned(&img, projection, tone)
     }
 
-    /// Width in pixels.
+    /// Width in pixels: the full panorama's width, which every renderer's geometry uses
+    /// (for a partial map the stored pixels are narrower: [`EnvMap::crop`]).
     pub fn width(&self) -> u32 {
-        self.width
+        self.crop.map_or(self.width, |c| c.full_width())
     }
-    /// Height in pixels.
+    /// Height in pixels (the full panorama's, as [`EnvMap::width`]).
     pub fn height(&self) -> u32 {
-        self.height
+        self.crop.map_or(self.height, |c| c.full_height())
     }
     /// The projection.
     pub fn projection(&self) -> Projection {
@@ -282,7 +293,8 @@ impl EnvMap {
         self.data.len() * 4
     }
 
-    /// Source pixel (x, y), `x < W`, `y < H`.
+    /// Stored pixel (x, y), `x < W`, `y < H` (for a partial map: of the stored crop,
+    /// `x <` [`EnvMap::stored_width`]).
     #[inline]
     pub fn pixel(&self, x: u32, y: u32) -> u32 {
         self.data[y as usize * (self.width as usize + 1) + x as usize]
@@ -296,9 +308,13 @@ impl EnvMap {
     }
 
     /// Sample at (u, v) (Q.16 map coordinates; u is expected in [0, W) for wrapping maps
-    /// and is clamped otherwise).
+    /// and is clamped otherwise). For a partial map, (u, v) are full-panorama
+    /// coordinates and uncovered positions give the background.
     #[inline(always)]
     pub fn sample(&self, sampler: Sampler, u: Fx, v: Fx) -> u32 {
+        if self.crop.is_some() {
+            return self.sample_cropped(sampler, u, v);
+        }
         match sampler {
             Sampler::Nearest => self.nearest(u, v),
             Sampler::Bilinear => self.bilinear(u, v),
@@ -395,7 +411,8 @@ impl EnvMap {
         }
     }
 
-    /// Nearest: the pixel containing (u, v), clamped into the image.
+    /// Nearest: the pixel containing (u, v), clamped into the image. (u, v) are stored
+    /// coordinates: for a partial map use [`EnvMap::nearest_cropped`].
     #[inline(always)]
     pub fn nearest(&self, u: Fx, v: Fx) -> u32 {
         let w = self.width as i64;
@@ -406,7 +423,8 @@ impl EnvMap {
     }
 
     /// Bilinear over the four pixel centers around (u − ½, v − ½), 8-bit weights;
-    /// wraps in u for 360° maps, clamps otherwise and in v.
+    /// wraps in u for 360° maps, clamps otherwise and in v. (u, v) are stored
+    /// coordinates: for a partial map use [`EnvMap::bilinear_cropped`].
     #[inline(always)]
     pub fn bilinear(&self, u: Fx, v: Fx) -> u32 {
         let w = self.width as i64;

@@ -19,6 +19,11 @@
 //! 5. Nearest or bilinear sampling (FIG. 10) writes 0RGB pixels into the caller's buffer,
 //!    optionally in row bands across threads (byte-identical to one thread).
 //!
+//! Partial panoramas ([`coverage`], [`gpano`], [`viewlimit`]): a map may store only the
+//! pixels of the area it covers plus their place in the full panorama (GPano XMP or an
+//! explicit [`Coverage`]); renderers keep the full geometry and sampling returns the
+//! background outside the crop; [`limit_view`] keeps a view inside the covered area.
+//!
 //! ## Conventions (`conventions.md`, followed exactly)
 //! * yaw ψ positive turns right (toward increasing longitude), any real value, reduced
 //!   mod 360°; pitch θ positive looks up, clamped to [−90°, 90°]; hfov is the horizontal
@@ -42,19 +47,23 @@
 
 pub mod accuracy;
 pub mod camera;
+pub mod coverage;
 pub mod cube;
 pub mod envmap;
 pub mod error;
 pub mod exact;
 pub mod fixed;
+pub mod gpano;
 pub mod light;
 pub mod lut;
 pub mod projection;
 pub mod raster;
 mod rows;
 pub mod synth;
+pub mod viewlimit;
 
 pub use camera::{Camera, View, MAX_OUTPUT_SIDE};
+pub use coverage::{Coverage, CoverageError, CoverageSource, Crop};
 pub use envmap::{EnvMap, Sampler, Tone, MAX_MAP_PIXELS, MAX_MAP_WIDTH};
 pub use error::{MapError, ViewError};
 pub use exact::{render_exact, render_exact_supersampled};
@@ -62,3 +71,4 @@ pub use projection::Projection;
 pub use raster::{
     IndexStep, LutChoice, RenderOptions, RenderPath, RenderReport, Renderer, RendererKind,
 };
+pub use viewlimit::limit_view;

@@ -251,6 +251,38 @@ impl<const BILINEAR: bool> Sink for PixelSink<'_, BILINEAR> {
     }
 }
 
+/// [`PixelSink`] for a partial map (see [`crate::coverage`]): full-panorama (u, v) are
+/// looked up in the crop, background outside. A separate sink so the full-map kernel
+/// keeps no per-pixel crop test.
+struct CropSink<'a, const BILINEAR: bool> {
+    row: &'a mut [u32],
+    map: &'a EnvMap,
+}
+
+impl<const BILINEAR: bool> Sink for CropSink<'_, BILINEAR> {
+    #[inline(always)]
+    fn put(&mut self, x: usize, u: Fx, v: Fx) {
+        self.row[x] = if BILINEAR {
+            self.map.bilinear_cropped(u, v)
+        } else {
+            self.map.nearest_cropped(u, v)
+        };
+    }
+    #[inline(always)]
+    fn background(&mut self, x: usize) {
+        self.row[x] = self.map.background();
+    }
+    #[inline]
+    fn exact(&mut self, x: usize, uv: Option<(f64, f64)>) {
+        let s = if BILINEAR {
+            Sampler::Bilinear
+        } else {
+            Sampler::Nearest
+        };
+        self.row[x] = crate::exact::sample_at(self.map, s, uv);
+    }
+}
+
 struct PosSink<'a> {
     row: &'a mut [Option<(f64, f64)>],
 }
@@ -355,6 +387,19 @@ impl Renderer {
         let row_scale = &self.row_scale[..];
         let w = width as usize;
         let bilinear = opts.sampler == Sampler::Bilinear;
+        if map.crop().is_some() {
+            for_each_row(out, w, opts.threads, |y, row| {
+                let scan = &scans[y];
+                if bilinear {
+                    let mut s = CropSink::<true> { row, map };
+                    render_row(scan, table, &frame, row_scale, &mut s);
+                } else {
+                    let mut s = CropSink::<false> { row, map };
+                    render_row(scan, table, &frame, row_scale, &mut s);
+                }
+            });
+            return Ok(report);
+        }
         for_each_row(out, w, opts.threads, |y, row| {
             let scan = &scans[y];
             if bilinear {

@@ -15,6 +15,7 @@ mod cli_common;
 mod convert_cmd;
 mod cube_cmd;
 mod ies_cmd;
+mod partial;
 mod render_cmd;
 mod window;
 
@@ -37,7 +38,7 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Render one view of a panorama to a PNG file.
-    Render(render_cmd::RenderArgs),
+    Render(Box<render_cmd::RenderArgs>),
     /// Convert equirect <-> cube maps.
     Convert(convert_cmd::ConvertArgs),
     /// Summarize an IES LM-63 file and sample its candela distribution.
@@ -49,7 +50,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Some(Command::Render(a)) => render_cmd::run(a),
+        Some(Command::Render(a)) => render_cmd::run(*a),
         Some(Command::Convert(a)) => convert_cmd::run(a),
         Some(Command::Ies(a)) => ies_cmd::run(a),
         Some(Command::Bench(a)) => bench_cmd::run(a),

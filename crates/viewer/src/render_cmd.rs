@@ -1,6 +1,6 @@
 //! `viewer render`: one view of a panorama to a PNG, headless.
 
-use crate::cli_common::{load_panorama_toned, parse_angle, parse_size, write_png_atomic};
+use crate::cli_common::{parse_angle, parse_size, write_png_atomic};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use lut_core::lut::Surface;
@@ -132,6 +132,15 @@ pub struct RenderArgs {
     /// curve x/(1+x) and sRGB. 8-bit images are shown as stored.
     #[arg(long, default_value = "0", value_parser = parse_stops, allow_hyphen_values = true)]
     pub exposure: f64,
+    /// The area the image covers, for partial panoramas: HFOVxVFOV[±YAW±PITCH] in
+    /// degrees (e.g. 120x60+30-10: 120 x 60 centred on yaw 30, pitch -10). Overrides
+    /// GPano XMP metadata in the file. Equirectangular images only.
+    #[arg(long, value_name = "HFOVxVFOV[±YAW±PITCH]", value_parser = crate::partial::parse_coverage, allow_hyphen_values = true)]
+    pub coverage: Option<lut_core::Coverage>,
+    /// Keep the view inside the covered area of a partial panorama: reduce hfov if the
+    /// view is larger than the coverage, then clamp pitch and yaw.
+    #[arg(long)]
+    pub view_limit: bool,
     /// Render on one thread.
     #[arg(long)]
     pub single_thread: bool,
@@ -193,7 +202,7 @@ impl RenderArgs {
 
 /// Run `viewer render`.
 pub fn run(a: RenderArgs) -> Result<()> {
-    let view = View::new(a.yaw, a.pitch, a.hfov).context("invalid view")?;
+    let mut view = View::new(a.yaw, a.pitch, a.hfov).context("invalid view")?;
     let (w, h) = a.size;
     let cube = match a.projection {
         ProjectionArg::Cube => true,
@@ -205,6 +214,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let mut out = vec![0u32; w as usize * h as usize];
     let sampler = a.options().sampler;
     if cube {
+        if a.coverage.is_some() {
+            anyhow::bail!("--coverage applies to equirectangular panoramas, not cube maps");
+        }
         let cube =
             crate::cube_cmd::load_cube(&a.panorama, a.layout.as_deref(), a.naming.as_deref())?;
         let kind = match a.cube_renderer {
@@ -232,7 +244,15 @@ pub fn run(a: RenderArgs) -> Result<()> {
         let tone = lut_core::Tone {
             exposure_ev: a.exposure,
         };
-        let map = load_panorama_toned(a.panorama.first().map(|p| p.as_path()), projection, tone)?;
+        let (map, _) = crate::partial::load_panorama_partial(
+            a.panorama.first().map(|p| p.as_path()),
+            projection,
+            tone,
+            a.coverage,
+        )?;
+        if a.view_limit {
+            view = lut_core::limit_view(view, w, h, &map.coverage());
+        }
         let opts = a.options();
         let mut renderer = Renderer::new(&map);
         let report = renderer.render(&map, view, &opts, &mut out, w, h)?;
@@ -251,6 +271,20 @@ pub fn run(a: RenderArgs) -> Result<()> {
                 report.min_step,
                 report.max_step
             );
+            if let Some(c) = crate::partial::coverage_text(&map) {
+                eprintln!("partial panorama: {c}");
+            }
+            if a.view_limit {
+                eprintln!(
+                    "view (limited): yaw {:.4} pitch {:.4} hfov {:.4}",
+                    view.yaw_deg(),
+                    view.pitch_deg(),
+                    view.hfov_deg()
+                );
+            }
+            if let Some(hd) = crate::partial::heading_text(&map, view.yaw_deg()) {
+                eprintln!("view centre {hd}");
+            }
         }
     }
     crate::ies_cmd::apply_lights(&a.lights, view, &mut out, w, h)?;

@@ -148,6 +148,7 @@ fn load(
     projection: Option<Projection>,
     naming: Option<&str>,
     tone: Tone,
+    coverage: Option<lut_core::Coverage>,
 ) -> Result<Box<Loaded>, String> {
     let hdr = matches!(&source, Source::File(p) if super::export::is_hdr_path(p));
     let map = match &source {
@@ -165,7 +166,9 @@ fn load(
         }
         Source::Sample => {
             let _ = proxy.send_event(UserEvent::Decoding { id });
-            crate::cli_common::load_panorama(None, projection).map_err(|e| format!("{e:#}"))?
+            crate::partial::load_panorama_partial(None, projection, Tone::default(), coverage)
+                .map_err(|e| format!("{e:#}"))?
+                .0
         }
         Source::File(p) => {
             let bytes = read_with_progress(p, |done, total| {
@@ -174,8 +177,16 @@ fn load(
             let _ = proxy.send_event(UserEvent::Decoding { id });
             // The same decoding as `EnvMap::load` (and so as `viewer render
             // --exposure`); 8-bit images ignore the tone.
-            EnvMap::decode_toned(&bytes, &p.display().to_string(), projection, tone)
-                .map_err(|e| e.to_string())?
+            // Partial panoramas: GPano XMP or the command line's --coverage.
+            crate::partial::decode_panorama(
+                &bytes,
+                &p.display().to_string(),
+                projection,
+                tone,
+                coverage,
+            )
+            .map_err(|e| format!("{e:#}"))?
+            .0
         }
     };
     let renderer = Renderer::new(&map);
@@ -256,6 +267,8 @@ struct App {
     /// Paths dropped since the last event batch: one drop of several items arrives as one
     /// event per item, and they open together (six face files are one cube map).
     pending_drops: Vec<PathBuf>,
+    /// `--coverage`, for the source given on the command line only.
+    coverage: Option<(Source, lut_core::Coverage)>,
 }
 
 /// Open the window and run until it is closed.
@@ -296,7 +309,9 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         naming: args.naming.clone(),
         lights,
         pending_drops: Vec::new(),
+        coverage: None,
     };
+    app.ctl.settings.view_limit = !args.no_view_limit;
     app.ctl.settings.cube_renderer = match args.cube_renderer {
         CubeRendererArg::Basic => CubeRenderer::Basic,
         CubeRendererArg::Scanline => CubeRenderer::Accelerated,
@@ -313,7 +328,9 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
     } else {
         args.panorama.first().cloned().map(Source::File)
     };
-    app.start_load(source.unwrap_or(Source::Sample), projection);
+    let source = source.unwrap_or(Source::Sample);
+    app.coverage = args.coverage.map(|c| (source.clone(), c));
+    app.start_load(source, projection);
     event_loop
         .run_app(&mut app)
         .map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
@@ -373,10 +390,23 @@ impl App {
         let tone = Tone {
             exposure_ev: self.ctl.settings.exposure_ev,
         };
+        let coverage = self
+            .coverage
+            .as_ref()
+            .filter(|(s, _)| *s == source)
+            .map(|(_, c)| *c);
         let spawned = std::thread::Builder::new()
             .name("viewer-load".into())
             .spawn(move || {
-                let result = load(&proxy, id, source, projection, naming.as_deref(), tone);
+                let result = load(
+                    &proxy,
+                    id,
+                    source,
+                    projection,
+                    naming.as_deref(),
+                    tone,
+                    coverage,
+                );
                 let _ = proxy.send_event(UserEvent::Done { id, result });
             });
         if let Err(e) = spawned {
@@ -429,6 +459,17 @@ impl App {
                             self.projection_source = Some(loaded.source.clone());
                         }
                         self.readouts.hdr = loaded.hdr;
+                        let map = match &loaded.scene {
+                            Scene::Map { map, .. } => Some(map),
+                            Scene::Cube(_) => None,
+                        };
+                        self.readouts.partial = map.and_then(crate::partial::coverage_text);
+                        self.readouts.pose_heading = map.and_then(EnvMap::pose_heading_deg);
+                        if self.print_view {
+                            if let Some(p) = &self.readouts.partial {
+                                println!("partial {p}");
+                            }
+                        }
                         self.current = Some(loaded);
                         self.map_generation += 1;
                     }
@@ -818,6 +859,18 @@ impl App {
         }
     }
 
+    /// The view limit for this frame: a partial map's coverage at the scene's size, when
+    /// the panel's "Keep the view inside" is on.
+    fn view_limit(&self, rect: Option<SceneRect>) -> Option<(lut_core::Coverage, (u32, u32))> {
+        let r = rect?;
+        match &self.current.as_ref()?.scene {
+            Scene::Map { map, .. } if self.ctl.settings.view_limit && map.crop().is_some() => {
+                Some((map.coverage(), (r.w, r.h)))
+            }
+            _ => None,
+        }
+    }
+
     /// Light the freshly rendered scene (as `viewer render --light ...` does); a scene
     /// that cannot be built (a light outside the room) is reported in the panel and the
     /// frame is left unlit.
@@ -874,6 +927,7 @@ impl App {
         let mut req = FrameRequests::default();
         let full = ctx.run_ui(raw, |ui| req = self.build_ui(ui, t, (w, h)));
         self.apply_requests(&req, t, el);
+        self.ctl.set_limit(self.view_limit(req.scene_rect));
         let frame = self.ctl.frame(t);
         let mut ui_ms = ui_t0.elapsed().as_secs_f64() * 1e3;
         if let Some(r) = req.scene_rect {

@@ -145,6 +145,8 @@ pub struct Settings {
     pub exposure_ev: f64,
     /// "Save view…": the export is the scene's size times this (1, 2 or 4).
     pub export_scale: u32,
+    /// Partial panoramas: keep the view's edges inside the covered area.
+    pub view_limit: bool,
 }
 
 impl Default for Settings {
@@ -161,6 +163,7 @@ impl Default for Settings {
             cube_renderer: CubeRenderer::Accelerated,
             exposure_ev: 0.0,
             export_scale: 1,
+            view_limit: true,
         }
     }
 }
@@ -420,6 +423,8 @@ pub struct Controller {
     prev_frame: Option<(f64, Look)>,
     fast_until: f64,
     last_frame_fast: bool,
+    /// The view limit in force: the covered area and the scene size it holds for.
+    limit: Option<(lut_core::Coverage, (u32, u32))>,
 }
 
 impl Controller {
@@ -437,6 +442,35 @@ impl Controller {
             prev_frame: None,
             fast_until: f64::NEG_INFINITY,
             last_frame_fast: false,
+            limit: None,
+        }
+    }
+
+    /// Keep every edge of a `size` scene inside `coverage` from now on (`None`: no
+    /// limit), and pull the current view in at once (`lut_core::limit_view`).
+    pub fn set_limit(&mut self, limit: Option<(lut_core::Coverage, (u32, u32))>) {
+        self.limit = limit;
+        self.apply_limit();
+    }
+
+    /// Apply the view limit; motion that ran into it stops in that direction.
+    fn apply_limit(&mut self) {
+        let Some((cov, (w, h))) = self.limit else {
+            return;
+        };
+        if w == 0 || h == 0 {
+            return;
+        }
+        let v = lut_core::limit_view(self.look.view(), w, h, &cov);
+        let l = Look::new(v.yaw_deg(), v.pitch_deg(), v.hfov_deg());
+        if l != self.look {
+            if l.yaw != self.look.yaw {
+                self.velocity.0 = 0.0;
+            }
+            if l.pitch != self.look.pitch {
+                self.velocity.1 = 0.0;
+            }
+            self.look = l;
         }
     }
 
@@ -634,6 +668,7 @@ impl Controller {
     /// whether this frame may be rendered cheaply.
     pub fn frame(&mut self, t: f64) -> Frame {
         self.tick(t);
+        self.apply_limit();
         if let Some((t0, prev)) = self.prev_frame {
             let dt = t - t0;
             if dt > 0.0 && prev != self.look {
@@ -1038,6 +1073,56 @@ mod tests {
         c.key(KeyAction::ZoomIn);
         close(c.look().hfov, 90.0 / ZOOM_PER_NOTCH, 1e-12, "+ key");
         c.key(KeyAction::Reset);
+        assert_eq!(c.look(), Look::default());
+    }
+
+    #[test]
+    fn view_limit_holds_against_keys_zoom_and_reset() {
+        // 100° x 50° across the seam (yaw 130 to -130), a 200x100 scene
+        let cov = lut_core::Coverage::new(100.0, 50.0, 180.0, 0.0).unwrap();
+        let size = (200, 100);
+        let inside =
+            |c: &Controller| lut_core::viewlimit::view_inside(c.look().view(), 200, 100, &cov);
+        let mut c = Controller::default();
+        c.set_limit(Some((cov, size)));
+        // the home view (yaw 0, hfov 90) cannot fit: pulled in, narrowed
+        assert!(inside(&c), "{:?}", c.look());
+        assert!(c.look().hfov < 90.0);
+        c.frame(0.0);
+        for held in [
+            Held {
+                right: true,
+                ..Held::default()
+            },
+            Held {
+                up: true,
+                ..Held::default()
+            },
+            Held {
+                left: true,
+                down: true,
+                ..Held::default()
+            },
+            Held {
+                zoom_out: true,
+                ..Held::default()
+            },
+        ] {
+            c.set_held(held, 0.0);
+            for i in 1..=300 {
+                c.frame(f64::from(i) / 60.0);
+                assert!(inside(&c), "{held:?} frame {i}: {:?}", c.look());
+            }
+            c.set_held(Held::default(), 5.0);
+            c.frame(0.0);
+        }
+        c.key(KeyAction::Reset);
+        c.frame(6.0);
+        assert!(inside(&c));
+        // switched off: the view may leave
+        c.set_limit(None);
+        c.key(KeyAction::Reset);
+        c.frame(7.0);
         assert_eq!(c.look(), Look::default());
     }
 

@@ -46,6 +46,14 @@ pub struct OpenArgs {
     /// Print the view of every rendered frame to stdout (for scripts and tests).
     #[arg(long)]
     pub print_view: bool,
+    /// The area the panorama covers: HFOVxVFOV[±YAW±PITCH] in degrees (e.g.
+    /// 120x60+30-10), overriding GPano XMP metadata; for the panorama given here only.
+    #[arg(long, value_name = "HFOVxVFOV[±YAW±PITCH]", value_parser = crate::partial::parse_coverage, allow_hyphen_values = true)]
+    pub coverage: Option<lut_core::Coverage>,
+    /// Start with the view limit off (partial panoramas; the panel's "Keep the view
+    /// inside" switches it).
+    #[arg(long)]
+    pub no_view_limit: bool,
     /// Luminaires lighting the scene (also added, moved and removed in the panel).
     #[command(flatten)]
     pub lights: crate::ies_cmd::LightArgs,

@@ -41,6 +41,10 @@ pub struct Readouts {
     pub hdr: bool,
     /// The last "Save view…": "saved PATH" or the error.
     pub export_status: Option<String>,
+    /// A partial panorama: what it covers (the view-limit checkbox is shown).
+    pub partial: Option<String>,
+    /// Compass heading of the map's longitude 0 (GPano `PoseHeadingDegrees`).
+    pub pose_heading: Option<f64>,
 }
 
 /// A background load in progress.
@@ -219,6 +223,13 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
         row("yaw", format!("{:8.2}°", m.look.yaw));
         row("pitch", format!("{:8.2}°", m.look.pitch));
         row("hfov", format!("{:8.2}°", m.look.hfov));
+        if let Some(p) = r.pose_heading {
+            let h = lut_core::coverage::compass_heading(p, m.look.yaw);
+            row(
+                "heading",
+                format!("{h:8.2}° {}", lut_core::coverage::compass_point(h)),
+            );
+        }
         row("in use", in_use_label(r).into());
         row("table", kib(r.table_bytes));
         if r.pixels > 0 && r.exact_pixels > 0 {
@@ -232,6 +243,15 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
         row("UI", format!("{:6.2} ms", r.ui_ms));
         row("fps", format!("{:6.1}", r.fps));
     });
+
+    if let Some(p) = &r.partial {
+        ui.separator();
+        ui.label(format!("Partial panorama: {p}"));
+        ui.checkbox(&mut m.settings.view_limit, "Keep the view inside")
+            .on_hover_text(
+                "Limit pitch, yaw and zoom so the view's edges stay in the covered area",
+            );
+    }
 
     ui.separator();
     let s = &mut *m.settings;

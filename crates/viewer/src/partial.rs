@@ -1,0 +1,94 @@
+//! Partial panoramas in the viewer: `--coverage`, loading with GPano XMP, and the texts
+//! the panel and `viewer render -v` show (coverage, compass heading).
+
+use anyhow::{Context, Result};
+use lut_core::coverage::{compass_heading, compass_point};
+use lut_core::{Coverage, CoverageSource, EnvMap, Projection, Tone};
+use std::path::Path;
+
+/// Parse `--coverage HFOVxVFOV[±YAW±PITCH]` (see `lut_core::Coverage`).
+pub fn parse_coverage(s: &str) -> Result<Coverage, String> {
+    s.parse::<Coverage>().map_err(|e| e.to_string())
+}
+
+/// Decode a panorama's bytes, placing it by `coverage` when given, else by the GPano XMP
+/// in the file (JPEG), else as a full panorama. Bad metadata is an error that says how to
+/// override it.
+pub fn decode_panorama(
+    bytes: &[u8],
+    what: &str,
+    projection: Option<Projection>,
+    tone: Tone,
+    coverage: Option<Coverage>,
+) -> Result<(EnvMap, CoverageSource)> {
+    EnvMap::decode_partial(bytes, what, projection, coverage, tone).map_err(|e| {
+        let hint = match (&e, coverage) {
+            (lut_core::CoverageError::Invalid { .. }, None) => {
+                " (give --coverage HFOVxVFOV±YAW±PITCH to place the image yourself, e.g. \
+                 --coverage 360x180 to show it as a full panorama)"
+            }
+            _ => "",
+        };
+        anyhow::anyhow!("{e}{hint}")
+    })
+}
+
+/// As `cli_common::load_panorama_toned`, with partial panoramas (see [`decode_panorama`]).
+/// `None` is the bundled sample.
+pub fn load_panorama_partial(
+    path: Option<&Path>,
+    projection: Option<Projection>,
+    tone: Tone,
+    coverage: Option<Coverage>,
+) -> Result<(EnvMap, CoverageSource)> {
+    match path {
+        Some(p) => {
+            let bytes =
+                std::fs::read(p).with_context(|| format!("{}: cannot read", p.display()))?;
+            decode_panorama(&bytes, &p.display().to_string(), projection, tone, coverage)
+        }
+        None => decode_panorama(
+            crate::assets::SAMPLE_JPEG,
+            crate::assets::SAMPLE_NAME,
+            projection,
+            tone,
+            coverage,
+        ),
+    }
+}
+
+/// "covers 120°×60° around yaw 30°, pitch −10° (stored 2000×1000 of 6000×3000)" for a
+/// partial map, `None` for a full one.
+pub fn coverage_text(map: &EnvMap) -> Option<String> {
+    let crop = map.crop()?;
+    let c = crop.coverage();
+    Some(format!(
+        "covers {:.1}°×{:.1}° around yaw {:.1}°, pitch {:.1}° (stored {}×{} of {}×{})",
+        c.hfov(),
+        c.vfov(),
+        c.yaw(),
+        c.pitch(),
+        crop.width(),
+        crop.height(),
+        crop.full_width(),
+        crop.full_height()
+    ))
+}
+
+/// "heading 213° (SW)" for the view centre, when the map knows its heading.
+pub fn heading_text(map: &EnvMap, yaw: f64) -> Option<String> {
+    let h = compass_heading(map.pose_heading_deg()?, yaw);
+    Some(format!("heading {h:.0}° ({})", compass_point(h)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coverage_flag_errors_name_the_text() {
+        assert!(parse_coverage("120x60+30-10").is_ok());
+        let e = parse_coverage("120x60+30").unwrap_err();
+        assert!(e.contains("120x60+30"), "{e}");
+    }
+}
