@@ -48,6 +48,7 @@ pub mod error;
 pub mod exact;
 pub mod fixed;
 pub mod light;
+pub mod load;
 pub mod lut;
 pub mod projection;
 pub mod raster;
@@ -58,6 +59,7 @@ pub use camera::{Camera, View, MAX_OUTPUT_SIDE};
 pub use envmap::{EnvMap, Sampler, Tone, MAX_MAP_PIXELS, MAX_MAP_WIDTH};
 pub use error::{MapError, ViewError};
 pub use exact::{render_exact, render_exact_supersampled};
+pub use load::{LoadOptions, LoadPhase, LoadProgress, DEFAULT_MAX_PIXELS};
 pub use projection::Projection;
 pub use raster::{
     IndexStep, LutChoice, RenderOptions, RenderPath, RenderReport, Renderer, RendererKind,
