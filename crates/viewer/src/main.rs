@@ -15,6 +15,7 @@ mod cli_common;
 mod convert_cmd;
 mod cube_cmd;
 mod ies_cmd;
+mod max_pixels;
 mod render_cmd;
 mod window;
 

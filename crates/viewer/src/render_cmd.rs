@@ -1,6 +1,6 @@
 //! `viewer render`: one view of a panorama to a PNG, headless.
 
-use crate::cli_common::{load_panorama_toned, parse_angle, parse_size, write_png_atomic};
+use crate::cli_common::{load_panorama_opts, parse_angle, parse_size, write_png_atomic};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use lut_core::lut::Surface;
@@ -135,6 +135,9 @@ pub struct RenderArgs {
     /// Render on one thread.
     #[arg(long)]
     pub single_thread: bool,
+    /// The pixel limit.
+    #[command(flatten)]
+    pub limit: crate::max_pixels::MaxPixelsArg,
     /// Print which path rendered and the table size.
     #[arg(long, short)]
     pub verbose: bool,
@@ -232,7 +235,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
         let tone = lut_core::Tone {
             exposure_ev: a.exposure,
         };
-        let map = load_panorama_toned(a.panorama.first().map(|p| p.as_path()), projection, tone)?;
+        let map = load_panorama_opts(
+            a.panorama.first().map(|p| p.as_path()),
+            &a.limit.options(projection, tone),
+        )?;
         let opts = a.options();
         let mut renderer = Renderer::new(&map);
         let report = renderer.render(&map, view, &opts, &mut out, w, h)?;

@@ -46,6 +46,9 @@ pub struct OpenArgs {
     /// Print the view of every rendered frame to stdout (for scripts and tests).
     #[arg(long)]
     pub print_view: bool,
+    /// The pixel limit for panoramas opened or dropped.
+    #[command(flatten)]
+    pub limit: crate::max_pixels::MaxPixelsArg,
     /// Luminaires lighting the scene (also added, moved and removed in the panel).
     #[command(flatten)]
     pub lights: crate::ies_cmd::LightArgs,
