@@ -551,47 +551,113 @@ impl EnvMap {
         coverage: Option<Coverage>,
         tone: Tone,
     ) -> Result<(EnvMap, CoverageSource), CoverageError> {
-        let equirect = matches!(projection, None | Some(Projection::Equirect));
-        if coverage.is_some() && !equirect {
-            return Err(invalid(
-                what,
-                "a coverage applies to equirectangular panoramas only",
-            ));
-        }
-        let meta = if coverage.is_none() && equirect {
-            crate::gpano::read_jpeg(bytes).map_err(|e| invalid(what, e.to_string()))?
-        } else {
-            None
+        let opts = crate::LoadOptions {
+            projection,
+            tone,
+            ..crate::LoadOptions::default()
         };
-        let heading = meta.as_ref().and_then(|g| g.pose_heading_degrees);
-        let has_crop = coverage.is_some() || meta.as_ref().is_some_and(|g| g.has_crop());
-        if !has_crop {
-            let mut m = EnvMap::decode_toned(bytes, what, projection, tone)?;
-            m.set_pose_heading_deg(heading);
-            return Ok((m, CoverageSource::Full));
-        }
-        let (iw, ih) = image_dimensions(bytes, what)?;
-        crate::envmap::check_map_size(what, iw, ih)?;
-        let (crop, source) = match (coverage, &meta) {
-            (Some(c), _) => (c.crop_for_image(iw, ih), CoverageSource::Explicit),
-            (None, Some(g)) => (g.crop_for_image(iw, ih), CoverageSource::Xmp),
-            // Not reached (`has_crop` needs one of them); the whole sphere is harmless.
-            (None, None) => (Coverage::FULL.crop_for_image(iw, ih), CoverageSource::Full),
-        };
-        let crop = crop.map_err(|e| invalid(what, e.to_string()))?;
-        // Decoded as "elliptical" only so that any aspect ratio is accepted and the
-        // padding column repeats the last column (no wrap); `into_partial` makes it the
-        // crop of an equirect (re-padded if the crop spans 360°).
-        let mut m = EnvMap::decode_toned(bytes, what, Some(Projection::Elliptical), tone)?;
-        m.set_pose_heading_deg(heading);
-        let m = m.into_partial(crop)?;
-        let source = if m.crop.is_none() {
-            CoverageSource::Full
-        } else {
-            source
-        };
-        Ok((m, source))
+        Self::decode_partial_with(bytes, what, &opts, coverage, &mut |_| {})
     }
+
+    /// As [`EnvMap::decode_partial`], with the pixel limit and projection of `opts` and
+    /// progress reports (see [`EnvMap::decode_with`]).
+    ///
+    /// # Errors
+    /// As [`EnvMap::decode_partial`].
+    pub fn decode_partial_with(
+        bytes: &[u8],
+        what: &str,
+        opts: &crate::LoadOptions,
+        coverage: Option<Coverage>,
+        progress: &mut dyn FnMut(crate::LoadProgress),
+    ) -> Result<(EnvMap, CoverageSource), CoverageError> {
+        place_partial(bytes, what, opts, coverage, |o| {
+            EnvMap::decode_with(bytes, what, o, progress)
+        })
+    }
+
+    /// As [`EnvMap::decode_partial_with`], streamed from a file (see
+    /// [`EnvMap::load_with`]): only the file's first 256 KiB are read for the metadata (an
+    /// XMP packet sits in an APP1 segment of at most 64 KiB before the image data).
+    ///
+    /// # Errors
+    /// As [`EnvMap::decode_partial`]; unreadable files are [`MapError::Decode`].
+    pub fn load_partial_with(
+        path: &std::path::Path,
+        opts: &crate::LoadOptions,
+        coverage: Option<Coverage>,
+        progress: &mut dyn FnMut(crate::LoadProgress),
+    ) -> Result<(EnvMap, CoverageSource), CoverageError> {
+        use std::io::Read;
+        let what = path.display().to_string();
+        let io_err = |e: std::io::Error| MapError::Decode {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        };
+        let mut head = Vec::new();
+        std::fs::File::open(path)
+            .map_err(io_err)?
+            .take(256 * 1024)
+            .read_to_end(&mut head)
+            .map_err(io_err)?;
+        place_partial(&head, &what, opts, coverage, |o| {
+            EnvMap::load_with(path, o, progress)
+        })
+    }
+}
+
+/// Decide how a panorama is placed (explicit coverage, GPano metadata found in `head`, or
+/// full), decode it with `decode`, and crop it into place.
+fn place_partial(
+    head: &[u8],
+    what: &str,
+    opts: &crate::LoadOptions,
+    coverage: Option<Coverage>,
+    decode: impl FnOnce(&crate::LoadOptions) -> Result<EnvMap, MapError>,
+) -> Result<(EnvMap, CoverageSource), CoverageError> {
+    let projection = opts.projection;
+    let equirect = matches!(projection, None | Some(Projection::Equirect));
+    if coverage.is_some() && !equirect {
+        return Err(invalid(
+            what,
+            "a coverage applies to equirectangular panoramas only",
+        ));
+    }
+    let meta = if coverage.is_none() && equirect {
+        crate::gpano::read_jpeg(head).map_err(|e| invalid(what, e.to_string()))?
+    } else {
+        None
+    };
+    let heading = meta.as_ref().and_then(|g| g.pose_heading_degrees);
+    let has_crop = coverage.is_some() || meta.as_ref().is_some_and(|g| g.has_crop());
+    if !has_crop {
+        let mut m = decode(opts)?;
+        m.set_pose_heading_deg(heading);
+        return Ok((m, CoverageSource::Full));
+    }
+    // Decoded as "elliptical" only so that any aspect ratio is accepted and the padding
+    // column repeats the last column (no wrap); `into_partial` makes it the crop of an
+    // equirect (re-padded if the crop spans 360°).
+    let mut m = decode(&crate::LoadOptions {
+        projection: Some(Projection::Elliptical),
+        ..*opts
+    })?;
+    let (iw, ih) = (m.width(), m.height());
+    let (crop, source) = match (coverage, &meta) {
+        (Some(c), _) => (c.crop_for_image(iw, ih), CoverageSource::Explicit),
+        (None, Some(g)) => (g.crop_for_image(iw, ih), CoverageSource::Xmp),
+        // Not reached (`has_crop` needs one of them); the whole sphere is harmless.
+        (None, None) => (Coverage::FULL.crop_for_image(iw, ih), CoverageSource::Full),
+    };
+    let crop = crop.map_err(|e| invalid(what, e.to_string()))?;
+    m.set_pose_heading_deg(heading);
+    let m = m.into_partial(crop)?;
+    let source = if m.crop.is_none() {
+        CoverageSource::Full
+    } else {
+        source
+    };
+    Ok((m, source))
 }
 
 /// Compass heading (degrees clockwise from north, [0, 360)) of the view centre at `yaw`
@@ -614,18 +680,6 @@ pub fn compass_point(h: f64) -> &'static str {
 }
 
 /// Image size from the header, without decoding.
-fn image_dimensions(bytes: &[u8], what: &str) -> Result<(u32, u32), MapError> {
-    let decode_err = |reason: String| MapError::Decode {
-        path: what.into(),
-        reason,
-    };
-    image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| decode_err(e.to_string()))?
-        .into_dimensions()
-        .map_err(|e| decode_err(e.to_string()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -179,42 +179,50 @@ impl EnvMap {
         projection: Projection,
         tone: Tone,
     ) -> Result<EnvMap, MapError> {
-        let (w, h) = (img.width(), img.height());
-        check_map_size("image", w, h)?;
-        let px: Vec<u32> = match img {
-            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_) => {
-                let k = 2f32.powf(tone.exposure_ev as f32);
-                img.to_rgb32f()
-                    .pixels()
-                    .map(|p| {
-                        let c = |x: f32| tone_map(x * k) as u32;
-                        (c(p[0]) << 16) | (c(p[1]) << 8) | c(p[2])
-                    })
-                    .collect()
-            }
-            _ => img
-                .to_rgb8()
-                .pixels()
-                .map(|p| ((p[0] as u32) << 16) | ((p[1] as u32) << 8) | p[2] as u32)
-                .collect(),
-        };
-        EnvMap::from_pixels(w, h, &px, projection)
+        crate::load::image_to_map("image", img, projection, tone, &mut |_| {})
+    }
+
+    /// A map from its padded buffer (`(width + 1) × (height + 1)`, padding filled).
+    pub(crate) fn from_padded(
+        width: u32,
+        height: u32,
+        projection: Projection,
+        data: Vec<u32>,
+    ) -> EnvMap {
+        debug_assert_eq!(data.len(), (width as usize + 1) * (height as usize + 1));
+        EnvMap {
+            width,
+            height,
+            projection,
+            data,
+            background: 0,
+            crop: None,
+            pose_heading: None,
+        }
+    }
+
+    /// The padded pixel buffer (for tests comparing two load paths).
+    #[cfg(test)]
+    pub(crate) fn raw(&self) -> &[u32] {
+        &self.data
     }
 
     /// Decode an image file (format from its contents) and check it can be the given
     /// projection. `None` means *auto*: a 2:1 image is equirectangular, anything else is
     /// an error asking for an explicit projection.
     ///
-    /// The pixel limit is checked from the header before the image is decoded.
+    /// The pixel limit ([`crate::load::DEFAULT_MAX_PIXELS`]) is checked from the header
+    /// before the image is decoded; [`EnvMap::load_with`] takes another limit and reports
+    /// progress.
     ///
     /// # Errors
     /// [`MapError`] naming the file and the reason.
     pub fn load(path: &Path, projection: Option<Projection>) -> Result<EnvMap, MapError> {
-        let bytes = std::fs::read(path).map_err(|e| MapError::Decode {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
-        Self::decode(&bytes, &path.display().to_string(), projection)
+        let opts = crate::load::LoadOptions {
+            projection,
+            ..Default::default()
+        };
+        Self::load_with(path, &opts, &mut |_| {})
     }
 
     /// As [`EnvMap::load`] for an in-memory encoded image; `what` names it in errors.
@@ -240,31 +248,12 @@ impl EnvMap {
         projection: Option<Projection>,
         tone: Tone,
     ) -> Result<EnvMap, MapError> {
-        let decode_err = |reason: String| MapError::Decode {
-            path: what.into(),
-            reason,
+        let opts = crate::load::LoadOptions {
+            projection,
+            tone,
+            ..Default::default()
         };
-        let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-            .with_guessed_format()
-            .map_err(|e| decode_err(e.to_string()))?;
-        if reader.format().is_none() {
-            return Err(decode_err(
-                "unrecognized or unsupported image format".into(),
-            ));
-        }
-        let (w, h) = reader
-            .into_dimensions()
-            .map_err(|e| decode_err(e.to_string()))?;
-        check_map_size(what, w, h)?;
-        let projection = resolve_projection(what, w, h, projection)?;
-        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-            .with_guessed_format()
-            .map_err(|e| decode_err(e.to_string()))?;
-        let mut limits = image::Limits::default();
-        limits.max_alloc = Some(MAX_MAP_PIXELS * 16);
-        reader.limits(limits);
-        let img = reader.decode().map_err(|e| decode_err(e.to_string()))?;
-        EnvMap::from_image_toned(&img, projection, tone)
+        Self::decode_with(bytes, what, &opts, &mut |_| {})
     }
 
     /// Width in pixels: the full panorama's width, which every renderer's geometry uses

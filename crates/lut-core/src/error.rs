@@ -68,6 +68,25 @@ pub enum MapError {
         /// Why.
         reason: String,
     },
+    /// The image has more pixels than the configured limit (read from the file header,
+    /// before any pixel buffer is allocated: a defence against decompression bombs).
+    #[error(
+        "{what}: the image is {width}x{height} = {pixels} pixels, above the limit of {limit} \
+         pixels, so it was not decoded (a defence against decompression bombs); raise the \
+         limit with --max-pixels"
+    )]
+    TooManyPixels {
+        /// The file or a description of the source.
+        what: String,
+        /// Width from the header.
+        width: u64,
+        /// Height from the header.
+        height: u64,
+        /// width × height.
+        pixels: u64,
+        /// The limit in force.
+        limit: u64,
+    },
     /// A non-2:1 image given (or detected) as equirectangular, or an unknown projection.
     #[error("{what}: {reason}")]
     Projection {

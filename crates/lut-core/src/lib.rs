@@ -55,6 +55,7 @@ pub mod exact;
 pub mod fixed;
 pub mod gpano;
 pub mod light;
+pub mod load;
 pub mod lut;
 pub mod projection;
 pub mod raster;
@@ -67,6 +68,7 @@ pub use coverage::{Coverage, CoverageError, CoverageSource, Crop};
 pub use envmap::{EnvMap, Sampler, Tone, MAX_MAP_PIXELS, MAX_MAP_WIDTH};
 pub use error::{MapError, ViewError};
 pub use exact::{render_exact, render_exact_supersampled};
+pub use load::{LoadOptions, LoadPhase, LoadProgress, DEFAULT_MAX_PIXELS};
 pub use projection::Projection;
 pub use raster::{
     IndexStep, LutChoice, RenderOptions, RenderPath, RenderReport, Renderer, RendererKind,

@@ -13,7 +13,7 @@
 //! Tables are built before timing (their build time is reported separately), so a frame's
 //! time is all the per-view work: per-scanline setup plus the kernels.
 
-use crate::cli_common::{load_panorama, parse_size, write_png_atomic};
+use crate::cli_common::{parse_size, write_png_atomic};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, ValueEnum};
 use lut_core::accuracy::position_error;
@@ -79,6 +79,9 @@ pub struct BenchArgs {
     /// Skip the cube renderers (they convert the map to a cube first, which takes a while).
     #[arg(long)]
     pub no_cube: bool,
+    /// The pixel limit for PANORAMA.
+    #[command(flatten)]
+    pub limit: crate::max_pixels::MaxPixelsArg,
 }
 
 fn parse_projection_name(s: &str) -> Result<Projection, String> {
@@ -233,7 +236,10 @@ pub fn run(a: BenchArgs) -> Result<()> {
 fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
     let t0 = Instant::now();
     let map = match &a.panorama {
-        Some(p) => load_panorama(Some(p), a.projection)?,
+        Some(p) => crate::cli_common::load_panorama_opts(
+            Some(p),
+            &a.limit.options(a.projection, lut_core::Tone::default()),
+        )?,
         None => lut_core::synth::grid_map(
             a.map_size.0,
             a.map_size.1,

@@ -43,35 +43,19 @@ pub fn parse_projection(s: &str) -> Result<Option<Projection>, String> {
     }
 }
 
-/// Load the panorama at `path`, or the bundled sample when `None`.
-pub fn load_panorama(path: Option<&Path>, projection: Option<Projection>) -> Result<EnvMap> {
-    load_panorama_toned(path, projection, lut_core::Tone::default())
-}
-
-/// As [`load_panorama`], showing HDR files (.hdr, .exr) through `tone`.
-pub fn load_panorama_toned(
-    path: Option<&Path>,
-    projection: Option<Projection>,
-    tone: lut_core::Tone,
-) -> Result<EnvMap> {
-    match path {
-        Some(p) => {
-            let bytes =
-                std::fs::read(p).with_context(|| format!("{}: cannot read", p.display()))?;
-            Ok(EnvMap::decode_toned(
-                &bytes,
-                &p.display().to_string(),
-                projection,
-                tone,
-            )?)
-        }
-        None => Ok(EnvMap::decode_toned(
+/// Load the panorama at `path` (the bundled sample when `None`) with `opts`: projection,
+/// tone and the pixel limit (`--max-pixels`, checked from the header before decoding).
+/// The file is streamed into the map, never held whole by this function.
+pub fn load_panorama_opts(path: Option<&Path>, opts: &lut_core::LoadOptions) -> Result<EnvMap> {
+    Ok(match path {
+        Some(p) => EnvMap::load_with(p, opts, &mut |_| {})?,
+        None => EnvMap::decode_with(
             crate::assets::SAMPLE_JPEG,
             crate::assets::SAMPLE_NAME,
-            projection,
-            tone,
-        )?),
-    }
+            opts,
+            &mut |_| {},
+        )?,
+    })
 }
 
 /// Write 0RGB pixels as an 8-bit RGB PNG atomically: a temporary file in the same folder,

@@ -47,6 +47,9 @@ pub struct ConvertArgs {
     /// Resampling filter.
     #[arg(long, default_value = "bilinear", value_parser = |s: &str| s.parse::<Sampler>())]
     pub sampler: Sampler,
+    /// The pixel limit for the input panorama (`--to cube`).
+    #[command(flatten)]
+    pub limit: crate::max_pixels::MaxPixelsArg,
 }
 
 /// Run `viewer convert`.
@@ -74,7 +77,8 @@ fn to_cube(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()> {
     };
     let projection: Option<Projection> =
         parse_projection(&a.projection).map_err(anyhow::Error::msg)?;
-    let map = EnvMap::load(input, projection)?;
+    let opts = a.limit.options(projection, lut_core::Tone::default());
+    let map = EnvMap::load_with(input, &opts, &mut |_| {})?;
     let face_size = a.face_size.unwrap_or((map.width() / 4).max(1));
     let cube = CubeMap::from_envmap(&map, face_size, a.sampler)?;
     write_cube(&cube, layout, output)

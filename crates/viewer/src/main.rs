@@ -5,16 +5,19 @@
 //! * `viewer convert ...` converts between equirectangular and cube maps.
 //! * `viewer ies ...` summarizes and samples an IES photometric file.
 //! * `viewer bench ...` measures speed against error.
+//! * `viewer bench-load ...` measures loading and panning huge (8k-32k) maps.
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod assets;
 mod bench_cmd;
+mod bench_load;
 mod cli_common;
 mod convert_cmd;
 mod cube_cmd;
 mod ies_cmd;
+mod max_pixels;
 mod partial;
 mod render_cmd;
 mod window;
@@ -45,6 +48,9 @@ enum Command {
     Ies(ies_cmd::IesArgs),
     /// Measure speed against error for every renderer configuration.
     Bench(bench_cmd::BenchArgs),
+    /// Huge panoramas: load time, table build, frame time and peak memory for generated
+    /// 8k, 16k and 32k equirectangular JPEGs (each in a fresh process).
+    BenchLoad(bench_load::BenchLoadArgs),
 }
 
 fn main() -> ExitCode {
@@ -54,6 +60,7 @@ fn main() -> ExitCode {
         Some(Command::Convert(a)) => convert_cmd::run(a),
         Some(Command::Ies(a)) => ies_cmd::run(a),
         Some(Command::Bench(a)) => bench_cmd::run(a),
+        Some(Command::BenchLoad(a)) => bench_load::run(a),
         None => window::run(cli.open),
     };
     match result {

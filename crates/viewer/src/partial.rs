@@ -1,9 +1,9 @@
 //! Partial panoramas in the viewer: `--coverage`, loading with GPano XMP, and the texts
 //! the panel and `viewer render -v` show (coverage, compass heading).
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use lut_core::coverage::{compass_heading, compass_point};
-use lut_core::{Coverage, CoverageSource, EnvMap, Projection, Tone};
+use lut_core::{Coverage, CoverageSource, EnvMap, LoadOptions};
 use std::path::Path;
 
 /// Parse `--coverage HFOVxVFOV[±YAW±PITCH]` (see `lut_core::Coverage`).
@@ -11,50 +11,39 @@ pub fn parse_coverage(s: &str) -> Result<Coverage, String> {
     s.parse::<Coverage>().map_err(|e| e.to_string())
 }
 
-/// Decode a panorama's bytes, placing it by `coverage` when given, else by the GPano XMP
-/// in the file (JPEG), else as a full panorama. Bad metadata is an error that says how to
-/// override it.
-pub fn decode_panorama(
-    bytes: &[u8],
-    what: &str,
-    projection: Option<Projection>,
-    tone: Tone,
-    coverage: Option<Coverage>,
-) -> Result<(EnvMap, CoverageSource)> {
-    EnvMap::decode_partial(bytes, what, projection, coverage, tone).map_err(|e| {
-        let hint = match (&e, coverage) {
-            (lut_core::CoverageError::Invalid { .. }, None) => {
-                " (give --coverage HFOVxVFOV±YAW±PITCH to place the image yourself, e.g. \
-                 --coverage 360x180 to show it as a full panorama)"
-            }
-            _ => "",
-        };
-        anyhow::anyhow!("{e}{hint}")
-    })
+/// Turn a placement error into one line that says how to override bad metadata.
+pub fn coverage_error(e: lut_core::CoverageError, coverage: Option<Coverage>) -> anyhow::Error {
+    let hint = match (&e, coverage) {
+        (lut_core::CoverageError::Invalid { .. }, None) => {
+            " (give --coverage HFOVxVFOV±YAW±PITCH to place the image yourself, e.g. \
+             --coverage 360x180 to show it as a full panorama)"
+        }
+        _ => "",
+    };
+    anyhow::anyhow!("{e}{hint}")
 }
 
-/// As `cli_common::load_panorama_toned`, with partial panoramas (see [`decode_panorama`]).
-/// `None` is the bundled sample.
+/// Load a panorama (`None`: the bundled sample) with the pixel limit, projection and tone
+/// of `opts`, placed by `coverage` when given, else by the GPano XMP in the file (JPEG),
+/// else as a full panorama; `progress` as in `EnvMap::load_with`. Bad metadata is an
+/// error that says how to override it.
 pub fn load_panorama_partial(
     path: Option<&Path>,
-    projection: Option<Projection>,
-    tone: Tone,
+    opts: &LoadOptions,
     coverage: Option<Coverage>,
+    progress: &mut dyn FnMut(lut_core::LoadProgress),
 ) -> Result<(EnvMap, CoverageSource)> {
     match path {
-        Some(p) => {
-            let bytes =
-                std::fs::read(p).with_context(|| format!("{}: cannot read", p.display()))?;
-            decode_panorama(&bytes, &p.display().to_string(), projection, tone, coverage)
-        }
-        None => decode_panorama(
+        Some(p) => EnvMap::load_partial_with(p, opts, coverage, progress),
+        None => EnvMap::decode_partial_with(
             crate::assets::SAMPLE_JPEG,
             crate::assets::SAMPLE_NAME,
-            projection,
-            tone,
+            opts,
             coverage,
+            progress,
         ),
     }
+    .map_err(|e| coverage_error(e, coverage))
 }
 
 /// "covers 120°×60° around yaw 30°, pitch −10° (stored 2000×1000 of 6000×3000)" for a

@@ -144,6 +144,9 @@ pub struct RenderArgs {
     /// Render on one thread.
     #[arg(long)]
     pub single_thread: bool,
+    /// The pixel limit.
+    #[command(flatten)]
+    pub limit: crate::max_pixels::MaxPixelsArg,
     /// Print which path rendered and the table size.
     #[arg(long, short)]
     pub verbose: bool,
@@ -246,9 +249,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
         };
         let (map, _) = crate::partial::load_panorama_partial(
             a.panorama.first().map(|p| p.as_path()),
-            projection,
-            tone,
+            &a.limit.options(projection, tone),
             a.coverage,
+            &mut |_| {},
         )?;
         if a.view_limit {
             view = lut_core::limit_view(view, w, h, &map.coverage());

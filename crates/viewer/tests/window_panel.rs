@@ -171,10 +171,9 @@ fn load_progress_and_errors_show_in_the_panel() {
     let busy = paint_panel(
         1.0,
         3,
-        Some(&LoadStatus::Reading {
-            name: "big.jpg".into(),
-            done: 30,
-            total: 100,
+        Some(&LoadStatus {
+            fraction: Some(0.3),
+            ..LoadStatus::new("big.jpg".into())
         }),
         Some("big.jpg: cannot read image: unsupported format"),
     )

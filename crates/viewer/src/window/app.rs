@@ -9,7 +9,7 @@ use super::input::{
 };
 use super::lights::{LightsKey, LightsState};
 use super::paint::{Compositor, SceneRect};
-use super::ui::{self, LoadStatus, PanelModel, Readouts};
+use super::ui::{self, LoadStatus, LoadStep, PanelModel, Readouts};
 use super::OpenArgs;
 use crate::render_cmd::{CubeRendererArg, ProjectionArg};
 use anyhow::{anyhow, Result};
@@ -18,7 +18,6 @@ use lut_core::{
     Camera, EnvMap, IndexStep, LutChoice, Projection, Renderer, RendererKind, Sampler, Tone,
 };
 use std::collections::VecDeque;
-use std::io::Read;
 use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::rc::Rc;
@@ -104,11 +103,8 @@ impl Loaded {
 enum UserEvent {
     Progress {
         id: u64,
-        done: u64,
-        total: u64,
-    },
-    Decoding {
-        id: u64,
+        step: LoadStep,
+        fraction: Option<f32>,
     },
     Done {
         id: u64,
@@ -116,86 +112,62 @@ enum UserEvent {
     },
 }
 
-/// Read `path` in chunks, reporting progress, so a large file never looks frozen.
-fn read_with_progress(
-    path: &std::path::Path,
-    mut progress: impl FnMut(u64, u64),
-) -> Result<Vec<u8>, String> {
-    let name = path.display();
-    let mut f = std::fs::File::open(path).map_err(|e| format!("{name}: cannot open: {e}"))?;
-    let total = f.metadata().map(|m| m.len()).unwrap_or(0);
-    let cap = usize::try_from(total).unwrap_or(0);
-    let mut bytes = Vec::with_capacity(cap);
-    let mut chunk = vec![0u8; 1 << 20];
-    loop {
-        let n = f
-            .read(&mut chunk)
-            .map_err(|e| format!("{name}: cannot read: {e}"))?;
-        if n == 0 {
-            break;
-        }
-        bytes.extend_from_slice(&chunk[..n]);
-        progress(bytes.len() as u64, total);
-    }
-    Ok(bytes)
-}
-
-/// The loading thread's work: read, decode, build tables.
+/// The loading thread's work: read, decode, convert, build tables, reporting each step
+/// (see `lut_core::load` for which decoders measure their progress).
 fn load(
     proxy: &EventLoopProxy<UserEvent>,
     id: u64,
     source: Source,
-    projection: Option<Projection>,
+    opts: &lut_core::LoadOptions,
     naming: Option<&str>,
-    tone: Tone,
     coverage: Option<lut_core::Coverage>,
 ) -> Result<Box<Loaded>, String> {
     let hdr = matches!(&source, Source::File(p) if super::export::is_hdr_path(p));
+    let send = |step: LoadStep, fraction: Option<f32>| {
+        let _ = proxy.send_event(UserEvent::Progress { id, step, fraction });
+    };
+    let mut on_progress = |p: lut_core::LoadProgress| send(p.phase.into(), p.fraction);
     let map = match &source {
         Source::Cube { paths, layout } => {
-            let _ = proxy.send_event(UserEvent::Decoding { id });
+            send(LoadStep::Decoding, None);
             let cube = crate::cube_cmd::load_cube(paths, layout.as_deref(), naming)
                 .map_err(|e| format!("{e:#}"))?;
             return Ok(Box::new(Loaded {
                 scene: Scene::Cube(cube),
                 source,
-                projection,
+                projection: opts.projection,
                 hdr: false,
-                exposure_ev: tone.exposure_ev,
+                exposure_ev: opts.tone.exposure_ev,
             }));
         }
+        // The same loading as `viewer render` (streamed from the file, the pixel limit
+        // checked from the header first; partial panoramas placed by GPano XMP or the
+        // command line's --coverage); 8-bit images ignore the tone.
         Source::Sample => {
-            let _ = proxy.send_event(UserEvent::Decoding { id });
-            crate::partial::load_panorama_partial(None, projection, Tone::default(), coverage)
+            crate::partial::load_panorama_partial(None, opts, coverage, &mut on_progress)
                 .map_err(|e| format!("{e:#}"))?
                 .0
         }
         Source::File(p) => {
-            let bytes = read_with_progress(p, |done, total| {
-                let _ = proxy.send_event(UserEvent::Progress { id, done, total });
-            })?;
-            let _ = proxy.send_event(UserEvent::Decoding { id });
-            // The same decoding as `EnvMap::load` (and so as `viewer render
-            // --exposure`); 8-bit images ignore the tone.
-            // Partial panoramas: GPano XMP or the command line's --coverage.
-            crate::partial::decode_panorama(
-                &bytes,
-                &p.display().to_string(),
-                projection,
-                tone,
-                coverage,
-            )
-            .map_err(|e| format!("{e:#}"))?
-            .0
+            crate::partial::load_panorama_partial(Some(p), opts, coverage, &mut on_progress)
+                .map_err(|e| format!("{e:#}"))?
+                .0
         }
     };
-    let renderer = Renderer::new(&map);
+    // Build both tables now, so the first frames do not wait for them.
+    send(LoadStep::Tables, Some(0.0));
+    let mut renderer = Renderer::new(&map);
+    let surface = lut_core::RenderOptions::default().surface;
+    renderer.table(surface, lut_core::lut::TableKind::Wide);
+    send(LoadStep::Tables, Some(0.5));
+    renderer.table(surface, lut_core::lut::TableKind::High);
+    send(LoadStep::Tables, Some(1.0));
     Ok(Box::new(Loaded {
         scene: Scene::Map { map, renderer },
         source,
-        projection,
+        projection: opts.projection,
         hdr,
-        exposure_ev: tone.exposure_ev,
+        exposure_ev: opts.tone.exposure_ev,
     }))
 }
 
@@ -260,6 +232,8 @@ struct App {
     next_frame_at: Option<Instant>,
     frame_times: VecDeque<Instant>,
     fatal: Option<anyhow::Error>,
+    /// `--max-pixels`: the pixel limit for every panorama opened.
+    max_pixels: u64,
     /// Cube face naming from the command line (for every cube opened).
     naming: Option<String>,
     /// The luminaires (panel state).
@@ -306,6 +280,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         next_frame_at: None,
         frame_times: VecDeque::new(),
         fatal: None,
+        max_pixels: args.limit.max_pixels,
         naming: args.naming.clone(),
         lights,
         pending_drops: Vec::new(),
@@ -374,21 +349,17 @@ impl App {
     fn start_load(&mut self, source: Source, projection: Option<Projection>) {
         self.next_load_id += 1;
         let id = self.next_load_id;
-        let name = source.name();
-        let status = match source {
-            Source::Sample | Source::Cube { .. } => LoadStatus::Decoding { name },
-            Source::File(_) => LoadStatus::Reading {
-                name,
-                done: 0,
-                total: 0,
-            },
-        };
+        let status = LoadStatus::new(source.name());
         self.loading = Some((id, source.clone(), status));
         self.keep_error = false;
         let proxy = self.proxy.clone();
         let naming = self.naming.clone();
-        let tone = Tone {
-            exposure_ev: self.ctl.settings.exposure_ev,
+        let opts = lut_core::LoadOptions {
+            projection,
+            tone: Tone {
+                exposure_ev: self.ctl.settings.exposure_ev,
+            },
+            max_pixels: self.max_pixels,
         };
         let coverage = self
             .coverage
@@ -398,15 +369,7 @@ impl App {
         let spawned = std::thread::Builder::new()
             .name("viewer-load".into())
             .spawn(move || {
-                let result = load(
-                    &proxy,
-                    id,
-                    source,
-                    projection,
-                    naming.as_deref(),
-                    tone,
-                    coverage,
-                );
+                let result = load(&proxy, id, source, &opts, naming.as_deref(), coverage);
                 let _ = proxy.send_event(UserEvent::Done { id, result });
             });
         if let Err(e) = spawned {
@@ -419,18 +382,9 @@ impl App {
     fn on_load_event(&mut self, ev: UserEvent) {
         let current_id = self.loading.as_ref().map(|l| l.0);
         match ev {
-            UserEvent::Progress { id, done, total } if Some(id) == current_id => {
-                if let Some((_, src, st)) = &mut self.loading {
-                    *st = LoadStatus::Reading {
-                        name: src.name(),
-                        done,
-                        total,
-                    };
-                }
-            }
-            UserEvent::Decoding { id } if Some(id) == current_id => {
-                if let Some((_, src, st)) = &mut self.loading {
-                    *st = LoadStatus::Decoding { name: src.name() };
+            UserEvent::Progress { id, step, fraction } if Some(id) == current_id => {
+                if let Some((_, _, st)) = &mut self.loading {
+                    st.advance(step, fraction);
                 }
             }
             UserEvent::Done { id, result } if Some(id) == current_id => {
@@ -445,9 +399,11 @@ impl App {
                             Scene::Cube(_) => {
                                 format!("{} (cube, {mw}px faces)", short_name(&loaded.source))
                             }
-                            Scene::Map { .. } => {
-                                format!("{} ({mw}×{mh}, {proj})", short_name(&loaded.source))
-                            }
+                            Scene::Map { ref map, .. } => format!(
+                                "{} ({mw}×{mh}, {proj}, {} in memory)",
+                                short_name(&loaded.source),
+                                format_bytes(map.bytes())
+                            ),
                         };
                         if let Some(g) = &self.gfx {
                             g.window
@@ -560,6 +516,12 @@ impl App {
                     lights: &mut self.lights,
                 },
             );
+        }
+        if let Some((_, _, l)) = &self.loading {
+            if !self.show_panel || self.current.is_none() {
+                // Nothing else shows the load: a box over the scene.
+                ui::loading_overlay(ui.ctx(), l);
+            }
         }
         // The scene: everything the panel leaves. Drags and wheel go through egui so a
         // click on the panel is never taken for a drag (hit-testing is egui's).
@@ -1003,6 +965,16 @@ impl App {
         }
         self.next_frame_at = next;
         Ok(())
+    }
+}
+
+/// A byte count for the readout: "2.00 GiB", "12.3 MiB".
+fn format_bytes(b: usize) -> String {
+    let b = b as f64;
+    if b >= f64::from(1u32 << 30) {
+        format!("{:.2} GiB", b / f64::from(1u32 << 30))
+    } else {
+        format!("{:.1} MiB", b / f64::from(1u32 << 20))
     }
 }
 

@@ -54,6 +54,9 @@ pub struct OpenArgs {
     /// inside" switches it).
     #[arg(long)]
     pub no_view_limit: bool,
+    /// The pixel limit for panoramas opened or dropped.
+    #[command(flatten)]
+    pub limit: crate::max_pixels::MaxPixelsArg,
     /// Luminaires lighting the scene (also added, moved and removed in the panel).
     #[command(flatten)]
     pub lights: crate::ies_cmd::LightArgs,

@@ -47,23 +47,157 @@ pub struct Readouts {
     pub pose_heading: Option<f64>,
 }
 
-/// A background load in progress.
+/// A step of loading a panorama in the window, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum LoadStep {
+    /// Reading the compressed file (JPEG: read whole before decoding).
+    Reading,
+    /// Decoding pixels.
+    Decoding,
+    /// Writing the pixels into the map (0RGB, padding).
+    Converting,
+    /// Building the look-up tables.
+    Tables,
+}
+
+impl LoadStep {
+    /// Every step, in order.
+    pub const ALL: [LoadStep; 4] = [
+        LoadStep::Reading,
+        LoadStep::Decoding,
+        LoadStep::Converting,
+        LoadStep::Tables,
+    ];
+
+    /// The label shown while the step runs.
+    pub fn label(self) -> &'static str {
+        match self {
+            LoadStep::Reading => "reading the file",
+            LoadStep::Decoding => "decoding",
+            LoadStep::Converting => "converting to the map",
+            LoadStep::Tables => "building look-up tables",
+        }
+    }
+
+    /// 1-based position in [`LoadStep::ALL`].
+    pub fn number(self) -> usize {
+        self as usize + 1
+    }
+}
+
+impl From<lut_core::LoadPhase> for LoadStep {
+    fn from(p: lut_core::LoadPhase) -> Self {
+        match p {
+            lut_core::LoadPhase::Reading => LoadStep::Reading,
+            lut_core::LoadPhase::Decoding => LoadStep::Decoding,
+            lut_core::LoadPhase::Converting => LoadStep::Converting,
+        }
+    }
+}
+
+/// A background load in progress: what the loading thread last reported.
 #[derive(Debug, Clone, PartialEq)]
-pub enum LoadStatus {
-    /// Reading the file: bytes done, total.
-    Reading {
-        /// File name.
-        name: String,
-        /// Bytes read so far.
-        done: u64,
-        /// File size.
-        total: u64,
-    },
-    /// Decoding and building tables.
-    Decoding {
-        /// File name.
-        name: String,
-    },
+pub struct LoadStatus {
+    /// File name.
+    pub name: String,
+    /// The current step.
+    pub step: LoadStep,
+    /// Done fraction of the step; `None` when the decoder reports no progress (JPEG
+    /// decoding, cube maps): drawn as an indeterminate bar with the elapsed time.
+    pub fraction: Option<f32>,
+    /// When the load started.
+    pub started: std::time::Instant,
+}
+
+impl LoadStatus {
+    /// A load of `name` that has not reported yet.
+    pub fn new(name: String) -> Self {
+        LoadStatus {
+            name,
+            step: LoadStep::Reading,
+            fraction: None,
+            started: std::time::Instant::now(),
+        }
+    }
+
+    /// Take a progress report. Steps only move forward and a step's fraction only
+    /// grows (a late or out-of-order report is ignored). True when something changed.
+    pub fn advance(&mut self, step: LoadStep, fraction: Option<f32>) -> bool {
+        let fraction = fraction.map(|f| if f.is_nan() { 0.0 } else { f.clamp(0.0, 1.0) });
+        if step < self.step {
+            return false;
+        }
+        if step == self.step {
+            match (self.fraction, fraction) {
+                (_, None) => return false,
+                (Some(old), Some(new)) if new <= old => return false,
+                _ => {}
+            }
+        }
+        self.step = step;
+        self.fraction = fraction;
+        true
+    }
+}
+
+/// A bar that says "busy, amount unknown": a block sliding to and fro with the time, never
+/// a fraction.
+fn indeterminate_bar(ui: &mut egui::Ui, t: f64) {
+    let w = ui.available_width().min(200.0);
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(w, 12.0), egui::Sense::hover());
+    let v = ui.visuals();
+    ui.painter().rect_filled(rect, 4.0, v.extreme_bg_color);
+    let block = rect.width() * 0.25;
+    let phase = (t * 0.6).rem_euclid(2.0) as f32;
+    let x = if phase < 1.0 { phase } else { 2.0 - phase } * (rect.width() - block);
+    let r = egui::Rect::from_min_size(
+        rect.min + egui::vec2(x, 0.0),
+        egui::vec2(block, rect.height()),
+    );
+    ui.painter().rect_filled(r, 4.0, v.selection.bg_fill);
+}
+
+/// The load's name, step, and a bar: the step's fraction when known, else an
+/// indeterminate bar with the elapsed time and the reason (repainted 5 times a second,
+/// not every frame, so drawing does not slow the decoder down).
+pub fn load_progress(ui: &mut egui::Ui, l: &LoadStatus) {
+    let t = l.started.elapsed().as_secs_f64();
+    ui.label(format!("Loading {}", l.name));
+    ui.label(format!(
+        "step {}/{}: {} · {t:.1} s",
+        l.step.number(),
+        LoadStep::ALL.len(),
+        l.step.label()
+    ));
+    match l.fraction {
+        Some(f) => {
+            ui.add(egui::ProgressBar::new(f).show_percentage());
+        }
+        None => {
+            indeterminate_bar(ui, t);
+            ui.small(if l.step == LoadStep::Decoding {
+                "this decoder reports no progress"
+            } else {
+                "no progress reported for this step"
+            });
+        }
+    }
+    ui.ctx()
+        .request_repaint_after(std::time::Duration::from_millis(200));
+}
+
+/// [`load_progress`] in a box in the middle of the window, for when the panel is hidden
+/// or there is no picture yet.
+pub fn loading_overlay(ctx: &egui::Context, l: &LoadStatus) {
+    egui::Area::new(egui::Id::new("loading"))
+        .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+        .interactable(false)
+        .show(ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| {
+                ui.set_width(260.0);
+                load_progress(ui, l);
+            });
+        });
 }
 
 /// What the panel shows and edits.
@@ -160,23 +294,7 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
 
     if let Some(l) = m.loading {
         ui.separator();
-        match l {
-            LoadStatus::Reading { name, done, total } => {
-                ui.label(format!("Loading {name}"));
-                let f = if *total > 0 {
-                    *done as f32 / *total as f32
-                } else {
-                    0.0
-                };
-                ui.add(egui::ProgressBar::new(f).show_percentage());
-            }
-            LoadStatus::Decoding { name } => {
-                ui.horizontal(|ui| {
-                    ui.spinner();
-                    ui.label(format!("Decoding {name}"));
-                });
-            }
-        }
+        load_progress(ui, l);
     }
     if let Some(e) = m.error {
         ui.separator();
@@ -522,5 +640,74 @@ fn lut_label(l: LutChoice) -> &'static str {
         LutChoice::Auto => "auto (by hfov)",
         LutChoice::Wide => "wide-FOV",
         LutChoice::High => "high-res",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{LoadStatus, LoadStep};
+
+    #[test]
+    fn advance_ignores_late_and_backward_reports() {
+        let mut s = LoadStatus::new("x".into());
+        assert!(s.advance(LoadStep::Decoding, Some(0.5)));
+        assert!(
+            !s.advance(LoadStep::Decoding, Some(0.4)),
+            "a fraction went back"
+        );
+        assert!(!s.advance(LoadStep::Reading, Some(0.9)), "a step went back");
+        assert!(
+            !s.advance(LoadStep::Decoding, None),
+            "a known fraction became unknown"
+        );
+        assert!(s.advance(LoadStep::Decoding, Some(f32::INFINITY)));
+        assert_eq!(s.fraction, Some(1.0));
+        assert!(s.advance(LoadStep::Converting, None));
+        assert_eq!((s.step, s.fraction), (LoadStep::Converting, None));
+    }
+
+    /// What the window shows during real loads (the loading thread's events, with the
+    /// table step it adds): steps only move forward, a step's known fractions grow and
+    /// every step ends at 1; JPEG decoding is shown as unknown, not as a made-up number.
+    #[test]
+    fn progress_of_real_loads_is_monotone_and_ends_at_one() {
+        let img = image::DynamicImage::ImageRgb8(image::RgbImage::from_fn(512, 256, |x, y| {
+            image::Rgb([(x % 251) as u8, (y % 241) as u8, ((x * y) % 239) as u8])
+        }));
+        for format in [image::ImageFormat::Png, image::ImageFormat::Jpeg] {
+            let mut bytes = Vec::new();
+            img.write_to(&mut std::io::Cursor::new(&mut bytes), format)
+                .unwrap();
+            let mut st = LoadStatus::new("t".into());
+            let mut shown = vec![(st.step, st.fraction)];
+            let opts = lut_core::LoadOptions::default();
+            lut_core::EnvMap::decode_with(&bytes, "t", &opts, &mut |p| {
+                if st.advance(p.phase.into(), p.fraction) {
+                    shown.push((st.step, st.fraction));
+                }
+            })
+            .unwrap();
+            for f in [0.0, 0.5, 1.0] {
+                if st.advance(LoadStep::Tables, Some(f)) {
+                    shown.push((st.step, st.fraction));
+                }
+            }
+            assert!(shown.windows(2).all(|w| w[0].0 <= w[1].0), "{shown:?}");
+            for step in LoadStep::ALL {
+                let fr: Vec<Option<f32>> =
+                    shown.iter().filter(|s| s.0 == step).map(|s| s.1).collect();
+                let known: Vec<f32> = fr.iter().flatten().copied().collect();
+                assert!(known.windows(2).all(|w| w[0] < w[1]), "{step:?} {fr:?}");
+                if step != LoadStep::Reading || format == image::ImageFormat::Jpeg {
+                    assert_eq!(fr.last(), Some(&Some(1.0)), "{format:?} {step:?} {fr:?}");
+                }
+            }
+            let decoding_first = shown.iter().find(|s| s.0 == LoadStep::Decoding).unwrap().1;
+            match format {
+                image::ImageFormat::Jpeg => assert_eq!(decoding_first, None),
+                _ => assert!(decoding_first.is_some()),
+            }
+            assert_eq!(shown.last(), Some(&(LoadStep::Tables, Some(1.0))));
+        }
     }
 }
