@@ -114,7 +114,7 @@ fn golden_every_projection() {
                 }
                 let mean = sum as f64 / n as f64;
                 match sampler {
-                    Sampler::Bilinear => assert!(
+                    Sampler::Bilinear | Sampler::Trilinear => assert!(
                         worst <= 20 && mean <= 0.5,
                         "{name}: LUT vs exact worst {worst} mean {mean:.3}"
                     ),

@@ -528,7 +528,7 @@ impl EnvMap {
     pub(crate) fn sample_cropped(&self, sampler: Sampler, u: Fx, v: Fx) -> u32 {
         match sampler {
             Sampler::Nearest => self.nearest_cropped(u, v),
-            Sampler::Bilinear => self.bilinear_cropped(u, v),
+            Sampler::Bilinear | Sampler::Trilinear => self.bilinear_cropped(u, v),
         }
     }
 

@@ -26,6 +26,10 @@ pub enum Sampler {
     Nearest,
     /// The four pixel centers around (u − ½, v − ½), weighted by the fractions.
     Bilinear,
+    /// Bilinear on the two pyramid levels around the pixel footprint, blended
+    /// (minification anti-aliasing, see [`crate::pyramid`]). Where no footprint is known
+    /// (single samples, cube maps, partial maps) it is bilinear.
+    Trilinear,
 }
 
 impl Sampler {
@@ -34,6 +38,7 @@ impl Sampler {
         match self {
             Sampler::Nearest => "nearest",
             Sampler::Bilinear => "bilinear",
+            Sampler::Trilinear => "trilinear",
         }
     }
 }
@@ -44,8 +49,9 @@ impl std::str::FromStr for Sampler {
         match s {
             "nearest" => Ok(Sampler::Nearest),
             "bilinear" => Ok(Sampler::Bilinear),
+            "trilinear" => Ok(Sampler::Trilinear),
             o => Err(format!(
-                "unknown sampler '{o}' (expected nearest or bilinear)"
+                "unknown sampler '{o}' (expected nearest, bilinear or trilinear)"
             )),
         }
     }
@@ -67,6 +73,8 @@ pub struct EnvMap {
     pub(crate) crop: Option<crate::coverage::Crop>,
     /// Compass heading of longitude 0 (GPano `PoseHeadingDegrees`).
     pub(crate) pose_heading: Option<f64>,
+    /// Minification pyramid levels 1.. (see [`crate::pyramid`]), built on first use.
+    pub(crate) levels: std::sync::OnceLock<Vec<EnvMap>>,
 }
 
 impl std::fmt::Debug for EnvMap {
@@ -152,6 +160,7 @@ impl EnvMap {
             background: 0,
             crop: None,
             pose_heading: None,
+            levels: std::sync::OnceLock::new(),
         })
     }
 
@@ -198,6 +207,7 @@ impl EnvMap {
             background: 0,
             crop: None,
             pose_heading: None,
+            levels: std::sync::OnceLock::new(),
         }
     }
 
@@ -306,7 +316,7 @@ impl EnvMap {
         }
         match sampler {
             Sampler::Nearest => self.nearest(u, v),
-            Sampler::Bilinear => self.bilinear(u, v),
+            Sampler::Bilinear | Sampler::Trilinear => self.bilinear(u, v),
         }
     }
 

@@ -45,24 +45,64 @@ pub fn exact_uv_at(
 pub fn sample_at(map: &EnvMap, sampler: Sampler, uv: Option<(f64, f64)>) -> u32 {
     match uv {
         None => map.background(),
-        Some((u, v)) => {
-            let w = map.width() as f64;
-            let u = if map.projection().wraps() {
-                let r = u.rem_euclid(w);
-                if r >= w {
-                    0.0
-                } else {
-                    r
-                }
-            } else {
-                u
-            };
-            map.sample(sampler, to_fx(u), to_fx(v))
-        }
+        Some((u, v)) => map.sample(sampler, to_fx(wrap_u(map, u)), to_fx(v)),
     }
 }
 
+/// Wrap u into [0, W) for 360° maps (f64 rounding can give W itself: that is 0).
+fn wrap_u(map: &EnvMap, u: f64) -> f64 {
+    let w = map.width() as f64;
+    if map.projection().wraps() {
+        let r = u.rem_euclid(w);
+        if r >= w {
+            0.0
+        } else {
+            r
+        }
+    } else {
+        u
+    }
+}
+
+/// [`sample_at`] with the trilinear sampler at level of detail `lod` (Q.8, see
+/// [`crate::pyramid::lod_q8`]).
+#[inline]
+pub fn sample_at_lod(map: &EnvMap, uv: Option<(f64, f64)>, lod: i32) -> u32 {
+    match uv {
+        None => map.background(),
+        Some((u, v)) => map.trilinear(to_fx(wrap_u(map, u)), to_fx(v), lod),
+    }
+}
+
+/// Exact pixel footprint at (x, y): the larger of the map-pixel distances to the exact
+/// positions of the next pixel to the right and below (u differences taken the short way
+/// round the seam). `None` where the map does not cover the pixel.
+fn exact_footprint(
+    cam: &Camera,
+    proj: Projection,
+    mw: f64,
+    mh: f64,
+    x: f64,
+    y: f64,
+    at: (f64, f64),
+) -> f64 {
+    let (u0, v0) = at;
+    let mut f: f64 = 0.0;
+    for (dx, dy) in [(1.0, 0.0), (0.0, 1.0)] {
+        if let Some((u, v)) = exact_uv_at(cam, proj, mw, mh, x + dx, y + dy) {
+            let mut du = (u - u0).abs();
+            if proj.wraps() && du > mw * 0.5 {
+                du = mw - du;
+            }
+            f = f.max(du).max((v - v0).abs());
+        }
+    }
+    f
+}
+
 /// Render `view` of `map` into `out` (row-major 0RGB, `width × height`), exactly.
+/// With [`Sampler::Trilinear`] the level of detail comes from the exact footprint of each
+/// pixel (differences of the exact mapping to the next pixel right and below).
 ///
 /// `threads`: split rows across the rayon pool when true; output is identical either way.
 ///
@@ -82,6 +122,20 @@ pub fn render_exact(
     let cam = Camera::new(view, width, height);
     let (mw, mh) = (map.width() as f64, map.height() as f64);
     let proj = map.projection();
+    if sampler == Sampler::Trilinear && map.crop().is_none() {
+        map.pyramid();
+        for_each_row(out, width as usize, threads, |y, line| {
+            for (x, px) in line.iter_mut().enumerate() {
+                let (xf, yf) = (x as f64 + 0.5, y as f64 + 0.5);
+                let uv = exact_uv_at(&cam, proj, mw, mh, xf, yf);
+                let lod = uv.map_or(0, |at| {
+                    crate::pyramid::lod_q8(exact_footprint(&cam, proj, mw, mh, xf, yf, at))
+                });
+                *px = sample_at_lod(map, uv, lod);
+            }
+        });
+        return Ok(());
+    }
     for_each_row(out, width as usize, threads, |y, line| {
         for (x, px) in line.iter_mut().enumerate() {
             *px = sample_at(

@@ -58,6 +58,7 @@ pub mod light;
 pub mod load;
 pub mod lut;
 pub mod projection;
+pub mod pyramid;
 pub mod raster;
 mod rows;
 pub mod synth;

@@ -15,7 +15,7 @@ use crate::camera::{check_size, Camera, View};
 use crate::envmap::{EnvMap, Sampler};
 use crate::error::ViewError;
 use crate::exact::{check_buffer, render_exact};
-use crate::fixed::{to_fx, Fx, FX_BITS};
+use crate::fixed::{to_fx, Fx, FX_BITS, FX_ONE};
 use crate::lut::{LutTable, Surface, TableKind, TableSpec};
 use crate::projection::Projection;
 use crate::rows::for_each_row;
@@ -161,6 +161,11 @@ struct Scan {
     shifts: [u8; STEP_REGIONS],
     /// Regions per unit of |X|.
     region_per_x: f64,
+    /// Angle between this scanline and the next at the centre column (radians).
+    row_angle: f64,
+    /// Vertical pixel footprint per region (level-0 map pixels; trilinear only): the
+    /// distance between this scanline's and the next one's table positions.
+    fy: [f32; STEP_REGIONS],
     lut_lo: i64,
     lut_hi: i64,
     zone_lo: i64,
@@ -215,6 +220,10 @@ trait Sink {
     }
     fn background(&mut self, x: usize);
     fn exact(&mut self, x: usize, uv: Option<(f64, f64)>);
+    /// The per-pixel step (dΛ, dV) of the span about to be emitted (its horizontal
+    /// footprint): the trilinear sink picks its pyramid level from it.
+    #[inline(always)]
+    fn footprint(&mut self, _dl: Fx, _dv: Fx, _region: usize) {}
 }
 
 struct PixelSink<'a, const BILINEAR: bool> {
@@ -280,6 +289,43 @@ impl<const BILINEAR: bool> Sink for CropSink<'_, BILINEAR> {
             Sampler::Nearest
         };
         self.row[x] = crate::exact::sample_at(self.map, s, uv);
+    }
+}
+
+/// Trilinear sampling (see [`crate::pyramid`]): the level of detail is set per span from
+/// the span's step and the scanline's vertical footprint.
+struct TriSink<'a> {
+    row: &'a mut [u32],
+    map: &'a EnvMap,
+    /// Vertical footprint per region of this scanline, in level-0 map pixels.
+    fy: [f32; STEP_REGIONS],
+    lod: i32,
+}
+
+impl Sink for TriSink<'_> {
+    #[inline(always)]
+    fn put(&mut self, x: usize, u: Fx, v: Fx) {
+        self.row[x] = self.map.trilinear(u, v, self.lod);
+    }
+    #[inline(always)]
+    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
+        self.map
+            .trilinear_span(&mut self.row[x..x + m], u, v, du, dv, self.lod);
+    }
+    #[inline(always)]
+    fn background(&mut self, x: usize) {
+        self.row[x] = self.map.background();
+    }
+    #[inline]
+    fn exact(&mut self, x: usize, uv: Option<(f64, f64)>) {
+        // Pole zones and pixels beyond the table: the footprint of the nearest span (or
+        // of the scanline, before the first span).
+        self.row[x] = crate::exact::sample_at_lod(self.map, uv, self.lod);
+    }
+    #[inline(always)]
+    fn footprint(&mut self, dl: Fx, dv: Fx, region: usize) {
+        let fx = dl.unsigned_abs().max(dv.unsigned_abs()) as f64 / FX_ONE as f64;
+        self.lod = crate::pyramid::lod_q8(fx.max(self.fy[region] as f64));
     }
 }
 
@@ -386,7 +432,21 @@ impl Renderer {
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
         let w = width as usize;
-        let bilinear = opts.sampler == Sampler::Bilinear;
+        let bilinear = opts.sampler != Sampler::Nearest;
+        if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
+            map.pyramid(); // built once, before the rows run in parallel
+            for_each_row(out, w, opts.threads, |y, row| {
+                let scan = &scans[y];
+                let mut s = TriSink {
+                    row,
+                    map,
+                    fy: scan.fy,
+                    lod: crate::pyramid::lod_q8(scan.fy[0] as f64),
+                };
+                render_row(scan, table, &frame, row_scale, &mut s);
+            });
+            return Ok(report);
+        }
         if map.crop().is_some() {
             for_each_row(out, w, opts.threads, |y, row| {
                 let scan = &scans[y];
@@ -527,6 +587,7 @@ impl Renderer {
                 sa,
                 ca,
                 t_per_x: 1.0 / rho,
+                row_angle: f / (f * f + yc * yc),
                 lut_lo: 0,
                 lut_hi: -1,
                 zone_lo: 0,
@@ -583,6 +644,9 @@ impl Renderer {
             min_step = 1;
             max_step = max_step.max(1);
         }
+        if opts.sampler == crate::envmap::Sampler::Trilinear {
+            vertical_footprints(scans, table, &frame);
+        }
         let report = RenderReport {
             path: match kind {
                 TableKind::Wide => RenderPath::LutWide,
@@ -595,6 +659,44 @@ impl Renderer {
             min_step,
         };
         (frame, report)
+    }
+}
+
+/// The vertical footprint of every scanline per region (see [`Scan::fy`]): table positions
+/// of the region's centre column on this scanline and the next (the previous one for the
+/// last row), Λ taken the short way round the seam; where the table does not cover both,
+/// the scanline's angular spacing in map pixels.
+fn vertical_footprints(scans: &mut [Scan], table: &LutTable, fr: &Frame) {
+    let n = scans.len();
+    let half_w = fr.w_out as f64 * 0.5;
+    let reg_x = half_w / STEP_REGIONS as f64;
+    let px_per_rad = fr.mw / TAU;
+    for y in 0..n {
+        let other = if y + 1 < n {
+            y + 1
+        } else {
+            y.saturating_sub(1)
+        };
+        let mut fy = [0f32; STEP_REGIONS];
+        for (r, f) in fy.iter_mut().enumerate() {
+            let x = ((half_w + (r as f64 + 0.5) * reg_x - 0.5).round() as i64)
+                .clamp(0, fr.w_out as i64 - 1);
+            let usable = |s: &Scan| {
+                s.lut && x >= s.lut_lo && x <= s.lut_hi && !(x >= s.zone_lo && x <= s.zone_hi)
+            };
+            *f = if other != y && usable(&scans[y]) && usable(&scans[other]) {
+                let (l0, v0) = read(&scans[y], table, fr, x);
+                let (l1, v1) = read(&scans[other], table, fr, x);
+                let mut dl = (l1 - l0).unsigned_abs() as i64;
+                if dl > fr.half_map_w_fx {
+                    dl = (fr.map_w_fx - dl).abs();
+                }
+                (dl.max((v1 - v0).abs()) as f64 / FX_ONE as f64) as f32
+            } else {
+                (scans[y].row_angle * px_per_rad) as f32
+            };
+        }
+        scans[y].fy = fy;
     }
 }
 
@@ -795,6 +897,7 @@ fn lut_run<S: Sink>(
         } else {
             ((l1 - l0) / m, (v1 - v0) / m)
         };
+        sink.footprint(dl, dv, region);
         if xe == x1 {
             // Last span: emit through x1 inclusive, ending exactly on the read value.
             emit(fr, row_scale, xs, m, (l0, v0), (dl, dv), sink);

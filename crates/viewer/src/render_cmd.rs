@@ -25,6 +25,9 @@ pub enum SamplerArg {
     Nearest,
     /// Bilinear.
     Bilinear,
+    /// Trilinear: bilinear on the two pyramid levels around the pixel footprint
+    /// (anti-aliased when zoomed out; the pyramid takes up to 1/3 more memory).
+    Trilinear,
 }
 
 /// Table choice.
@@ -187,6 +190,7 @@ impl RenderArgs {
             sampler: match self.sampler {
                 SamplerArg::Nearest => Sampler::Nearest,
                 SamplerArg::Bilinear => Sampler::Bilinear,
+                SamplerArg::Trilinear => Sampler::Trilinear,
             },
             index_step: self.index_step,
             lut: match self.lut {

@@ -427,7 +427,7 @@ impl CubeMap {
     pub fn sample_uv(&self, sampler: Sampler, face: Face, u: f64, v: f64) -> u32 {
         match sampler {
             Sampler::Nearest => self.nearest(face, u, v),
-            Sampler::Bilinear => self.bilinear(face, u, v),
+            Sampler::Bilinear | Sampler::Trilinear => self.bilinear(face, u, v),
         }
     }
 

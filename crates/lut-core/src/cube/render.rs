@@ -184,7 +184,9 @@ pub fn render(
     let frame = Frame::new(view, width, height, cube.face_size());
     match sampler {
         Sampler::Nearest => render_with(cube, &frame, NearestFetch, renderer, out, threads),
-        Sampler::Bilinear => render_with(cube, &frame, BilinearFetch, renderer, out, threads),
+        Sampler::Bilinear | Sampler::Trilinear => {
+            render_with(cube, &frame, BilinearFetch, renderer, out, threads)
+        }
     }
     Ok(())
 }
