@@ -79,6 +79,10 @@ pub struct BenchArgs {
     /// Skip the cube renderers (they convert the map to a cube first, which takes a while).
     #[arg(long)]
     pub no_cube: bool,
+    /// Skip the minification set (zoomed out: bilinear and trilinear against the exact
+    /// render supersampled 8x8, which takes a while).
+    #[arg(long)]
+    pub no_minify: bool,
     /// The pixel limit for PANORAMA.
     #[command(flatten)]
     pub limit: crate::max_pixels::MaxPixelsArg,
@@ -211,6 +215,9 @@ struct Row {
     mean_err_px: Option<f64>,
     /// PSNR against the exact render with the same sampler (null: identical images).
     psnr_db: Option<f64>,
+    /// PSNR against the exact render supersampled 8×8 per pixel (the minification set).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    psnr_ss_db: Option<f64>,
     /// Fraction of pixels the LUT renderer evaluated exactly (pole zones, beyond a table).
     exact_fraction: Option<f64>,
     table_bytes: Option<usize>,
@@ -333,6 +340,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
                     .pos_count
                     .map(|n| if n > 0 { e.sum / n as f64 } else { 0.0 }),
                 psnr_db: psnr(e.sse, e.samples),
+                psnr_ss_db: None,
                 exact_fraction: is_lut.then(|| e.exact_px as f64 / e.px.max(1) as f64),
                 table_bytes: is_lut.then_some(table_bytes[ti]),
                 table_build_ms: is_lut.then_some(build_ms[ti]),
@@ -342,6 +350,13 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         }
     }
 
+    let mut minify_note = None;
+    if !a.no_minify {
+        let (mut mrows, note) = minify_set(a, &map, &mut renderer, threads)?;
+        rows.append(&mut mrows);
+        minify_note = Some(note);
+    }
+
     if let Some(p) = &a.plot {
         plot(p, &rows).with_context(|| format!("{}: cannot draw the chart", p.display()))?;
     }
@@ -349,8 +364,124 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&rows)?);
     } else {
         print_table(&rows, build_ms, table_bytes);
+        if let Some(n) = minify_note {
+            println!("{n}");
+        }
     }
     Ok(())
+}
+
+/// The minification set: zoomed out (hfov 120 at a third of the output size, so one
+/// screen pixel covers several map pixels), the five fixed views; bilinear and trilinear,
+/// LUT (adaptive step) and exact, timed and compared by PSNR with the exact render
+/// supersampled 8×8 per pixel (box filter, bilinear sub-samples).
+fn minify_set(
+    a: &BenchArgs,
+    map: &EnvMap,
+    renderer: &mut Renderer,
+    threads: usize,
+) -> Result<(Vec<Row>, String)> {
+    let (w, h) = ((a.size.0 / 3).max(1), (a.size.1 / 3).max(1));
+    let hfov = 120.0;
+    let views = [
+        (0.0, 0.0),
+        (180.0, 0.0),
+        (37.5, 25.0),
+        (-100.0, -45.0),
+        (60.0, 80.0),
+    ]
+    .iter()
+    .map(|&(y, p)| View::new(y, p, hfov).map_err(|e| anyhow!("bench view: {e}")))
+    .collect::<Result<Vec<_>>>()?;
+    let t = Instant::now();
+    map.pyramid();
+    let pyr_ms = t.elapsed().as_secs_f64() * 1e3;
+    let n = w as usize * h as usize;
+    let mut truths = Vec::new();
+    for (i, v) in views.iter().enumerate() {
+        let mut t = vec![0u32; n];
+        lut_core::render_exact_supersampled(map, *v, Sampler::Bilinear, 8, &mut t, w, h, true)?;
+        truths.push(t);
+        progress(a, &format!("minify: 8x8 truth {}/{}", i + 1, views.len()));
+    }
+    let cfgs = [
+        (RendererKind::Lut, Sampler::Nearest),
+        (RendererKind::Lut, Sampler::Bilinear),
+        (RendererKind::Lut, Sampler::Trilinear),
+        (RendererKind::Exact, Sampler::Bilinear),
+        (RendererKind::Exact, Sampler::Trilinear),
+    ];
+    let mut rows = Vec::new();
+    let mut out = vec![0u32; n];
+    for (kind, sampler) in cfgs {
+        let opts = RenderOptions {
+            renderer: kind,
+            sampler,
+            index_step: IndexStep::Adaptive,
+            lut: LutChoice::Wide,
+            ..RenderOptions::default()
+        };
+        let (mut err, mut times) = (0u64, Vec::new());
+        for (v, truth) in views.iter().zip(&truths) {
+            renderer.render(map, *v, &opts, &mut out, w, h)?;
+            err += sse(&out, truth);
+        }
+        for _ in 0..a.passes {
+            for v in &views {
+                let t = Instant::now();
+                renderer.render(map, *v, &opts, &mut out, w, h)?;
+                times.push(t.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+        let is_lut = kind == RendererKind::Lut;
+        let row = Row {
+            renderer: if is_lut { "lut" } else { "exact" },
+            sampler: sampler.name(),
+            index_step: if is_lut {
+                serde_json::json!("adaptive")
+            } else {
+                serde_json::Value::Null
+            },
+            lut: is_lut.then_some("wide"),
+            width: w,
+            height: h,
+            threads,
+            map_width: map.width(),
+            map_height: map.height(),
+            projection: format!("{:?}", map.projection()).to_lowercase(),
+            hfov,
+            frames: views.len(),
+            ms_median: median(&times),
+            ms_min: times.iter().cloned().fold(f64::INFINITY, f64::min),
+            ms_max: times.iter().cloned().fold(0.0, f64::max),
+            max_err_px: None,
+            mean_err_px: None,
+            psnr_db: None,
+            psnr_ss_db: psnr(err, (n * views.len() * 3) as u64),
+            exact_fraction: None,
+            table_bytes: None,
+            table_build_ms: None,
+        };
+        progress(a, &row_line(&row));
+        rows.push(row);
+    }
+    let mut note = format!(
+        "minification set: {w}x{h} at hfov {hfov}, {} views; pyramid built in {pyr_ms:.0} ms, \
+         {:.1} MiB ({:.0} % of the map); PSNR against the exact render supersampled 8x8:",
+        views.len(),
+        map.pyramid_bytes() as f64 / 1048576.0,
+        100.0 * map.pyramid_bytes() as f64 / map.bytes() as f64
+    );
+    for r in &rows {
+        note.push_str(&format!(
+            "\n  {:<6} {:<9} {:>7.2} ms  {:>5.1} dB",
+            r.renderer,
+            r.sampler,
+            r.ms_median,
+            r.psnr_ss_db.unwrap_or(f64::INFINITY)
+        ));
+    }
+    Ok((rows, note))
 }
 
 /// Progress goes to stderr (with --json, stdout is only the JSON array).
