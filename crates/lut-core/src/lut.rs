@@ -211,14 +211,18 @@ fn atan2_pos(y: f64, x: f64) -> f64 {
 
 /// Q15.16 of a map coordinate (saturating; NaN gives 0).
 ///
-/// Rounds to nearest (ties to even) by adding and subtracting 1.5·2⁵², exact for any
-/// |y| < 2⁵¹ (y is clamped to the i32 range first): `f64::round` is a library call on
-/// the baseline x86-64 target and cost 7 % of the build.
+/// Rounds to nearest (ties to even) by adding 1.5·2⁵²: for |y| ≤ 2³¹ the sum's unit in the
+/// last place is 1, so it is rounded to an integer, and its low 32 mantissa bits are that
+/// integer in two's complement. `f64::round` is a library call on the baseline x86-64
+/// target, and a saturating `as i32` another ~20 instructions: together 15 % of the build.
 #[inline]
 fn q16(x: f64) -> i32 {
     const MAGIC: f64 = 6755399441055744.0;
     let y = (x * 65536.0).clamp(i32::MIN as f64, i32::MAX as f64);
-    ((y + MAGIC) - MAGIC) as i32
+    if y.is_nan() {
+        return 0;
+    }
+    (y + MAGIC).to_bits() as u32 as i32
 }
 
 impl LutTable {
@@ -338,9 +342,13 @@ impl LutTable {
                     }
                     k = k_end;
                 }
-                for (k, e) in errs.iter().enumerate() {
-                    if (k as f64 * step) as f32 >= zone {
-                        worst_ok = worst_ok.max(*e);
+                if zone < 0.0 {
+                    worst_ok = errs.iter().fold(0.0, |a, &e| a.max(e));
+                } else {
+                    for (k, e) in errs.iter().enumerate() {
+                        if (k as f64 * step) as f32 >= zone {
+                            worst_ok = worst_ok.max(*e);
+                        }
                     }
                 }
                 (zone, worst_ok)
@@ -980,5 +988,25 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn q16_rounds_to_nearest_and_saturates() {
+        for x in [
+            0.0, 1.0, -1.0, 0.3, -0.3, 1234.567, -32767.9, 32767.99, 1e-9, -1e-9,
+        ] {
+            let y = x * 65536.0;
+            let got = q16(x);
+            assert!((got as f64 - y).abs() <= 0.5, "{x}: {got} vs {y}");
+            assert_eq!(got, y.round() as i32, "{x}");
+        }
+        // ties go to even
+        assert_eq!(q16(0.5 / 65536.0), 0);
+        assert_eq!(q16(1.5 / 65536.0), 2);
+        assert_eq!(q16(-1.5 / 65536.0), -2);
+        assert_eq!(q16(1e9), i32::MAX);
+        assert_eq!(q16(-1e9), i32::MIN);
+        assert_eq!(q16(f64::NAN), 0);
+        assert_eq!(q16(f64::INFINITY), i32::MAX);
     }
 }
