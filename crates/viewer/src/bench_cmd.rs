@@ -272,11 +272,13 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
     // Tables: built once, timed, before any frame.
     let mut build_ms = [0.0f64; 2];
     let mut table_bytes = [0usize; 2];
+    let mut unfolded_bytes = [0usize; 2];
     for (i, kind) in [TableKind::Wide, TableKind::High].into_iter().enumerate() {
         let t = Instant::now();
         let table = renderer.table(Surface::Cylinder, kind);
         build_ms[i] = t.elapsed().as_secs_f64() * 1e3;
         table_bytes[i] = table.bytes();
+        unfolded_bytes[i] = table.unfolded_bytes();
     }
 
     let cube_map = if a.no_cube {
@@ -363,7 +365,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&rows)?);
     } else {
-        print_table(&rows, build_ms, table_bytes);
+        print_table(&rows, build_ms, table_bytes, unfolded_bytes);
         if let Some(n) = minify_note {
             println!("{n}");
         }
@@ -904,7 +906,7 @@ fn row_line(r: &Row) -> String {
     )
 }
 
-fn print_table(rows: &[Row], build_ms: [f64; 2], bytes: [usize; 2]) {
+fn print_table(rows: &[Row], build_ms: [f64; 2], bytes: [usize; 2], unfolded: [usize; 2]) {
     let mut o = std::io::stdout().lock();
     if let Some(r) = rows.first() {
         let _ = writeln!(
@@ -915,11 +917,15 @@ fn print_table(rows: &[Row], build_ms: [f64; 2], bytes: [usize; 2]) {
     }
     let _ = writeln!(
         o,
-        "tables: wide {:.1} ms, {} KiB; high {:.1} ms, {} KiB",
+        "tables: wide {:.1} ms, {} KiB (unfolded {} KiB, 1/{:.2}); high {:.1} ms, {} KiB (unfolded {} KiB, 1/{:.2})",
         build_ms[0],
         bytes[0] / 1024,
+        unfolded[0] / 1024,
+        unfolded[0] as f64 / bytes[0].max(1) as f64,
         build_ms[1],
-        bytes[1] / 1024
+        bytes[1] / 1024,
+        unfolded[1] / 1024,
+        unfolded[1] as f64 / bytes[1].max(1) as f64
     );
     let _ = writeln!(
         o,
