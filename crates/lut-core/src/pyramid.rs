@@ -13,7 +13,7 @@
 //! and the ±180° seam stays at a level column boundary); a 6000×3000 map gets
 //! 3000×1500, 1500×750 and 750×375.
 //!
-//! The level of detail is `log2(footprint)` in Q.8 ([`lod_q8`]), where the footprint is
+//! The level of detail is `log2(footprint) − ½` in Q.8 ([`lod_q8`]), where the footprint is
 //! the larger side of the pixel's extent in level-0 map pixels. The LUT renderer takes the
 //! horizontal extent from each span's index-interpolation step and the vertical one per
 //! scanline from its angular row spacing (the LUT's per-scanline scale); the exact
@@ -28,13 +28,20 @@ use rayon::prelude::*;
 /// Smallest level side built.
 const MIN_LEVEL_SIDE: u32 = 2;
 
+/// Level-of-detail bias in levels: blending towards level 1 starts at a footprint of
+/// √2 map pixels instead of 1. Between 1 and √2 bilinear barely aliases, and a frame at
+/// the common zoom (about one map pixel per screen pixel) then costs one bilinear sample
+/// per pixel instead of two.
+pub const LOD_BIAS: f32 = -0.5;
+
 /// Level of detail in Q.8 (256 = one level) for a footprint of `footprint` level-0 map
-/// pixels per screen pixel: 0 at or below one (magnification), else log2 of it.
+/// pixels per screen pixel: log2 of it plus [`LOD_BIAS`], and 0 (level 0, plain bilinear)
+/// below that.
 #[inline]
 pub fn lod_q8(footprint: f64) -> i32 {
     if footprint > 1.0 {
         // f32 log2 is plenty: the blend weight has 8 bits.
-        ((footprint as f32).log2() * 256.0).min(i32::MAX as f32 / 2.0) as i32
+        (((footprint as f32).log2() + LOD_BIAS) * 256.0).clamp(0.0, i32::MAX as f32 / 2.0) as i32
     } else {
         0
     }
@@ -266,8 +273,9 @@ mod tests {
     fn lod_of_footprints() {
         assert_eq!(lod_q8(0.5), 0);
         assert_eq!(lod_q8(1.0), 0);
-        assert_eq!(lod_q8(2.0), 256);
-        assert_eq!(lod_q8(8.0), 768);
-        assert!((lod_q8(3.0) - 405).abs() <= 1);
+        assert_eq!(lod_q8(1.4), 0);
+        assert_eq!(lod_q8(2.0), 128);
+        assert_eq!(lod_q8(8.0), 640);
+        assert!((lod_q8(3.0) - 277).abs() <= 1);
     }
 }

@@ -90,7 +90,7 @@ impl Default for RenderOptions {
         RenderOptions {
             renderer: RendererKind::Lut,
             sampler: Sampler::Bilinear,
-            index_step: IndexStep::Fixed(4),
+            index_step: IndexStep::Adaptive,
             lut: LutChoice::Auto,
             surface: Surface::Cylinder,
             threads: true,

@@ -1014,7 +1014,12 @@ fn plot(path: &Path, rows: &[Row]) -> Result<()> {
         for (lut, sampler, color, label) in series {
             let sel: Vec<&Row> = rows
                 .iter()
-                .filter(|r| r.renderer == "lut" && r.lut == Some(lut) && r.sampler == sampler)
+                .filter(|r| {
+                    r.renderer == "lut"
+                        && r.lut == Some(lut)
+                        && r.sampler == sampler
+                        && r.max_err_px.is_some()
+                })
                 .collect();
             let pts: Vec<(f64, f64, String)> = sel
                 .iter()

@@ -92,6 +92,12 @@ pub struct Sample {
     pub frame_ms_bilinear: f64,
     /// Median frame of the pan, nearest.
     pub frame_ms_nearest: f64,
+    /// Median frame of the pan, trilinear (the pyramid built before the pan).
+    pub frame_ms_trilinear: f64,
+    /// Time to build the pyramid (trilinear's levels).
+    pub pyramid_s: f64,
+    /// Bytes of the pyramid.
+    pub pyramid_bytes: u64,
     /// Peak resident memory after loading (VmHWM).
     pub peak_after_load_bytes: u64,
     /// Peak resident memory of the whole child (VmHWM at the end).
@@ -161,12 +167,12 @@ fn print_table(rows: &[Sample], a: &BenchLoadArgs) {
         a.frames
     );
     println!(
-        "| map | JPEG | load s (read + decode + convert) | tables s | frame ms bilinear | frame ms nearest | map GiB | peak RSS after load GiB | peak RSS GiB |"
+        "| map | JPEG | load s (read + decode + convert) | tables s | frame ms bilinear | frame ms nearest | pyramid s | frame ms trilinear | map GiB | pyramid GiB | peak RSS after load GiB | peak RSS GiB |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for s in rows {
         println!(
-            "| {}x{} | {:.1} MB | {:.2} ({:.2} + {:.2} + {:.2}) | {:.3} | {:.1} | {:.1} | {:.2} | {:.2} | {:.2} |",
+            "| {}x{} | {:.1} MB | {:.2} ({:.2} + {:.2} + {:.2}) | {:.3} | {:.1} | {:.1} | {:.2} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} |",
             s.width,
             s.height,
             s.file_bytes as f64 / 1e6,
@@ -177,7 +183,10 @@ fn print_table(rows: &[Sample], a: &BenchLoadArgs) {
             s.tables_s,
             s.frame_ms_bilinear,
             s.frame_ms_nearest,
+            s.pyramid_s,
+            s.frame_ms_trilinear,
             gib(s.map_bytes),
+            gib(s.pyramid_bytes),
             gib(s.peak_after_load_bytes),
             gib(s.peak_bytes),
         );
@@ -288,6 +297,10 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
     };
     let frame_ms_bilinear = pan(Sampler::Bilinear)?;
     let frame_ms_nearest = pan(Sampler::Nearest)?;
+    let t = Instant::now();
+    map.pyramid();
+    let pyramid_s = t.elapsed().as_secs_f64();
+    let frame_ms_trilinear = pan(Sampler::Trilinear)?;
     Ok(Sample {
         width: map.width(),
         height: map.height(),
@@ -301,6 +314,9 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
         table_bytes,
         frame_ms_bilinear,
         frame_ms_nearest,
+        frame_ms_trilinear,
+        pyramid_s,
+        pyramid_bytes: map.pyramid_bytes() as u64,
         peak_after_load_bytes: peak_after_load,
         peak_bytes: proc_status_bytes("VmHWM:").unwrap_or(0),
     })

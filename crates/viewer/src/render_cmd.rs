@@ -123,7 +123,7 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value_t = SamplerArg::Bilinear)]
     pub sampler: SamplerArg,
     /// Index interpolation step: 1, 2, 4, 8, 16, or "adaptive".
-    #[arg(long, default_value = "4", value_parser = parse_step)]
+    #[arg(long, default_value = "adaptive", value_parser = parse_step)]
     pub index_step: IndexStep,
     /// Which look-up table.
     #[arg(long, value_enum, default_value_t = LutArg::Auto)]

@@ -154,13 +154,16 @@ fn load(
                 .0
         }
     };
-    // Build both tables now, so the first frames do not wait for them.
+    // Build both tables and the pyramid (the window's default sampler is trilinear) now,
+    // so the first frames do not wait for them.
     send(LoadStep::Tables, Some(0.0));
     let mut renderer = Renderer::new(&map);
     let surface = lut_core::RenderOptions::default().surface;
     renderer.table(surface, lut_core::lut::TableKind::Wide);
-    send(LoadStep::Tables, Some(0.5));
+    send(LoadStep::Tables, Some(0.3));
     renderer.table(surface, lut_core::lut::TableKind::High);
+    send(LoadStep::Tables, Some(0.5));
+    map.pyramid();
     send(LoadStep::Tables, Some(1.0));
     Ok(Box::new(Loaded {
         scene: Scene::Map { map, renderer },

@@ -156,7 +156,9 @@ impl Default for Settings {
             drag: DragStyle::Grab,
             inertia: true,
             aa: AaMode::default(),
-            sampler: Sampler::Bilinear,
+            // Trilinear: bilinear when zoomed in, anti-aliased from the pyramid when
+            // zoomed out (built on the loader thread).
+            sampler: Sampler::Trilinear,
             index_step: o.index_step,
             renderer: o.renderer,
             lut: o.lut,
@@ -959,7 +961,7 @@ mod tests {
         assert!(due > t && due <= t + 0.15, "due {due}, stopped at {t}");
         let f = c.frame(due);
         assert!(!f.fast);
-        assert_eq!(c.settings.sampler_for(f.fast), Sampler::Bilinear);
+        assert_eq!(c.settings.sampler_for(f.fast), Sampler::Trilinear);
         // Exactly one: after it, nothing is pending.
         assert_eq!(c.wake_at(), None);
     }
@@ -980,7 +982,7 @@ mod tests {
             aa: AaMode::Always,
             ..Settings::default()
         };
-        assert_eq!(s.sampler_for(true), Sampler::Bilinear);
+        assert_eq!(s.sampler_for(true), Sampler::Trilinear);
         let s = Settings {
             aa: AaMode::Off,
             ..Settings::default()

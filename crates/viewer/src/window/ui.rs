@@ -56,7 +56,7 @@ pub enum LoadStep {
     Decoding,
     /// Writing the pixels into the map (0RGB, padding).
     Converting,
-    /// Building the look-up tables.
+    /// Building the look-up tables and the minification pyramid.
     Tables,
 }
 
@@ -75,7 +75,7 @@ impl LoadStep {
             LoadStep::Reading => "reading the file",
             LoadStep::Decoding => "decoding",
             LoadStep::Converting => "converting to the map",
-            LoadStep::Tables => "building look-up tables",
+            LoadStep::Tables => "building look-up tables and pyramid",
         }
     }
 
@@ -388,7 +388,7 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
         egui::ComboBox::from_id_salt("sampler")
             .selected_text(s.sampler.name())
             .show_ui(ui, |ui| {
-                for x in [Sampler::Bilinear, Sampler::Nearest] {
+                for x in [Sampler::Trilinear, Sampler::Bilinear, Sampler::Nearest] {
                     ui.selectable_value(&mut s.sampler, x, x.name());
                 }
             });
