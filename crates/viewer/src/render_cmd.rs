@@ -82,6 +82,30 @@ pub enum CubeRendererArg {
     Scanline,
 }
 
+/// How to read a panorama: the options `viewer render` and the window share.
+#[derive(Args, Debug, Clone)]
+pub struct InputArgs {
+    /// Map projection: auto (2:1 is equirect; a folder or several files are a cube),
+    /// equirect, cylinder, sine, elliptical, diamond, cube.
+    #[arg(long, value_name = "NAME", default_value = "auto", value_parser = parse_projection_arg)]
+    pub projection: ProjectionArg,
+    /// Cube input layout: files, cross, strip, 3x2 (detected when omitted).
+    #[arg(long)]
+    pub layout: Option<String>,
+    /// Cube face naming/orientation: conventions, cube2, irrlicht (see docs/cube.md).
+    #[arg(long)]
+    pub naming: Option<String>,
+    /// Cube renderer (per pixel, or per scanline with face segments).
+    #[arg(long, value_enum, default_value_t = CubeRendererArg::Scanline)]
+    pub cube_renderer: CubeRendererArg,
+    /// The area the image covers, for partial panoramas: HFOVxVFOV[±YAW±PITCH] in
+    /// degrees (e.g. 120x60+30-10: 120 x 60 centred on yaw 30, pitch -10). Overrides
+    /// GPano XMP metadata in the file. Equirectangular images only (in the window: the
+    /// panorama named on the command line only).
+    #[arg(long, value_name = "HFOVxVFOV[±YAW±PITCH]", value_parser = crate::partial::parse_coverage, allow_hyphen_values = true)]
+    pub coverage: Option<lut_core::Coverage>,
+}
+
 /// Arguments of `viewer render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -103,19 +127,9 @@ pub struct RenderArgs {
     /// Output size WIDTHxHEIGHT (each side 1..=16384).
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Map projection: auto (2:1 is equirect; a folder or several files are a cube),
-    /// equirect, cylinder, sine, elliptical, diamond, cube.
-    #[arg(long, default_value = "auto", value_parser = parse_projection_arg)]
-    pub projection: ProjectionArg,
-    /// Cube input layout: files, cross, strip, 3x2 (detected when omitted).
-    #[arg(long)]
-    pub layout: Option<String>,
-    /// Cube face naming/orientation: conventions, cube2, irrlicht (see docs/cube.md).
-    #[arg(long)]
-    pub naming: Option<String>,
-    /// Cube renderer.
-    #[arg(long, value_enum, default_value_t = CubeRendererArg::Scanline)]
-    pub cube_renderer: CubeRendererArg,
+    /// How to read the panorama (shared with the window).
+    #[command(flatten)]
+    pub input: InputArgs,
     /// Renderer.
     #[arg(long, value_enum, default_value_t = RendererArg::Lut)]
     pub renderer: RendererArg,
@@ -135,11 +149,6 @@ pub struct RenderArgs {
     /// curve x/(1+x) and sRGB. 8-bit images are shown as stored.
     #[arg(long, default_value = "0", value_parser = parse_stops, allow_hyphen_values = true)]
     pub exposure: f64,
-    /// The area the image covers, for partial panoramas: HFOVxVFOV[±YAW±PITCH] in
-    /// degrees (e.g. 120x60+30-10: 120 x 60 centred on yaw 30, pitch -10). Overrides
-    /// GPano XMP metadata in the file. Equirectangular images only.
-    #[arg(long, value_name = "HFOVxVFOV[±YAW±PITCH]", value_parser = crate::partial::parse_coverage, allow_hyphen_values = true)]
-    pub coverage: Option<lut_core::Coverage>,
     /// Keep the view inside the covered area of a partial panorama: reduce hfov if the
     /// view is larger than the coverage, then clamp pitch and yaw.
     #[arg(long)]
@@ -211,7 +220,7 @@ impl RenderArgs {
 pub fn run(a: RenderArgs) -> Result<()> {
     let mut view = View::new(a.yaw, a.pitch, a.hfov).context("invalid view")?;
     let (w, h) = a.size;
-    let cube = match a.projection {
+    let cube = match a.input.projection {
         ProjectionArg::Cube => true,
         ProjectionArg::Auto => {
             a.panorama.len() > 1 || a.panorama.first().is_some_and(|p| p.is_dir())
@@ -221,12 +230,15 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let mut out = vec![0u32; w as usize * h as usize];
     let sampler = a.options().sampler;
     if cube {
-        if a.coverage.is_some() {
+        if a.input.coverage.is_some() {
             anyhow::bail!("--coverage applies to equirectangular panoramas, not cube maps");
         }
-        let cube =
-            crate::cube_cmd::load_cube(&a.panorama, a.layout.as_deref(), a.naming.as_deref())?;
-        let kind = match a.cube_renderer {
+        let cube = crate::cube_cmd::load_cube(
+            &a.panorama,
+            a.input.layout.as_deref(),
+            a.input.naming.as_deref(),
+        )?;
+        let kind = match a.input.cube_renderer {
             CubeRendererArg::Basic => lut_core::cube::CubeRenderer::Basic,
             CubeRendererArg::Scanline => lut_core::cube::CubeRenderer::Accelerated,
         };
@@ -244,7 +256,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
                 a.panorama.len()
             );
         }
-        let projection = match a.projection {
+        let projection = match a.input.projection {
             ProjectionArg::Map(p) => Some(p),
             _ => None,
         };
@@ -254,7 +266,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         let (map, _) = crate::partial::load_panorama_partial(
             a.panorama.first().map(|p| p.as_path()),
             &a.limit.options(projection, tone),
-            a.coverage,
+            a.input.coverage,
             &mut |_| {},
         )?;
         if a.view_limit {

@@ -250,7 +250,7 @@ struct App {
 
 /// Open the window and run until it is closed.
 pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
-    let projection = match args.projection {
+    let projection = match args.input.projection {
         ProjectionArg::Map(p) => Some(p),
         ProjectionArg::Auto | ProjectionArg::Cube => None,
     };
@@ -284,30 +284,30 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         frame_times: VecDeque::new(),
         fatal: None,
         max_pixels: args.limit.max_pixels,
-        naming: args.naming.clone(),
+        naming: args.input.naming.clone(),
         lights,
         pending_drops: Vec::new(),
         coverage: None,
     };
     app.ctl.settings.view_limit = !args.no_view_limit;
-    app.ctl.settings.cube_renderer = match args.cube_renderer {
+    app.ctl.settings.cube_renderer = match args.input.cube_renderer {
         CubeRendererArg::Basic => CubeRenderer::Basic,
         CubeRendererArg::Scanline => CubeRenderer::Accelerated,
     };
-    let cube = match args.projection {
+    let cube = match args.input.projection {
         ProjectionArg::Cube => true,
         ProjectionArg::Map(_) => false,
         ProjectionArg::Auto => args.panorama.len() > 1 || args.panorama.iter().any(|p| p.is_dir()),
     };
     // One image in auto is a map (as `viewer render` takes it); `--projection cube` or
     // `--layout` makes it a cube.
-    let source = if cube || args.layout.is_some() {
-        Source::of_paths(args.panorama, true, args.layout)
+    let source = if cube || args.input.layout.is_some() {
+        Source::of_paths(args.panorama, true, args.input.layout)
     } else {
         args.panorama.first().cloned().map(Source::File)
     };
     let source = source.unwrap_or(Source::Sample);
-    app.coverage = args.coverage.map(|c| (source.clone(), c));
+    app.coverage = args.input.coverage.map(|c| (source.clone(), c));
     app.start_load(source, projection);
     event_loop
         .run_app(&mut app)

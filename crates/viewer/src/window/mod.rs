@@ -16,7 +16,7 @@ pub mod lights;
 pub mod paint;
 pub mod ui;
 
-use crate::render_cmd::{CubeRendererArg, ProjectionArg};
+use crate::render_cmd::ProjectionArg;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -27,29 +27,15 @@ pub struct OpenArgs {
     /// reads, or a cube map (a folder, six face files, or one layout image with
     /// --projection cube). Drop another file or folder on the window to open it.
     pub panorama: Vec<PathBuf>,
-    /// Projection: auto (2:1 images are equirect; a folder or several files are a cube),
-    /// equirect, cylinder, sine, elliptical, diamond or cube.
-    #[arg(long, value_name = "NAME", default_value = "auto", value_parser = crate::render_cmd::parse_projection_arg)]
-    pub projection: ProjectionArg,
-    /// Cube input layout: files, cross, strip, 3x2 (detected when omitted).
-    #[arg(long)]
-    pub layout: Option<String>,
-    /// Cube face naming/orientation: conventions, cube2, irrlicht (see docs/cube.md).
-    #[arg(long)]
-    pub naming: Option<String>,
-    /// Cube renderer (also chosen in the panel).
-    #[arg(long, value_enum, default_value_t = CubeRendererArg::Scanline)]
-    pub cube_renderer: CubeRendererArg,
+    /// How to read the panorama (the same options as `viewer render`).
+    #[command(flatten)]
+    pub input: crate::render_cmd::InputArgs,
     /// Initial window size in logical pixels, WIDTHxHEIGHT.
     #[arg(long, value_name = "WxH", default_value = "1024x640", value_parser = crate::cli_common::parse_size)]
     pub size: (u32, u32),
     /// Print the view of every rendered frame to stdout (for scripts and tests).
     #[arg(long)]
     pub print_view: bool,
-    /// The area the panorama covers: HFOVxVFOV[±YAW±PITCH] in degrees (e.g.
-    /// 120x60+30-10), overriding GPano XMP metadata; for the panorama given here only.
-    #[arg(long, value_name = "HFOVxVFOV[±YAW±PITCH]", value_parser = crate::partial::parse_coverage, allow_hyphen_values = true)]
-    pub coverage: Option<lut_core::Coverage>,
     /// Start with the view limit off (partial panoramas; the panel's "Keep the view
     /// inside" switches it).
     #[arg(long)]
@@ -73,7 +59,7 @@ pub fn run(a: OpenArgs) -> anyhow::Result<()> {
         // exists but does not decode is reported in the window instead.
         std::fs::metadata(p).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
     }
-    if a.panorama.len() > 1 && matches!(a.projection, ProjectionArg::Map(_)) {
+    if a.panorama.len() > 1 && matches!(a.input.projection, ProjectionArg::Map(_)) {
         anyhow::bail!(
             "{} files given: a single panorama takes one file (six faces are a cube map)",
             a.panorama.len()
