@@ -2,26 +2,14 @@
 //! from its header with one line naming the file, its size, the limit and the flag, and
 //! a nonzero exit; raising the limit lets it through.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::PathBuf;
+use std::process::Output;
 
-fn viewer(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_viewer"))
-        .args(args)
-        .env("RUST_BACKTRACE", "0")
-        .output()
-        .expect("run viewer")
-}
+mod common;
+use common::{s, viewer};
 
 fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("viewer-maxpx-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+    common::tmpdir("viewer-maxpx", name)
 }
 
 fn crc32(data: &[u8]) -> u32 {

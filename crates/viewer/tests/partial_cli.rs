@@ -3,25 +3,12 @@
 
 use lut_core::gpano::{insert_xmp, xmp_packet};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn viewer(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_viewer"))
-        .args(args)
-        .env("RUST_BACKTRACE", "0")
-        .output()
-        .expect("run viewer")
-}
+mod common;
+use common::{s, viewer};
 
 fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("viewer-partial-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+    common::tmpdir("viewer-partial-cli", name)
 }
 
 /// A 240×120 JPEG, never darker than 40 per channel, tagged as columns 360..600 (across

@@ -2,25 +2,12 @@
 //! (a one-line message naming the value and the reason, a nonzero exit, no panic, no file).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn viewer(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_viewer"))
-        .args(args)
-        .env("RUST_BACKTRACE", "0")
-        .output()
-        .expect("run viewer")
-}
+mod common;
+use common::{s, viewer};
 
 fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("viewer-render-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+    common::tmpdir("viewer-render-cli", name)
 }
 
 /// A bad invocation: exit code nonzero, a message naming `needle`, no panic, no output file.
