@@ -110,7 +110,11 @@ fn pole_rows_and_seam_columns_render() {
         (179.99, 89.99, 0.5),
     ] {
         let view = View::new(yaw, pitch, hfov).unwrap();
-        for sampler in [lut_core::Sampler::Nearest, lut_core::Sampler::Bilinear] {
+        for sampler in [
+            lut_core::Sampler::Nearest,
+            lut_core::Sampler::Bilinear,
+            lut_core::Sampler::Trilinear,
+        ] {
             let opts = RenderOptions {
                 sampler,
                 ..RenderOptions::default()
@@ -151,5 +155,42 @@ fn widest_map_fixed_point_limits() {
             36,
             IndexStep::Fixed(16),
         );
+    }
+}
+
+/// The trilinear sampler at degenerate sizes and hard views: no panic, and on a map with
+/// an odd side (no pyramid levels) it is exactly bilinear.
+#[test]
+fn trilinear_on_degenerate_sizes_and_odd_maps() {
+    for (mw, mh) in [(1024u32, 512u32), (1023, 511)] {
+        let map = lut_core::synth::grid_map(mw, mh, Projection::Equirect).unwrap();
+        let mut r = Renderer::new(&map);
+        for (w, h) in [(1u32, 1u32), (1, 777), (777, 1), (97, 3)] {
+            for (yaw, pitch, hfov) in [
+                (0.0, 0.0, 170.0),
+                (180.0, 90.0, 120.0),
+                (-45.0, -89.9999, 0.01),
+            ] {
+                let view = View::new(yaw, pitch, hfov).unwrap();
+                let mut tri = vec![0u32; (w * h) as usize];
+                let mut bi = vec![0u32; (w * h) as usize];
+                for (sampler, out) in [
+                    (lut_core::Sampler::Trilinear, &mut tri),
+                    (lut_core::Sampler::Bilinear, &mut bi),
+                ] {
+                    let opts = RenderOptions {
+                        sampler,
+                        ..RenderOptions::default()
+                    };
+                    r.render(&map, view, &opts, out, w, h).unwrap();
+                }
+                if mw % 2 == 1 {
+                    assert_eq!(
+                        tri, bi,
+                        "odd map {mw}x{mh}, {w}x{h}, view {yaw},{pitch},{hfov}"
+                    );
+                }
+            }
+        }
     }
 }
