@@ -3,9 +3,10 @@
 
     python3 scripts/peers.py [--size 1920x1080] [--threads 2] [--out /tmp/peers]
                              [--viewer target/release/viewer] [--no-install] [--no-ffmpeg]
+                             [--no-py360]
 
 1. Installs the peers with the ordinary tools if missing: `pip install
-   opencv-python-headless numpy`, `apt-get install -y ffmpeg`.
+   opencv-python-headless numpy py360convert`, `apt-get install -y ffmpeg`.
 2. Runs `viewer bench --json --export-maps OUT` (our numbers, hfov-90 view set, the
    generated 8192x4096 grid map, same thread count) which also exports the source map,
    the exact sampling maps (OpenCV convention: u - 0.5, v - 0.5) and our exact renders.
@@ -14,7 +15,8 @@
      CV_16SC2; the conversion is timed separately as map building), bilinear and nearest;
    * OpenCV with the map built per view in numpy (float64 math, float32 maps), + remap;
    * ffmpeg `v360` (equirect -> flat), which builds its whole table for each view: timed
-     as (ffmpeg run with v360) - (the same run with a plain crop instead), per view.
+     as (ffmpeg run with v360) - (the same run with a plain crop instead), per view;
+   * py360convert `e2p` (numpy; builds its sampling grid on every call), one call per view.
    All with the same thread count (`cv2.setNumThreads`, ffmpeg `-filter_threads`).
 4. Prints a table: median ms per frame, our time as a ratio to theirs, and their PSNR
    against our exact render (same sampler). Writes OUT/peers.json.
@@ -44,6 +46,12 @@ def install(no_install):
             sys.exit("peers: opencv-python-headless and numpy are missing (pip install them)")
         subprocess.run([sys.executable, "-m", "pip", "install", "-q",
                         "opencv-python-headless", "numpy"], check=True)
+    try:
+        import py360convert  # noqa: F401
+    except ImportError:
+        if not no_install:
+            subprocess.run([sys.executable, "-m", "pip", "install", "-q", "py360convert"],
+                           check=True)
     if shutil.which("ffmpeg") is None and not no_install:
         env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
         subprocess.run(["apt-get", "update", "-q"], check=True, env=env)
@@ -101,6 +109,7 @@ def main():
     ap.add_argument("--reps", type=int, default=3, help="timed repetitions per view")
     ap.add_argument("--no-install", action="store_true")
     ap.add_argument("--no-ffmpeg", action="store_true")
+    ap.add_argument("--no-py360", action="store_true", help="skip py360convert")
     ap.add_argument("--bench-args", default="", help="extra arguments for viewer bench")
     a = ap.parse_args()
     install(a.no_install)
@@ -126,9 +135,9 @@ def main():
     srcp = np.ascontiguousarray(np.concatenate([src[:, -1:], src, src[:, :1]], axis=1))
 
     res = {k: [] for k in ["cv_float_bil", "cv_fixed_bil", "cv_float_nn", "cv_fixed_nn",
-                           "cv_convert", "np_build", "np_build_remap", "ff_v360"]}
+                           "cv_convert", "np_build", "np_build_remap", "ff_v360", "py360"]}
     imgs = {k: [] for k in ["cv_float_bil", "cv_fixed_bil", "cv_float_nn", "cv_fixed_nn",
-                            "np_build_remap", "ff_v360"]}
+                            "np_build_remap", "ff_v360", "py360"]}
     np_map_err = 0.0
     for i, v in enumerate(meta["views"]):
         rd = lambda name, dt: np.fromfile(os.path.join(a.out, v[name]), dtype=dt)  # noqa: E731
@@ -205,6 +214,25 @@ def main():
             print(f"peers: ffmpeg view {i + 1}/{len(meta['views'])}", file=sys.stderr)
         res["ff_base"] = base
 
+    try:
+        import py360convert
+    except ImportError:
+        py360convert = None
+    if not a.no_py360 and py360convert is not None:
+        vfov_deg = lambda hf: 2 * np.degrees(np.arctan(np.tan(np.radians(hf) / 2) * h / w))  # noqa: E731
+        for i, v in enumerate(meta["views"]):
+            ex_bil = np.fromfile(os.path.join(a.out, v["exact_bilinear"]),
+                                 dtype=np.uint8).reshape(h, w, 3)
+            # e2p(equirect, (h_fov, v_fov), u_deg (yaw, + right), v_deg (pitch, + up),
+            # (out_h, out_w)): it builds its sampling grid for every call, like v360.
+            yaw = (v["yaw"] + 180.0) % 360.0 - 180.0
+            t = time.perf_counter()
+            o = py360convert.e2p(src, (v["hfov"], vfov_deg(v["hfov"])), yaw, v["pitch"],
+                                 (h, w), mode="bilinear")
+            res["py360"].append(time.perf_counter() - t)
+            imgs["py360"].append((np.clip(o, 0, 255).astype(np.uint8), ex_bil))
+            print(f"peers: py360convert view {i + 1}/{len(meta['views'])}", file=sys.stderr)
+
     def our(sampler, step):
         for r in ours:
             if (r["renderer"] == "lut" and r["sampler"] == sampler and r["lut"] == "wide"
@@ -242,6 +270,7 @@ def main():
     add("numpy map build per view (float64)", "np_build", None, "-")
     add("OpenCV per view: numpy map + remap", "np_build_remap", lut_bil, "lut bilinear adaptive")
     add("ffmpeg v360 per view (table build + 1 frame)", "ff_v360", lut_bil, "lut bilinear adaptive")
+    add("py360convert e2p per view (grid + 1 frame)", "py360", lut_bil, "lut bilinear adaptive")
     add("our plain gather (precomputed indices)", "cv_fixed_nn", ours_of("gather", "nearest"),
         "gather")
     rows[-1]["peer"] = "OpenCV fixed nearest vs our plain gather"
