@@ -3,10 +3,10 @@
 
     python3 scripts/peers.py [--size 1920x1080] [--threads 2] [--out /tmp/peers]
                              [--viewer target/release/viewer] [--no-install] [--no-ffmpeg]
-                             [--no-py360]
+                             [--no-py360] [--no-nona]
 
 1. Installs the peers with the ordinary tools if missing: `pip install
-   opencv-python-headless numpy py360convert`, `apt-get install -y ffmpeg`.
+   opencv-python-headless numpy py360convert`, `apt-get install -y ffmpeg hugin-tools`.
 2. Runs `viewer bench --json --export-maps OUT` (our numbers, hfov-90 view set, the
    generated 8192x4096 grid map, same thread count) which also exports the source map,
    the exact sampling maps (OpenCV convention: u - 0.5, v - 0.5) and our exact renders.
@@ -16,7 +16,8 @@
    * OpenCV with the map built per view in numpy (float64 math, float32 maps), + remap;
    * ffmpeg `v360` (equirect -> flat), which builds its whole table for each view: timed
      as (ffmpeg run with v360) - (the same run with a plain crop instead), per view;
-   * py360convert `e2p` (numpy; builds its sampling grid on every call), one call per view.
+   * py360convert `e2p` (numpy; builds its sampling grid on every call), one call per view;
+   * Hugin's `nona` from a PTO project per view, timed minus a 1x1-output run (loading).
    All with the same thread count (`cv2.setNumThreads`, ffmpeg `-filter_threads`).
 4. Prints a table: median ms per frame, our time as a ratio to theirs, and their PSNR
    against our exact render (same sampler). Writes OUT/peers.json.
@@ -52,10 +53,12 @@ def install(no_install):
         if not no_install:
             subprocess.run([sys.executable, "-m", "pip", "install", "-q", "py360convert"],
                            check=True)
-    if shutil.which("ffmpeg") is None and not no_install:
+    missing = [pkg for pkg, exe in [("ffmpeg", "ffmpeg"), ("hugin-tools", "nona")]
+               if shutil.which(exe) is None]
+    if missing and not no_install:
         env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
         subprocess.run(["apt-get", "update", "-q"], check=True, env=env)
-        subprocess.run(["apt-get", "install", "-y", "-q", "ffmpeg"], check=True, env=env)
+        subprocess.run(["apt-get", "install", "-y", "-q"] + missing, check=True, env=env)
 
 
 def psnr(a, b):
@@ -110,6 +113,7 @@ def main():
     ap.add_argument("--no-install", action="store_true")
     ap.add_argument("--no-ffmpeg", action="store_true")
     ap.add_argument("--no-py360", action="store_true", help="skip py360convert")
+    ap.add_argument("--no-nona", action="store_true", help="skip Hugin's nona")
     ap.add_argument("--bench-args", default="", help="extra arguments for viewer bench")
     a = ap.parse_args()
     install(a.no_install)
@@ -135,9 +139,9 @@ def main():
     srcp = np.ascontiguousarray(np.concatenate([src[:, -1:], src, src[:, :1]], axis=1))
 
     res = {k: [] for k in ["cv_float_bil", "cv_fixed_bil", "cv_float_nn", "cv_fixed_nn",
-                           "cv_convert", "np_build", "np_build_remap", "ff_v360", "py360"]}
+                           "cv_convert", "np_build", "np_build_remap", "ff_v360", "py360", "nona"]}
     imgs = {k: [] for k in ["cv_float_bil", "cv_fixed_bil", "cv_float_nn", "cv_fixed_nn",
-                            "np_build_remap", "ff_v360", "py360"]}
+                            "np_build_remap", "ff_v360", "py360", "nona"]}
     np_map_err = 0.0
     for i, v in enumerate(meta["views"]):
         rd = lambda name, dt: np.fromfile(os.path.join(a.out, v[name]), dtype=dt)  # noqa: E731
@@ -233,6 +237,39 @@ def main():
             imgs["py360"].append((np.clip(o, 0, 255).astype(np.uint8), ex_bil))
             print(f"peers: py360convert view {i + 1}/{len(meta['views'])}", file=sys.stderr)
 
+    if not a.no_nona and shutil.which("nona"):
+        # Hugin's nona: one run per view from a PTO project (equirect input, rectilinear
+        # output), timed minus the same run with a 1x1 output (loading the map).
+        tif = os.path.join(a.out, "map.tif")
+        cv2.imwrite(tif, src[:, :, ::-1])
+        pto_path, out_prefix = os.path.join(a.out, "view.pto"), os.path.join(a.out, "nona")
+
+        def nona(yaw, pitch, hfov, ow, oh):
+            # The source is turned by -yaw, -pitch (PTools image yaw/pitch). PTools applies
+            # pitch before yaw, so only pitch-0 views match our camera exactly; the cost
+            # does not depend on the view.
+            with open(pto_path, "w") as f:
+                f.write(f'p f0 w{ow} h{oh} v{hfov} E0 R0 n"TIFF_m c:NONE"\nm i0\n'
+                        f'i w{mw} h{mh} f4 v360 Ra0 Rb0 Rc0 Rd0 Re0 Eev0 Er1 Eb1 r0 '
+                        f'p{-pitch} y{-yaw} TrX0 TrY0 TrZ0 j0 a0 b0 c0 d0 e0 g0 t0 Va1 Vb0 '
+                        f'Vc0 Vd0 Vx0 Vy0 Vm5 n"{tif}"\n')
+            t = time.perf_counter()
+            subprocess.run(["nona", "-o", out_prefix, pto_path], check=True,
+                           stdout=subprocess.DEVNULL)
+            return time.perf_counter() - t
+
+        base_s = statistics.median([nona(0, 0, 90, 1, 1) for _ in range(a.reps + 1)][1:])
+        for i, v in enumerate(meta["views"]):
+            yaw = (v["yaw"] + 180.0) % 360.0 - 180.0
+            times = [nona(yaw, v["pitch"], v["hfov"], w, h) for _ in range(a.reps)]
+            res["nona"].extend(max(t - base_s, 0.0) for t in times)
+            if v["pitch"] == 0:
+                o = cv2.imread(out_prefix + "0000.tif", cv2.IMREAD_UNCHANGED)[:, :, 2::-1]
+                ex_bil = np.fromfile(os.path.join(a.out, v["exact_bilinear"]),
+                                     dtype=np.uint8).reshape(h, w, 3)
+                imgs["nona"].append((np.ascontiguousarray(o[:, :, :3]), ex_bil))
+            print(f"peers: nona view {i + 1}/{len(meta['views'])}", file=sys.stderr)
+
     def our(sampler, step):
         for r in ours:
             if (r["renderer"] == "lut" and r["sampler"] == sampler and r["lut"] == "wide"
@@ -271,6 +308,8 @@ def main():
     add("OpenCV per view: numpy map + remap", "np_build_remap", lut_bil, "lut bilinear adaptive")
     add("ffmpeg v360 per view (table build + 1 frame)", "ff_v360", lut_bil, "lut bilinear adaptive")
     add("py360convert e2p per view (grid + 1 frame)", "py360", lut_bil, "lut bilinear adaptive")
+    add("Hugin nona per view (minus loading; PSNR: pitch-0 views)", "nona", lut_bil,
+        "lut bilinear adaptive")
     add("our plain gather (precomputed indices)", "cv_fixed_nn", ours_of("gather", "nearest"),
         "gather")
     rows[-1]["peer"] = "OpenCV fixed nearest vs our plain gather"
