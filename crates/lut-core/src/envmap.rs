@@ -373,7 +373,11 @@ impl EnvMap {
                 let i = y0 * stride + x0;
                 // One bounds check for the 2×2 block.
                 let q = &data[i..i + stride + 2];
-                *o = bilerp_swar(q[0], q[1], q[stride], q[stride + 1], fx, fy);
+                *o = lerp_px(
+                    lerp_px(q[0], q[1], fx),
+                    lerp_px(q[stride], q[stride + 1], fx),
+                    fy,
+                );
                 uu += du;
                 vv += dv;
             }
@@ -518,29 +522,6 @@ pub fn resolve_projection(
     }
 }
 
-/// Bilinear blend of a 2×2 block (`p00 p01` over `p10 p11`) with 8-bit weights, equal bit
-/// for bit to `lerp_px(lerp_px(p00, p01, fx), lerp_px(p10, p11, fx), fy)` but with 8
-/// multiplies instead of 12: the horizontal blends of both rows run together, red and blue
-/// of both rows in the four 16-bit lanes of one `u64` (each lane ≤ 255 · 256 < 2^16, so
-/// no lane carries into the next), green of both rows in the two lanes of one `u32`.
-#[inline(always)]
-pub fn bilerp_swar(p00: u32, p01: u32, p10: u32, p11: u32, fx: u32, fy: u32) -> u32 {
-    const RB: u32 = 0x00FF_00FF;
-    let (ix, iy) = (256 - fx, 256 - fy);
-    let rb_a = (p00 & RB) as u64 | ((p10 & RB) as u64) << 32;
-    let rb_b = (p01 & RB) as u64 | ((p11 & RB) as u64) << 32;
-    let rb = ((rb_a * ix as u64 + rb_b * fx as u64 + 0x0080_0080_0080_0080) >> 8)
-        & 0x00FF_00FF_00FF_00FF;
-    let g_a = (p00 >> 8 & 0xFF) | (p10 >> 8 & 0xFF) << 16;
-    let g_b = (p01 >> 8 & 0xFF) | (p11 >> 8 & 0xFF) << 16;
-    let g = ((g_a * ix + g_b * fx + 0x0080_0080) >> 8) & RB;
-    let (rb_t, rb_b) = (rb as u32, (rb >> 32) as u32);
-    let (g_t, g_b) = (g & 0xFF, g >> 16);
-    let rb = ((rb_t * iy + rb_b * fy + 0x0080_0080) >> 8) & RB;
-    let g = ((g_t * iy + g_b * fy + 0x80) >> 8) & 0xFF;
-    rb | g << 8
-}
-
 /// Blend two 0RGB pixels: `a · (256 − w) + b · w`, rounded, two channels per multiply.
 #[inline(always)]
 pub fn lerp_px(a: u32, b: u32, w: u32) -> u32 {
@@ -558,44 +539,6 @@ mod tests {
     fn ramp(w: u32, h: u32, p: Projection) -> EnvMap {
         let px: Vec<u32> = (0..w * h).map(|i| (i % w) << 16 | (i / w) << 8).collect();
         EnvMap::from_pixels(w, h, &px, p).unwrap()
-    }
-
-    #[test]
-    fn swar_bilinear_equals_three_lerps() {
-        let mut x = 0x1234_5678u32;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            x
-        };
-        for _ in 0..200_000 {
-            let p: [u32; 4] = [
-                next() & 0xFFFFFF,
-                next() & 0xFFFFFF,
-                next() & 0xFFFFFF,
-                next() & 0xFFFFFF,
-            ];
-            let (fx, fy) = (next() & 0xFF, next() & 0xFF);
-            let want = lerp_px(lerp_px(p[0], p[1], fx), lerp_px(p[2], p[3], fx), fy);
-            assert_eq!(
-                bilerp_swar(p[0], p[1], p[2], p[3], fx, fy),
-                want,
-                "{p:x?} {fx} {fy}"
-            );
-        }
-        for p in [0u32, 0xFFFFFF] {
-            for (fx, fy) in [(0, 0), (255, 255), (0, 255), (128, 1)] {
-                assert_eq!(
-                    bilerp_swar(p, 0xFFFFFF ^ p, p, 0xFFFFFF ^ p, fx, fy),
-                    lerp_px(
-                        lerp_px(p, 0xFFFFFF ^ p, fx),
-                        lerp_px(p, 0xFFFFFF ^ p, fx),
-                        fy
-                    )
-                );
-            }
-        }
     }
 
     #[test]
