@@ -152,16 +152,7 @@ impl EnvMap {
         }
         let (top, last) = data.split_at_mut(h * stride);
         last.copy_from_slice(&top[(h - 1) * stride..h * stride]);
-        Ok(EnvMap {
-            width,
-            height,
-            projection,
-            data,
-            background: 0,
-            crop: None,
-            pose_heading: None,
-            levels: std::sync::OnceLock::new(),
-        })
+        Ok(EnvMap::from_padded(width, height, projection, data))
     }
 
     /// Build a map from a decoded image (any colour type; converted to 8-bit RGB; HDR

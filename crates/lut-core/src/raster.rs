@@ -211,12 +211,7 @@ trait Sink {
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, w_fx: Fx) {
-        let (mut u, mut v) = (u, v);
-        for i in 0..m {
-            self.put(x + i, wrap_u(u, w_fx), v);
-            u += du;
-            v += dv;
-        }
+        put_run(self, x, m, (u, v), (du, dv), w_fx);
     }
     fn background(&mut self, x: usize);
     fn exact(&mut self, x: usize, uv: Option<(f64, f64)>);
@@ -226,56 +221,43 @@ trait Sink {
     fn footprint(&mut self, _dl: Fx, _dv: Fx, _region: usize) {}
 }
 
-struct PixelSink<'a, const BILINEAR: bool> {
+/// [`Sink::span`] pixel by pixel through [`Sink::put`].
+#[inline(always)]
+fn put_run<S: Sink + ?Sized>(s: &mut S, x: usize, m: usize, uv: (Fx, Fx), d: (Fx, Fx), w_fx: Fx) {
+    let (mut u, mut v) = uv;
+    for i in 0..m {
+        s.put(x + i, wrap_u(u, w_fx), v);
+        u += d.0;
+        v += d.1;
+    }
+}
+
+/// Writes sampled pixels. `CROP`: a partial map (see [`crate::coverage`]): full-panorama
+/// (u, v) are looked up in the crop, background outside; a const parameter so the
+/// full-map kernel keeps no per-pixel crop test.
+struct PixelSink<'a, const BILINEAR: bool, const CROP: bool> {
     row: &'a mut [u32],
     map: &'a EnvMap,
 }
 
-impl<const BILINEAR: bool> Sink for PixelSink<'_, BILINEAR> {
+impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CROP> {
     #[inline(always)]
     fn put(&mut self, x: usize, u: Fx, v: Fx) {
-        self.row[x] = if BILINEAR {
-            self.map.bilinear(u, v)
-        } else {
-            self.map.nearest(u, v)
+        self.row[x] = match (BILINEAR, CROP) {
+            (true, false) => self.map.bilinear(u, v),
+            (false, false) => self.map.nearest(u, v),
+            (true, true) => self.map.bilinear_cropped(u, v),
+            (false, true) => self.map.nearest_cropped(u, v),
         };
     }
     #[inline(always)]
-    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
-        self.map
-            .sample_span::<BILINEAR>(&mut self.row[x..x + m], u, v, du, dv);
-    }
-    #[inline(always)]
-    fn background(&mut self, x: usize) {
-        self.row[x] = self.map.background();
-    }
-    #[inline]
-    fn exact(&mut self, x: usize, uv: Option<(f64, f64)>) {
-        let s = if BILINEAR {
-            Sampler::Bilinear
+    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, w_fx: Fx) {
+        if CROP {
+            put_run(self, x, m, (u, v), (du, dv), w_fx); // per pixel: the crop test
         } else {
-            Sampler::Nearest
-        };
-        self.row[x] = crate::exact::sample_at(self.map, s, uv);
-    }
-}
-
-/// [`PixelSink`] for a partial map (see [`crate::coverage`]): full-panorama (u, v) are
-/// looked up in the crop, background outside. A separate sink so the full-map kernel
-/// keeps no per-pixel crop test.
-struct CropSink<'a, const BILINEAR: bool> {
-    row: &'a mut [u32],
-    map: &'a EnvMap,
-}
-
-impl<const BILINEAR: bool> Sink for CropSink<'_, BILINEAR> {
-    #[inline(always)]
-    fn put(&mut self, x: usize, u: Fx, v: Fx) {
-        self.row[x] = if BILINEAR {
-            self.map.bilinear_cropped(u, v)
-        } else {
-            self.map.nearest_cropped(u, v)
-        };
+            self.map
+                .sample_span::<BILINEAR>(&mut self.row[x..x + m], u, v, du, dv);
+        }
     }
     #[inline(always)]
     fn background(&mut self, x: usize) {
@@ -447,29 +429,27 @@ impl Renderer {
             });
             return Ok(report);
         }
-        if map.crop().is_some() {
-            for_each_row(out, w, opts.threads, |y, row| {
-                let scan = &scans[y];
-                if bilinear {
-                    let mut s = CropSink::<true> { row, map };
-                    render_row(scan, table, &frame, row_scale, &mut s);
-                } else {
-                    let mut s = CropSink::<false> { row, map };
-                    render_row(scan, table, &frame, row_scale, &mut s);
-                }
+        // One monomorphized kernel per (sampler, partial map): no per-pixel dispatch.
+        fn rows<const BILINEAR: bool, const CROP: bool>(
+            out: &mut [u32],
+            w: usize,
+            threads: bool,
+            k: (&[Scan], &LutTable, &Frame, &[i64]),
+            map: &EnvMap,
+        ) {
+            let (scans, table, frame, row_scale) = k;
+            for_each_row(out, w, threads, |y, row| {
+                let mut s = PixelSink::<BILINEAR, CROP> { row, map };
+                render_row(&scans[y], table, frame, row_scale, &mut s);
             });
-            return Ok(report);
         }
-        for_each_row(out, w, opts.threads, |y, row| {
-            let scan = &scans[y];
-            if bilinear {
-                let mut s = PixelSink::<true> { row, map };
-                render_row(scan, table, &frame, row_scale, &mut s);
-            } else {
-                let mut s = PixelSink::<false> { row, map };
-                render_row(scan, table, &frame, row_scale, &mut s);
-            }
-        });
+        let k = (&scans[..], table, &frame, row_scale);
+        match (bilinear, map.crop().is_some()) {
+            (true, false) => rows::<true, false>(out, w, opts.threads, k, map),
+            (false, false) => rows::<false, false>(out, w, opts.threads, k, map),
+            (true, true) => rows::<true, true>(out, w, opts.threads, k, map),
+            (false, true) => rows::<false, true>(out, w, opts.threads, k, map),
+        }
         Ok(report)
     }
 
