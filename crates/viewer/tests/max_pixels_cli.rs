@@ -12,33 +12,9 @@ fn tmpdir(name: &str) -> PathBuf {
     common::tmpdir("viewer-maxpx", name)
 }
 
-fn crc32(data: &[u8]) -> u32 {
-    let mut c = 0xFFFF_FFFFu32;
-    for &b in data {
-        c ^= u32::from(b);
-        for _ in 0..8 {
-            c = if c & 1 != 0 {
-                0xEDB8_8320 ^ (c >> 1)
-            } else {
-                c >> 1
-            };
-        }
-    }
-    !c
-}
-
-/// A PNG signature and a valid IHDR claiming `w × h`, no image data.
-fn png_header_only(w: u32, h: u32) -> Vec<u8> {
-    let mut v = vec![0x89, b'P', b'N', b'G', 0x0D, 0x0A, 0x1A, 0x0A];
-    let mut chunk = b"IHDR".to_vec();
-    chunk.extend_from_slice(&w.to_be_bytes());
-    chunk.extend_from_slice(&h.to_be_bytes());
-    chunk.extend_from_slice(&[8, 2, 0, 0, 0]);
-    v.extend_from_slice(&13u32.to_be_bytes());
-    v.extend_from_slice(&chunk);
-    v.extend_from_slice(&crc32(&chunk).to_be_bytes());
-    v
-}
+#[path = "../../../tests/support/bombs.rs"]
+mod bombs;
+use bombs::png_header_only;
 
 fn assert_refused(o: &Output, parts: &[&str]) {
     let err = String::from_utf8_lossy(&o.stderr);
