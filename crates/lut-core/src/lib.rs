@@ -13,11 +13,15 @@
 //! 3. Per frame: pitch picks the table rows of each scanline (two rows blended), zoom is
 //!    one scale factor per scanline, yaw is a column offset added to u with wrap-around.
 //! 4. Per scanline: the table is read every Nth pixel and map coordinates are interpolated
-//!    in fixed point between; spans near a pole (where longitude changes fast) use a
-//!    shorter step or exact evaluation, chosen per scanline from an error budget; the
-//!    ±180° seam is unwrapped per span, never smeared.
-//! 5. Nearest or bilinear sampling (FIG. 10) writes 0RGB pixels into the caller's buffer,
+//!    in fixed point between; the step is chosen per region of each scanline from an
+//!    analytic error bound (shorter near a pole, where longitude changes fast, with exact
+//!    evaluation in a small zone); the ±180° seam is unwrapped per span, never smeared.
+//! 5. Nearest or bilinear sampling (FIG. 10), or trilinear from a pyramid of the map
+//!    when zoomed out ([`pyramid`]), writes 0RGB pixels into the caller's buffer,
 //!    optionally in row bands across threads (byte-identical to one thread).
+//!
+//! Loading ([`load`]): a pixel limit checked from the file header before decoding, 8-bit
+//! images decoded straight into the map's buffer, progress reports.
 //!
 //! Partial panoramas ([`coverage`], [`gpano`], [`viewlimit`]): a map may store only the
 //! pixels of the area it covers plus their place in the full panorama (GPano XMP or an

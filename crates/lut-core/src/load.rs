@@ -8,7 +8,7 @@
 //! header alone (`imagesize` reads the PNG IHDR, the JPEG SOF, the EXR and Radiance
 //! headers, nothing more), then from the decoder's own dimensions. `image`'s [`Limits`]
 //! are set as a second line of defence (sides at most `max_pixels / 2` and
-//! [`MAX_MAP_WIDTH`](crate::MAX_MAP_WIDTH), decoder allocations at most 16 bytes per
+//! [`MAX_MAP_WIDTH`], decoder allocations at most 16 bytes per
 //! allowed pixel). [`crate::MAX_MAP_PIXELS`] stays the hard limit whatever is asked.
 //!
 //! ## Memory

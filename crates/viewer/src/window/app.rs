@@ -664,7 +664,7 @@ impl App {
     }
 
     /// "Save view…" / P: render the current view at the scene's size times the export
-    /// scale, full quality (the chosen sampler, bilinear by default, never the fast
+    /// scale, full quality (the chosen sampler, trilinear by default, never the fast
     /// nearest), lit as shown, and write it to `view-N.png` in the current directory.
     fn save_view(&mut self) {
         let scene = match self.readouts.scene {

@@ -102,7 +102,7 @@ pub enum DragStyle {
 /// When to spend time on anti-aliasing (the paper's three modes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum AaMode {
-    /// Always the chosen sampler (bilinear by default) with index interpolation.
+    /// Always the chosen sampler (trilinear by default) with index interpolation.
     Always,
     /// Nearest sampling while the view turns fast, full quality once it stops.
     #[default]
