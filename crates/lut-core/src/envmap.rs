@@ -33,27 +33,16 @@ pub enum Sampler {
 }
 
 impl Sampler {
-    /// Name used on the command line.
+    /// Name used on the command line (see [`crate::Named`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Sampler::Nearest => "nearest",
-            Sampler::Bilinear => "bilinear",
-            Sampler::Trilinear => "trilinear",
-        }
+        crate::Named::name(self)
     }
 }
 
 impl std::str::FromStr for Sampler {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "nearest" => Ok(Sampler::Nearest),
-            "bilinear" => Ok(Sampler::Bilinear),
-            "trilinear" => Ok(Sampler::Trilinear),
-            o => Err(format!(
-                "unknown sampler '{o}' (expected nearest, bilinear or trilinear)"
-            )),
-        }
+        crate::parse_name(s).ok_or_else(|| crate::named::unknown_name::<Sampler>("sampler", s))
     }
 }
 

@@ -61,6 +61,7 @@ pub mod gpano;
 pub mod light;
 pub mod load;
 pub mod lut;
+mod named;
 pub mod projection;
 pub mod pyramid;
 pub mod raster;
@@ -70,10 +71,13 @@ pub mod viewlimit;
 
 pub use camera::{Camera, View, MAX_OUTPUT_SIDE};
 pub use coverage::{Coverage, CoverageError, CoverageSource, Crop};
+pub use cube::{CubeRenderer, Layout, Naming};
 pub use envmap::{EnvMap, Sampler, Tone, MAX_MAP_PIXELS, MAX_MAP_WIDTH};
 pub use error::{MapError, ViewError};
 pub use exact::{render_exact, render_exact_supersampled};
 pub use load::{LoadOptions, LoadPhase, LoadProgress, DEFAULT_MAX_PIXELS};
+pub use lut::Surface;
+pub use named::{name_list, parse_name, Named};
 pub use projection::Projection;
 pub use raster::{
     IndexStep, LutChoice, RenderOptions, RenderPath, RenderReport, Renderer, RendererKind,

@@ -57,12 +57,9 @@ pub enum Surface {
 }
 
 impl Surface {
-    /// Name used on the command line.
+    /// Name used on the command line (see [`crate::Named`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Surface::Cylinder => "cylinder",
-            Surface::Plane => "plane",
-        }
+        crate::Named::name(self)
     }
 }
 

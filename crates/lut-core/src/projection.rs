@@ -44,15 +44,9 @@ impl Projection {
         Projection::Diamond,
     ];
 
-    /// The lower-case name used on the command line.
+    /// The lower-case name used on the command line (see [`crate::Named`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Projection::Equirect => "equirect",
-            Projection::Cylinder => "cylinder",
-            Projection::Sine => "sine",
-            Projection::Elliptical => "elliptical",
-            Projection::Diamond => "diamond",
-        }
+        crate::Named::name(self)
     }
 
     /// True when map rows are 360° of longitude end to end, so sampling wraps in u.
@@ -183,16 +177,16 @@ impl fmt::Display for Projection {
 impl FromStr for Projection {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.to_ascii_lowercase().as_str() {
-            "equirect" | "equirectangular" | "spherical" | "sphere" => Ok(Projection::Equirect),
-            "cylinder" | "cylindrical" => Ok(Projection::Cylinder),
-            "sine" => Ok(Projection::Sine),
-            "elliptical" | "sinusoidal" => Ok(Projection::Elliptical),
-            "diamond" => Ok(Projection::Diamond),
-            other => Err(format!(
-                "unknown projection '{other}' (expected equirect, cylinder, sine, elliptical or diamond)"
-            )),
-        }
+        // The names in any case, and a few aliases.
+        let s = s.to_ascii_lowercase();
+        crate::parse_name(&s)
+            .or(match s.as_str() {
+                "equirectangular" | "spherical" | "sphere" => Some(Projection::Equirect),
+                "cylindrical" => Some(Projection::Cylinder),
+                "sinusoidal" => Some(Projection::Elliptical),
+                _ => None,
+            })
+            .ok_or_else(|| crate::named::unknown_name::<Projection>("projection", &s))
     }
 }
 

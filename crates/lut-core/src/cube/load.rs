@@ -52,14 +52,9 @@ impl Layout {
     /// All layouts.
     pub const ALL: [Layout; 4] = [Layout::Files, Layout::Cross, Layout::Strip, Layout::Grid3x2];
 
-    /// Name used on the command line.
+    /// Name used on the command line (see [`crate::Named`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Layout::Files => "files",
-            Layout::Cross => "cross",
-            Layout::Strip => "strip",
-            Layout::Grid3x2 => "3x2",
-        }
+        crate::Named::name(self)
     }
 
     /// Grid of a single-image layout in face cells: (columns, rows); `None` for files.
@@ -97,15 +92,7 @@ impl Layout {
 impl std::str::FromStr for Layout {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "files" => Ok(Layout::Files),
-            "cross" => Ok(Layout::Cross),
-            "strip" => Ok(Layout::Strip),
-            "3x2" => Ok(Layout::Grid3x2),
-            o => Err(format!(
-                "unknown layout '{o}' (expected files, cross, strip or 3x2)"
-            )),
-        }
+        crate::parse_name(s).ok_or_else(|| crate::named::unknown_name::<Layout>("layout", s))
     }
 }
 
@@ -183,13 +170,9 @@ pub enum Naming {
 }
 
 impl Naming {
-    /// Name used on the command line.
+    /// Name used on the command line (see [`crate::Named`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Naming::Conventions => "conventions",
-            Naming::Cube2 => "cube2",
-            Naming::Irrlicht => "irrlicht",
-        }
+        crate::Named::name(self)
     }
 
     /// Where the image a file name calls `named` goes, and how it is turned.
@@ -220,14 +203,14 @@ impl Naming {
 impl std::str::FromStr for Naming {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "conventions" | "plain" | "opengl" | "gl" => Ok(Naming::Conventions),
-            "cube2" | "sauerbraten" => Ok(Naming::Cube2),
-            "irrlicht" => Ok(Naming::Irrlicht),
-            o => Err(format!(
-                "unknown naming '{o}' (expected conventions, cube2 or irrlicht)"
-            )),
-        }
+        // The names, and a few aliases.
+        crate::parse_name(s)
+            .or(match s {
+                "plain" | "opengl" | "gl" => Some(Naming::Conventions),
+                "sauerbraten" => Some(Naming::Cube2),
+                _ => None,
+            })
+            .ok_or_else(|| crate::named::unknown_name::<Naming>("naming", s))
     }
 }
 

@@ -46,25 +46,22 @@ pub enum CubeRenderer {
 }
 
 impl CubeRenderer {
-    /// Name used on the command line.
+    /// Name used on the command line (see [`crate::Named`]): `basic` or `scanline`.
     pub fn name(self) -> &'static str {
-        match self {
-            CubeRenderer::Basic => "basic",
-            CubeRenderer::Accelerated => "accelerated",
-        }
+        crate::Named::name(self)
     }
 }
 
 impl std::str::FromStr for CubeRenderer {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "basic" => Ok(CubeRenderer::Basic),
-            "accelerated" | "accel" => Ok(CubeRenderer::Accelerated),
-            o => Err(format!(
-                "unknown cube renderer '{o}' (expected basic or accelerated)"
-            )),
-        }
+        // The names, and the paper's word for the scanline renderer.
+        crate::parse_name(s)
+            .or(match s {
+                "accelerated" | "accel" => Some(CubeRenderer::Accelerated),
+                _ => None,
+            })
+            .ok_or_else(|| crate::named::unknown_name::<CubeRenderer>("cube renderer", s))
     }
 }
 
