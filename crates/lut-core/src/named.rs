@@ -159,7 +159,12 @@ impl Named for IndexStep {
     fn help(self) -> &'static str {
         match self {
             IndexStep::Adaptive => "The longest step the error bound allows, per scanline region",
-            _ => "Read the table every N pixels and interpolate between",
+            IndexStep::Fixed(1) => "Read the table at every pixel",
+            IndexStep::Fixed(2) => "Read the table every 2nd pixel, interpolate between",
+            IndexStep::Fixed(4) => "Read the table every 4th pixel, interpolate between",
+            IndexStep::Fixed(8) => "Read the table every 8th pixel, interpolate between",
+            IndexStep::Fixed(16) => "Read the table every 16th pixel, interpolate between",
+            IndexStep::Fixed(_) => "Not a step rendering accepts",
         }
     }
 }

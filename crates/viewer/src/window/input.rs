@@ -18,10 +18,12 @@
 //!   than [`FAST_HFOV_PER_S`] is rendered with nearest sampling; [`SETTLE_S`] after the
 //!   motion stops one full-quality frame is due ([`Controller::wake_at`]).
 
+use crate::scene::SceneOptions;
 use glam::DVec3;
 use lut_core::camera::{dir_to_lat_long, wrap_deg};
-use lut_core::cube::CubeRenderer;
-use lut_core::{Camera, IndexStep, LutChoice, RenderOptions, RendererKind, Sampler, View};
+use lut_core::{
+    Camera, CubeRenderer, IndexStep, LutChoice, Named, RenderOptions, RendererKind, Sampler, View,
+};
 
 /// Narrowest horizontal field of view the wheel and keys reach, degrees.
 pub const HFOV_MIN: f64 = 1.0;
@@ -111,13 +113,39 @@ pub enum AaMode {
     Off,
 }
 
-impl AaMode {
-    /// Label in the panel and docs.
-    pub fn label(self) -> &'static str {
+impl Named for DragStyle {
+    const ALL: &'static [Self] = &[DragStyle::Grab, DragStyle::Qtvr];
+    fn name(self) -> &'static str {
+        match self {
+            DragStyle::Grab => "grab",
+            DragStyle::Qtvr => "QTVR",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            DragStyle::Grab => "The scene point under the cursor stays under the cursor",
+            DragStyle::Qtvr => "Turning speed proportional to the distance from the press point",
+        }
+    }
+}
+
+/// The labels in the panel and docs.
+impl Named for AaMode {
+    const ALL: &'static [Self] = &[AaMode::Always, AaMode::StillOnly, AaMode::Off];
+    fn name(self) -> &'static str {
         match self {
             AaMode::Always => "Always",
             AaMode::StillOnly => "Still only",
             AaMode::Off => "Off",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            AaMode::Always => "Always the chosen sampler",
+            AaMode::StillOnly => {
+                "Nearest sampling while the view turns fast, full quality once it stops"
+            }
+            AaMode::Off => "Always nearest sampling",
         }
     }
 }
@@ -190,6 +218,14 @@ impl Settings {
             lut: self.lut,
             threads: true,
             ..RenderOptions::default()
+        }
+    }
+
+    /// Options of a frame of a map or a cube map.
+    pub fn scene_options(&self, fast: bool) -> SceneOptions {
+        SceneOptions {
+            render: self.render_options(fast),
+            cube: self.cube_renderer,
         }
     }
 }

@@ -1,71 +1,22 @@
-//! Helpers shared by the subcommands: parsing sizes and angles, loading panoramas,
-//! writing images atomically.
+//! Writing images: 0RGB pixels to RGB bytes, and files written atomically (a temporary
+//! file in the same folder, then a rename), so a failed write leaves nothing behind.
 
 use anyhow::{anyhow, Context, Result};
-use lut_core::{EnvMap, Projection};
 use std::path::{Path, PathBuf};
 
-/// Parse "WxH" into (w, h), each in 1..=MAX_OUTPUT_SIDE.
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (a, b) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("size '{s}' must look like WIDTHxHEIGHT, e.g. 1280x720"))?;
-    let w: u32 = a
-        .trim()
-        .parse()
-        .map_err(|_| format!("size '{s}': width '{a}' is not a whole number"))?;
-    let h: u32 = b
-        .trim()
-        .parse()
-        .map_err(|_| format!("size '{s}': height '{b}' is not a whole number"))?;
-    lut_core::camera::check_size(w, h).map_err(|e| format!("size '{s}': {e}"))?;
-    Ok((w, h))
-}
-
-/// Parse a finite angle in degrees.
-pub fn parse_angle(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{s}' is not a number of degrees"))?;
-    if !v.is_finite() {
-        return Err(format!("'{s}' is not a finite number of degrees"));
+/// 0RGB pixels as packed 8-bit RGB bytes (`R G B R G B …`).
+pub fn rgb24(pixels: &[u32]) -> Vec<u8> {
+    let mut rgb = Vec::with_capacity(pixels.len() * 3);
+    for p in pixels {
+        rgb.extend_from_slice(&[(p >> 16) as u8, (p >> 8) as u8, *p as u8]);
     }
-    Ok(v)
-}
-
-/// `auto` or a projection name.
-pub fn parse_projection(s: &str) -> Result<Option<Projection>, String> {
-    if s == "auto" {
-        Ok(None)
-    } else {
-        s.parse().map(Some)
-    }
-}
-
-/// Load the panorama at `path` (the bundled sample when `None`) with `opts`: projection,
-/// tone and the pixel limit (`--max-pixels`, checked from the header before decoding).
-/// The file is streamed into the map, never held whole by this function.
-pub fn load_panorama_opts(path: Option<&Path>, opts: &lut_core::LoadOptions) -> Result<EnvMap> {
-    Ok(match path {
-        Some(p) => EnvMap::load_with(p, opts, &mut |_| {})?,
-        None => EnvMap::decode_with(
-            crate::assets::SAMPLE_JPEG,
-            crate::assets::SAMPLE_NAME,
-            opts,
-            &mut |_| {},
-        )?,
-    })
+    rgb
 }
 
 /// Write 0RGB pixels as an 8-bit RGB PNG atomically: a temporary file in the same folder,
 /// then rename. On any error nothing is left at `out`.
 pub fn write_png_atomic(out: &Path, pixels: &[u32], width: u32, height: u32) -> Result<()> {
-    let mut rgb = Vec::with_capacity(pixels.len() * 3);
-    for p in pixels {
-        rgb.extend_from_slice(&[(p >> 16) as u8, (p >> 8) as u8, *p as u8]);
-    }
-    let img = image::RgbImage::from_raw(width, height, rgb)
+    let img = image::RgbImage::from_raw(width, height, rgb24(pixels))
         .ok_or_else(|| anyhow!("internal: pixel buffer does not match {width}x{height}"))?;
     // The format follows the extension (PNG unless it names another encoder we have).
     let format = match image::ImageFormat::from_path(out) {
@@ -117,4 +68,32 @@ pub fn write_image_atomic(
     tmp.persist(out)
         .map_err(|e| anyhow!("{}: cannot write: {}", out.display(), e.error))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rgb24_drops_the_top_byte() {
+        assert_eq!(
+            rgb24(&[0xFF12_3456, 0x00AB_CDEF]),
+            [0x12, 0x34, 0x56, 0xAB, 0xCD, 0xEF]
+        );
+    }
+
+    #[test]
+    fn png_round_trips_and_failures_leave_nothing() {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("a.png");
+        let px = [0x0010_2030u32, 0x0040_5060, 0x0070_8090, 0x00A0_B0C0];
+        write_png_atomic(&out, &px, 2, 2).unwrap();
+        let img = image::open(&out).unwrap().to_rgb8();
+        assert_eq!(img.into_raw(), rgb24(&px));
+        assert!(write_png_atomic(&out, &px, 3, 2).is_err());
+        let nowhere = tmp.path().join("no/such/b.png");
+        let e = write_png_atomic(&nowhere, &px, 2, 2).unwrap_err();
+        assert!(format!("{e:#}").contains("does not exist"), "{e:#}");
+        assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 1);
+    }
 }
