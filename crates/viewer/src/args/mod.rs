@@ -1,6 +1,6 @@
 //! Command-line arguments the commands share, and the parsers of their values.
 //!
-//! * [`named`]: the one clap value parser of every option enum (`lut_core::Named`).
+//! * [`mod@named`]: the one clap value parser of every option enum (`lut_core::Named`).
 //! * [`values`]: sizes "WxH", angles, stops.
 //! * [`input`]: how a panorama is read (`--projection`, `--layout`, `--naming`, …).
 //! * [`max_pixels`]: the pixel limit.

@@ -20,6 +20,8 @@ use std::sync::Arc;
 
 /// Options that light a rendered room panorama (flattened into `viewer render` and the
 /// window).
+// The field docs are the command-line help: `[:YAW,PITCH]` there is not a link.
+#[allow(rustdoc::broken_intra_doc_links)]
 #[derive(Args, Debug, Default, Clone)]
 pub struct LightArgs {
     /// Place a luminaire: FILE.ies@X,Y,Z[:YAW,PITCH] in metres and degrees (repeatable).

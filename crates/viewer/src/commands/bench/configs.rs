@@ -65,8 +65,8 @@ fn views(at: &[(f64, f64)], hfov: f64) -> Result<Vec<View>> {
         .collect()
 }
 
-/// The fixed, documented view sets. Each has the fixed views ([`FIXED`]; `full` adds
-/// [`FULL_EXTRA`]) and a pan at pitch 10° (yaw advancing by 360°/n, offset 3.7° so no
+/// The fixed, documented view sets. Each has the fixed views (`FIXED`; `full` adds
+/// `FULL_EXTRA`) and a pan at pitch 10° (yaw advancing by 360°/n, offset 3.7° so no
 /// frame is axis-aligned). The wide table's set is at hfov 90°, the high table's at hfov
 /// 50° (its natural range, < 60°; forcing the high table at 90° would make the pixels
 /// beyond it exact).

@@ -14,7 +14,7 @@
 //! time is all the per-view work: per-scanline setup plus the kernels. A third set, the
 //! minification set, compares samplers zoomed out with a supersampled truth.
 //!
-//! * [`configs`]: the view sets and the renderer configurations;
+//! * [`mod@configs`]: the view sets and the renderer configurations;
 //! * [`measure`]: the thread pool, errors, PSNR, timing;
 //! * [`report`]: the rows (`--json`) and the text table;
 //! * [`plot`]: `--plot`; [`export`]: `--export-maps`.
