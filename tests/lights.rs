@@ -223,6 +223,28 @@ fn non_numbers_and_bad_angles_error_with_the_line() {
 }
 
 #[test]
+fn error_messages_escape_control_characters_from_the_file() {
+    // An escape sequence in a value: the message shows it escaped, never raw.
+    let e = err(&GOOD.replace("90 40 0", "90 \x1b[2J\x1b[31mred 0"));
+    let msg = e.to_string();
+    assert!(!msg.chars().any(|c| c.is_control()), "{msg:?}");
+    assert!(msg.contains("'\\u{1b}[2J\\u{1b}[31mred'"), "{msg}");
+    assert_eq!(line_of(&e), 9);
+    // In a TILT= file name and in trailing data; bidi overrides too; long text is cut.
+    let e = err(&GOOD.replace("TILT=NONE", "TILT=\x07lamp\u{202e}.tlt"));
+    let msg = e.to_string();
+    assert!(
+        !msg.chars().any(|c| c.is_control() || c == '\u{202e}'),
+        "{msg:?}"
+    );
+    assert!(msg.contains("TILT=\\u{7}lamp\\u{202e}.tlt"), "{msg}");
+    let e = err(&format!("{GOOD}\x1b{}\n", "z".repeat(200)));
+    let msg = e.to_string();
+    assert!(!msg.chars().any(|c| c.is_control()), "{msg:?}");
+    assert!(msg.contains('…') && msg.len() < 200, "{msg}");
+}
+
+#[test]
 fn undeclared_symmetry_is_an_error_naming_the_angle_line() {
     let f = IesFile::parse(&GOOD.replace("\n0 90\n", "\n0 120\n"), "odd.ies").unwrap();
     let e = LightTable::from_ies(&f, &TableOptions::default()).unwrap_err();
@@ -451,6 +473,7 @@ fn distance_series_halves_and_interpolates_by_log_distance() {
     let opts = TableOptions {
         reference_distance: 2.0,
         max_levels: 4,
+        ..TableOptions::default()
     };
     let t = LightTable::from_ies(&f, &opts).unwrap();
     assert_eq!(t.level_count(), 4);
@@ -778,6 +801,7 @@ fn series_lookup_matches_the_tables_inside_and_outside_constant_ranges() {
         &TableOptions {
             reference_distance: 1.0,
             max_levels: 3,
+            ..TableOptions::default()
         },
     )
     .unwrap();
