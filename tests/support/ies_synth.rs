@@ -1,0 +1,34 @@
+//! Synthetic IES files for the light tests: any angles, candela from a function.
+
+use lut_core::light::IesFile;
+
+/// A type-C (or A/B) file with the given angles and values f(h, v) (horizontal-major).
+pub fn synth(ptype: u32, v: &[f64], h: &[f64], f: impl Fn(f64, f64) -> f64, mult: f64) -> IesFile {
+    let mut s = String::from("IESNA:LM-63-2002\n[TEST] synthetic\nTILT=NONE\n");
+    s += &format!(
+        "1 -1 {mult} {} {} {ptype} 2 0 0 0\n1 1 10\n",
+        v.len(),
+        h.len()
+    );
+    s += &v
+        .iter()
+        .map(|a| a.to_string())
+        .collect::<Vec<_>>()
+        .join(" ");
+    s += "\n";
+    s += &h
+        .iter()
+        .map(|a| a.to_string())
+        .collect::<Vec<_>>()
+        .join(" ");
+    s += "\n";
+    for &hh in h {
+        s += &v
+            .iter()
+            .map(|&vv| f(hh, vv).to_string())
+            .collect::<Vec<_>>()
+            .join(" ");
+        s += "\n";
+    }
+    IesFile::parse(&s, "synthetic.ies").expect("synthetic file parses")
+}
