@@ -158,8 +158,12 @@ pub(crate) struct Level {
     above: f64,
     left: Option<f64>,
     right: Option<f64>,
-    /// Ghost entries on each side of the window (0 linear, 1 Catmull-Rom).
-    g: usize,
+    /// Window index of full-grid plane i: i + p_off, within 0..=p_max (the window with
+    /// its neighbours); rows likewise.
+    p_off: isize,
+    p_max: isize,
+    r_off: isize,
+    r_max: isize,
     /// Values of the window with `g` neighbours on each side, horizontal-major:
     /// `values[(ih - ps + g) * stride + (iv - rs + g)]`, lux at d_ref.
     values: Vec<f64>,
@@ -355,7 +359,10 @@ impl Grid {
             above: above * spec.scale,
             left: left.map(|c| c * spec.scale),
             right: right.map(|c| c * spec.scale),
-            g,
+            p_off: g as isize - ps as isize,
+            p_max: wh as isize - 1,
+            r_off: g as isize - rs as isize,
+            r_max: wv as isize - 1,
             values,
             stride: wv,
             interpolation: spec.interpolation,
@@ -426,27 +433,25 @@ impl Level {
 
     /// Window index of full-grid plane `ih + d` (d from −1 to 2), clamped into the
     /// stored window: at a window edge the fraction is 0 or 1, so the clamped neighbour
-    /// is multiplied by zero.
+    /// is multiplied by zero (or is an equal value).
     #[inline]
     fn plane(&self, ih: usize, d: isize) -> usize {
-        let w = (self.pe - self.ps + 2 * self.g) as isize;
-        (ih as isize - self.ps as isize + self.g as isize + d).clamp(0, w) as usize
+        (ih as isize + self.p_off + d).clamp(0, self.p_max) as usize
     }
 
     #[inline]
     fn row(&self, iv: usize, d: isize) -> usize {
-        let w = (self.re - self.rs + 2 * self.g) as isize;
-        (iv as isize - self.rs as isize + self.g as isize + d).clamp(0, w) as usize
+        (iv as isize + self.r_off + d).clamp(0, self.r_max) as usize
     }
 
     #[inline]
     fn bilinear(&self, ih: usize, th: f64, iv: usize, tv: f64) -> f64 {
         let (p0, p1) = (self.plane(ih, 0), self.plane(ih, 1));
         let (r0, r1) = (self.row(iv, 0), self.row(iv, 1));
-        let row0 = &self.values[p0 * self.stride..(p0 + 1) * self.stride];
-        let row1 = &self.values[p1 * self.stride..(p1 + 1) * self.stride];
-        let a = row0[r0] + (row0[r1] - row0[r0]) * tv;
-        let b = row1[r0] + (row1[r1] - row1[r0]) * tv;
+        let (i0, i1) = (p0 * self.stride, p1 * self.stride);
+        let v = &self.values;
+        let a = v[i0 + r0] + (v[i0 + r1] - v[i0 + r0]) * tv;
+        let b = v[i1 + r0] + (v[i1 + r1] - v[i1 + r0]) * tv;
         a + (b - a) * th
     }
 
