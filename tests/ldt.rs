@@ -2,12 +2,15 @@
 //! symmetry indicator, relative and absolute photometry, malformed files, choosing the
 //! format by content.
 
-use glam::DVec3;
 use lut_core::light::{
     detect_format, IesFile, Interpolation, LdtError, LdtFile, LdtSymmetry, LdtType, LightError,
     LightFileFormat, LightTable, Photometry, PhotometrySource, Symmetry, TableOptions,
 };
 use std::path::PathBuf;
+
+#[path = "support/light_fixtures.rs"]
+mod light_fixtures;
+use light_fixtures::sphere;
 
 fn ldt_path(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -35,18 +38,6 @@ fn opts(interpolation: Interpolation) -> TableOptions {
 /// Relative closeness: |a − b| ≤ tol · max(|b|, 1).
 fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * b.abs().max(1.0)
-}
-
-/// Directions spread over the whole sphere (a spiral), in the light's frame.
-fn sphere(n: usize) -> Vec<DVec3> {
-    (0..n)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-            let r = (1.0 - z * z).sqrt();
-            let ph = i as f64 * 2.399_963_229_728_653;
-            DVec3::new(r * ph.cos(), r * ph.sin(), z)
-        })
-        .collect()
 }
 
 // ---------------------------------------------------------------- the fixtures

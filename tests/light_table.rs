@@ -2,11 +2,10 @@
 //! (EP 0613099 claim 8) with lookups identical to the uncut table, and the interpolation
 //! between measured angles (linear or Catmull-Rom).
 
-#[path = "support/ies_synth.rs"]
-mod ies_synth;
+#[path = "support/light_fixtures.rs"]
+mod light_fixtures;
 
-use glam::DVec3;
-use ies_synth::synth;
+use light_fixtures::{sphere, synth};
 use lut_core::light::{Interpolation, LdtFile, LightTable, Photometry, Symmetry, TableOptions};
 use std::path::PathBuf;
 
@@ -31,18 +30,6 @@ fn build(p: &Photometry, interpolation: Interpolation, cut: bool) -> LightTable 
         ..TableOptions::default()
     };
     LightTable::from_photometry(p, &o).unwrap()
-}
-
-/// Directions spread over the whole sphere (a spiral), in the light's frame.
-fn sphere(n: usize) -> Vec<DVec3> {
-    (0..n)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-            let r = (1.0 - z * z).sqrt();
-            let ph = i as f64 * 2.399_963_229_728_653;
-            DVec3::new(r * ph.cos(), r * ph.sin(), z)
-        })
-        .collect()
 }
 
 /// The cut and the uncut table give the same bits: over the sphere at distances across

@@ -10,9 +10,9 @@ use lut_core::{Camera, View};
 use std::path::PathBuf;
 use std::sync::Arc;
 
-#[path = "support/ies_synth.rs"]
-mod ies_synth;
-use ies_synth::synth;
+#[path = "support/light_fixtures.rs"]
+mod light_fixtures;
+use light_fixtures::synth;
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -57,18 +57,24 @@ fn malformed_file_fails_with_one_line_naming_the_line() {
         "IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 -3 1 1 2 0 0 0\n1 1 10\n0 45 90\n0\n1 2 3\n",
     )
     .unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_viewer"))
-        .arg("ies")
-        .arg(&bad)
-        .output()
-        .expect("viewer runs");
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    let err = failure(&bad);
     assert!(
         err.contains("bad.ies:3:") && err.contains("number of vertical angles"),
         "{err}"
     );
+}
+
+/// `viewer ies FILE` fails with exactly one line on stderr; that line.
+fn failure(file: &std::path::Path) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_viewer"))
+        .arg("ies")
+        .arg(file)
+        .output()
+        .expect("viewer runs");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    err
 }
 
 fn ldt_fixture(name: &str) -> PathBuf {
@@ -136,14 +142,7 @@ fn malformed_eulumdat_file_fails_with_one_line_naming_the_line() {
     let text = std::fs::read_to_string(ldt_fixture("bilateral_c0_c180.ldt")).unwrap();
     let text = text.replacen("\n3\n2\n24\n", "\n3\n9\n24\n", 1);
     std::fs::write(&bad, text).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_viewer"))
-        .arg("ies")
-        .arg(&bad)
-        .output()
-        .expect("viewer runs");
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    let err = failure(&bad);
     assert!(
         err.contains("bad.ldt:3:") && err.contains("symmetry indicator Isym"),
         "{err}"
