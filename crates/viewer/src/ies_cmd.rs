@@ -1,10 +1,12 @@
-//! `viewer ies`: summarize an IES LM-63 file and sample its candela distribution; and the
-//! `--light ...` options that `viewer render` flattens in to light a room panorama.
+//! `viewer ies`: summarize an IES LM-63 or EULUMDAT file (chosen by content) and sample its
+//! candela distribution; and the `--light ...` options that `viewer render` flattens in to
+//! light a room panorama.
 
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use lut_core::light::{
-    shade_frame, IesFile, LightScene, LightTable, Luminaire, Room, ShadeOptions, TableOptions, Tilt,
+    shade_frame, LightScene, LightTable, Luminaire, Photometry, PhotometrySource, Room,
+    ShadeOptions, TableOptions,
 };
 use lut_core::{Camera, View};
 use std::collections::HashMap;
@@ -14,7 +16,7 @@ use std::sync::Arc;
 /// Arguments of `viewer ies`.
 #[derive(Args, Debug)]
 pub struct IesArgs {
-    /// The IES file.
+    /// The IES or EULUMDAT (.ldt) file; the format is recognized by content.
     pub file: PathBuf,
     /// Print the interpolated candela at VERTICAL,HORIZONTAL degrees (repeatable). Type C:
     /// vertical γ from nadir, horizontal C.
@@ -42,17 +44,21 @@ fn parse_pair(s: &str) -> Result<(f64, f64), String> {
 
 /// Run `viewer ies`.
 pub fn run(a: IesArgs) -> Result<()> {
-    let file = IesFile::load(&a.file)?;
-    let table = LightTable::from_ies(&file, &TableOptions::default())?;
+    let file = Photometry::load(&a.file)?;
+    let table = LightTable::from_photometry(&file, &TableOptions::default())?;
     let rated = file.rated_lumens();
     let flux = table.luminous_flux();
     let tilt = match &file.tilt {
-        Tilt::None => "none".to_string(),
-        Tilt::Include(t) => format!(
+        None => "none".to_string(),
+        Some(t) => format!(
             "include ({} angles, geometry {})",
             t.angles.len(),
             t.geometry
         ),
+    };
+    let ldt = match &file.source {
+        PhotometrySource::Ldt(l) => Some(l),
+        PhotometrySource::Ies(_) => None,
     };
     let (v, h) = (&file.vertical_angles, &file.horizontal_angles);
     let samples: Vec<(f64, f64, f64)> = a
@@ -63,7 +69,7 @@ pub fn run(a: IesArgs) -> Result<()> {
     if a.json {
         let obj = serde_json::json!({
             "file": a.file.display().to_string(),
-            "format": file.format.name(),
+            "format": file.format_name(),
             "photometric_type": file.photometric_type.letter(),
             "symmetry": table.symmetry().name(),
             "tilt": tilt,
@@ -71,7 +77,7 @@ pub fn run(a: IesArgs) -> Result<()> {
             "horizontal_angles": h.len(),
             "vertical_range": [v[0], v[v.len() - 1]],
             "horizontal_range": [h[0], h[h.len() - 1]],
-            "candela_multiplier": file.candela_multiplier,
+            "candela_multiplier": file.candela_scale(),
             "rated_lumens": rated,
             "lumens": flux,
             "max_candela": file.max_candela(),
@@ -80,12 +86,25 @@ pub fn run(a: IesArgs) -> Result<()> {
                 "vertical": sv, "horizontal": sh, "candela": c
             })).collect::<Vec<_>>(),
         });
+        let mut obj = obj;
+        if let Some(l) = ldt {
+            obj["eulumdat"] = serde_json::json!({
+                "type_indicator": l.type_indicator.code(),
+                "symmetry_indicator": l.symmetry.code(),
+                "absolute_photometry": l.is_absolute(),
+                "lamp_flux": l.lamp_flux(),
+                "light_output_ratio": l.light_output_ratio,
+                "conversion_factor": l.conversion_factor,
+                "measurement_tilt": l.measurement_tilt,
+                "lamp_sets": l.lamp_sets.len(),
+            });
+        }
         println!("{obj}");
         return Ok(());
     }
     println!("file:               {}", a.file.display());
-    println!("format:             {}", file.format.name());
-    if let Some(l) = file.keyword("LUMINAIRE") {
+    println!("format:             {}", file.format_name());
+    if let Some(l) = file.luminaire() {
         println!("luminaire:          {l}");
     }
     println!("photometric type:   {}", file.photometric_type.letter());
@@ -103,7 +122,26 @@ pub fn run(a: IesArgs) -> Result<()> {
         h[0],
         h[h.len() - 1]
     );
-    println!("candela multiplier: {}", file.candela_multiplier);
+    if let Some(l) = ldt {
+        println!(
+            "EULUMDAT:           Ityp {} ({}), Isym {}, {} lamp set(s), LORL {} %, tilt during \
+             measurement {}°",
+            l.type_indicator.code(),
+            l.type_indicator.name(),
+            l.symmetry.code(),
+            l.lamp_sets.len(),
+            l.light_output_ratio,
+            l.measurement_tilt
+        );
+        println!(
+            "candela scale:      {} (cd/klm × first lamp set's {} lm / 1000 × conversion factor {})",
+            file.candela_scale(),
+            l.lamp_flux(),
+            l.conversion_factor
+        );
+    } else {
+        println!("candela multiplier: {}", file.candela_scale());
+    }
     match rated {
         Some(r) => println!("rated lumens:       {r}"),
         None => println!("rated lumens:       absolute photometry"),
@@ -119,7 +157,8 @@ pub fn run(a: IesArgs) -> Result<()> {
 /// Options that light a rendered room panorama (flattened into `viewer render`).
 #[derive(Args, Debug, Default, Clone)]
 pub struct LightArgs {
-    /// Place a luminaire: FILE.ies@X,Y,Z[:YAW,PITCH] in metres and degrees (repeatable).
+    /// Place a luminaire: FILE@X,Y,Z[:YAW,PITCH] in metres and degrees (repeatable); FILE is
+    /// an IES or EULUMDAT (.ldt) file, recognized by content.
     /// World frame: X right, Y up from the floor, Z forward at yaw 0; the camera is at
     /// (0, camera height, 0). Aim defaults to straight down (yaw 0, pitch -90).
     #[arg(long = "light", value_parser = parse_light, allow_hyphen_values = true)]
@@ -151,7 +190,7 @@ pub struct LightArgs {
 /// One `--light FILE.ies@X,Y,Z[:YAW,PITCH]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightSpec {
-    /// The IES file.
+    /// The IES or EULUMDAT (.ldt) file; the format is recognized by content.
     pub file: PathBuf,
     /// Position in metres.
     pub position: [f64; 3],
