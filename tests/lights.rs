@@ -10,41 +10,14 @@ use lut_core::{Camera, View};
 use std::path::PathBuf;
 use std::sync::Arc;
 
+#[path = "support/light_fixtures.rs"]
+mod light_fixtures;
+use light_fixtures::synth;
+
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../tests/data/ies")
         .join(name)
-}
-
-/// A type-C (or A/B) file with the given angles and values f(h, v) (horizontal-major).
-fn synth(ptype: u32, v: &[f64], h: &[f64], f: impl Fn(f64, f64) -> f64, mult: f64) -> IesFile {
-    let mut s = String::from("IESNA:LM-63-2002\n[TEST] synthetic\nTILT=NONE\n");
-    s += &format!(
-        "1 -1 {mult} {} {} {ptype} 2 0 0 0\n1 1 10\n",
-        v.len(),
-        h.len()
-    );
-    s += &v
-        .iter()
-        .map(|a| a.to_string())
-        .collect::<Vec<_>>()
-        .join(" ");
-    s += "\n";
-    s += &h
-        .iter()
-        .map(|a| a.to_string())
-        .collect::<Vec<_>>()
-        .join(" ");
-    s += "\n";
-    for &hh in h {
-        s += &v
-            .iter()
-            .map(|&vv| f(hh, vv).to_string())
-            .collect::<Vec<_>>()
-            .join(" ");
-        s += "\n";
-    }
-    IesFile::parse(&s, "synthetic.ies").expect("synthetic file parses")
 }
 
 fn table(f: &IesFile) -> LightTable {
@@ -220,6 +193,28 @@ fn non_numbers_and_bad_angles_error_with_the_line() {
     let e = err(&format!("{GOOD}7\n"));
     assert_eq!(line_of(&e), 10);
     assert!(e.to_string().contains("end of the data"), "{e}");
+}
+
+#[test]
+fn error_messages_escape_control_characters_from_the_file() {
+    // An escape sequence in a value: the message shows it escaped, never raw.
+    let e = err(&GOOD.replace("90 40 0", "90 \x1b[2J\x1b[31mred 0"));
+    let msg = e.to_string();
+    assert!(!msg.chars().any(|c| c.is_control()), "{msg:?}");
+    assert!(msg.contains("'\\u{1b}[2J\\u{1b}[31mred'"), "{msg}");
+    assert_eq!(line_of(&e), 9);
+    // In a TILT= file name and in trailing data; bidi overrides too; long text is cut.
+    let e = err(&GOOD.replace("TILT=NONE", "TILT=\x07lamp\u{202e}.tlt"));
+    let msg = e.to_string();
+    assert!(
+        !msg.chars().any(|c| c.is_control() || c == '\u{202e}'),
+        "{msg:?}"
+    );
+    assert!(msg.contains("TILT=\\u{7}lamp\\u{202e}.tlt"), "{msg}");
+    let e = err(&format!("{GOOD}\x1b{}\n", "z".repeat(200)));
+    let msg = e.to_string();
+    assert!(!msg.chars().any(|c| c.is_control()), "{msg:?}");
+    assert!(msg.contains('…') && msg.len() < 200, "{msg}");
 }
 
 #[test]
@@ -451,6 +446,7 @@ fn distance_series_halves_and_interpolates_by_log_distance() {
     let opts = TableOptions {
         reference_distance: 2.0,
         max_levels: 4,
+        ..TableOptions::default()
     };
     let t = LightTable::from_ies(&f, &opts).unwrap();
     assert_eq!(t.level_count(), 4);
@@ -778,6 +774,7 @@ fn series_lookup_matches_the_tables_inside_and_outside_constant_ranges() {
         &TableOptions {
             reference_distance: 1.0,
             max_levels: 3,
+            ..TableOptions::default()
         },
     )
     .unwrap();

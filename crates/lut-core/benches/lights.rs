@@ -1,4 +1,5 @@
-//! Per-frame cost of lighting a 1920×1080 frame with 1 and 8 goniometric luminaires.
+//! Per-frame cost of lighting a 1920×1080 frame with 1 and 8 goniometric luminaires
+//! (linear interpolation, the default), and with 8 using Catmull-Rom.
 //!
 //! Run: `cargo bench -p lut-core --bench lights`.
 //! The luminaire is a synthetic type C, bilateral (0-180) distribution with 5° steps and
@@ -7,13 +8,14 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::DVec3;
 use lut_core::light::{
-    shade_frame, IesFile, LightScene, LightTable, Luminaire, Room, ShadeOptions, TableOptions,
+    shade_frame, IesFile, Interpolation, LightScene, LightTable, Luminaire, Room, ShadeOptions,
+    TableOptions,
 };
 use lut_core::{Camera, View};
 use std::hint::black_box;
 use std::sync::Arc;
 
-fn synthetic_table() -> LightTable {
+fn synthetic_table(interpolation: Interpolation) -> LightTable {
     let v: Vec<f64> = (0..=36).map(|i| i as f64 * 5.0).collect();
     let h: Vec<f64> = (0..=12).map(|i| i as f64 * 15.0).collect();
     let mut s = format!(
@@ -43,11 +45,16 @@ fn synthetic_table() -> LightTable {
         s += "\n";
     }
     let f = IesFile::parse(&s, "bench.ies").expect("bench file parses");
-    LightTable::from_ies(&f, &TableOptions::default()).expect("bench table builds")
+    let opts = TableOptions {
+        interpolation,
+        ..TableOptions::default()
+    };
+    LightTable::from_ies(&f, &opts).expect("bench table builds")
 }
 
 fn bench_lights(c: &mut Criterion) {
-    let table = Arc::new(synthetic_table());
+    let linear = Arc::new(synthetic_table(Interpolation::Linear));
+    let cubic = Arc::new(synthetic_table(Interpolation::CatmullRom));
     let room = Room::new(6.0, 5.0, 2.8, 1.5).expect("room");
     let (w, h) = (1920u32, 1080u32);
     let cam = Camera::new(View::new(30.0, -15.0, 100.0).expect("view"), w, h);
@@ -58,19 +65,28 @@ fn bench_lights(c: &mut Criterion) {
     let mut group = c.benchmark_group("lights_1920x1080");
     group.throughput(Throughput::Elements(u64::from(w * h)));
     group.sample_size(10);
-    for n in [0usize, 1, 8] {
+    // 0, 1 and 8 lights with linear interpolation (the default), 8 with Catmull-Rom.
+    let cases = [
+        ("lights", 0usize, &linear),
+        ("lights", 1, &linear),
+        ("lights", 8, &linear),
+        ("lights_catmull_rom", 8, &cubic),
+    ];
+    for (name, n, table) in cases {
         let lights: Vec<Luminaire> = (0..n)
             .map(|i| {
                 let a = i as f64 / n as f64 * std::f64::consts::TAU;
-                let mut l =
-                    Luminaire::new(table.clone(), DVec3::new(2.0 * a.cos(), 2.7, 1.8 * a.sin()));
+                let mut l = Luminaire::new(
+                    Arc::clone(table),
+                    DVec3::new(2.0 * a.cos(), 2.7, 1.8 * a.sin()),
+                );
                 l.yaw_deg = i as f64 * 37.0;
                 l
             })
             .collect();
         let scene = LightScene::new(room, lights).expect("scene");
         let opts = ShadeOptions::default();
-        group.bench_with_input(BenchmarkId::new("lights", n), &n, |b, _| {
+        group.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
             b.iter(|| {
                 frame.copy_from_slice(&base);
                 shade_frame(black_box(&scene), &cam, &mut frame, w, h, &opts).expect("shade");

@@ -1,4 +1,5 @@
-//! `viewer ies`: JSON summary and samples of a real fixture, and clean failures.
+//! `viewer ies`: JSON summary and samples of IES and EULUMDAT fixtures (chosen by content),
+//! and clean failures.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -56,16 +57,94 @@ fn malformed_file_fails_with_one_line_naming_the_line() {
         "IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 -3 1 1 2 0 0 0\n1 1 10\n0 45 90\n0\n1 2 3\n",
     )
     .unwrap();
+    let err = failure(&bad);
+    assert!(
+        err.contains("bad.ies:3:") && err.contains("number of vertical angles"),
+        "{err}"
+    );
+}
+
+/// `viewer ies FILE` fails with exactly one line on stderr; that line.
+fn failure(file: &std::path::Path) -> String {
     let out = Command::new(env!("CARGO_BIN_EXE_viewer"))
         .arg("ies")
-        .arg(&bad)
+        .arg(file)
         .output()
         .expect("viewer runs");
     assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    err
+}
+
+fn ldt_fixture(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data/ldt")
+        .join(name)
+}
+
+/// `viewer ies FILE --json` with samples, parsed.
+fn summary(file: &std::path::Path, samples: &[&str]) -> serde_json::Value {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_viewer"));
+    cmd.arg("ies").arg(file).arg("--json");
+    for s in samples {
+        cmd.args(["--sample", s]);
+    }
+    let out = cmd.output().expect("viewer runs");
     assert!(
-        err.contains("bad.ies:3:") && err.contains("number of vertical angles"),
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object")
+}
+
+#[test]
+fn eulumdat_files_are_read_by_content_whatever_their_name() {
+    let samples = ["0,0", "37.5,100", "100,200", "12.5,345"];
+    let ldt = summary(&ldt_fixture("bilateral_c90_c270.ldt"), &samples);
+    assert_eq!(ldt["format"], "EULUMDAT");
+    assert_eq!(ldt["symmetry"], "bilateral 90-270");
+    assert_eq!(ldt["eulumdat"]["symmetry_indicator"], 3);
+    assert_eq!(ldt["rated_lumens"], 2000.0);
+    // The same candela as the IES twin at every sample.
+    let ies = summary(&ldt_fixture("bilateral_c90_c270.ies"), &samples);
+    assert_eq!(ies["format"], "LM-63-2002");
+    for i in 0..samples.len() {
+        let a = ldt["samples"][i]["candela"].as_f64().unwrap();
+        let b = ies["samples"][i]["candela"].as_f64().unwrap();
+        assert!(
+            (a - b).abs() < 1e-9 * b.max(1.0),
+            "{}: {a} vs {b}",
+            samples[i]
+        );
+    }
+    assert!(ldt["samples"][0]["candela"].as_f64().unwrap() > 0.0);
+    // Misnamed both ways: the content decides.
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("downlight.ies");
+    std::fs::copy(ldt_fixture("absolute_led.ldt"), &a).unwrap();
+    let v = summary(&a, &[]);
+    assert_eq!(v["format"], "EULUMDAT");
+    assert_eq!(v["rated_lumens"], serde_json::Value::Null);
+    assert_eq!(v["eulumdat"]["absolute_photometry"], true);
+    let b = dir.path().join("downlight.ldt");
+    std::fs::copy(fixture("absolute_photometry.ies"), &b).unwrap();
+    let w = summary(&b, &[]);
+    assert_eq!(w["format"], "LM-63-1995");
+    assert_eq!(v["max_candela"], w["max_candela"]);
+}
+
+#[test]
+fn malformed_eulumdat_file_fails_with_one_line_naming_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.ldt");
+    let text = std::fs::read_to_string(ldt_fixture("bilateral_c0_c180.ldt")).unwrap();
+    let text = text.replacen("\n3\n2\n24\n", "\n3\n9\n24\n", 1);
+    std::fs::write(&bad, text).unwrap();
+    let err = failure(&bad);
+    assert!(
+        err.contains("bad.ldt:3:") && err.contains("symmetry indicator Isym"),
         "{err}"
     );
 }

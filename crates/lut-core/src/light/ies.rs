@@ -6,8 +6,10 @@
 //! The file is a header (format line, `[KEYWORD] value` lines or free text), a `TILT=` line,
 //! the optional tilt block, then whitespace- (or comma-) separated numbers that may be
 //! spread over any number of lines. Every error names the file, the 1-based line and what
-//! was expected there.
+//! was expected there; text quoted from the file has its control characters escaped, so
+//! a hostile file cannot put escape sequences into a terminal through an error message.
 
+use super::{quoted, sanitize};
 use std::path::Path;
 
 /// Largest accepted number of vertical or horizontal angles (real files have ≤ 361).
@@ -188,15 +190,16 @@ impl IesFile {
     /// Read and parse a file.
     ///
     /// # Errors
-    /// [`IesError::Io`] when it cannot be read, otherwise as [`IesFile::parse`].
+    /// [`IesError::Io`] when it cannot be read (or is larger than
+    /// [`MAX_FILE_BYTES`](super::MAX_FILE_BYTES)), otherwise as [`IesFile::parse`].
     pub fn load(path: &Path) -> Result<IesFile, IesError> {
         let name = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|e| IesError::Io {
+        // UTF-8, or Latin-1 as old files often are; refused past MAX_FILE_BYTES.
+        let text = super::read_text(path).map_err(|reason| IesError::Io {
             file: name.clone(),
-            reason: e.to_string(),
+            reason,
         })?;
-        // Old files are often Latin-1: header text may be mangled, numbers are ASCII.
-        IesFile::parse(&String::from_utf8_lossy(&bytes), &name)
+        IesFile::parse(&text, &name)
     }
 
     /// Parse the text of an IES file; `file` names it in errors.
@@ -232,7 +235,7 @@ pub enum IesError {
         line: usize,
         /// What was expected there.
         expected: String,
-        /// What was there instead.
+        /// What was there instead (file text quoted and with control characters escaped).
         found: String,
     },
     /// The file ended before a field.
@@ -255,7 +258,7 @@ pub enum IesError {
         file: String,
         /// 1-based line of the TILT line.
         line: usize,
-        /// The referenced tilt file.
+        /// The referenced tilt file (control characters escaped).
         name: String,
     },
 }
@@ -325,7 +328,7 @@ impl<'a> Parser<'a> {
         let (text, line) = (tok.text, tok.line);
         match text.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok((v, line)),
-            _ => Err(self.syntax(line, expected, format!("'{text}'"))),
+            _ => Err(self.syntax(line, expected, quoted(text))),
         }
     }
 
@@ -338,11 +341,11 @@ impl<'a> Parser<'a> {
             Ok(v) => v,
             Err(_) => match text.parse::<f64>() {
                 Ok(f) if f.is_finite() && f.fract() == 0.0 && f.abs() < 1e12 => f as i64,
-                _ => return Err(self.syntax(line, full, format!("'{text}'"))),
+                _ => return Err(self.syntax(line, full, quoted(text))),
             },
         };
         if v < min || v > max {
-            return Err(self.syntax(line, full, format!("'{text}'")));
+            return Err(self.syntax(line, full, quoted(text)));
         }
         Ok((v as u32, line))
     }
@@ -445,14 +448,14 @@ impl<'a> Parser<'a> {
                 return Err(self.syntax(
                     tilt_idx + 1,
                     "TILT=NONE, TILT=INCLUDE or TILT=<file>",
-                    format!("'{tilt_text}'"),
+                    quoted(tilt_text),
                 ))
             }
             _ => {
                 return Err(IesError::TiltFileUnsupported {
                     file: self.file.to_string(),
                     line: tilt_idx + 1,
-                    name: value.to_string(),
+                    name: sanitize(value),
                 })
             }
         };
@@ -568,7 +571,7 @@ impl<'a> Parser<'a> {
             return Err(self.syntax(
                 extra.line,
                 format!("the end of the data after {} candela values", nv * nh),
-                format!("'{}'", extra.text),
+                quoted(extra.text),
             ));
         }
         Ok(IesFile {

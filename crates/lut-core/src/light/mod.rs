@@ -1,6 +1,10 @@
 //! Goniometric luminaires (EP 0613099) lighting a room panorama.
 //!
 //! * [`ies`]: the IES LM-63 parser (1986/1991/1995/2002/2019; types A, B, C; TILT).
+//! * [`ldt`]: the EULUMDAT (.ldt) parser (symmetry indicators 0-4, type indicators 0-3,
+//!   relative and absolute photometry).
+//! * [`photometry`]: one photometric model for both formats ([`Photometry`]), loaded by
+//!   content, not by file name.
 //! * [`table`]: the patent's light table: a 2-D table indexed by the pair of polar angles
 //!   of the direction relative to the light's aim, with fractional-index interpolation,
 //!   symmetry folded at lookup (only the measured subset is stored), constant ranges left
@@ -16,12 +20,75 @@
 //! See `docs/lights.md` for the design.
 
 pub mod ies;
+pub mod ldt;
+mod level;
+pub mod photometry;
 pub mod shade;
 pub mod table;
 
 pub use ies::{IesError, IesFile, IesFormat, PhotometricType, Tilt, TiltData};
+pub use ldt::{LampSet, LdtError, LdtFile, LdtSymmetry, LdtType};
+pub use photometry::{detect_format, LightFileFormat, Photometry, PhotometrySource};
 pub use shade::{lux_at, shade_frame, LightScene, Luminaire, Room, ShadeOptions};
-pub use table::{LightTable, Symmetry, TableOptions};
+pub use table::{Interpolation, LightTable, Symmetry, TableOptions};
+
+/// Largest photometric file read, in bytes. Real IES and EULUMDAT files are well under
+/// 1 MB; the largest table the parsers accept (4 M values) fits in this.
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
+/// Read a photometric file as text, refusing files over [`MAX_FILE_BYTES`] before reading
+/// them. UTF-8 when valid, else ISO-8859-1 (what EULUMDAT prescribes and what old IES
+/// files use): every byte becomes the character of the same number, so header text keeps
+/// its accents and the numbers are unchanged. The `Err` is the reason, for the caller's
+/// error type.
+pub(crate) fn read_text(path: &std::path::Path) -> Result<String, String> {
+    use std::io::Read;
+    let f = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut bytes = Vec::new();
+    f.take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(format!(
+            "larger than {} MiB, far more than any photometric file needs",
+            MAX_FILE_BYTES >> 20
+        ));
+    }
+    Ok(match String::from_utf8(bytes) {
+        Ok(s) => s,
+        Err(e) => e.into_bytes().iter().map(|&b| char::from(b)).collect(),
+    })
+}
+
+/// Text from a file made safe to print in a one-line message: control characters
+/// (escape sequences, carriage returns, ...) and invisible format characters (bidi
+/// overrides, zero-width spaces, byte-order marks) are written as `\u{..}` escapes, and
+/// anything past 40 characters is cut and marked with `…`.
+pub(crate) fn sanitize(text: &str) -> String {
+    const MAX: usize = 40;
+    let mut out = String::new();
+    for (i, c) in text.chars().enumerate() {
+        if i == MAX {
+            out.push('…');
+            break;
+        }
+        let invisible = matches!(
+            c,
+            '\u{200b}'..='\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{feff}'
+        );
+        if c.is_control() || invisible {
+            out.push_str(&format!("\\u{{{:x}}}", c as u32));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// [`sanitize`]d text in single quotes, for the "found ..." part of an error.
+pub(crate) fn quoted(text: &str) -> String {
+    format!("'{}'", sanitize(text))
+}
 
 /// Why a light table, a scene or a shading request cannot be used.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -30,7 +97,29 @@ pub enum LightError {
     /// The IES file is unreadable or malformed.
     #[error(transparent)]
     Ies(#[from] IesError),
-    /// An [`IesFile`] assembled by hand whose fields do not agree.
+    /// The EULUMDAT file is unreadable or malformed.
+    #[error(transparent)]
+    Ldt(#[from] LdtError),
+    /// The file could not be read.
+    #[error("{file}: cannot read: {reason}")]
+    Io {
+        /// The file.
+        file: String,
+        /// Why.
+        reason: String,
+    },
+    /// The file is neither an IES nor an EULUMDAT file (judged by content, then by its
+    /// extension).
+    #[error(
+        "{file}: not a photometric file: neither IES LM-63 (no IESNA/IES: format line, no \
+         TILT= line) nor EULUMDAT (lines 2 to 7 are not the type and symmetry indicators, \
+         the C-plane and gamma counts and steps)"
+    )]
+    UnknownFormat {
+        /// The file.
+        file: String,
+    },
+    /// A [`Photometry`] (or an [`IesFile`]) assembled by hand whose fields do not agree.
     #[error("{file}: inconsistent photometric data: expected {expected}")]
     Inconsistent {
         /// The file's name.

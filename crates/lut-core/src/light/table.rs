@@ -2,14 +2,17 @@
 //!
 //! * Claim 1-3: illumination values in a 2-D table indexed by the direction from the light
 //!   relative to its aim, as a pair of polar angles (vertical, horizontal); the index has
-//!   an integer and a fractional part and the value is filtered (bilinear) by the fraction.
-//!   The table is kept at the file's measured angles, so lookups are exact there and linear
-//!   between; a uniformly spaced axis is indexed by one multiply, any other by bisection.
+//!   an integer and a fractional part and the value is filtered by the fraction: bilinear,
+//!   or Catmull-Rom ([`Interpolation`]). The table is kept at the file's measured angles,
+//!   so lookups are exact there; a uniformly spaced axis is indexed by one multiply, any
+//!   other by bisection.
 //! * Claim 9: the symmetry of the file (rotational, quadrant, bilateral about 0-180 or
 //!   90-270, lateral for types A/B) is folded at lookup: only the measured subset is stored.
-//! * Claim 8: leading and trailing vertical ranges where every value is the same constant
-//!   (zero beyond a cut-off, say) are not stored; the constant is substituted at lookup.
-//!   Outside the measured vertical range the value is zero.
+//! * Claim 8, in both directions: leading and trailing vertical ranges (rows) and
+//!   horizontal ranges (C or H planes) where every value the interpolation reads is the
+//!   same constant (zero beyond a cut-off, a dark side) are not stored; the constant is
+//!   substituted at lookup, giving bit for bit the lookups of the uncut table. Outside the
+//!   measured vertical range the value is zero.
 //! * Claims 4-7: a series of tables for increasing distance. Level k serves distance
 //!   d_ref·2^k; it is level k−1 pre-filtered with a [¼ ½ ¼] kernel and decimated, so it is
 //!   about half the size in each dimension that still has three or more entries. The
@@ -31,37 +34,43 @@
 //! (LM-63 leaves types A and B loosely defined; near the beam axis all three agree that
 //! horizontal is left-right and vertical is up-down.)
 
-use super::ies::{IesError, IesFile, PhotometricType, TiltData};
+use super::ies::{IesFile, PhotometricType, TiltData};
+use super::ldt::LdtFile;
+use super::level::{Edge, Edges, Grid, Level, LevelSpec};
+use super::photometry::Photometry;
+pub use super::photometry::Symmetry;
 use super::LightError;
 use glam::DVec3;
 
-/// The symmetry a file's horizontal angles declare, folded at lookup.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Symmetry {
-    /// Type C, one horizontal angle: the same in every C plane.
-    Rotational,
-    /// Type C, C from 0 to 90: symmetric about the 0-180 and 90-270 planes.
-    Quadrant,
-    /// Type C, C from 0 to 180: symmetric about the 0-180 plane.
-    Bilateral0To180,
-    /// Type C, C from 90 to 270: symmetric about the 90-270 plane.
-    Bilateral90To270,
-    /// Type A/B, H from 0: symmetric left-right (H → |H|).
-    Lateral,
-    /// No symmetry: the full measured range is stored (type C wraps around 360°).
-    None,
+/// How a table value is filtered between measured angles (claim 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Interpolation {
+    /// Bilinear: continuous, never overshoots, exact at the measured angles.
+    #[default]
+    Linear,
+    /// Catmull-Rom (bicubic over 4 × 4 values, the form Blender Cycles uses for IES
+    /// lights): smooth slopes, exact at the measured angles; may overshoot near sharp
+    /// cut-offs, and is clamped at zero.
+    CatmullRom,
 }
 
-impl Symmetry {
-    /// A short name: "rotational", "quadrant", "bilateral 0-180", ...
+impl Interpolation {
+    /// Every value, in the order menus list them.
+    pub const ALL: &'static [Interpolation] = &[Interpolation::Linear, Interpolation::CatmullRom];
+
+    /// The name used by the command line and messages.
     pub fn name(self) -> &'static str {
         match self {
-            Symmetry::Rotational => "rotational",
-            Symmetry::Quadrant => "quadrant",
-            Symmetry::Bilateral0To180 => "bilateral 0-180",
-            Symmetry::Bilateral90To270 => "bilateral 90-270",
-            Symmetry::Lateral => "lateral",
-            Symmetry::None => "none",
+            Interpolation::Linear => "linear",
+            Interpolation::CatmullRom => "catmull-rom",
+        }
+    }
+
+    /// One-line help.
+    pub fn help(self) -> &'static str {
+        match self {
+            Interpolation::Linear => "bilinear between measured angles (default)",
+            Interpolation::CatmullRom => "bicubic Catmull-Rom (as Blender Cycles), clamped at 0",
         }
     }
 }
@@ -74,6 +83,11 @@ pub struct TableOptions {
     pub reference_distance: f64,
     /// Most tables in the distance series (1 = no series). Default 4.
     pub max_levels: usize,
+    /// Filtering between measured angles. Default linear.
+    pub interpolation: Interpolation,
+    /// Leave constant ranges out of the stored tables (claim 8). Default true; the
+    /// lookups are the same either way, only the memory differs.
+    pub cut_constant_ranges: bool,
 }
 
 impl Default for TableOptions {
@@ -81,291 +95,9 @@ impl Default for TableOptions {
         TableOptions {
             reference_distance: 4.0,
             max_levels: 4,
+            interpolation: Interpolation::Linear,
+            cut_constant_ranges: true,
         }
-    }
-}
-
-/// One table axis: increasing angles, with a fast path when they are evenly spaced.
-#[derive(Debug, Clone, PartialEq)]
-struct Axis {
-    a: Vec<f64>,
-    /// (first angle, 1 / step) when evenly spaced.
-    uniform: Option<(f64, f64)>,
-}
-
-impl Axis {
-    fn new(a: Vec<f64>) -> Axis {
-        let uniform = if a.len() >= 2 {
-            let step = (a[a.len() - 1] - a[0]) / (a.len() - 1) as f64;
-            let even = a
-                .windows(2)
-                .all(|w| ((w[1] - w[0]) - step).abs() <= 1e-9 * step.abs().max(1.0));
-            (even && step > 0.0).then(|| (a[0], 1.0 / step))
-        } else {
-            None
-        };
-        Axis { a, uniform }
-    }
-
-    fn first(&self) -> f64 {
-        self.a[0]
-    }
-
-    fn last(&self) -> f64 {
-        self.a[self.a.len() - 1]
-    }
-
-    /// Integer index and fraction of `x`, which lies in [first, last]: x sits between
-    /// entries i and i+1 at fraction t (i = 0, t = 0 for a one-entry axis).
-    #[inline]
-    fn locate(&self, x: f64) -> (usize, f64) {
-        let n = self.a.len();
-        if n < 2 {
-            return (0, 0.0);
-        }
-        if let Some((a0, inv)) = self.uniform {
-            let f = ((x - a0) * inv).max(0.0);
-            let i = (f as usize).min(n - 2);
-            return (i, (f - i as f64).clamp(0.0, 1.0));
-        }
-        let i = self.a.partition_point(|&v| v <= x).clamp(1, n - 1) - 1;
-        let (x0, x1) = (self.a[i], self.a[i + 1]);
-        (i, ((x - x0) / (x1 - x0)).clamp(0.0, 1.0))
-    }
-}
-
-/// One table of the distance series: values at (horizontal, vertical) angle pairs,
-/// normalized to the reference distance, with constant vertical ranges cut off.
-#[derive(Debug, Clone, PartialEq)]
-struct Level {
-    h: Axis,
-    /// The stored vertical subset (constant ranges removed).
-    v: Axis,
-    /// Horizontal-major: values[ih * nv + iv], lux at d_ref.
-    values: Vec<f64>,
-    /// The measured vertical range; zero outside.
-    v_measured: (f64, f64),
-    /// Constant below / above the stored vertical subset.
-    below: f64,
-    above: f64,
-    /// Type C without symmetry whose last angle is short of 360°: wrap to the first.
-    wrap: bool,
-    /// Type A/B: zero outside the measured horizontal range.
-    h_bounded: bool,
-}
-
-impl Level {
-    /// The value at vertical angle v when it lies in a range that is not stored (zero
-    /// outside the measured range, or a constant range); `None` inside the stored rows.
-    #[inline]
-    fn constant_at(&self, v: f64) -> Option<f64> {
-        if !(v >= self.v_measured.0 && v <= self.v_measured.1) {
-            Some(0.0)
-        } else if v < self.v.first() {
-            Some(self.below)
-        } else if v > self.v.last() {
-            Some(self.above)
-        } else {
-            None
-        }
-    }
-
-    /// The value at (folded) horizontal angle h and vertical angle v.
-    #[inline]
-    fn sample(&self, h: f64, v: f64) -> f64 {
-        if let Some(c) = self.constant_at(v) {
-            return c;
-        }
-        let nv = self.v.a.len();
-        let nh = self.h.a.len();
-        let (ih0, ih1, th) = if nh == 1 {
-            (0, 0, 0.0)
-        } else if h > self.h.last() || h < self.h.first() {
-            if self.wrap && h > self.h.last() {
-                let span = self.h.first() + 360.0 - self.h.last();
-                (nh - 1, 0, ((h - self.h.last()) / span).clamp(0.0, 1.0))
-            } else if self.h_bounded {
-                return 0.0;
-            } else {
-                // Folding keeps h inside; a rounding step outside clamps to the edge.
-                let i = if h > self.h.last() { nh - 1 } else { 0 };
-                (i, i, 0.0)
-            }
-        } else {
-            let (i, t) = self.h.locate(h);
-            (i, i + 1, t)
-        };
-        let (iv, tv) = self.v.locate(v);
-        let iv1 = (iv + 1).min(nv - 1);
-        let row0 = &self.values[ih0 * nv..ih0 * nv + nv];
-        let row1 = &self.values[ih1 * nv..ih1 * nv + nv];
-        let a = row0[iv] + (row0[iv1] - row0[iv]) * tv;
-        let b = row1[iv] + (row1[iv1] - row1[iv]) * tv;
-        a + (b - a) * th
-    }
-}
-
-/// A full measured grid in f64 (before trimming), horizontal-major.
-#[derive(Debug, Clone)]
-struct Grid {
-    h: Vec<f64>,
-    v: Vec<f64>,
-    vals: Vec<f64>,
-}
-
-#[derive(Debug, Clone, Copy)]
-enum Edge {
-    /// Mirror about the end entries (symmetry planes, poles, range ends).
-    Mirror,
-    /// Periodic with this many distinct entries.
-    Wrap(usize),
-}
-
-/// [¼ ½ ¼] pre-filter along one line of `n` values read with `get(i)`.
-fn filter_line(line: &[f64], edge: Edge) -> Vec<f64> {
-    let n = line.len();
-    let at = |i: isize| -> f64 {
-        match edge {
-            Edge::Mirror => {
-                let i = if i < 0 {
-                    -i
-                } else if i >= n as isize {
-                    2 * (n as isize - 1) - i
-                } else {
-                    i
-                };
-                line[i.clamp(0, n as isize - 1) as usize]
-            }
-            Edge::Wrap(p) => line[i.rem_euclid(p as isize) as usize],
-        }
-    };
-    (0..n as isize)
-        .map(|i| 0.25 * at(i - 1) + 0.5 * at(i) + 0.25 * at(i + 1))
-        .collect()
-}
-
-/// Every other index, always keeping the last.
-fn kept(n: usize) -> Vec<usize> {
-    let mut k: Vec<usize> = (0..n).step_by(2).collect();
-    if k.last() != Some(&(n - 1)) {
-        k.push(n - 1);
-    }
-    k
-}
-
-impl Grid {
-    /// Pre-filter and decimate each dimension with ≥ 3 entries; `None` when none has.
-    /// `h_periodic`: the horizontal angles go round the full circle (type C, no symmetry).
-    fn halve(&self, h_periodic: bool) -> Option<Grid> {
-        let (nh, nv) = (self.h.len(), self.v.len());
-        if nh < 3 && nv < 3 {
-            return None;
-        }
-        let mut g = self.clone();
-        if nv >= 3 {
-            let keep = kept(nv);
-            let mut vals = Vec::with_capacity(nh * keep.len());
-            for row in g.vals.chunks_exact(nv) {
-                let f = filter_line(row, Edge::Mirror);
-                vals.extend(keep.iter().map(|&i| f[i]));
-            }
-            g.v = keep.iter().map(|&i| g.v[i]).collect();
-            g.vals = vals;
-        }
-        let nv = g.v.len();
-        if nh >= 3 {
-            let h_edge = if h_periodic {
-                // A last angle of first + 360 repeats the first: one period is n − 1.
-                let dup = (self.h[nh - 1] - self.h[0] - 360.0).abs() < 1e-6;
-                Edge::Wrap(if dup { nh - 1 } else { nh })
-            } else {
-                Edge::Mirror
-            };
-            let keep = kept(nh);
-            let mut cols = vec![0.0; keep.len() * nv];
-            let mut line = vec![0.0; nh];
-            for iv in 0..nv {
-                for (ih, l) in line.iter_mut().enumerate() {
-                    *l = g.vals[ih * nv + iv];
-                }
-                let f = filter_line(&line, h_edge);
-                for (k, &i) in keep.iter().enumerate() {
-                    cols[k * nv + iv] = f[i];
-                }
-            }
-            g.h = keep.iter().map(|&i| g.h[i]).collect();
-            g.vals = cols;
-        }
-        Some(g)
-    }
-
-    /// Cut constant leading/trailing vertical ranges and normalize to lux at d_ref.
-    fn to_level(&self, scale: f64, wrap: bool, h_bounded: bool) -> Level {
-        let nv = self.v.len();
-        let row_const = |iv: usize| -> Option<f64> {
-            let c = self.vals[iv];
-            (0..self.h.len())
-                .all(|ih| self.vals[ih * nv + iv] == c)
-                .then_some(c)
-        };
-        // Largest `lead` with rows 0..=lead all the same constant; likewise `trail`.
-        let mut lead = 0;
-        let mut below = 0.0;
-        if let Some(c) = row_const(0) {
-            below = c;
-            while lead + 1 < nv && row_const(lead + 1) == Some(c) {
-                lead += 1;
-            }
-        }
-        let mut trail = nv - 1;
-        let mut above = 0.0;
-        if let Some(c) = row_const(nv - 1) {
-            above = c;
-            while trail > lead && row_const(trail - 1) == Some(c) {
-                trail -= 1;
-            }
-        }
-        let (start, end) = (lead, trail.max(lead));
-        let stored = end - start + 1;
-        let mut values = Vec::with_capacity(self.h.len() * stored);
-        for row in self.vals.chunks_exact(nv) {
-            values.extend(row[start..=end].iter().map(|&c| c * scale));
-        }
-        Level {
-            h: Axis::new(self.h.clone()),
-            v: Axis::new(self.v[start..=end].to_vec()),
-            values,
-            v_measured: (self.v[0], self.v[nv - 1]),
-            below: below * scale,
-            above: above * scale,
-            wrap,
-            h_bounded,
-        }
-    }
-}
-
-/// An [`IesFile`] built by hand (its fields are public) must still be consistent.
-fn check_file(f: &IesFile) -> Result<(), LightError> {
-    let (nv, nh) = (f.vertical_angles.len(), f.horizontal_angles.len());
-    let increasing =
-        |a: &[f64]| a.iter().all(|x| x.is_finite()) && a.windows(2).all(|w| w[0] < w[1]);
-    let what = if nv == 0 || nh == 0 {
-        Some("at least one vertical and one horizontal angle")
-    } else if f.candela.len() != nv * nh {
-        Some("vertical × horizontal candela values")
-    } else if !increasing(&f.vertical_angles) || !increasing(&f.horizontal_angles) {
-        Some("finite, strictly increasing angles")
-    } else if !f.candela.iter().all(|c| c.is_finite()) || !f.candela_multiplier.is_finite() {
-        Some("finite candela values and multiplier")
-    } else {
-        None
-    };
-    match what {
-        Some(expected) => Err(LightError::Inconsistent {
-            file: f.name.clone(),
-            expected,
-        }),
-        None => Ok(()),
     }
 }
 
@@ -374,6 +106,7 @@ fn check_file(f: &IesFile) -> Result<(), LightError> {
 pub struct LightTable {
     photometric_type: PhotometricType,
     symmetry: Symmetry,
+    interpolation: Interpolation,
     levels: Vec<Level>,
     d_ref: f64,
     d_ref2: f64,
@@ -381,14 +114,30 @@ pub struct LightTable {
 }
 
 impl LightTable {
-    /// Build the series from a parsed file: candela × multiplier (negative values, which
-    /// some instruments write for noise, become 0).
+    /// Build the series from an IES file: candela × multiplier.
+    ///
+    /// # Errors
+    /// As [`Photometry::from_ies`] and [`LightTable::from_photometry`].
+    pub fn from_ies(file: &IesFile, opts: &TableOptions) -> Result<LightTable, LightError> {
+        LightTable::from_photometry(&Photometry::from_ies(file)?, opts)
+    }
+
+    /// Build the series from an EULUMDAT file (see [`Photometry::from_ldt`]).
+    ///
+    /// # Errors
+    /// As [`LightTable::from_photometry`].
+    pub fn from_ldt(file: &LdtFile, opts: &TableOptions) -> Result<LightTable, LightError> {
+        LightTable::from_photometry(&Photometry::from_ldt(file), opts)
+    }
+
+    /// Build the series from a photometric distribution, IES or EULUMDAT (negative
+    /// candela, which some instruments write for noise, become 0).
     ///
     /// # Errors
     /// [`LightError::BadOption`] for a reference distance that is not a positive finite
-    /// number or `max_levels` of 0; [`LightError::Ies`] when the horizontal angles declare
-    /// no symmetry LM-63 knows (type C must start at 0°, or at 90° ending at 270°).
-    pub fn from_ies(file: &IesFile, opts: &TableOptions) -> Result<LightTable, LightError> {
+    /// number or `max_levels` of 0; [`LightError::Inconsistent`] when the fields do not
+    /// agree (counts, increasing angles, symmetry against the horizontal angles).
+    pub fn from_photometry(p: &Photometry, opts: &TableOptions) -> Result<LightTable, LightError> {
         if !(opts.reference_distance.is_finite() && opts.reference_distance > 0.0) {
             return Err(LightError::BadOption {
                 name: "reference distance",
@@ -403,87 +152,84 @@ impl LightTable {
                 value: 0.0,
             });
         }
-        check_file(file)?;
-        let h = &file.horizontal_angles;
-        let (first, last) = (h[0], h[h.len() - 1]);
-        let close = |a: f64, b: f64| (a - b).abs() < 1e-6;
-        let symmetry = match file.photometric_type {
-            PhotometricType::C => {
-                if h.len() == 1 {
-                    Symmetry::Rotational
-                } else if close(first, 0.0) && close(last, 90.0) {
-                    Symmetry::Quadrant
-                } else if close(first, 0.0) && close(last, 180.0) {
-                    Symmetry::Bilateral0To180
-                } else if close(first, 90.0) && close(last, 270.0) {
-                    Symmetry::Bilateral90To270
-                } else if close(first, 0.0) && last > 180.0 {
-                    Symmetry::None
-                } else {
-                    return Err(IesError::Syntax {
-                        file: file.name.clone(),
-                        line: file.horizontal_angles_line,
-                        expected: "type C horizontal angles from 0 to 0, 90, 180 or 180-360, \
-                                   or from 90 to 270"
-                            .into(),
-                        found: format!("{first} to {last}"),
-                    }
-                    .into());
-                }
-            }
-            _ => {
-                if close(first, 0.0) && h.len() > 1 {
-                    Symmetry::Lateral
-                } else {
-                    Symmetry::None
-                }
-            }
-        };
-        let is_c = file.photometric_type == PhotometricType::C;
-        let wrap = is_c && symmetry == Symmetry::None && !close(last, 360.0);
-        let h_bounded = !is_c;
-        let h_periodic = is_c && symmetry == Symmetry::None;
+        p.check()?;
+        let is_c = p.photometric_type == PhotometricType::C;
+        let symmetry = p.symmetry;
         let mut grid = Grid {
-            h: h.clone(),
-            v: file.vertical_angles.clone(),
-            vals: file
-                .candela
-                .iter()
-                .map(|&c| (c * file.candela_multiplier).max(0.0))
-                .collect(),
+            h: p.horizontal_angles.clone(),
+            v: p.vertical_angles.clone(),
+            vals: p.candela.iter().map(|&c| c.max(0.0)).collect(),
+        };
+        // A type C table without symmetry goes round the circle: close it with a plane at
+        // 360° so lookups never wrap, and read neighbours periodically.
+        let h_edges = match symmetry {
+            Symmetry::None if is_c => {
+                grid.close_circle();
+                let p = grid.h.len() - 1;
+                Edges {
+                    lo: Edge::Wrap(p),
+                    hi: Edge::Wrap(p),
+                }
+            }
+            Symmetry::None => Edges {
+                lo: Edge::Clamp,
+                hi: Edge::Clamp,
+            },
+            Symmetry::Lateral => Edges {
+                lo: Edge::Mirror,
+                hi: Edge::Clamp,
+            },
+            _ => Edges::MIRROR,
+        };
+        // Vertically: mirrored at the poles (type C γ 0 and 180, type A V ±90), repeated
+        // at the end of a shorter measured range.
+        let pole = |a: f64| match p.photometric_type {
+            PhotometricType::C => a == 0.0 || a == 180.0,
+            PhotometricType::A => a.abs() == 90.0,
+            PhotometricType::B => false,
+        };
+        let edge = |a: f64| if pole(a) { Edge::Mirror } else { Edge::Clamp };
+        let v_edges = Edges {
+            lo: edge(grid.v[0]),
+            hi: edge(grid.v[grid.v.len() - 1]),
         };
         let d_ref = opts.reference_distance;
-        let scale = 1.0 / (d_ref * d_ref);
-        let mut levels = vec![grid.to_level(scale, wrap, h_bounded)];
+        let spec = LevelSpec {
+            scale: 1.0 / (d_ref * d_ref),
+            interpolation: opts.interpolation,
+            cut: opts.cut_constant_ranges,
+            h_edges,
+            v_edges,
+            h_bounded: !is_c,
+        };
+        let mut levels = vec![grid.to_level(&spec)];
         while levels.len() < opts.max_levels {
-            match grid.halve(h_periodic) {
+            match grid.halve(h_edges) {
                 Some(g) => {
-                    levels.push(g.to_level(scale, wrap, h_bounded));
+                    levels.push(g.to_level(&spec));
                     grid = g;
                 }
                 None => break,
             }
         }
         Ok(LightTable {
-            photometric_type: file.photometric_type,
+            photometric_type: p.photometric_type,
             symmetry,
+            interpolation: opts.interpolation,
             levels,
             d_ref,
             d_ref2: d_ref * d_ref,
-            tilt: match &file.tilt {
-                super::ies::Tilt::Include(t) => Some(t.clone()),
-                super::ies::Tilt::None => None,
-            },
+            tilt: p.tilt.clone(),
         })
     }
 
-    /// Parse an IES file and build its table with default options.
+    /// Read an IES or EULUMDAT file (chosen by content, see [`Photometry::load`]) and build
+    /// its table with default options.
     ///
     /// # Errors
-    /// As [`IesFile::load`] and [`LightTable::from_ies`].
+    /// As [`Photometry::load`] and [`LightTable::from_photometry`].
     pub fn load(path: &std::path::Path) -> Result<LightTable, LightError> {
-        let f = IesFile::load(path)?;
-        LightTable::from_ies(&f, &TableOptions::default())
+        LightTable::from_photometry(&Photometry::load(path)?, &TableOptions::default())
     }
 
     /// The goniometer type.
@@ -494,6 +240,11 @@ impl LightTable {
     /// The symmetry folded at lookup.
     pub fn symmetry(&self) -> Symmetry {
         self.symmetry
+    }
+
+    /// The filtering between measured angles.
+    pub fn interpolation(&self) -> Interpolation {
+        self.interpolation
     }
 
     /// The reference distance in metres.
@@ -511,9 +262,17 @@ impl LightTable {
         self.levels.len()
     }
 
-    /// (horizontal entries, stored vertical entries) of table `k`, `None` past the end.
+    /// (stored horizontal entries, stored vertical entries) of table `k` (constant ranges
+    /// cut; a type C table without symmetry counts its closing plane at 360°), `None`
+    /// past the end.
     pub fn level_size(&self, k: usize) -> Option<(usize, usize)> {
-        self.levels.get(k).map(|l| (l.h.a.len(), l.v.a.len()))
+        self.levels.get(k).map(Level::size)
+    }
+
+    /// Number of f64 values table `k` holds (its stored window plus, for Catmull-Rom, the
+    /// ring of neighbours around it), `None` past the end.
+    pub fn stored_values(&self, k: usize) -> Option<usize> {
+        self.levels.get(k).map(Level::stored_values)
     }
 
     /// Fold a horizontal angle (degrees) into the stored subset by the symmetry.
@@ -522,7 +281,7 @@ impl LightTable {
             PhotometricType::C => {
                 let c = h.rem_euclid(360.0);
                 match self.symmetry {
-                    Symmetry::Rotational => self.levels[0].h.first(),
+                    Symmetry::Rotational => self.levels[0].h_first(),
                     Symmetry::Quadrant => {
                         let c = if c > 180.0 { 360.0 - c } else { c };
                         if c > 90.0 {
@@ -671,39 +430,5 @@ impl LightTable {
             total += ring * st * dlat * dlon;
         }
         total
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn axis_locate_uniform_and_not() {
-        let u = Axis::new(vec![0.0, 10.0, 20.0, 30.0]);
-        assert!(u.uniform.is_some());
-        assert_eq!(u.locate(15.0), (1, 0.5));
-        assert_eq!(u.locate(30.0), (2, 1.0));
-        let n = Axis::new(vec![0.0, 5.0, 20.0]);
-        assert!(n.uniform.is_none());
-        assert_eq!(n.locate(12.5), (1, 0.5));
-        assert_eq!(n.locate(0.0), (0, 0.0));
-    }
-
-    #[test]
-    fn kept_halves_and_keeps_the_end() {
-        assert_eq!(kept(5), vec![0, 2, 4]);
-        assert_eq!(kept(4), vec![0, 2, 3]);
-        assert_eq!(kept(37).len(), 19);
-    }
-
-    #[test]
-    fn filter_preserves_constants_and_sums() {
-        let f = filter_line(&[2.0, 2.0, 2.0], Edge::Mirror);
-        assert_eq!(f, vec![2.0, 2.0, 2.0]);
-        let x = [1.0, 5.0, 3.0, 0.0];
-        let f = filter_line(&x, Edge::Wrap(4));
-        let (a, b): (f64, f64) = (x.iter().sum(), f.iter().sum());
-        assert!((a - b).abs() < 1e-12);
     }
 }

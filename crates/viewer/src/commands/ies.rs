@@ -1,16 +1,17 @@
-//! `viewer ies`: summarize an IES LM-63 file and sample its candela distribution. (The
-//! `--light ...` options that light a rendered room are in [`crate::lighting`].)
+//! `viewer ies`: summarize an IES LM-63 or EULUMDAT file (chosen by content) and sample its
+//! candela distribution. (The `--light ...` options that light a rendered room are in
+//! [`crate::lighting`].)
 
 use crate::args::values::finite;
 use anyhow::Result;
 use clap::Args;
-use lut_core::light::{IesFile, LightTable, TableOptions, Tilt};
+use lut_core::light::{LightTable, Photometry, PhotometrySource, TableOptions};
 use std::path::PathBuf;
 
 /// Arguments of `viewer ies`.
 #[derive(Args, Debug)]
 pub struct IesArgs {
-    /// The IES file.
+    /// The IES or EULUMDAT (.ldt) file; the format is recognized by content.
     pub file: PathBuf,
     /// Print the interpolated candela at VERTICAL,HORIZONTAL degrees (repeatable). Type C:
     /// vertical γ from nadir, horizontal C.
@@ -34,17 +35,21 @@ fn parse_pair(s: &str) -> Result<(f64, f64), String> {
 
 /// Run `viewer ies`.
 pub fn run(a: IesArgs) -> Result<()> {
-    let file = IesFile::load(&a.file)?;
-    let table = LightTable::from_ies(&file, &TableOptions::default())?;
+    let file = Photometry::load(&a.file)?;
+    let table = LightTable::from_photometry(&file, &TableOptions::default())?;
     let rated = file.rated_lumens();
     let flux = table.luminous_flux();
     let tilt = match &file.tilt {
-        Tilt::None => "none".to_string(),
-        Tilt::Include(t) => format!(
+        None => "none".to_string(),
+        Some(t) => format!(
             "include ({} angles, geometry {})",
             t.angles.len(),
             t.geometry
         ),
+    };
+    let ldt = match &file.source {
+        PhotometrySource::Ldt(l) => Some(l),
+        PhotometrySource::Ies(_) => None,
     };
     let (v, h) = (&file.vertical_angles, &file.horizontal_angles);
     let samples: Vec<(f64, f64, f64)> = a
@@ -55,7 +60,7 @@ pub fn run(a: IesArgs) -> Result<()> {
     if a.json {
         let obj = serde_json::json!({
             "file": a.file.display().to_string(),
-            "format": file.format.name(),
+            "format": file.format_name(),
             "photometric_type": file.photometric_type.letter(),
             "symmetry": table.symmetry().name(),
             "tilt": tilt,
@@ -63,7 +68,7 @@ pub fn run(a: IesArgs) -> Result<()> {
             "horizontal_angles": h.len(),
             "vertical_range": [v[0], v[v.len() - 1]],
             "horizontal_range": [h[0], h[h.len() - 1]],
-            "candela_multiplier": file.candela_multiplier,
+            "candela_multiplier": file.candela_scale(),
             "rated_lumens": rated,
             "lumens": flux,
             "max_candela": file.max_candela(),
@@ -72,12 +77,25 @@ pub fn run(a: IesArgs) -> Result<()> {
                 "vertical": sv, "horizontal": sh, "candela": c
             })).collect::<Vec<_>>(),
         });
+        let mut obj = obj;
+        if let Some(l) = ldt {
+            obj["eulumdat"] = serde_json::json!({
+                "type_indicator": l.type_indicator.code(),
+                "symmetry_indicator": l.symmetry.code(),
+                "absolute_photometry": l.is_absolute(),
+                "lamp_flux": l.lamp_flux(),
+                "light_output_ratio": l.light_output_ratio,
+                "conversion_factor": l.conversion_factor,
+                "measurement_tilt": l.measurement_tilt,
+                "lamp_sets": l.lamp_sets.len(),
+            });
+        }
         println!("{obj}");
         return Ok(());
     }
     println!("file:               {}", a.file.display());
-    println!("format:             {}", file.format.name());
-    if let Some(l) = file.keyword("LUMINAIRE") {
+    println!("format:             {}", file.format_name());
+    if let Some(l) = file.luminaire() {
         println!("luminaire:          {l}");
     }
     println!("photometric type:   {}", file.photometric_type.letter());
@@ -95,7 +113,26 @@ pub fn run(a: IesArgs) -> Result<()> {
         h[0],
         h[h.len() - 1]
     );
-    println!("candela multiplier: {}", file.candela_multiplier);
+    if let Some(l) = ldt {
+        println!(
+            "EULUMDAT:           Ityp {} ({}), Isym {}, {} lamp set(s), LORL {} %, tilt during \
+             measurement {}°",
+            l.type_indicator.code(),
+            l.type_indicator.name(),
+            l.symmetry.code(),
+            l.lamp_sets.len(),
+            l.light_output_ratio,
+            l.measurement_tilt
+        );
+        println!(
+            "candela scale:      {} (cd/klm × first lamp set's {} lm / 1000 × conversion factor {})",
+            file.candela_scale(),
+            l.lamp_flux(),
+            l.conversion_factor
+        );
+    } else {
+        println!("candela multiplier: {}", file.candela_scale());
+    }
     match rated {
         Some(r) => println!("rated lumens:       {r}"),
         None => println!("rated lumens:       absolute photometry"),

@@ -24,7 +24,8 @@ use std::sync::Arc;
 #[allow(rustdoc::broken_intra_doc_links)]
 #[derive(Args, Debug, Default, Clone)]
 pub struct LightArgs {
-    /// Place a luminaire: FILE.ies@X,Y,Z[:YAW,PITCH] in metres and degrees (repeatable).
+    /// Place a luminaire: FILE@X,Y,Z[:YAW,PITCH] in metres and degrees (repeatable); FILE is
+    /// an IES or EULUMDAT (.ldt) file, recognized by content.
     /// World frame: X right, Y up from the floor, Z forward at yaw 0; the camera is at
     /// (0, camera height, 0). Aim defaults to straight down (yaw 0, pitch -90).
     #[arg(long = "light", value_parser = parse_light, allow_hyphen_values = true)]
@@ -56,7 +57,7 @@ pub struct LightArgs {
 /// One `--light FILE.ies@X,Y,Z[:YAW,PITCH]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightSpec {
-    /// The IES file.
+    /// The IES or EULUMDAT (.ldt) file; the format is recognized by content.
     pub file: PathBuf,
     /// Position in metres.
     pub position: [f64; 3],
