@@ -1,7 +1,7 @@
 //! Cube panoramas (Wei, Gao, Gong 2003, "The technique of browsing virtual world based on
 //! cubic panorama"): six square faces, a per-pixel renderer and a per-scanline-segment one.
 //!
-//! # Geometry (`conventions.md`, cube section)
+//! # Geometry (`docs/conventions.md`, cube section)
 //! Face `k` is exactly the view the project's camera renders with hfov 90° into a square
 //! image at the face's yaw/pitch:
 //!
@@ -26,26 +26,22 @@
 //! each border texel's center. Bilinear sampling then never branches and never clamps at a
 //! face edge, and reads across into the neighbour, so edges and corners show no seam.
 //!
-//! # Renderers
-//! [`render`] with [`CubeRenderer::Basic`] (the paper's section 1: per pixel, ray → face →
+//! # Renderers (`render/cube.rs`)
+//! [`crate::Renderer::render`] of a [`crate::Scene::Cube`] with [`CubeRenderer::Basic`] (the paper's section 1: per pixel, ray → face →
 //! face coordinates → sample) or [`CubeRenderer::Accelerated`] (section 2: each scanline is
 //! a 3-D line, cut into face segments found by binary search, stepped inside each segment
 //! without choosing a face). Both compute every ray and every face coordinate with the
 //! same expressions, and the accelerated path *proves* each segment's face before using
 //! it (falling back to the per-pixel choice where it cannot), so the two images are
-//! byte-identical. See [`render`] and `docs/cube.md`.
+//! byte-identical. See `docs/cube.md`.
+//!
+//! Loading from files is `io/cube.rs`; layouts and namings are `cube/layout.rs`.
 
-mod load;
-mod render;
+pub(crate) mod layout;
 
-pub use load::{
-    layout_dimensions, load_cube, load_face_files, load_layout_image, Layout, Naming, Transform,
-};
-pub use render::{render, scanline_runs, CubeRenderer};
-
-use crate::camera::{lat_long_to_dir, View};
-use crate::envmap::{lerp_px, EnvMap, Sampler};
-use crate::fixed::{to_fx, FX_BITS, FX_HALF, FX_ONE};
+use crate::geom::camera::{check_size, lat_long_to_dir, View};
+use crate::geom::fixed::{to_fx, FX_BITS, FX_HALF, FX_ONE};
+use crate::map::sample::{lerp_px, Sampler};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -53,7 +49,7 @@ use std::path::PathBuf;
 /// Largest accepted face side: six 8192² faces are 1.6 GB of 0RGB texels.
 pub const MAX_FACE_SIZE: u32 = 8192;
 
-/// One face of a cube map, in the order of `conventions.md` (which is also the tie order).
+/// One face of a cube map, in the order of `docs/conventions.md` (which is also the tie order).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Face {
     /// yaw 0, pitch 0 (+Z).
@@ -308,7 +304,7 @@ fn bilinear_clamped(px: &[u32], n: u32, u: f64, v: f64) -> u32 {
 
 impl CubeMap {
     /// Build a cube map from six `size × size` row-major 0RGB faces in [`Face::ALL`] order,
-    /// each oriented as `conventions.md` requires.
+    /// each oriented as `docs/conventions.md` requires.
     ///
     /// # Errors
     /// [`CubeError::FaceSize`] or [`CubeError::Buffer`].
@@ -355,37 +351,6 @@ impl CubeMap {
             out[k] = data;
         }
         Ok(CubeMap { size, faces: out })
-    }
-
-    /// Render a cube map from a panorama: each face is the exact renderer's hfov-90° view
-    /// at the face's yaw/pitch (the definition in `conventions.md`).
-    ///
-    /// # Errors
-    /// [`CubeError::FaceSize`] for a bad `face_size`.
-    pub fn from_envmap(
-        map: &EnvMap,
-        face_size: u32,
-        sampler: Sampler,
-    ) -> Result<CubeMap, CubeError> {
-        check_face_size("cube map", face_size)?;
-        let n = face_size as usize;
-        let mut faces: [Vec<u32>; 6] = Default::default();
-        for (k, face) in Face::ALL.iter().enumerate() {
-            let mut buf = vec![0u32; n * n];
-            crate::exact::render_exact(
-                map,
-                face.view(),
-                sampler,
-                &mut buf,
-                face_size,
-                face_size,
-                true,
-            )
-            .map_err(|e| CubeError::Usage(format!("cannot render {} face: {e}", face.name())))?;
-            faces[k] = buf;
-        }
-        let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
-        CubeMap::from_faces(face_size, refs)
     }
 
     /// Face side in texels.
@@ -477,7 +442,7 @@ impl CubeMap {
     }
 
     /// Resample to an equirectangular `width × height` image (row-major 0RGB): each pixel
-    /// center's (λ, φ) per `conventions.md`, sampled in that direction.
+    /// center's (λ, φ) per `docs/conventions.md`, sampled in that direction.
     ///
     /// # Errors
     /// [`CubeError::Usage`] for an empty or oversized output.
@@ -487,7 +452,7 @@ impl CubeMap {
         height: u32,
         sampler: Sampler,
     ) -> Result<Vec<u32>, CubeError> {
-        crate::camera::check_size(width, height).map_err(|e| CubeError::Usage(e.to_string()))?;
+        check_size(width, height).map_err(|e| CubeError::Usage(e.to_string()))?;
         let (w, h) = (width as usize, height as usize);
         let mut out = vec![0u32; w * h];
         out.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
@@ -534,7 +499,7 @@ impl CubeMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::Camera;
+    use crate::geom::camera::Camera;
 
     #[test]
     fn faces_are_the_conventions_camera() {

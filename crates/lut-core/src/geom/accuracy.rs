@@ -8,9 +8,9 @@
 //! row is almost one direction, so an unscaled u error there says nothing about the image.
 //! Both the scaled ("angular") and the raw distances are reported.
 
-use crate::camera::{Camera, View};
-use crate::exact::exact_uv;
-use crate::projection::Projection;
+use crate::geom::camera::{Camera, View};
+use crate::geom::mapping::exact_uv;
+use crate::geom::projection::Projection;
 
 /// Angular-metric position error of `got` against `exact` at latitude `phi`.
 #[inline]

@@ -1,10 +1,8 @@
-//! The camera of `conventions.md`: yaw/pitch/hfov → rays through output pixel centers.
+//! The camera of `docs/conventions.md`: yaw/pitch/hfov → rays through output pixel centers.
 
 use crate::error::ViewError;
+use crate::geom::limits::MAX_OUTPUT_SIDE;
 use glam::DVec3;
-
-/// Largest accepted output side, in pixels (per side). 16384 keeps a frame under 1 GiB.
-pub const MAX_OUTPUT_SIDE: u32 = 16384;
 
 /// A validated view: angles in degrees as the user gives them, normalized.
 ///

@@ -1,10 +1,11 @@
-//! Partial panoramas: maps that cover only part of the sphere.
+//! Coverage: the part of the sphere a partial panorama covers, and where its stored pixels
+//! sit in the full panorama.
 //!
-//! A phone or stitcher panorama often covers, say, 240° × 80° of the sphere. Such a map is
-//! kept as an [`EnvMap`] that stores **only the covered pixels** plus a [`Crop`]: where
-//! those pixels sit in the full equirectangular panorama they were cut from. Every
-//! renderer uses the *full* panorama's geometry ([`EnvMap::width`], [`EnvMap::height`]), so
-//! the tables and the exact renderer do not change; only sampling looks at the crop:
+//! A phone or stitcher panorama often covers, say, 240° × 80° of the sphere. Such a map
+//! stores **only the covered pixels** plus a [`Crop`]: where those pixels sit in the full
+//! equirectangular panorama they were cut from. Every renderer uses the *full* panorama's
+//! geometry, so the tables and the exact renderer do not change; only sampling looks at the
+//! crop (the cropped samplers of `map/crop.rs`):
 //!
 //! * a full-panorama position (u, v) is **covered** when the pixel containing it lies in
 //!   the crop (the same rule for nearest and bilinear, so both show the same edge);
@@ -14,40 +15,14 @@
 //! * a crop as wide as the full panorama wraps across the ±180° seam like a full map, and
 //!   a crop that straddles the seam (`left + width > full width`) is read across it.
 //!
-//! The coverage comes from GPano XMP metadata ([`crate::gpano`]) or is given explicitly
-//! as a [`Coverage`] (`HFOVxVFOV[±YAW±PITCH]`, degrees). [`crate::viewlimit`] keeps a view
-//! inside it.
+//! The coverage comes from GPano XMP metadata (`io/gpano.rs`) or is given explicitly as a
+//! [`Coverage`] (`HFOVxVFOV[±YAW±PITCH]`, degrees). The view limit (`geom/viewlimit.rs`)
+//! keeps a view inside it.
 
-use crate::envmap::{EnvMap, Tone};
-use crate::error::MapError;
-use crate::fixed::{Fx, FX_BITS, FX_HALF};
-use crate::projection::Projection;
-use crate::{Sampler, MAX_MAP_WIDTH};
-
-/// Why a coverage, a crop or GPano metadata cannot be used.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum CoverageError {
-    /// A `--coverage` text that does not follow the grammar.
-    #[error("coverage '{text}': {reason}")]
-    Syntax {
-        /// The text as given.
-        text: String,
-        /// What is wrong with it.
-        reason: String,
-    },
-    /// Metadata or a coverage that does not describe a usable part of a panorama.
-    #[error("{what}: {reason}")]
-    Invalid {
-        /// The file, metadata field or value concerned.
-        what: String,
-        /// Why.
-        reason: String,
-    },
-    /// The image itself cannot be read or used.
-    #[error(transparent)]
-    Map(#[from] MapError),
-}
+use crate::error::CoverageError;
+use crate::geom::camera::wrap_deg;
+use crate::geom::fixed::{Fx, FX_BITS};
+use crate::geom::limits::{MAX_MAP_HEIGHT, MAX_MAP_WIDTH};
 
 fn invalid(what: impl Into<String>, reason: impl Into<String>) -> CoverageError {
     CoverageError::Invalid {
@@ -118,7 +93,7 @@ impl Coverage {
         Ok(Coverage {
             hfov,
             vfov,
-            yaw: crate::camera::wrap_deg(yaw),
+            yaw: wrap_deg(yaw),
             pitch,
         })
     }
@@ -162,7 +137,7 @@ impl Coverage {
         if self.full_width() {
             return true;
         }
-        let d = crate::camera::wrap_deg(lambda.to_degrees() - self.yaw);
+        let d = wrap_deg(lambda.to_degrees() - self.yaw);
         d.abs() <= self.hfov / 2.0 + eps
     }
 
@@ -179,7 +154,7 @@ impl Coverage {
         let fw = (image_w as f64 * 360.0 / self.hfov).round();
         let fh = (image_h as f64 * 180.0 / self.vfov).round();
         let what = format!("coverage {self}");
-        if fw > MAX_MAP_WIDTH as f64 || fh > crate::envmap::MAX_MAP_HEIGHT as f64 {
+        if fw > MAX_MAP_WIDTH as f64 || fh > MAX_MAP_HEIGHT as f64 {
             return Err(invalid(
                 what,
                 format!(
@@ -298,7 +273,7 @@ impl Crop {
         if full_width < 2 || full_height < 2 || width < 2 || height < 2 {
             return Err(invalid(what, "every size must be at least 2 pixels"));
         }
-        if full_width > MAX_MAP_WIDTH || full_height > crate::envmap::MAX_MAP_HEIGHT {
+        if full_width > MAX_MAP_WIDTH || full_height > MAX_MAP_HEIGHT {
             return Err(invalid(
                 what,
                 format!("full panorama sides above {MAX_MAP_WIDTH} are not supported"),
@@ -363,7 +338,7 @@ impl Crop {
         Coverage {
             hfov,
             vfov,
-            yaw: crate::camera::wrap_deg(west + hfov / 2.0),
+            yaw: wrap_deg(west + hfov / 2.0),
             pitch: north - vfov / 2.0,
         }
     }
@@ -371,7 +346,7 @@ impl Crop {
     /// Stored-pixel position of full-panorama position (u, v) (Q.16), or `None` when
     /// the pixel containing it is not covered.
     #[inline]
-    fn locate(&self, u: Fx, v: Fx) -> Option<(Fx, Fx)> {
+    pub(crate) fn locate(&self, u: Fx, v: Fx) -> Option<(Fx, Fx)> {
         let wfx = (self.full_width as i64) << FX_BITS;
         let hfx = (self.full_height as i64) << FX_BITS;
         // Renderers pass u in [0, W); anything else is wrapped, v is clamped as the full
@@ -394,272 +369,6 @@ impl Crop {
     }
 }
 
-/// What a decoded panorama turned out to cover.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum CoverageSource {
-    /// The whole sphere (no metadata, or metadata describing the whole panorama).
-    Full,
-    /// GPano XMP metadata in the file.
-    Xmp,
-    /// An explicit [`Coverage`] given by the caller.
-    Explicit,
-}
-
-impl EnvMap {
-    /// Where the stored pixels sit in the full panorama, for a partial map.
-    pub fn crop(&self) -> Option<Crop> {
-        self.crop
-    }
-
-    /// The covered area in degrees ([`Coverage::FULL`] for a whole map; for projections
-    /// other than equirectangular the crop is not used and this is also `FULL`).
-    pub fn coverage(&self) -> Coverage {
-        self.crop.map_or(Coverage::FULL, |c| c.coverage())
-    }
-
-    /// Compass heading, in degrees, of the map's centre column (longitude 0): GPano
-    /// `PoseHeadingDegrees`, when the file has it.
-    pub fn pose_heading_deg(&self) -> Option<f64> {
-        self.pose_heading
-    }
-
-    /// Set (or clear) the compass heading of longitude 0 (see
-    /// [`EnvMap::pose_heading_deg`]). Non-finite values clear it.
-    pub fn set_pose_heading_deg(&mut self, heading: Option<f64>) {
-        self.pose_heading = heading
-            .filter(|h| h.is_finite())
-            .map(|h| h.rem_euclid(360.0));
-    }
-
-    /// Width of the stored pixels (the crop's width for a partial map, else
-    /// [`EnvMap::width`]).
-    pub fn stored_width(&self) -> u32 {
-        self.width
-    }
-    /// Height of the stored pixels.
-    pub fn stored_height(&self) -> u32 {
-        self.height
-    }
-
-    /// Turn a map holding the pixels of `crop` (`crop.width() × crop.height()`) into a
-    /// partial equirectangular map of the full panorama. A crop that is the whole
-    /// panorama gives an ordinary map.
-    ///
-    /// # Errors
-    /// [`CoverageError::Invalid`] when the stored size is not the crop's size.
-    pub fn into_partial(self, crop: Crop) -> Result<EnvMap, CoverageError> {
-        if (self.width, self.height) != (crop.width, crop.height) {
-            return Err(invalid(
-                format!(
-                    "crop {}x{} of a {}x{} panorama",
-                    crop.width, crop.height, crop.full_width, crop.full_height
-                ),
-                format!("the image is {}x{}", self.width, self.height),
-            ));
-        }
-        // The padding column must repeat column 0 only when the crop spans 360°.
-        let wrap = crop.width == crop.full_width;
-        let mut m = if self.projection.wraps() == wrap {
-            self
-        } else {
-            let (w, h) = (self.width, self.height);
-            let px: Vec<u32> = (0..h)
-                .flat_map(|y| (0..w).map(move |x| (x, y)))
-                .map(|(x, y)| self.pixel(x, y))
-                .collect();
-            // (elliptical maps pad by repeating the last column)
-            let pad_as = if wrap {
-                Projection::Equirect
-            } else {
-                Projection::Elliptical
-            };
-            let mut m = EnvMap::from_pixels(w, h, &px, pad_as)?;
-            m.background = self.background;
-            m.pose_heading = self.pose_heading;
-            m
-        };
-        // Bilinear only wraps for column −1 / W; a non-360° crop never asks for those
-        // (see `bilinear_cropped`), so the projection can say equirect in both cases.
-        m.projection = Projection::Equirect;
-        m.crop = if crop.is_full() { None } else { Some(crop) };
-        Ok(m)
-    }
-
-    /// Nearest sample at a full-panorama position (Q.16) of a partial map: the covered
-    /// pixel containing it, or the background. For a map without a crop it is
-    /// [`EnvMap::nearest`].
-    #[inline]
-    pub fn nearest_cropped(&self, u: Fx, v: Fx) -> u32 {
-        match self.crop {
-            None => self.nearest(u, v),
-            Some(c) => match c.locate(u, v) {
-                Some((su, sv)) => self.nearest(su, sv),
-                None => self.background,
-            },
-        }
-    }
-
-    /// Bilinear sample at a full-panorama position (Q.16) of a partial map: background
-    /// where the containing pixel is not covered; inside, the four nearest covered pixel
-    /// centres, clamped to the crop's edge texels (wrapping only for a 360°-wide crop).
-    /// For a map without a crop it is [`EnvMap::bilinear`].
-    #[inline]
-    pub fn bilinear_cropped(&self, u: Fx, v: Fx) -> u32 {
-        match self.crop {
-            None => self.bilinear(u, v),
-            Some(c) => match c.locate(u, v) {
-                Some((su, sv)) => {
-                    // Left edge: clamp to column 0 rather than wrap to the last column
-                    // (the right edge reads the padding column, which repeats the last).
-                    let su = if c.width < c.full_width {
-                        su.max(FX_HALF)
-                    } else {
-                        su
-                    };
-                    self.bilinear(su, sv)
-                }
-                None => self.background,
-            },
-        }
-    }
-
-    /// [`EnvMap::sample`] for a partial map.
-    #[inline]
-    pub(crate) fn sample_cropped(&self, sampler: Sampler, u: Fx, v: Fx) -> u32 {
-        match sampler {
-            Sampler::Nearest => self.nearest_cropped(u, v),
-            Sampler::Bilinear | Sampler::Trilinear => self.bilinear_cropped(u, v),
-        }
-    }
-
-    /// Decode an image file's bytes as a possibly partial panorama.
-    ///
-    /// * `coverage` given: the image covers that area (equirectangular); any GPano
-    ///   metadata is ignored.
-    /// * otherwise, for JPEGs with GPano XMP (see [`crate::gpano`]) and an `auto` or
-    ///   equirectangular projection: the metadata places the image in the full panorama
-    ///   and supplies the compass heading;
-    /// * otherwise: as [`EnvMap::decode_toned`].
-    ///
-    /// # Errors
-    /// [`CoverageError`] naming `what` for bad metadata or coverage (an explicit
-    /// coverage overrides bad metadata), or the image's [`MapError`].
-    pub fn decode_partial(
-        bytes: &[u8],
-        what: &str,
-        projection: Option<Projection>,
-        coverage: Option<Coverage>,
-        tone: Tone,
-    ) -> Result<(EnvMap, CoverageSource), CoverageError> {
-        let opts = crate::LoadOptions {
-            projection,
-            tone,
-            ..crate::LoadOptions::default()
-        };
-        Self::decode_partial_with(bytes, what, &opts, coverage, &mut |_| {})
-    }
-
-    /// As [`EnvMap::decode_partial`], with the pixel limit and projection of `opts` and
-    /// progress reports (see [`EnvMap::decode_with`]).
-    ///
-    /// # Errors
-    /// As [`EnvMap::decode_partial`].
-    pub fn decode_partial_with(
-        bytes: &[u8],
-        what: &str,
-        opts: &crate::LoadOptions,
-        coverage: Option<Coverage>,
-        progress: &mut dyn FnMut(crate::LoadProgress),
-    ) -> Result<(EnvMap, CoverageSource), CoverageError> {
-        place_partial(bytes, what, opts, coverage, |o| {
-            EnvMap::decode_with(bytes, what, o, progress)
-        })
-    }
-
-    /// As [`EnvMap::decode_partial_with`], streamed from a file (see
-    /// [`EnvMap::load_with`]): only the file's first 256 KiB are read for the metadata (an
-    /// XMP packet sits in an APP1 segment of at most 64 KiB before the image data).
-    ///
-    /// # Errors
-    /// As [`EnvMap::decode_partial`]; unreadable files are [`MapError::Decode`].
-    pub fn load_partial_with(
-        path: &std::path::Path,
-        opts: &crate::LoadOptions,
-        coverage: Option<Coverage>,
-        progress: &mut dyn FnMut(crate::LoadProgress),
-    ) -> Result<(EnvMap, CoverageSource), CoverageError> {
-        use std::io::Read;
-        let what = path.display().to_string();
-        let io_err = |e: std::io::Error| MapError::Decode {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        };
-        let mut head = Vec::new();
-        std::fs::File::open(path)
-            .map_err(io_err)?
-            .take(256 * 1024)
-            .read_to_end(&mut head)
-            .map_err(io_err)?;
-        place_partial(&head, &what, opts, coverage, |o| {
-            EnvMap::load_with(path, o, progress)
-        })
-    }
-}
-
-/// Decide how a panorama is placed (explicit coverage, GPano metadata found in `head`, or
-/// full), decode it with `decode`, and crop it into place.
-fn place_partial(
-    head: &[u8],
-    what: &str,
-    opts: &crate::LoadOptions,
-    coverage: Option<Coverage>,
-    decode: impl FnOnce(&crate::LoadOptions) -> Result<EnvMap, MapError>,
-) -> Result<(EnvMap, CoverageSource), CoverageError> {
-    let projection = opts.projection;
-    let equirect = matches!(projection, None | Some(Projection::Equirect));
-    if coverage.is_some() && !equirect {
-        return Err(invalid(
-            what,
-            "a coverage applies to equirectangular panoramas only",
-        ));
-    }
-    let meta = if coverage.is_none() && equirect {
-        crate::gpano::read_jpeg(head).map_err(|e| invalid(what, e.to_string()))?
-    } else {
-        None
-    };
-    let heading = meta.as_ref().and_then(|g| g.pose_heading_degrees);
-    let has_crop = coverage.is_some() || meta.as_ref().is_some_and(|g| g.has_crop());
-    if !has_crop {
-        let mut m = decode(opts)?;
-        m.set_pose_heading_deg(heading);
-        return Ok((m, CoverageSource::Full));
-    }
-    // Decoded as "elliptical" only so that any aspect ratio is accepted and the padding
-    // column repeats the last column (no wrap); `into_partial` makes it the crop of an
-    // equirect (re-padded if the crop spans 360°).
-    let mut m = decode(&crate::LoadOptions {
-        projection: Some(Projection::Elliptical),
-        ..*opts
-    })?;
-    let (iw, ih) = (m.width(), m.height());
-    let (crop, source) = match (coverage, &meta) {
-        (Some(c), _) => (c.crop_for_image(iw, ih), CoverageSource::Explicit),
-        (None, Some(g)) => (g.crop_for_image(iw, ih), CoverageSource::Xmp),
-        // Not reached (`has_crop` needs one of them); the whole sphere is harmless.
-        (None, None) => (Coverage::FULL.crop_for_image(iw, ih), CoverageSource::Full),
-    };
-    let crop = crop.map_err(|e| invalid(what, e.to_string()))?;
-    m.set_pose_heading_deg(heading);
-    let m = m.into_partial(crop)?;
-    let source = if m.crop.is_none() {
-        CoverageSource::Full
-    } else {
-        source
-    };
-    Ok((m, source))
-}
-
 /// Compass heading (degrees clockwise from north, [0, 360)) of the view centre at `yaw`
 /// for a map whose longitude 0 faces `pose_heading` (GPano `PoseHeadingDegrees`, see
 /// [`EnvMap::pose_heading_deg`]): yaw stays relative to the map; positive yaw turns
@@ -679,11 +388,9 @@ pub fn compass_point(h: f64) -> &'static str {
     POINTS[((h.rem_euclid(360.0) + 22.5) / 45.0) as usize % 8]
 }
 
-/// Image size from the header, without decoding.
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fixed::to_fx;
 
     #[test]
     fn grammar() {
@@ -772,92 +479,6 @@ mod tests {
         assert!(Crop::new(0, 50, 0, 0, 10, 10).is_err());
         assert!(Crop::new(100, 50, 0, 0, 0, 10).is_err());
         assert_eq!(Crop::new(100, 50, 250, 0, 10, 10).unwrap().left(), 50);
-    }
-
-    fn partial(crop: Crop) -> EnvMap {
-        let (w, h) = (crop.width(), crop.height());
-        let px: Vec<u32> = (0..w * h)
-            .map(|i| 0x010000 * (i % w) + 0x100 * (i / w) + 1)
-            .collect();
-        let mut m = EnvMap::from_pixels(w, h, &px, Projection::Elliptical)
-            .unwrap()
-            .into_partial(crop)
-            .unwrap();
-        m.set_background(0xABCDEF);
-        m
-    }
-
-    #[test]
-    fn sampling_inside_outside_and_across_the_seam() {
-        // 10 columns from column 95 of 100: 95..100 and 0..5
-        let m = partial(Crop::new(100, 50, 95, 10, 10, 20).unwrap());
-        assert_eq!((m.width(), m.height(), m.stored_width()), (100, 50, 10));
-        let at = |u: f64, v: f64| m.nearest_cropped(to_fx(u), to_fx(v));
-        assert_eq!(at(95.5, 10.5), m.pixel(0, 0));
-        assert_eq!(at(99.5, 29.5), m.pixel(4, 19));
-        assert_eq!(at(0.5, 12.5), m.pixel(5, 2));
-        assert_eq!(at(4.99, 12.5), m.pixel(9, 2));
-        for (u, v) in [
-            (5.0, 12.5),
-            (94.99, 12.5),
-            (50.0, 20.0),
-            (97.0, 9.99),
-            (97.0, 30.0),
-        ] {
-            assert_eq!(at(u, v), 0xABCDEF, "({u}, {v})");
-            assert_eq!(m.bilinear_cropped(to_fx(u), to_fx(v)), 0xABCDEF);
-        }
-        // bilinear across the seam blends stored columns 4 and 5
-        let b = m.bilinear_cropped(to_fx(100.0), to_fx(12.5));
-        assert_eq!(b, crate::envmap::lerp_px(m.pixel(4, 2), m.pixel(5, 2), 128));
-        // edges clamp to the edge texels
-        assert_eq!(m.bilinear_cropped(to_fx(95.1), to_fx(10.1)), m.pixel(0, 0));
-        assert_eq!(m.bilinear_cropped(to_fx(4.9), to_fx(29.9)), m.pixel(9, 19));
-        // sample() goes through the crop
-        assert_eq!(
-            m.sample(Sampler::Nearest, to_fx(0.5), to_fx(12.5)),
-            m.pixel(5, 2)
-        );
-        assert_eq!(
-            m.sample(Sampler::Bilinear, to_fx(50.0), to_fx(12.5)),
-            0xABCDEF
-        );
-    }
-
-    #[test]
-    fn full_width_crop_wraps() {
-        let m = partial(Crop::new(16, 20, 0, 5, 16, 6).unwrap());
-        let b = m.bilinear_cropped(to_fx(0.0), to_fx(7.5));
-        assert_eq!(
-            b,
-            crate::envmap::lerp_px(m.pixel(15, 2), m.pixel(0, 2), 128)
-        );
-        let b = m.bilinear_cropped(to_fx(15.9999), to_fx(7.5));
-        assert_eq!(
-            b,
-            crate::envmap::lerp_px(m.pixel(15, 2), m.pixel(0, 2), 128)
-        );
-        assert_eq!(m.nearest_cropped(to_fx(3.5), to_fx(4.9)), 0xABCDEF);
-        assert_eq!(m.nearest_cropped(to_fx(3.5), to_fx(11.0)), 0xABCDEF);
-    }
-
-    #[test]
-    fn whole_crop_is_a_plain_map() {
-        let m = partial(Crop::new(16, 8, 0, 0, 16, 8).unwrap());
-        assert!(m.crop().is_none());
-        assert_eq!(m.coverage(), Coverage::FULL);
-        let b = m.bilinear(to_fx(0.0), to_fx(2.5));
-        assert_eq!(
-            b,
-            crate::envmap::lerp_px(m.pixel(15, 2), m.pixel(0, 2), 128)
-        );
-    }
-
-    #[test]
-    fn wrong_stored_size_is_an_error() {
-        let m = EnvMap::from_pixels(4, 4, &[0; 16], Projection::Cylinder).unwrap();
-        let e = m.into_partial(Crop::new(100, 50, 0, 0, 5, 4).unwrap());
-        assert!(matches!(e, Err(CoverageError::Invalid { .. })));
     }
 
     #[test]

@@ -21,8 +21,8 @@
 //!   highest latitude seen is nondecreasing in θ, and so is the lowest: the pitches that
 //!   fit form an interval, found by bisection (always keeping the side that fits).
 
-use crate::camera::{wrap_deg, View};
-use crate::coverage::Coverage;
+use crate::geom::camera::{wrap_deg, View};
+use crate::geom::coverage::Coverage;
 
 /// How far the frame reaches, for one pitch: latitude extremes and the half-width in
 /// longitude around the view's yaw (degrees; 180 when a pole is in the frame).
@@ -184,7 +184,7 @@ pub fn limit_view(view: View, width: u32, height: u32, cov: &Coverage) -> View {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::{dir_to_lat_long, Camera};
+    use crate::geom::camera::{dir_to_lat_long, Camera};
     use proptest::prelude::*;
 
     /// Every border pixel's centre ray of `view` lies in `cov` (0.0001° slack).

@@ -30,7 +30,9 @@
 //!   `image width / CroppedAreaImageWidthPixels`, provided the height agrees within 1 %;
 //!   otherwise an error.
 
-use crate::coverage::{CoverageError, Crop};
+use crate::error::CoverageError;
+use crate::geom::coverage::Crop;
+use crate::geom::limits::MAX_MAP_WIDTH;
 
 /// The GPano namespace URI.
 pub const GPANO_NS: &str = "http://ns.google.com/photos/1.0/panorama/";
@@ -250,7 +252,7 @@ impl GPano {
         }
         let full_w = (fw * s).round();
         let full_h = (fh * s).round();
-        let max = crate::MAX_MAP_WIDTH as f64;
+        let max = MAX_MAP_WIDTH as f64;
         if full_w > max || full_h > max {
             return Err(err(GPanoError::Inconsistent(format!(
                 "full panorama {full_w}x{full_h} (at the image's scale) is larger than \
@@ -307,7 +309,7 @@ pub fn jpeg_xmp(bytes: &[u8]) -> Option<&[u8]> {
 /// # Errors
 /// [`GPanoError`] as [`GPano::from_xmp`]; XMP that is not UTF-8 is an error only when it
 /// mentions GPano.
-pub fn read_jpeg(bytes: &[u8]) -> Result<Option<GPano>, GPanoError> {
+pub fn read_gpano(bytes: &[u8]) -> Result<Option<GPano>, GPanoError> {
     let Some(xmp) = jpeg_xmp(bytes) else {
         return Ok(None);
     };
@@ -418,7 +420,7 @@ mod tests {
             )
             .unwrap();
         let tagged = insert_xmp(&jpeg, &xmp).unwrap();
-        let g = read_jpeg(&tagged).unwrap().unwrap();
+        let g = read_gpano(&tagged).unwrap().unwrap();
         assert_eq!(g.cropped_area_left_pixels, Some(100.0));
         assert_eq!(g.pose_heading_degrees, None);
         let c = g.crop_for_image(300, 200).unwrap();
@@ -429,8 +431,8 @@ mod tests {
         // the image still decodes
         assert!(image::load_from_memory(&tagged).is_ok());
         // untagged JPEG and non-JPEG bytes: nothing
-        assert_eq!(read_jpeg(&jpeg).unwrap(), None);
-        assert_eq!(read_jpeg(b"\x89PNG....").unwrap(), None);
+        assert_eq!(read_gpano(&jpeg).unwrap(), None);
+        assert_eq!(read_gpano(b"\x89PNG....").unwrap(), None);
     }
 
     #[test]
@@ -524,9 +526,9 @@ mod tests {
         let xmp = xmp_packet(&[("FullPanoWidthPixels", "10")]);
         let full = insert_xmp(&[0xFF, 0xD8, 0xFF, 0xD9], &xmp).unwrap();
         for n in 0..full.len() {
-            let _ = read_jpeg(&full[..n]);
+            let _ = read_gpano(&full[..n]);
         }
-        assert!(read_jpeg(&full).unwrap().is_some());
+        assert!(read_gpano(&full).unwrap().is_some());
         assert!(insert_xmp(b"GIF89a", &xmp).is_err());
         assert!(insert_xmp(&[0xFF, 0xD8], &"x".repeat(70000)).is_err());
     }

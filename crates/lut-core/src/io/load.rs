@@ -9,7 +9,7 @@
 //! headers, nothing more), then from the decoder's own dimensions. `image`'s [`Limits`]
 //! are set as a second line of defence (sides at most `max_pixels / 2` and
 //! [`MAX_MAP_WIDTH`], decoder allocations at most 16 bytes per
-//! allowed pixel). [`crate::MAX_MAP_PIXELS`] stays the hard limit whatever is asked.
+//! allowed pixel). [`MAX_MAP_PIXELS`] stays the hard limit whatever is asked.
 //!
 //! ## Memory
 //! 8-bit images (gray, gray + alpha, RGB, RGBA: every JPEG and 8-bit PNG) are decoded by
@@ -32,10 +32,11 @@
 //! no progress: that phase starts with `fraction: None` and reports `Some(1.0)` only
 //! when it is finished. Events are throttled to steps of at least 1/200.
 
-use crate::envmap::{check_map_size, resolve_projection, tone_map, EnvMap, Tone};
-use crate::error::MapError;
-use crate::projection::Projection;
-use crate::{MAX_MAP_PIXELS, MAX_MAP_WIDTH};
+use crate::error::{MapError, SizeProblem};
+use crate::geom::limits::{MAX_MAP_PIXELS, MAX_MAP_WIDTH};
+use crate::geom::projection::Projection;
+use crate::map::envmap::{check_map_size, EnvMap};
+use crate::map::tone::{tone_map, Tone};
 use image::{ColorType, DynamicImage, ImageDecoder, Limits};
 use rayon::prelude::*;
 use std::cell::{Cell, RefCell};
@@ -104,7 +105,7 @@ pub struct LoadProgress {
 /// Check `width × height` against `limit`.
 ///
 /// # Errors
-/// [`MapError::TooManyPixels`] naming `what`, the size, the limit and `--max-pixels`.
+/// [`MapError::TooManyPixels`] naming `what`, the size and the limit.
 pub fn check_pixel_limit(what: &str, width: u64, height: u64, limit: u64) -> Result<(), MapError> {
     let pixels = width.saturating_mul(height);
     if pixels > limit {
@@ -196,54 +197,68 @@ impl<R: Seek> Seek for Counted<'_, '_, R> {
     }
 }
 
-impl EnvMap {
-    /// Load an image file as a map with `opts`, reporting progress to `progress` (see
-    /// the [module docs](crate::load) for the phases, the pixel limit and the memory
-    /// used). The file is streamed, never read whole into memory by this function.
-    ///
-    /// # Errors
-    /// [`MapError::TooManyPixels`] when the header announces more than
-    /// `opts.max_pixels` (nothing decoded), otherwise as [`EnvMap::load`].
-    pub fn load_with(
-        path: &Path,
-        opts: &LoadOptions,
-        progress: &mut dyn FnMut(LoadProgress),
-    ) -> Result<EnvMap, MapError> {
-        let what = path.display().to_string();
-        let io_err = |e: std::io::Error| MapError::Decode {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        };
-        let file = std::fs::File::open(path).map_err(io_err)?;
-        let len = file.metadata().map_err(io_err)?.len();
-        decode_reader(
-            std::io::BufReader::with_capacity(1 << 20, file),
-            len,
-            &what,
-            opts,
-            progress,
-        )
-    }
+/// Load an image file as a map with `opts`, reporting progress to `progress` (see the
+/// [`LoadOptions`] and [`LoadProgress`] docs for the phases and the pixel limit). The file
+/// is streamed, never read whole into memory by this function. `opts.projection` `None`
+/// means *auto*: a 2:1 image is equirectangular, anything else is an error.
+///
+/// # Errors
+/// [`MapError::TooManyPixels`] when the header announces more than `opts.max_pixels`
+/// (nothing decoded), [`MapError::Decode`] for an unreadable or undecodable file,
+/// [`MapError::Size`] for an unsupported size, [`MapError::UnknownProjection`] /
+/// [`MapError::EquirectNotTwoToOne`] when the projection does not fit the image.
+pub fn load_map(
+    path: &Path,
+    opts: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+) -> Result<EnvMap, MapError> {
+    let what = path.display().to_string();
+    let io_err = |e: std::io::Error| MapError::Decode {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    };
+    let file = std::fs::File::open(path).map_err(io_err)?;
+    let len = file.metadata().map_err(io_err)?.len();
+    decode_reader(
+        std::io::BufReader::with_capacity(1 << 20, file),
+        len,
+        &what,
+        opts,
+        progress,
+    )
+}
 
-    /// As [`EnvMap::load_with`] for an in-memory encoded image; `what` names it in
-    /// errors.
-    ///
-    /// # Errors
-    /// As [`EnvMap::load_with`].
-    pub fn decode_with(
-        bytes: &[u8],
-        what: &str,
-        opts: &LoadOptions,
-        progress: &mut dyn FnMut(LoadProgress),
-    ) -> Result<EnvMap, MapError> {
-        decode_reader(
-            std::io::Cursor::new(bytes),
-            bytes.len() as u64,
-            what,
-            opts,
-            progress,
-        )
-    }
+/// As [`load_map`] for an in-memory encoded image; `what` names it in errors.
+///
+/// # Errors
+/// As [`load_map`].
+pub fn decode_map(
+    bytes: &[u8],
+    what: &str,
+    opts: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+) -> Result<EnvMap, MapError> {
+    decode_reader(
+        std::io::Cursor::new(bytes),
+        bytes.len() as u64,
+        what,
+        opts,
+        progress,
+    )
+}
+
+/// A map from a decoded image (any colour type; 8-bit images as stored, HDR
+/// (floating-point) ones through `tone`: exposure, the tone curve `x / (1 + x)`, then sRGB
+/// encoding; negative and NaN values become 0 and +∞ white, never propagated).
+///
+/// # Errors
+/// [`MapError::Size`] for an empty or oversized image.
+pub fn map_from_image(
+    img: &DynamicImage,
+    projection: Projection,
+    tone: Tone,
+) -> Result<EnvMap, MapError> {
+    image_to_map("image", img, projection, tone, &mut |_| {})
 }
 
 /// `image`'s limits for a load under `max_pixels`: the second line of defence after the
@@ -371,10 +386,9 @@ fn alloc_map(what: &str, w: u32, h: u32) -> Result<Vec<u32>, MapError> {
         what: what.into(),
         width: w,
         height: h,
-        reason: format!(
-            "not enough memory for the map ({:.2} GiB)",
-            (n * 4) as f64 / f64::from(1u32 << 30)
-        ),
+        problem: SizeProblem::OutOfMemory {
+            bytes: n as u64 * 4,
+        },
     })?;
     drop(probe);
     Ok(vec![0u32; n])
@@ -493,8 +507,8 @@ fn fill_rows(
 }
 
 /// A decoded image as a map: 8-bit images as stored, floating-point ones through `tone`
-/// (see [`EnvMap::from_image_toned`]).
-pub(crate) fn image_to_map(
+/// (see [`map_from_image`]).
+fn image_to_map(
     what: &str,
     img: &DynamicImage,
     projection: Projection,
@@ -550,6 +564,33 @@ pub(crate) fn image_to_map(
     Ok(EnvMap::from_padded(w, h, projection, data))
 }
 
+/// Pick the projection for an image: explicit, or auto (2:1 → equirect, else an error).
+///
+/// # Errors
+/// [`MapError::UnknownProjection`] when auto cannot decide,
+/// [`MapError::EquirectNotTwoToOne`] when an equirect is not 2:1.
+pub fn resolve_projection(
+    what: &str,
+    w: u32,
+    h: u32,
+    projection: Option<Projection>,
+) -> Result<Projection, MapError> {
+    match projection {
+        None if w != 2 * h => Err(MapError::UnknownProjection {
+            what: what.into(),
+            width: w,
+            height: h,
+        }),
+        Some(Projection::Equirect) if w != 2 * h => Err(MapError::EquirectNotTwoToOne {
+            what: what.into(),
+            width: w,
+            height: h,
+        }),
+        None => Ok(Projection::Equirect),
+        Some(p) => Ok(p),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -572,7 +613,7 @@ mod tests {
     fn same(a: &EnvMap, b: &EnvMap) {
         assert_eq!((a.width(), a.height()), (b.width(), b.height()));
         assert_eq!(a.projection(), b.projection());
-        assert!(a.raw() == b.raw(), "padded buffers differ");
+        assert!(a.padded() == b.padded(), "padded buffers differ");
     }
 
     /// Every 8-bit colour type decoded in place equals the map built from the decoded
@@ -593,8 +634,8 @@ mod tests {
                     projection: Some(proj),
                     ..LoadOptions::default()
                 };
-                let got = EnvMap::decode_with(&png, "t.png", &opts, &mut |_| {}).unwrap();
-                let want = EnvMap::from_image(img, proj).unwrap();
+                let got = decode_map(&png, "t.png", &opts, &mut |_| {}).unwrap();
+                let want = map_from_image(img, proj, Tone::default()).unwrap();
                 same(&got, &want);
             }
         }
@@ -603,11 +644,11 @@ mod tests {
             &DynamicImage::ImageRgb8(base.to_rgb8()),
             image::ImageFormat::Jpeg,
         );
-        let got = EnvMap::decode_with(&jpg, "t.jpg", &LoadOptions::default(), &mut |_| {}).unwrap();
+        let got = decode_map(&jpg, "t.jpg", &LoadOptions::default(), &mut |_| {}).unwrap();
         let dec = image::load_from_memory(&jpg).unwrap();
         same(
             &got,
-            &EnvMap::from_image(&dec, Projection::Equirect).unwrap(),
+            &map_from_image(&dec, Projection::Equirect, Tone::default()).unwrap(),
         );
     }
 
@@ -621,17 +662,17 @@ mod tests {
                 projection: Some(Projection::Cylinder),
                 ..LoadOptions::default()
             };
-            let got = EnvMap::decode_with(&png, "t.png", &opts, &mut |_| {}).unwrap();
+            let got = decode_map(&png, "t.png", &opts, &mut |_| {}).unwrap();
             same(
                 &got,
-                &EnvMap::from_image(&img, Projection::Cylinder).unwrap(),
+                &map_from_image(&img, Projection::Cylinder, Tone::default()).unwrap(),
             );
         }
     }
 
     fn events(bytes: &[u8]) -> Vec<LoadProgress> {
         let mut ev = Vec::new();
-        EnvMap::decode_with(bytes, "t", &LoadOptions::default(), &mut |p| ev.push(p)).unwrap();
+        decode_map(bytes, "t", &LoadOptions::default(), &mut |p| ev.push(p)).unwrap();
         ev
     }
 
@@ -707,7 +748,7 @@ mod tests {
             max_pixels: 64 * 32 - 1,
             ..LoadOptions::default()
         };
-        let e = EnvMap::decode_with(&png, "pano.png", &opts, &mut |_| {}).unwrap_err();
+        let e = decode_map(&png, "pano.png", &opts, &mut |_| {}).unwrap_err();
         assert!(matches!(
             e,
             MapError::TooManyPixels {
@@ -719,13 +760,40 @@ mod tests {
             }
         ));
         let msg = e.to_string();
-        for part in ["pano.png", "64x32", "2047", "--max-pixels"] {
+        for part in ["pano.png", "64x32", "2047"] {
             assert!(msg.contains(part), "{msg}");
         }
+        // No command-line flag names in library messages (the viewer adds its hints).
+        assert!(!msg.contains("--"), "{msg}");
         let ok = LoadOptions {
             max_pixels: 64 * 32,
             ..LoadOptions::default()
         };
-        assert!(EnvMap::decode_with(&png, "pano.png", &ok, &mut |_| {}).is_ok());
+        assert!(decode_map(&png, "pano.png", &ok, &mut |_| {}).is_ok());
+    }
+
+    #[test]
+    fn hdr_images_are_toned_and_clamped() {
+        let mut img = image::Rgb32FImage::new(4, 2);
+        for (i, p) in img.pixels_mut().enumerate() {
+            let v = [f32::NAN, -1.0, 1.0, f32::INFINITY, 0.5, 2.0, 0.0, 1e9][i];
+            *p = image::Rgb([v, v, v]);
+        }
+        let dynimg = image::DynamicImage::ImageRgb32F(img);
+        let m = map_from_image(&dynimg, Projection::Equirect, Tone::default()).unwrap();
+        let g = |x, y| m.pixel(x, y) & 0xFF;
+        assert_eq!((g(0, 0), g(1, 0), g(2, 0), g(3, 0)), (0, 0, 188, 255));
+        let brighter =
+            map_from_image(&dynimg, Projection::Equirect, Tone { exposure_ev: 1.0 }).unwrap();
+        // +1 EV on 0.5 is 1.0
+        assert_eq!(brighter.pixel(0, 1) & 0xFF, 188);
+    }
+
+    #[test]
+    fn auto_projection() {
+        assert!(resolve_projection("x", 100, 50, None).is_ok());
+        assert!(resolve_projection("x", 100, 60, None).is_err());
+        assert!(resolve_projection("x", 100, 60, Some(Projection::Equirect)).is_err());
+        assert!(resolve_projection("x", 100, 60, Some(Projection::Cylinder)).is_ok());
     }
 }

@@ -14,7 +14,7 @@
 
 use super::table::LightTable;
 use super::{LightError, PhotometricType};
-use crate::camera::Camera;
+use crate::geom::camera::Camera;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::{Arc, OnceLock};

@@ -38,7 +38,7 @@
 //! and table kind); for an 8192-wide map 1.4 % of the wide table's cells and 0.6 % of the
 //! high table's are measured.
 
-use crate::projection::Projection;
+use crate::geom::projection::Projection;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -727,7 +727,7 @@ fn entry_error(p: Projection, w: f64, h: f64, exact: (f64, f64, f64), got: (f64,
     } else {
         w * 0.5 + il
     };
-    crate::accuracy::position_error(p, w, h, phi, (ue, ve), (ui, vi))
+    crate::geom::accuracy::position_error(p, w, h, phi, (ue, ve), (ui, vi))
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! Zoomed out on a large map, one screen pixel covers several map pixels and bilinear
 //! sampling (four texels) aliases: moiré on fine patterns, sparkle while panning. The
 //! pyramid stores the map again at half, quarter, ... size (a 2×2 box filter per level,
-//! averaged in 8-bit sRGB like [`crate::render_exact_supersampled`]), the same idea as
+//! averaged in 8-bit sRGB like the supersampled exact renderer), the same idea as
 //! EP 0613099's series of tables halving in size. The sampler picks the two levels around
 //! the pixel footprint and blends bilinear samples of both (trilinear).
 //!
@@ -21,8 +21,9 @@
 //! map more, built on first use. Partial (cropped) maps get no pyramid: they sample
 //! bilinearly.
 
-use crate::envmap::{lerp_px, EnvMap};
-use crate::fixed::Fx;
+use crate::geom::fixed::Fx;
+use crate::map::envmap::EnvMap;
+use crate::map::sample::lerp_px;
 use rayon::prelude::*;
 
 /// Smallest level side built.
@@ -62,7 +63,7 @@ impl EnvMap {
     }
 
     /// Level `k` of the pyramid (0 = this map); clamped to the last level built.
-    fn level(&self, k: usize) -> (&EnvMap, u32) {
+    pub(crate) fn level(&self, k: usize) -> (&EnvMap, u32) {
         if k == 0 {
             return (self, 0);
         }
@@ -99,33 +100,6 @@ impl EnvMap {
             self.bilinear_cropped(u, v)
         } else {
             self.bilinear(u, v)
-        }
-    }
-
-    /// [`EnvMap::trilinear`] over a run of positions stepping linearly (see
-    /// [`EnvMap::sample_span`]), one level of detail for the run.
-    pub fn trilinear_span(&self, out: &mut [u32], u: Fx, v: Fx, du: Fx, dv: Fx, lod: i32) {
-        if lod <= 0 || self.crop.is_some() {
-            return self.sample_span::<true>(out, u, v, du, dv);
-        }
-        let k = (lod >> 8) as usize;
-        let frac = (lod & 0xFF) as u32;
-        let (a_map, ka) = self.level(k);
-        let (b_map, kb) = self.level(k + 1);
-        a_map.sample_span::<true>(out, u >> ka, v >> ka, du >> ka, dv >> ka);
-        if frac == 0 || kb == ka {
-            return;
-        }
-        let mut scratch = [0u32; 64];
-        let (mut u, mut v) = (u, v);
-        for chunk in out.chunks_mut(scratch.len()) {
-            let s = &mut scratch[..chunk.len()];
-            b_map.sample_span::<true>(s, u >> kb, v >> kb, du >> kb, dv >> kb);
-            for (o, b) in chunk.iter_mut().zip(s.iter()) {
-                *o = lerp_px(*o, *b, frac);
-            }
-            u += du * chunk.len() as i64;
-            v += dv * chunk.len() as i64;
         }
     }
 }
@@ -185,8 +159,8 @@ fn to_level(x: Fx, k: u32) -> Fx {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fixed::{to_fx, FX_BITS};
-    use crate::projection::Projection;
+    use crate::geom::fixed::to_fx;
+    use crate::geom::projection::Projection;
 
     fn checker(w: u32, h: u32) -> EnvMap {
         let px: Vec<u32> = (0..h)
@@ -243,30 +217,6 @@ mod tests {
         // (6..8, 4..6): both give the average of those four.
         let (u, v) = (to_fx(7.0), to_fx(5.0));
         assert_eq!(m.trilinear(u, v, 256), m.pyramid()[0].pixel(3, 2));
-    }
-
-    #[test]
-    fn span_equals_per_pixel() {
-        let m = crate::synth::grid_map(256, 128, Projection::Equirect).unwrap();
-        for lod in [0, 100, 256, 300, 700, 5000] {
-            let (u, v, du, dv) = (to_fx(250.3), to_fx(40.2), to_fx(1.7), to_fx(-0.4));
-            let mut out = vec![0u32; 100];
-            m.trilinear_span(&mut out, u, v, du, dv, lod);
-            for (i, o) in out.iter().enumerate() {
-                let uu = (u + du * i as i64).rem_euclid(256 << FX_BITS);
-                let vv = v + dv * i as i64;
-                // The span steps each level by du >> k (truncated): up to i/65536 px
-                // off after i pixels, which can move an 8-bit weight by one step.
-                let want = m.trilinear(uu, vv, lod);
-                for s in [0, 8, 16] {
-                    let (a, b) = ((o >> s) & 0xFF, (want >> s) & 0xFF);
-                    assert!(
-                        a.abs_diff(b) <= 2,
-                        "lod {lod} pixel {i}: {o:06x} vs {want:06x}"
-                    );
-                }
-            }
-        }
     }
 
     #[test]

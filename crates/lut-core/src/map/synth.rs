@@ -2,9 +2,9 @@
 //! and lines show. Generated for any projection by evaluating one function of direction
 //! at each map pixel's center, so the same scene can be rendered from every projection.
 
-use crate::envmap::EnvMap;
 use crate::error::MapError;
-use crate::projection::Projection;
+use crate::geom::projection::Projection;
+use crate::map::envmap::EnvMap;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -43,7 +43,7 @@ pub fn scene_color(lambda: f64, phi: f64) -> u32 {
 /// # Errors
 /// [`MapError::Size`] for unsupported sizes.
 pub fn grid_map(w: u32, h: u32, projection: Projection) -> Result<EnvMap, MapError> {
-    crate::envmap::check_map_size("generated map", w, h)?;
+    crate::map::envmap::check_map_size("generated map", w, h)?;
     let (wf, hf) = (w as f64, h as f64);
     let mut px = vec![0u32; w as usize * h as usize];
     px.par_chunks_mut(w as usize)

@@ -1,7 +1,7 @@
 //! The paper's two cube renderers: basic (per pixel) and accelerated (per scanline segment).
 //!
 //! # Rays
-//! With the rotation `R` of `conventions.md` (pitch about X, then yaw about Y), the ray of
+//! With the rotation `R` of `docs/conventions.md` (pitch about X, then yaw about Y), the ray of
 //! output pixel (x, y) is `R · (dx, dy, f)` with `dx = x + ½ − W/2`, `dy = H/2 − (y + ½)`.
 //! Both renderers evaluate it as `P + dx · B`, where `P = dy · R₁ + f · R₂` (the row part)
 //! and `B = R₀ = (cos ψ, 0, −sin ψ)` (the image's x axis in the world): each scanline is a
@@ -27,11 +27,12 @@
 //! so the two images are byte-identical (tested over sweeps of views, sizes and both
 //! samplers in `tests/cube.rs`).
 
-use super::{face_axes, face_of, face_uv, CubeMap, Face};
-use crate::camera::{check_size, View};
-use crate::envmap::Sampler;
-use crate::error::ViewError;
-use crate::exact::check_buffer;
+use super::exact::render_exact;
+use super::frame::Frame;
+use crate::cube::{check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face};
+use crate::geom::camera::View;
+use crate::map::envmap::EnvMap;
+use crate::map::sample::Sampler;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -70,7 +71,7 @@ impl std::str::FromStr for CubeRenderer {
 
 /// Per-frame constants: the rotation's columns and the image geometry.
 #[derive(Clone, Copy)]
-struct Frame {
+struct Rays {
     /// Column 0 of R: world direction of image +x (B in the module docs).
     b: DVec3,
     /// Column 1 of R: world direction of image +y (up).
@@ -85,8 +86,8 @@ struct Frame {
     delta: f64,
 }
 
-impl Frame {
-    fn new(view: View, w: u32, h: u32, face_size: u32) -> Frame {
+impl Rays {
+    fn new(view: View, w: u32, h: u32, face_size: u32) -> Rays {
         let focal = (w as f64 / 2.0) / (view.hfov() / 2.0).tan();
         let (sp, cp) = view.pitch().sin_cos();
         let (sy, cy) = view.yaw().sin_cos();
@@ -98,7 +99,7 @@ impl Frame {
         // ulps of that (~1e-15 relative). 1e-9 relative is far above it and far below a
         // pixel's change of margin except within 1e-9 px of an edge.
         let delta = 1e-9 * (focal + w as f64 + h as f64);
-        Frame {
+        Rays {
             b,
             r1,
             r2,
@@ -161,39 +162,31 @@ impl Fetch for BilinearFetch {
     }
 }
 
-/// Render `view` of `cube` into `out` (row-major 0RGB, `width × height`, any size from
-/// 1×1) with the chosen renderer. `threads` splits rows into bands across the rayon pool;
-/// the output is identical either way, and identical between the two renderers.
-///
-/// # Errors
-/// [`ViewError::BadSize`] for a bad size, [`ViewError::BufferSize`] when `out` does not
-/// hold `width × height` pixels.
-#[allow(clippy::too_many_arguments)]
-pub fn render(
+/// Render `view` of `cube` into `frame` with the chosen renderer (the entry is
+/// [`crate::Renderer::render`] of a [`crate::Scene::Cube`]). `threads` splits rows into
+/// bands across the rayon pool; the output is identical either way, and identical between
+/// the two renderers.
+pub(crate) fn render_cube(
     cube: &CubeMap,
     view: View,
     sampler: Sampler,
     renderer: CubeRenderer,
-    out: &mut [u32],
-    width: u32,
-    height: u32,
+    frame: &mut Frame<'_>,
     threads: bool,
-) -> Result<(), ViewError> {
-    check_size(width, height)?;
-    check_buffer(out, width, height)?;
-    let frame = Frame::new(view, width, height, cube.face_size());
+) {
+    let rays = Rays::new(view, frame.width(), frame.height(), cube.face_size());
+    let out = frame.pixels_mut();
     match sampler {
-        Sampler::Nearest => render_with(cube, &frame, NearestFetch, renderer, out, threads),
+        Sampler::Nearest => render_with(cube, &rays, NearestFetch, renderer, out, threads),
         Sampler::Bilinear | Sampler::Trilinear => {
-            render_with(cube, &frame, BilinearFetch, renderer, out, threads)
+            render_with(cube, &rays, BilinearFetch, renderer, out, threads)
         }
     }
-    Ok(())
 }
 
 fn render_with<S: Fetch>(
     cube: &CubeMap,
-    frame: &Frame,
+    frame: &Rays,
     s: S,
     renderer: CubeRenderer,
     out: &mut [u32],
@@ -225,7 +218,7 @@ fn render_with<S: Fetch>(
 #[inline(always)]
 fn per_pixel<S: Fetch>(
     cube: &CubeMap,
-    frame: &Frame,
+    frame: &Rays,
     s: S,
     y: usize,
     line: &mut [u32],
@@ -242,7 +235,7 @@ fn per_pixel<S: Fetch>(
     }
 }
 
-fn basic_row<S: Fetch>(cube: &CubeMap, frame: &Frame, s: S, y: usize, line: &mut [u32]) {
+fn basic_row<S: Fetch>(cube: &CubeMap, frame: &Rays, s: S, y: usize, line: &mut [u32]) {
     per_pixel(cube, frame, s, y, line, 0, line.len());
 }
 
@@ -297,7 +290,7 @@ fn margin(face: Face, d: DVec3) -> f64 {
 
 fn accel_row<S: Fetch>(
     cube: &CubeMap,
-    frame: &Frame,
+    frame: &Rays,
     s: S,
     y: usize,
     line: &mut [u32],
@@ -347,7 +340,7 @@ fn accel_row<S: Fetch>(
 #[allow(clippy::too_many_arguments)]
 fn run<const F: usize, S: Fetch>(
     cube: &CubeMap,
-    frame: &Frame,
+    frame: &Rays,
     s: S,
     p: DVec3,
     line: &mut [u32],
@@ -374,7 +367,7 @@ pub fn scanline_runs(
     face_size: u32,
     y: u32,
 ) -> Vec<(u32, u32, Face, bool)> {
-    let frame = Frame::new(view, width, height, face_size);
+    let frame = Rays::new(view, width, height, face_size);
     let w = width as usize;
     let p = frame.row(frame.dy(y as usize));
     let b = frame.b;
@@ -402,4 +395,31 @@ pub fn scanline_runs(
         out.extend(tail.into_iter().rev());
     }
     out
+}
+
+impl CubeMap {
+    /// Render a cube map from a panorama: each face is the exact renderer's hfov-90° view
+    /// at the face's yaw/pitch (the definition in `docs/conventions.md`).
+    ///
+    /// # Errors
+    /// [`CubeError::FaceSize`] for a bad `face_size`.
+    pub fn from_envmap(
+        map: &EnvMap,
+        face_size: u32,
+        sampler: Sampler,
+    ) -> Result<CubeMap, CubeError> {
+        check_face_size("cube map", face_size)?;
+        let n = face_size as usize;
+        let mut faces: [Vec<u32>; 6] = Default::default();
+        for (k, face) in Face::ALL.iter().enumerate() {
+            let mut buf = vec![0u32; n * n];
+            let mut frame = Frame::new(&mut buf, face_size, face_size).map_err(|e| {
+                CubeError::Usage(format!("cannot render {} face: {e}", face.name()))
+            })?;
+            render_exact(map, face.view(), sampler, &mut frame, true);
+            faces[k] = buf;
+        }
+        let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
+        CubeMap::from_faces(face_size, refs)
+    }
 }

@@ -4,41 +4,15 @@
 //! against. It shares only the sampler with the LUT renderer (so image differences are
 //! geometry differences).
 
-use crate::camera::{check_size, dir_to_lat_long, Camera, View};
-use crate::envmap::{EnvMap, Sampler};
-use crate::error::ViewError;
-use crate::fixed::to_fx;
-use crate::projection::Projection;
-use crate::rows::for_each_row;
-
-/// Exact map position of the center of output pixel (x, y), or `None` when the map does
-/// not cover that direction.
-#[inline]
-pub fn exact_uv(
-    cam: &Camera,
-    projection: Projection,
-    map_w: f64,
-    map_h: f64,
-    x: u32,
-    y: u32,
-) -> Option<(f64, f64)> {
-    let (lambda, phi) = dir_to_lat_long(cam.world_ray(x as f64 + 0.5, y as f64 + 0.5));
-    projection.uv(lambda, phi, map_w, map_h)
-}
-
-/// Exact map position of an arbitrary image-plane point (used for supersampling).
-#[inline]
-pub fn exact_uv_at(
-    cam: &Camera,
-    projection: Projection,
-    map_w: f64,
-    map_h: f64,
-    px: f64,
-    py: f64,
-) -> Option<(f64, f64)> {
-    let (lambda, phi) = dir_to_lat_long(cam.world_ray(px, py));
-    projection.uv(lambda, phi, map_w, map_h)
-}
+use super::frame::Frame;
+use super::rows::for_each_row;
+use crate::geom::camera::{Camera, View};
+use crate::geom::fixed::to_fx;
+use crate::geom::mapping::{exact_uv, exact_uv_at};
+use crate::geom::projection::Projection;
+use crate::map::envmap::EnvMap;
+use crate::map::pyramid::lod_q8;
+use crate::map::sample::Sampler;
 
 /// Sample `map` at an f64 position, wrapping u for 360° maps (background if uncovered).
 #[inline]
@@ -65,7 +39,7 @@ fn wrap_u(map: &EnvMap, u: f64) -> f64 {
 }
 
 /// [`sample_at`] with the trilinear sampler at level of detail `lod` (Q.8, see
-/// [`crate::pyramid::lod_q8`]).
+/// `map/pyramid.rs`).
 #[inline]
 pub fn sample_at_lod(map: &EnvMap, uv: Option<(f64, f64)>, lod: i32) -> u32 {
     match uv {
@@ -100,25 +74,21 @@ fn exact_footprint(
     f
 }
 
-/// Render `view` of `map` into `out` (row-major 0RGB, `width × height`), exactly.
-/// With [`Sampler::Trilinear`] the level of detail comes from the exact footprint of each
-/// pixel (differences of the exact mapping to the next pixel right and below).
+/// Render `view` of `map` into `frame`, exactly (also reached through
+/// [`crate::Renderer::render`] with [`crate::RendererKind::Exact`]). With
+/// [`Sampler::Trilinear`] the level of detail comes from the exact footprint of each pixel
+/// (differences of the exact mapping to the next pixel right and below).
 ///
 /// `threads`: split rows across the rayon pool when true; output is identical either way.
-///
-/// # Errors
-/// [`ViewError`] for a bad size or buffer length.
 pub fn render_exact(
     map: &EnvMap,
     view: View,
     sampler: Sampler,
-    out: &mut [u32],
-    width: u32,
-    height: u32,
+    frame: &mut Frame<'_>,
     threads: bool,
-) -> Result<(), ViewError> {
-    check_size(width, height)?;
-    check_buffer(out, width, height)?;
+) {
+    let (width, height) = (frame.width(), frame.height());
+    let out = frame.pixels_mut();
     let cam = Camera::new(view, width, height);
     let (mw, mh) = (map.width() as f64, map.height() as f64);
     let proj = map.projection();
@@ -129,12 +99,12 @@ pub fn render_exact(
                 let (xf, yf) = (x as f64 + 0.5, y as f64 + 0.5);
                 let uv = exact_uv_at(&cam, proj, mw, mh, xf, yf);
                 let lod = uv.map_or(0, |at| {
-                    crate::pyramid::lod_q8(exact_footprint(&cam, proj, mw, mh, xf, yf, at))
+                    lod_q8(exact_footprint(&cam, proj, mw, mh, xf, yf, at))
                 });
                 *px = sample_at_lod(map, uv, lod);
             }
         });
-        return Ok(());
+        return;
     }
     for_each_row(out, width as usize, threads, |y, line| {
         for (x, px) in line.iter_mut().enumerate() {
@@ -145,27 +115,20 @@ pub fn render_exact(
             );
         }
     });
-    Ok(())
 }
 
 /// Render `view` supersampled `n × n` per output pixel (exact geometry, box filter over
 /// the sub-samples, in 8-bit sRGB as stored): the reference for minification quality.
-///
-/// # Errors
-/// [`ViewError`] for a bad size or buffer length.
-#[allow(clippy::too_many_arguments)]
 pub fn render_exact_supersampled(
     map: &EnvMap,
     view: View,
     sampler: Sampler,
     n: u32,
-    out: &mut [u32],
-    width: u32,
-    height: u32,
+    frame: &mut Frame<'_>,
     threads: bool,
-) -> Result<(), ViewError> {
-    check_size(width, height)?;
-    check_buffer(out, width, height)?;
+) {
+    let (width, height) = (frame.width(), frame.height());
+    let out = frame.pixels_mut();
     let n = n.max(1);
     let cam = Camera::new(view, width, height);
     let (mw, mh) = (map.width() as f64, map.height() as f64);
@@ -189,22 +152,4 @@ pub fn render_exact_supersampled(
             *px = (((r + half) / nn) << 16) | (((g + half) / nn) << 8) | ((b + half) / nn);
         }
     });
-    Ok(())
-}
-
-/// Check that `out` holds exactly `width × height` pixels.
-///
-/// # Errors
-/// [`ViewError::BufferSize`].
-pub fn check_buffer(out: &[u32], width: u32, height: u32) -> Result<(), ViewError> {
-    let needed = width as usize * height as usize;
-    if out.len() != needed {
-        return Err(ViewError::BufferSize {
-            len: out.len(),
-            width,
-            height,
-            needed,
-        });
-    }
-    Ok(())
 }

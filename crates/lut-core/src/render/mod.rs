@@ -1,41 +1,68 @@
-//! The LUT renderer: per-frame scanline setup and the scanline kernels.
+//! Rendering: the frame type, the [`Scene`] (a map or a cube map) and the one render
+//! entry, [`Renderer::render`].
 //!
-//! Per frame (and only per frame) each output scanline gets: its table rows (band and
-//! blend weight, from pitch), its column scale (from zoom), its index-interpolation step
-//! (from an error bound), and the pixel ranges that the table covers and that must be
-//! evaluated exactly (near a pole, or beyond the table's field of view). Yaw is one
-//! column offset added to u. Nothing else is recomputed when the view turns.
+//! The LUT renderer (US 5,748,194) is split by what runs how often:
+//! * per frame, `setup.rs`: each scanline's table rows, column scale, index steps (from
+//!   the analytic bounds of `steps.rs`) and exact-pixel ranges; nothing else is
+//!   recomputed when the view turns;
+//! * per scanline, `scanline.rs`: the table read every Nth pixel, map coordinates stepped
+//!   in Q.16 fixed point between reads, longitude unwrapped across each span (a span over
+//!   the ±180° seam steps continuously and wraps per pixel instead of smearing across the
+//!   whole map); `rows.rs` runs the rows on one thread or in bands on rayon;
+//! * per pixel, `kernel/`: the span kernels, with the rules they keep;
+//! * `sink.rs`: where a scanline writes (pixels per sampler, or positions).
 //!
-//! Per scanline the kernel reads the table every Nth pixel and steps map coordinates in
-//! Q.16 fixed point between reads. Longitude is unwrapped across each span, so a span
-//! over the ±180° seam steps continuously and wraps per pixel instead of smearing across
-//! the whole map.
+//! `exact.rs` is the per-pixel reference renderer, `cube.rs` the cube renderers.
 
-use crate::camera::{check_size, Camera, View};
-use crate::envmap::{EnvMap, Sampler};
+pub(crate) mod cube;
+pub(crate) mod exact;
+pub(crate) mod frame;
+pub(crate) mod kernel;
+pub(crate) mod rows;
+pub(crate) mod scanline;
+pub(crate) mod setup;
+pub(crate) mod sink;
+pub(crate) mod steps;
+
+use crate::cube::CubeMap;
 use crate::error::ViewError;
-use crate::exact::{check_buffer, render_exact};
-use crate::fixed::{to_fx, Fx, FX_BITS, FX_ONE};
+use crate::geom::camera::{check_size, View};
+use crate::geom::projection::Projection;
 use crate::lut::{LutTable, Surface, TableKind, TableSpec};
-use crate::projection::Projection;
-use crate::rows::for_each_row;
-use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use crate::map::envmap::EnvMap;
+use crate::map::pyramid::lod_q8;
+use crate::map::sample::Sampler;
+use cube::{render_cube, CubeRenderer};
+use exact::render_exact;
+use frame::Frame;
+use rows::for_each_row;
+use scanline::{render_row, ROW_SCALE_ONE};
+use setup::{check_step, prepare, Scan, Setup};
+use sink::{PixelSink, PosSink, TriSink};
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
 pub const LUT_SWITCH_HFOV: f64 = 60.0;
 
-/// Largest sampling-position error, in source pixels, index interpolation may add to a
-/// span (on top of [`crate::lut::TABLE_ERROR_BUDGET`]).
-pub const SPAN_ERROR_BUDGET: f64 = 0.02;
+/// What to render: a map (any projection, full or partial) or a cube map.
+#[derive(Debug, Clone, Copy)]
+pub enum Scene<'a> {
+    /// An environment map, drawn by the LUT or the exact renderer.
+    Map(&'a EnvMap),
+    /// A cube map, drawn by one of the cube renderers.
+    Cube(&'a CubeMap),
+}
 
-/// Largest step the adaptive mode takes.
-pub const ADAPTIVE_MAX_STEP: u32 = 64;
+impl<'a> From<&'a EnvMap> for Scene<'a> {
+    fn from(m: &'a EnvMap) -> Self {
+        Scene::Map(m)
+    }
+}
 
-/// Each scanline is cut into this many regions of |X| (distance from the screen's
-/// centre column), each with its own index step: the curvature of the map coordinates
-/// peaks in one region and is small elsewhere, so a per-region step is several times
-/// longer on average than one step per scanline, at the same error bound.
-const STEP_REGIONS: usize = 8;
+impl<'a> From<&'a CubeMap> for Scene<'a> {
+    fn from(c: &'a CubeMap) -> Self {
+        Scene::Cube(c)
+    }
+}
 
 /// Which renderer draws the frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -63,8 +90,8 @@ pub enum IndexStep {
     /// Read the table every N pixels, N in {1, 2, 4, 8, 16}; shortened per scanline where
     /// the error bound requires it (near the poles).
     Fixed(u32),
-    /// The longest power-of-two step (up to [`ADAPTIVE_MAX_STEP`]) whose error bound stays
-    /// within [`SPAN_ERROR_BUDGET`], per scanline.
+    /// The longest power-of-two step (up to [`crate::ADAPTIVE_MAX_STEP`]) whose error
+    /// bound stays within [`crate::SPAN_ERROR_BUDGET`], per region of each scanline.
     Adaptive,
 }
 
@@ -83,6 +110,8 @@ pub struct RenderOptions {
     pub surface: Surface,
     /// Render row bands on the rayon pool (output identical either way).
     pub threads: bool,
+    /// The cube renderer, for a [`Scene::Cube`] (both give the same pixels).
+    pub cube: CubeRenderer,
 }
 
 impl Default for RenderOptions {
@@ -94,6 +123,7 @@ impl Default for RenderOptions {
             lut: LutChoice::Auto,
             surface: Surface::Cylinder,
             threads: true,
+            cube: CubeRenderer::Accelerated,
         }
     }
 }
@@ -107,6 +137,8 @@ pub enum RenderPath {
     LutHigh,
     /// The exact renderer.
     Exact,
+    /// A cube map, with the given renderer.
+    Cube(CubeRenderer),
 }
 
 impl RenderPath {
@@ -116,6 +148,8 @@ impl RenderPath {
             RenderPath::LutWide => "lut-wide",
             RenderPath::LutHigh => "lut-high",
             RenderPath::Exact => "exact",
+            RenderPath::Cube(CubeRenderer::Basic) => "cube-basic",
+            RenderPath::Cube(CubeRenderer::Accelerated) => "cube-accelerated",
         }
     }
 }
@@ -126,11 +160,11 @@ pub struct RenderReport {
     /// The path.
     pub path: RenderPath,
     /// Pixels the LUT path evaluated exactly (pole zones, beyond the table). Equal to
-    /// `pixels` for the exact path.
+    /// `pixels` for the exact path, 0 for a cube map.
     pub exact_pixels: u64,
     /// Pixels in the frame.
     pub pixels: u64,
-    /// Bytes of the table used (0 for exact).
+    /// Bytes of the table used (0 for exact; the texels for a cube map).
     pub table_bytes: usize,
     /// Largest index step used on any scanline.
     pub max_step: u32,
@@ -140,57 +174,6 @@ pub struct RenderReport {
 
 /// Sampling positions of a frame, row-major; `None` where the background shows.
 pub type Positions = Vec<Option<(f64, f64)>>;
-
-/// Per-scanline setup, computed once per frame.
-#[derive(Debug, Clone, Copy, Default)]
-struct Scan {
-    /// The table covers part of this row.
-    lut: bool,
-    band: usize,
-    wa: i64,
-    neg_v: bool,
-    back: bool,
-    /// Column coordinate per unit of X (X = x + ½ − W/2).
-    col_per_x: f64,
-    /// t per unit of X (1/ρ).
-    t_per_x: f64,
-    /// sin and cos of the (unfolded) scanline angle.
-    sa: f64,
-    ca: f64,
-    /// log2 of the index step per region of |X| (see [`STEP_REGIONS`]).
-    shifts: [u8; STEP_REGIONS],
-    /// Regions per unit of |X|.
-    region_per_x: f64,
-    /// Angle between this scanline and the next at the centre column (radians).
-    row_angle: f64,
-    /// Vertical pixel footprint per region (level-0 map pixels; trilinear only): the
-    /// distance between this scanline's and the next one's table positions.
-    fy: [f32; STEP_REGIONS],
-    lut_lo: i64,
-    lut_hi: i64,
-    zone_lo: i64,
-    zone_hi: i64,
-}
-
-/// Per-frame constants shared by all rows.
-#[derive(Debug, Clone, Copy)]
-struct Frame {
-    w_out: usize,
-    proj: Projection,
-    mw: f64,
-    mh: f64,
-    map_w_fx: Fx,
-    half_map_w_fx: Fx,
-    map_h_fx: Fx,
-    half_map_h_fx: Fx,
-    /// W/2 + yaw, in map pixels, Q.16 (rectangular maps: u = Λ + off).
-    off_fx: Fx,
-    /// yaw in map pixels, Q.16 (scaled rows: u = W/2 + s · wrap(Λ + yaw)).
-    yaw_fx: Fx,
-    yaw: f64,
-    coverage: bool,
-    scaled: bool,
-}
 
 /// The renderer: owns the tables for one map geometry and per-frame scratch.
 #[derive(Debug, Default)]
@@ -203,128 +186,13 @@ pub struct Renderer {
     row_scale: Vec<i64>,
 }
 
-/// Where a renderer writes: pixels, or (for measurement) sampling positions.
-trait Sink {
-    fn put(&mut self, x: usize, u: Fx, v: Fx);
-    /// `m` pixels from `x` on at (u + i·du, v + i·dv), u wrapped per pixel into [0, W)
-    /// (`w_fx` = W in Q.16); v inside the map.
-    #[allow(clippy::too_many_arguments)]
-    #[inline(always)]
-    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, w_fx: Fx) {
-        put_run(self, x, m, (u, v), (du, dv), w_fx);
-    }
-    fn background(&mut self, x: usize);
-    fn exact(&mut self, x: usize, uv: Option<(f64, f64)>);
-    /// The per-pixel step (dΛ, dV) of the span about to be emitted (its horizontal
-    /// footprint): the trilinear sink picks its pyramid level from it.
-    #[inline(always)]
-    fn footprint(&mut self, _dl: Fx, _dv: Fx, _region: usize) {}
-}
-
-/// [`Sink::span`] pixel by pixel through [`Sink::put`].
-#[inline(always)]
-fn put_run<S: Sink + ?Sized>(s: &mut S, x: usize, m: usize, uv: (Fx, Fx), d: (Fx, Fx), w_fx: Fx) {
-    let (mut u, mut v) = uv;
-    for i in 0..m {
-        s.put(x + i, wrap_u(u, w_fx), v);
-        u += d.0;
-        v += d.1;
-    }
-}
-
-/// Writes sampled pixels. `CROP`: a partial map (see [`crate::coverage`]): full-panorama
-/// (u, v) are looked up in the crop, background outside; a const parameter so the
-/// full-map kernel keeps no per-pixel crop test.
-struct PixelSink<'a, const BILINEAR: bool, const CROP: bool> {
-    row: &'a mut [u32],
-    map: &'a EnvMap,
-}
-
-impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CROP> {
-    #[inline(always)]
-    fn put(&mut self, x: usize, u: Fx, v: Fx) {
-        self.row[x] = match (BILINEAR, CROP) {
-            (true, false) => self.map.bilinear(u, v),
-            (false, false) => self.map.nearest(u, v),
-            (true, true) => self.map.bilinear_cropped(u, v),
-            (false, true) => self.map.nearest_cropped(u, v),
-        };
-    }
-    #[inline(always)]
-    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, w_fx: Fx) {
-        if CROP {
-            put_run(self, x, m, (u, v), (du, dv), w_fx); // per pixel: the crop test
-        } else {
-            self.map
-                .sample_span::<BILINEAR>(&mut self.row[x..x + m], u, v, du, dv);
-        }
-    }
-    #[inline(always)]
-    fn background(&mut self, x: usize) {
-        self.row[x] = self.map.background();
-    }
-    #[inline]
-    fn exact(&mut self, x: usize, uv: Option<(f64, f64)>) {
-        let s = if BILINEAR {
-            Sampler::Bilinear
-        } else {
-            Sampler::Nearest
-        };
-        self.row[x] = crate::exact::sample_at(self.map, s, uv);
-    }
-}
-
-/// Trilinear sampling (see [`crate::pyramid`]): the level of detail is set per span from
-/// the span's step and the scanline's vertical footprint.
-struct TriSink<'a> {
-    row: &'a mut [u32],
-    map: &'a EnvMap,
-    /// Vertical footprint per region of this scanline, in level-0 map pixels.
-    fy: [f32; STEP_REGIONS],
-    lod: i32,
-}
-
-impl Sink for TriSink<'_> {
-    #[inline(always)]
-    fn put(&mut self, x: usize, u: Fx, v: Fx) {
-        self.row[x] = self.map.trilinear(u, v, self.lod);
-    }
-    #[inline(always)]
-    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
-        self.map
-            .trilinear_span(&mut self.row[x..x + m], u, v, du, dv, self.lod);
-    }
-    #[inline(always)]
-    fn background(&mut self, x: usize) {
-        self.row[x] = self.map.background();
-    }
-    #[inline]
-    fn exact(&mut self, x: usize, uv: Option<(f64, f64)>) {
-        // Pole zones and pixels beyond the table: the footprint of the nearest span (or
-        // of the scanline, before the first span).
-        self.row[x] = crate::exact::sample_at_lod(self.map, uv, self.lod);
-    }
-    #[inline(always)]
-    fn footprint(&mut self, dl: Fx, dv: Fx, region: usize) {
-        let fx = dl.unsigned_abs().max(dv.unsigned_abs()) as f64 / FX_ONE as f64;
-        self.lod = crate::pyramid::lod_q8(fx.max(self.fy[region] as f64));
-    }
-}
-
-struct PosSink<'a> {
-    row: &'a mut [Option<(f64, f64)>],
-}
-
-impl Sink for PosSink<'_> {
-    fn put(&mut self, x: usize, u: Fx, v: Fx) {
-        self.row[x] = Some((crate::fixed::from_fx(u), crate::fixed::from_fx(v)));
-    }
-    fn background(&mut self, x: usize) {
-        self.row[x] = None;
-    }
-    fn exact(&mut self, x: usize, uv: Option<(f64, f64)>) {
-        self.row[x] = uv;
-    }
+/// The table of `surface` and `kind` among `tables` (built by [`Renderer::table`]).
+fn find(tables: &[(Surface, TableKind, LutTable)], surface: Surface, kind: TableKind) -> &LutTable {
+    &tables
+        .iter()
+        .find(|(s, k, _)| *s == surface && *k == kind)
+        .expect("table built before it is looked up")
+        .2
 }
 
 impl Renderer {
@@ -380,25 +248,38 @@ impl Renderer {
         }
     }
 
-    /// Render `view` of `map` into `out` (row-major 0RGB, `width × height`).
+    /// Render `view` of `scene` into `frame`: the one render entry for maps (LUT or exact,
+    /// as `opts.renderer` says) and cube maps (with `opts.cube`).
     ///
     /// # Errors
-    /// [`ViewError`] for a bad size, buffer length or index step.
+    /// [`ViewError::BadIndexStep`] for an index step not in {1, 2, 4, 8, 16} (the frame's
+    /// size was checked when it was made).
     pub fn render(
         &mut self,
-        map: &EnvMap,
+        scene: Scene<'_>,
         view: View,
         opts: &RenderOptions,
-        out: &mut [u32],
-        width: u32,
-        height: u32,
+        frame: &mut Frame<'_>,
     ) -> Result<RenderReport, ViewError> {
-        check_size(width, height)?;
-        check_buffer(out, width, height)?;
         check_step(opts.index_step)?;
+        let (width, height) = (frame.width(), frame.height());
         let pixels = width as u64 * height as u64;
+        let map = match scene {
+            Scene::Map(map) => map,
+            Scene::Cube(cube) => {
+                render_cube(cube, view, opts.sampler, opts.cube, frame, opts.threads);
+                return Ok(RenderReport {
+                    path: RenderPath::Cube(opts.cube),
+                    exact_pixels: 0,
+                    pixels,
+                    table_bytes: cube.bytes(),
+                    max_step: 1,
+                    min_step: 1,
+                });
+            }
+        };
         if opts.renderer == RendererKind::Exact {
-            render_exact(map, view, opts.sampler, out, width, height, opts.threads)?;
+            render_exact(map, view, opts.sampler, frame, opts.threads);
             return Ok(RenderReport {
                 path: RenderPath::Exact,
                 exact_pixels: pixels,
@@ -409,11 +290,24 @@ impl Renderer {
             });
         }
         self.set_geometry(map.width(), map.height(), map.projection());
-        let (frame, report) = self.prepare(view, opts, width, height);
-        let table = self.find(opts.surface, Self::table_kind(view, opts));
+        let kind = Self::table_kind(view, opts);
+        let geometry = self.geometry.expect("geometry set above");
+        self.table(opts.surface, kind);
+        let table = find(&self.tables, opts.surface, kind);
+        let (setup, report) = prepare(
+            table,
+            kind,
+            geometry,
+            &mut self.scans,
+            view,
+            opts,
+            width,
+            height,
+        );
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
         let w = width as usize;
+        let out = frame.pixels_mut();
         let bilinear = opts.sampler != Sampler::Nearest;
         if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
             map.pyramid(); // built once, before the rows run in parallel
@@ -423,9 +317,9 @@ impl Renderer {
                     row,
                     map,
                     fy: scan.fy,
-                    lod: crate::pyramid::lod_q8(scan.fy[0] as f64),
+                    lod: lod_q8(scan.fy[0] as f64),
                 };
-                render_row(scan, table, &frame, row_scale, &mut s);
+                render_row(scan, table, &setup, row_scale, &mut s);
             });
             return Ok(report);
         }
@@ -434,16 +328,16 @@ impl Renderer {
             out: &mut [u32],
             w: usize,
             threads: bool,
-            k: (&[Scan], &LutTable, &Frame, &[i64]),
+            k: (&[Scan], &LutTable, &Setup, &[i64]),
             map: &EnvMap,
         ) {
-            let (scans, table, frame, row_scale) = k;
+            let (scans, table, setup, row_scale) = k;
             for_each_row(out, w, threads, |y, row| {
                 let mut s = PixelSink::<BILINEAR, CROP> { row, map };
-                render_row(&scans[y], table, frame, row_scale, &mut s);
+                render_row(&scans[y], table, setup, row_scale, &mut s);
             });
         }
-        let k = (&scans[..], table, &frame, row_scale);
+        let k = (&scans[..], table, &setup, row_scale);
         match (bilinear, map.crop().is_some()) {
             (true, false) => rows::<true, false>(out, w, opts.threads, k, map),
             (false, false) => rows::<false, false>(out, w, opts.threads, k, map),
@@ -473,498 +367,27 @@ impl Renderer {
         check_size(width, height)?;
         check_step(opts.index_step)?;
         self.set_geometry(map_w, map_h, projection);
-        let (frame, report) = self.prepare(view, opts, width, height);
-        let table = self.find(opts.surface, Self::table_kind(view, opts));
+        let kind = Self::table_kind(view, opts);
+        let geometry = self.geometry.expect("geometry set above");
+        self.table(opts.surface, kind);
+        let table = find(&self.tables, opts.surface, kind);
+        let (setup, report) = prepare(
+            table,
+            kind,
+            geometry,
+            &mut self.scans,
+            view,
+            opts,
+            width,
+            height,
+        );
         let mut out = vec![None; width as usize * height as usize];
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
         for_each_row(&mut out, width as usize, true, |y, row| {
             let mut s = PosSink { row };
-            render_row(&scans[y], table, &frame, row_scale, &mut s);
+            render_row(&scans[y], table, &setup, row_scale, &mut s);
         });
         Ok((out, report))
     }
-
-    fn find(&self, surface: Surface, kind: TableKind) -> &LutTable {
-        &self
-            .tables
-            .iter()
-            .find(|(s, k, _)| *s == surface && *k == kind)
-            .expect("table built in prepare()")
-            .2
-    }
-
-    /// Per-frame setup: one [`Scan`] per output row.
-    fn prepare(
-        &mut self,
-        view: View,
-        opts: &RenderOptions,
-        width: u32,
-        height: u32,
-    ) -> (Frame, RenderReport) {
-        let kind = Self::table_kind(view, opts);
-        let (mw, mh, proj) = self.geometry.expect("geometry set");
-        self.table(opts.surface, kind);
-        let table = self
-            .tables
-            .iter()
-            .find(|(s, k, _)| *s == opts.surface && *k == kind)
-            .map(|(_, _, t)| t)
-            .expect("table built above");
-        let scans = &mut self.scans;
-        let cam = Camera::new(view, width, height);
-        let f = cam.focal;
-        let (mwf, mhf) = (mw as f64, mh as f64);
-        let yaw = view.yaw();
-        let yaw_px = yaw / TAU * mwf;
-        let frame = Frame {
-            w_out: width as usize,
-            proj,
-            mw: mwf,
-            mh: mhf,
-            map_w_fx: (mw as i64) << FX_BITS,
-            half_map_w_fx: (mw as i64) << (FX_BITS - 1),
-            map_h_fx: (mh as i64) << FX_BITS,
-            half_map_h_fx: to_fx(mhf * 0.5),
-            off_fx: to_fx(mwf * 0.5 + yaw_px),
-            yaw_fx: to_fx(yaw_px),
-            yaw,
-            coverage: !proj.full_sphere(),
-            scaled: proj.scaled_rows(),
-        };
-        let nominal = match opts.index_step {
-            IndexStep::Fixed(n) => n,
-            IndexStep::Adaptive => ADAPTIVE_MAX_STEP,
-        };
-        // Second-derivative bound factors of the map coordinates (see step_for()).
-        let (v1, v2) = proj.profile_derivative_bounds(mwf, mhf);
-        let coupling = proj.row_scale_coupling(mwf, mhf);
-        let bounds = StepBounds {
-            lam_px: mwf / TAU,
-            v1,
-            v2,
-            coupling,
-        };
-        let pitch = view.pitch();
-        let half_w = width as f64 * 0.5;
-        scans.clear();
-        let mut exact_pixels = 0u64;
-        let (mut max_step, mut min_step) = (0u32, u32::MAX);
-        for y in 0..height {
-            let yc = height as f64 * 0.5 - (y as f64 + 0.5);
-            let rho = yc.hypot(f);
-            let alpha = pitch + yc.atan2(f);
-            let (sa, ca) = alpha.sin_cos();
-            let neg_v = alpha < 0.0;
-            let mut a = alpha.abs();
-            let back = a > FRAC_PI_2;
-            if back {
-                a = PI - a;
-            }
-            let mut scan = Scan {
-                neg_v,
-                back,
-                sa,
-                ca,
-                t_per_x: 1.0 / rho,
-                row_angle: f / (f * f + yc * yc),
-                lut_lo: 0,
-                lut_hi: -1,
-                zone_lo: 0,
-                zone_hi: -1,
-                ..Scan::default()
-            };
-            let row_coord = match opts.surface {
-                Surface::Cylinder => {
-                    scan.col_per_x = 1.0 / rho;
-                    Some(a)
-                }
-                Surface::Plane => {
-                    if back || a >= table.row_max() {
-                        None
-                    } else {
-                        scan.col_per_x = 1.0 / (rho * a.cos());
-                        Some(a.tan())
-                    }
-                }
-            };
-            if let Some(rc) = row_coord.filter(|rc| *rc <= table.row_max()) {
-                let (band, wa) = table.row_position(rc);
-                scan.lut = true;
-                scan.band = band;
-                scan.wa = wa;
-                let xc = table.col_max() / scan.col_per_x;
-                let (lo, hi) = x_range(half_w, xc, width);
-                scan.lut_lo = lo;
-                scan.lut_hi = hi;
-                let zone = table.zone(band);
-                let mut t_min = 0.0;
-                if zone >= 0.0 {
-                    let xz = zone / scan.col_per_x;
-                    let (zl, zh) = x_range(half_w, xz, width);
-                    scan.zone_lo = zl;
-                    scan.zone_hi = zh;
-                    t_min = xz * scan.t_per_x;
-                }
-                let (sn, c) = (a.sin().abs(), a.cos().abs());
-                let reg_x = half_w / STEP_REGIONS as f64;
-                scan.region_per_x = 1.0 / reg_x;
-                for (r, shift) in scan.shifts.iter_mut().enumerate() {
-                    let (x_lo, x_hi) = (r as f64 * reg_x, (r + 1) as f64 * reg_x);
-                    let n = step_for(&bounds, (sn, c), t_min, x_lo, x_hi, scan.t_per_x, nominal);
-                    *shift = n.trailing_zeros() as u8;
-                    max_step = max_step.max(n);
-                    min_step = min_step.min(n);
-                }
-            }
-            exact_pixels += exact_count(&scan, width as i64);
-            scans.push(scan);
-        }
-        if min_step == u32::MAX {
-            min_step = 1;
-            max_step = max_step.max(1);
-        }
-        if opts.sampler == crate::envmap::Sampler::Trilinear {
-            vertical_footprints(scans, table, &frame);
-        }
-        let report = RenderReport {
-            path: match kind {
-                TableKind::Wide => RenderPath::LutWide,
-                TableKind::High => RenderPath::LutHigh,
-            },
-            exact_pixels,
-            pixels: width as u64 * height as u64,
-            table_bytes: table.bytes(),
-            max_step,
-            min_step,
-        };
-        (frame, report)
-    }
-}
-
-/// The vertical footprint of every scanline per region (see [`Scan::fy`]): table positions
-/// of the region's centre column on this scanline and the next (the previous one for the
-/// last row), Λ taken the short way round the seam; where the table does not cover both,
-/// the scanline's angular spacing in map pixels.
-fn vertical_footprints(scans: &mut [Scan], table: &LutTable, fr: &Frame) {
-    let n = scans.len();
-    let half_w = fr.w_out as f64 * 0.5;
-    let reg_x = half_w / STEP_REGIONS as f64;
-    let px_per_rad = fr.mw / TAU;
-    for y in 0..n {
-        let other = if y + 1 < n {
-            y + 1
-        } else {
-            y.saturating_sub(1)
-        };
-        let mut fy = [0f32; STEP_REGIONS];
-        for (r, f) in fy.iter_mut().enumerate() {
-            let x = ((half_w + (r as f64 + 0.5) * reg_x - 0.5).round() as i64)
-                .clamp(0, fr.w_out as i64 - 1);
-            let usable = |s: &Scan| {
-                s.lut && x >= s.lut_lo && x <= s.lut_hi && !(x >= s.zone_lo && x <= s.zone_hi)
-            };
-            *f = if other != y && usable(&scans[y]) && usable(&scans[other]) {
-                let (l0, v0) = read(&scans[y], table, fr, x);
-                let (l1, v1) = read(&scans[other], table, fr, x);
-                let mut dl = (l1 - l0).unsigned_abs() as i64;
-                if dl > fr.half_map_w_fx {
-                    dl = (fr.map_w_fx - dl).abs();
-                }
-                (dl.max((v1 - v0).abs()) as f64 / FX_ONE as f64) as f32
-            } else {
-                (scans[y].row_angle * px_per_rad) as f32
-            };
-        }
-        scans[y].fy = fy;
-    }
-}
-
-fn check_step(s: IndexStep) -> Result<(), ViewError> {
-    match s {
-        IndexStep::Fixed(n) if !matches!(n, 1 | 2 | 4 | 8 | 16) => Err(ViewError::BadIndexStep(n)),
-        _ => Ok(()),
-    }
-}
-
-/// Inclusive pixel range with |x + ½ − W/2| ≤ r, clamped to the row (empty: lo > hi).
-fn x_range(half_w: f64, r: f64, width: u32) -> (i64, i64) {
-    if r.is_nan() || r < 0.0 {
-        return (0, -1);
-    }
-    let r = r.min(1e12);
-    let lo = (half_w - 0.5 - r).ceil().max(0.0) as i64;
-    let hi = (half_w - 0.5 + r).floor().min(width as f64 - 1.0) as i64;
-    (lo, hi)
-}
-
-/// Pixels of a row the LUT path evaluates exactly.
-fn exact_count(s: &Scan, w: i64) -> u64 {
-    if !s.lut || s.lut_lo > s.lut_hi {
-        return w as u64;
-    }
-    let outside = s.lut_lo + (w - 1 - s.lut_hi);
-    let zl = s.zone_lo.max(s.lut_lo);
-    let zh = s.zone_hi.min(s.lut_hi);
-    let zone = if zl <= zh { zh - zl + 1 } else { 0 };
-    (outside + zone) as u64
-}
-
-/// Factors of the second-derivative bound of the map coordinates along a scanline.
-struct StepBounds {
-    /// W / 2π: Λ pixels per radian of longitude.
-    lam_px: f64,
-    /// max |dV/dφ| and |d²V/dφ²| over the covered latitudes.
-    v1: f64,
-    v2: f64,
-    /// How a V error turns into a u error through the row scale.
-    coupling: f64,
-}
-
-/// The longest power-of-two step ≤ `nominal` whose linear-interpolation error is bounded
-/// by [`SPAN_ERROR_BUDGET`] for every span that starts at |X| ∈ [x_lo, x_hi] (pixels from
-/// the screen's centre column) on this scanline.
-///
-/// Along a scanline at folded angle `a` (s = sin a, c = cos a) the direction is
-/// (t, s, c), λ = atan2(t, c), φ = atan2(s, ρ) with ρ = √(t²+c²), and t = X/ρ_screen
-/// linear in the pixel (`dt` per pixel). |λ_tt| = 2|t|c/ρ⁴ exactly: unimodal in |t|
-/// with its peak 0.6495/c² at |t| = c/√3, so its maximum over an interval is at the point
-/// of the interval nearest the peak. φ_t = −s·t/(ρ(1+t²)) and
-/// φ_tt = −s·(c²(1+t²) − 2t²ρ²)/(ρ³(1+t²)²), whose second factor is at most 1/ρ in size
-/// (checked on a dense grid of t and c): |φ_tt| ≤ s/ρ, largest at the smallest |t|, and
-/// |φ_t| ≤ s. Pixels with |t| < `t_min` are evaluated exactly (pole zone) and bound no
-/// span. A span of n pixels from |X| in [x_lo, x_hi] covers |X| ∈ [x_lo − n, x_hi + n];
-/// linear interpolation over it errs by at most (n·dt)²/8 · max|f''| there. (Bounds
-/// checked numerically; 10 % margin added.)
-fn step_for(
-    b: &StepBounds,
-    sc: (f64, f64),
-    t_min: f64,
-    x_lo: f64,
-    x_hi: f64,
-    dt: f64,
-    nominal: u32,
-) -> u32 {
-    let mut n = nominal.max(1);
-    loop {
-        let reach = n as f64;
-        let t_lo = ((x_lo - reach) * dt).max(t_min).max(0.0);
-        let t_hi = ((x_hi + reach) * dt).max(t_lo);
-        let bound = span_bound(b, sc, t_lo, t_hi);
-        let len = reach * dt;
-        if n == 1 || (bound.is_finite() && len * len / 8.0 * bound <= SPAN_ERROR_BUDGET) {
-            return n;
-        }
-        n >>= 1;
-    }
-}
-
-/// Bound on the second derivative (in source pixels per unit t²) of the map position
-/// along a scanline over |t| ∈ [t_lo, t_hi] (see [`step_for`]).
-fn span_bound(b: &StepBounds, (s, c): (f64, f64), t_lo: f64, t_hi: f64) -> f64 {
-    let lam_tt = if c <= 0.0 {
-        if t_lo > 0.0 {
-            0.0
-        } else {
-            f64::INFINITY
-        }
-    } else {
-        let t = (c / 3f64.sqrt()).clamp(t_lo, t_hi);
-        let r2 = t * t + c * c;
-        2.0 * t * c / (r2 * r2)
-    };
-    let rho_min = (t_lo * t_lo + c * c).sqrt();
-    let phi_tt = if rho_min > 0.0 {
-        1.125 * s / rho_min
-    } else {
-        f64::INFINITY
-    };
-    let v_tt = b.v1 * phi_tt + b.v2 * s * s;
-    1.1 * (b.lam_px * lam_tt + (1.0 + b.coupling) * v_tt)
-}
-
-/// Render one scanline into `sink`.
-#[inline]
-fn render_row<S: Sink>(scan: &Scan, table: &LutTable, fr: &Frame, row_scale: &[i64], sink: &mut S) {
-    let w = fr.w_out as i64;
-    if !scan.lut || scan.lut_lo > scan.lut_hi {
-        exact_run(scan, fr, 0, w - 1, sink);
-        return;
-    }
-    exact_run(scan, fr, 0, scan.lut_lo - 1, sink);
-    let zl = scan.zone_lo.max(scan.lut_lo);
-    let zh = scan.zone_hi.min(scan.lut_hi);
-    if zl <= zh {
-        lut_run(scan, table, fr, row_scale, scan.lut_lo, zl - 1, sink);
-        exact_run(scan, fr, zl, zh, sink);
-        lut_run(scan, table, fr, row_scale, zh + 1, scan.lut_hi, sink);
-    } else {
-        lut_run(scan, table, fr, row_scale, scan.lut_lo, scan.lut_hi, sink);
-    }
-    exact_run(scan, fr, scan.lut_hi + 1, w - 1, sink);
-}
-
-/// Exact evaluation of pixels x0..=x1 of a scanline (pole zones, beyond the table).
-#[inline(never)]
-fn exact_run<S: Sink>(scan: &Scan, fr: &Frame, x0: i64, x1: i64, sink: &mut S) {
-    let half_w = fr.w_out as f64 * 0.5;
-    let c2 = scan.ca * scan.ca;
-    for x in x0.max(0)..=x1 {
-        let t = (x as f64 + 0.5 - half_w) * scan.t_per_x;
-        let lambda = t.atan2(scan.ca) + fr.yaw;
-        let phi = scan.sa.atan2((t * t + c2).sqrt());
-        sink.exact(x as usize, fr.proj.uv(lambda, phi, fr.mw, fr.mh));
-    }
-}
-
-/// Unfolded table read at pixel x: (Λ, V) in Q.16 for the yaw-0 frame.
-#[inline(always)]
-fn read(scan: &Scan, table: &LutTable, fr: &Frame, x: i64) -> (Fx, Fx) {
-    let big_x = x as f64 + 0.5 - fr.w_out as f64 * 0.5;
-    let (mut l, mut v) = table.lookup(scan.band, scan.wa, big_x.abs() * scan.col_per_x);
-    if scan.back {
-        l = fr.half_map_w_fx - l;
-    }
-    if big_x < 0.0 {
-        l = -l;
-    }
-    if scan.neg_v {
-        v = -v;
-    }
-    (l, v)
-}
-
-/// LUT evaluation of pixels x0..=x1: table reads every 2^shift pixels (the shift of the
-/// region the span starts in), fixed-point steps between.
-#[inline(always)]
-fn lut_run<S: Sink>(
-    scan: &Scan,
-    table: &LutTable,
-    fr: &Frame,
-    row_scale: &[i64],
-    x0: i64,
-    x1: i64,
-    sink: &mut S,
-) {
-    if x0 > x1 {
-        return;
-    }
-    let half_w = fr.w_out as f64 * 0.5;
-    let last_region = STEP_REGIONS - 1;
-    let mut xs = x0;
-    let (mut l0, mut v0) = read(scan, table, fr, xs);
-    loop {
-        let big_x = (xs as f64 + 0.5 - half_w).abs();
-        let region = ((big_x * scan.region_per_x) as usize).min(last_region);
-        let shift = scan.shifts[region] as u32;
-        let n = 1i64 << shift;
-        let xe = (xs + n).min(x1);
-        if xe == xs {
-            emit(fr, row_scale, xs, 1, (l0, v0), (0, 0), sink);
-            return;
-        }
-        let (mut l1, v1) = read(scan, table, fr, xe);
-        // Unwrap longitude across the span: a ±180° seam is a jump of one map width.
-        let d = l1 - l0;
-        if d > fr.half_map_w_fx {
-            l1 -= fr.map_w_fx;
-        } else if d < -fr.half_map_w_fx {
-            l1 += fr.map_w_fx;
-        }
-        let m = xe - xs;
-        let (dl, dv) = if m == n {
-            ((l1 - l0) >> shift, (v1 - v0) >> shift)
-        } else {
-            ((l1 - l0) / m, (v1 - v0) / m)
-        };
-        sink.footprint(dl, dv, region);
-        if xe == x1 {
-            // Last span: emit through x1 inclusive, ending exactly on the read value.
-            emit(fr, row_scale, xs, m, (l0, v0), (dl, dv), sink);
-            emit(fr, row_scale, x1, 1, (l1, v1), (0, 0), sink);
-            return;
-        }
-        emit(fr, row_scale, xs, m, (l0, v0), (dl, dv), sink);
-        xs = xe;
-        l0 = l1;
-        v0 = v1;
-    }
-}
-
-/// Emit `m` pixels from `x` on, starting at (Λ, V) and stepping by (dΛ, dV).
-#[inline(always)]
-fn emit<S: Sink>(
-    fr: &Frame,
-    row_scale: &[i64],
-    x: i64,
-    m: i64,
-    start: (Fx, Fx),
-    step: (Fx, Fx),
-    sink: &mut S,
-) {
-    let (l, vv) = start;
-    let (dl, dvv) = step;
-    // v = H/2 − V
-    let mut v = fr.half_map_h_fx - vv;
-    let dv = -dvv;
-    let x = x as usize;
-    let m = m as usize;
-    if fr.scaled {
-        let mut lw = l + fr.yaw_fx;
-        for i in 0..m {
-            // wrap Λ + yaw into (−W/2, W/2], as λ into (−π, π]
-            let mut a = lw;
-            if a > fr.half_map_w_fx || a <= -fr.half_map_w_fx {
-                a = fr.half_map_w_fx - (fr.half_map_w_fx - a).rem_euclid(fr.map_w_fx);
-            }
-            let s = row_scale_at(row_scale, v, fr.mh as usize);
-            let u = fr.half_map_w_fx + ((s * a) >> ROW_SCALE_BITS);
-            sink.put(x + i, u, v);
-            lw += dl;
-            v += dv;
-        }
-        return;
-    }
-    let wfx = fr.map_w_fx;
-    let mut u = wrap_u(l + fr.off_fx, wfx);
-    if !(0..wfx).contains(&u) {
-        u = u.rem_euclid(wfx);
-    }
-    if fr.coverage {
-        for i in 0..m {
-            let uu = wrap_u(u, wfx);
-            if v < 0 || v > fr.map_h_fx {
-                sink.background(x + i);
-            } else {
-                sink.put(x + i, uu, v);
-            }
-            u += dl;
-            v += dv;
-        }
-    } else {
-        sink.span(x, m, u, v, dl, dv, wfx);
-    }
-}
-
-#[inline(always)]
-fn wrap_u(u: Fx, w: Fx) -> Fx {
-    if u >= w {
-        u - w
-    } else if u < 0 {
-        u + w
-    } else {
-        u
-    }
-}
-
-/// Fractional bits of the row scale s.
-const ROW_SCALE_BITS: u32 = 30;
-const ROW_SCALE_ONE: f64 = (1u64 << ROW_SCALE_BITS) as f64;
-
-/// Row scale s(v) (Q.30), linear between map rows.
-#[inline(always)]
-fn row_scale_at(rs: &[i64], v: Fx, h: usize) -> i64 {
-    let vi = (v >> FX_BITS).clamp(0, h as i64 - 1) as usize;
-    let fr = (v - ((vi as i64) << FX_BITS)).clamp(0, 1 << FX_BITS);
-    rs[vi] + (((rs[vi + 1] - rs[vi]) * fr) >> FX_BITS)
 }
