@@ -2,7 +2,7 @@
 //! constant ranges, interpolation, distance series) and room lighting.
 
 use glam::DVec3;
-use lut_core::light::{
+use lut_core::{
     lux_at, shade_frame, IesError, IesFile, IesFormat, LightError, LightScene, LightTable,
     Luminaire, PhotometricType, Room, ShadeOptions, Symmetry, TableOptions, Tilt,
 };

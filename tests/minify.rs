@@ -7,6 +7,7 @@ use lut_core::{
     render_exact, render_exact_supersampled, EnvMap, Projection, RenderOptions, Renderer, Sampler,
     View,
 };
+use lut_core::{Frame, Scene};
 
 /// PSNR (dB) of `a` against `b` over all channels.
 fn psnr(a: &[u32], b: &[u32]) -> f64 {
@@ -45,7 +46,12 @@ fn lut(map: &EnvMap, view: View, sampler: Sampler, w: u32, h: u32) -> Vec<u32> {
         ..RenderOptions::default()
     };
     Renderer::new(map)
-        .render(map, view, &opts, &mut out, w, h)
+        .render(
+            Scene::Map(map),
+            view,
+            &opts,
+            &mut Frame::new(&mut out, w, h).unwrap(),
+        )
         .unwrap();
     out
 }
@@ -62,12 +68,24 @@ fn trilinear_is_closer_to_the_supersampled_truth_when_zoomed_out() {
     ] {
         let view = View::new(yaw, pitch, hfov).unwrap();
         let mut truth = vec![0u32; (w * h) as usize];
-        render_exact_supersampled(&map, view, Sampler::Bilinear, 8, &mut truth, w, h, true)
-            .unwrap();
+        render_exact_supersampled(
+            &map,
+            view,
+            Sampler::Bilinear,
+            8,
+            &mut Frame::new(&mut truth, w, h).unwrap(),
+            true,
+        );
         let bi = lut(&map, view, Sampler::Bilinear, w, h);
         let tri = lut(&map, view, Sampler::Trilinear, w, h);
         let mut tri_exact = vec![0u32; (w * h) as usize];
-        render_exact(&map, view, Sampler::Trilinear, &mut tri_exact, w, h, true).unwrap();
+        render_exact(
+            &map,
+            view,
+            Sampler::Trilinear,
+            &mut Frame::new(&mut tri_exact, w, h).unwrap(),
+            true,
+        );
         let (pb, pt, pe) = (
             psnr(&bi, &truth),
             psnr(&tri, &truth),

@@ -4,13 +4,15 @@
 //! elsewhere, including crops that straddle the ±180° seam or span 360°; the view limit
 //! keeps every border pixel's ray inside a partial panorama at the seam.
 
-use lut_core::camera::{dir_to_lat_long, Camera};
-use lut_core::exact::exact_uv;
-use lut_core::gpano::{insert_xmp, xmp_packet};
+use lut_core::exact_uv;
+use lut_core::LoadOptions;
+use lut_core::{dir_to_lat_long, Camera};
+use lut_core::{insert_xmp, xmp_packet};
 use lut_core::{
     limit_view, Coverage, CoverageSource, EnvMap, IndexStep, Projection, RenderOptions, Renderer,
-    RendererKind, Sampler, Tone, View,
+    RendererKind, Sampler, View,
 };
+use lut_core::{Frame, Scene};
 
 const FULL_W: u32 = 512;
 const FULL_H: u32 = 256;
@@ -80,7 +82,8 @@ fn padded_reference(jpeg: &[u8], left: u32, top: u32) -> EnvMap {
 
 fn load_partial(jpeg: &[u8]) -> EnvMap {
     let (mut m, src) =
-        EnvMap::decode_partial(jpeg, "test.jpg", None, None, Tone::default()).unwrap();
+        lut_core::decode_partial(jpeg, "test.jpg", &LoadOptions::default(), None, &mut |_| {})
+            .unwrap();
     assert_eq!(src, CoverageSource::Xmp);
     m.set_background(BG);
     m
@@ -96,7 +99,12 @@ fn render(map: &EnvMap, view: View, renderer: RendererKind, sampler: Sampler) ->
         ..RenderOptions::default()
     };
     Renderer::new(map)
-        .render(map, view, &opts, &mut out, w as u32, h as u32)
+        .render(
+            Scene::Map(map),
+            view,
+            &opts,
+            &mut Frame::new(&mut out, w as u32, h as u32).unwrap(),
+        )
         .unwrap();
     out
 }
@@ -258,8 +266,14 @@ fn explicit_coverage_overrides_the_metadata() {
     let jpeg = tagged_jpeg(200, 60, 160, 100, Some("123.5"));
     // the same placement in degrees: 112.5 x 70.3125, west edge -39.375, north 47.8125
     let cov = Coverage::new(112.5, 70.3125, -39.375 + 56.25, 47.8125 - 35.15625).unwrap();
-    let (m, src) =
-        EnvMap::decode_partial(&jpeg, "t.jpg", None, Some(cov), Tone::default()).unwrap();
+    let (m, src) = lut_core::decode_partial(
+        &jpeg,
+        "t.jpg",
+        &LoadOptions::default(),
+        Some(cov),
+        &mut |_| {},
+    )
+    .unwrap();
     assert_eq!(src, CoverageSource::Explicit);
     let c = m.crop().unwrap();
     assert_eq!(
@@ -268,7 +282,14 @@ fn explicit_coverage_overrides_the_metadata() {
     );
     // a different coverage puts it elsewhere and ignores the XMP
     let cov = "360x90+0+0".parse::<Coverage>().unwrap();
-    let (m, _) = EnvMap::decode_partial(&jpeg, "t.jpg", None, Some(cov), Tone::default()).unwrap();
+    let (m, _) = lut_core::decode_partial(
+        &jpeg,
+        "t.jpg",
+        &LoadOptions::default(),
+        Some(cov),
+        &mut |_| {},
+    )
+    .unwrap();
     let c = m.crop().unwrap();
     assert_eq!(
         (c.full_width(), c.full_height(), c.left(), c.top()),
@@ -277,12 +298,15 @@ fn explicit_coverage_overrides_the_metadata() {
     // the heading comes with the metadata
     assert_eq!(load_partial(&jpeg).pose_heading_deg(), Some(123.5));
     // a coverage for a non-equirect projection is refused
-    let e = EnvMap::decode_partial(
+    let e = lut_core::decode_partial(
         &jpeg,
         "t.jpg",
-        Some(Projection::Cylinder),
+        &LoadOptions {
+            projection: Some(Projection::Cylinder),
+            ..LoadOptions::default()
+        },
         Some(cov),
-        Tone::default(),
+        &mut |_| {},
     );
     assert!(e.is_err());
 }
@@ -306,13 +330,28 @@ fn bad_metadata_is_a_clear_error_and_coverage_is_the_way_out() {
         ("CroppedAreaImageHeightPixels", "32"),
     ]);
     let bad = insert_xmp(&jpeg, &xmp).unwrap();
-    let e = EnvMap::decode_partial(&bad, "bad.jpg", None, None, Tone::default()).unwrap_err();
+    let e = lut_core::decode_partial(&bad, "bad.jpg", &LoadOptions::default(), None, &mut |_| {})
+        .unwrap_err();
     let msg = e.to_string();
     assert!(msg.contains("bad.jpg") && msg.contains("below"), "{msg}");
     let cov = "180x90+0+0".parse().unwrap();
-    assert!(EnvMap::decode_partial(&bad, "bad.jpg", None, Some(cov), Tone::default()).is_ok());
+    assert!(lut_core::decode_partial(
+        &bad,
+        "bad.jpg",
+        &LoadOptions::default(),
+        Some(cov),
+        &mut |_| {}
+    )
+    .is_ok());
     // an untagged 2:1 JPEG is an ordinary map
-    let (m, src) = EnvMap::decode_partial(&jpeg, "plain.jpg", None, None, Tone::default()).unwrap();
+    let (m, src) = lut_core::decode_partial(
+        &jpeg,
+        "plain.jpg",
+        &LoadOptions::default(),
+        None,
+        &mut |_| {},
+    )
+    .unwrap();
     assert_eq!(src, CoverageSource::Full);
     assert!(m.crop().is_none());
 }
@@ -365,7 +404,7 @@ fn view_limit_keeps_every_border_ray_inside_at_the_seam() {
 /// stay within the project's 0.05 px bound of the exact ones.
 #[test]
 fn non_square_pixel_geometry_keeps_the_lut_bound() {
-    use lut_core::accuracy::compare_positions;
+    use lut_core::compare_positions;
     for (mw, mh) in [(640u32, 160u32), (400, 400), (300, 600)] {
         let mut r = Renderer::default();
         for (yaw, pitch, hfov) in [

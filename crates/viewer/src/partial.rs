@@ -2,7 +2,7 @@
 //! the panel and `viewer render -v` show (coverage, compass heading).
 
 use anyhow::Result;
-use lut_core::coverage::{compass_heading, compass_point};
+use lut_core::{compass_heading, compass_point};
 use lut_core::{Coverage, CoverageSource, EnvMap, LoadOptions};
 use std::path::Path;
 
@@ -11,8 +11,12 @@ pub fn parse_coverage(s: &str) -> Result<Coverage, String> {
     s.parse::<Coverage>().map_err(|e| e.to_string())
 }
 
-/// Turn a placement error into one line that says how to override bad metadata.
+/// Turn a placement error into one line that says how to override bad metadata (or, for
+/// an image that cannot be read, the hint of [`crate::cli_common::map_error`]).
 pub fn coverage_error(e: lut_core::CoverageError, coverage: Option<Coverage>) -> anyhow::Error {
+    if let lut_core::CoverageError::Map(m) = e {
+        return crate::cli_common::map_error(m);
+    }
     let hint = match (&e, coverage) {
         (lut_core::CoverageError::Invalid { .. }, None) => {
             " (give --coverage HFOVxVFOV±YAW±PITCH to place the image yourself, e.g. \
@@ -34,8 +38,8 @@ pub fn load_panorama_partial(
     progress: &mut dyn FnMut(lut_core::LoadProgress),
 ) -> Result<(EnvMap, CoverageSource)> {
     match path {
-        Some(p) => EnvMap::load_partial_with(p, opts, coverage, progress),
-        None => EnvMap::decode_partial_with(
+        Some(p) => lut_core::load_partial(p, opts, coverage, progress),
+        None => lut_core::decode_partial(
             crate::assets::SAMPLE_JPEG,
             crate::assets::SAMPLE_NAME,
             opts,

@@ -5,7 +5,7 @@
 //! # Namings (orientation)
 //! Which image goes on which face, and turned how, is a [`Naming`]:
 //! * [`Naming::Conventions`]: every name means the face it says, and the image is that
-//!   face exactly as `conventions.md` defines it (the hfov-90° view at the face's
+//!   face exactly as `docs/conventions.md` defines it (the hfov-90° view at the face's
 //!   yaw/pitch, up toward +Y on the sides; the up face's bottom edge meets the front's top
 //!   edge). `px ... nz` in this naming are the OpenGL / RenderMan / Direct3D cube-map
 //!   faces, which follow the same orientation. Default for word and axis names.
@@ -160,10 +160,10 @@ impl Transform {
     }
 }
 
-/// How named face images map onto the faces of `conventions.md` (see the module docs).
+/// How named face images map onto the faces of `docs/conventions.md` (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Naming {
-    /// Names mean what they say; images oriented as `conventions.md` (and OpenGL).
+    /// Names mean what they say; images oriented as `docs/conventions.md` (and OpenGL).
     Conventions,
     /// Sauerbraten / Cube 2 sky boxes (`ft rt bk lf up dn`).
     Cube2,

@@ -295,7 +295,7 @@ impl Crop {
         })
     }
 
-    /// Full panorama width in pixels (the map's [`EnvMap::width`]).
+    /// Full panorama width in pixels (the map's [`crate::EnvMap::width`]).
     pub fn full_width(&self) -> u32 {
         self.full_width
     }
@@ -371,7 +371,7 @@ impl Crop {
 
 /// Compass heading (degrees clockwise from north, [0, 360)) of the view centre at `yaw`
 /// for a map whose longitude 0 faces `pose_heading` (GPano `PoseHeadingDegrees`, see
-/// [`EnvMap::pose_heading_deg`]): yaw stays relative to the map; positive yaw turns
+/// [`crate::EnvMap::pose_heading_deg`]): yaw stays relative to the map; positive yaw turns
 /// right, which is clockwise seen from above, so the heading is the sum.
 pub fn compass_heading(pose_heading: f64, yaw: f64) -> f64 {
     let h = (pose_heading + yaw).rem_euclid(360.0);

@@ -3,10 +3,10 @@
 //! * [`Fx`]: map coordinates in **Q.16** (16 fractional bits) held in `i64`. Per-pixel
 //!   index interpolation steps these by an integer increment; `i64` means no overflow for
 //!   any supported map width, and on x86-64 an `i64` add costs what an `i32` add does.
-//! * Table entries are `i32` in **Q15.16** (see [`crate::lut`]): ±32767 map pixels, enough
+//! * Table entries are `i32` in **Q15.16** (see [`crate::LutTable`]): ±32767 map pixels, enough
 //!   for the folded one-eighth region of maps up to 131 068 pixels wide.
 //! * Bilinear weights are 8-bit (`0..=255` out of 256), so two colour channels blend in
-//!   one `u32` (see [`crate::envmap`]). Weight quantization moves a sample by at most
+//!   one `u32` (see [`crate::EnvMap`]). Weight quantization moves a sample by at most
 //!   1/512 pixel and is the same for every renderer, exact included.
 
 /// Fractional bits of [`Fx`].

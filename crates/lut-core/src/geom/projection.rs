@@ -1,6 +1,6 @@
 //! Environment-map projections on surfaces of revolution: direction (λ, φ) ↔ map (u, v).
 //!
-//! Pure math, no pixels. Formulas are exactly those of `conventions.md`:
+//! Pure math, no pixels. Formulas are exactly those of `docs/conventions.md`:
 //!
 //! | projection | u | v |
 //! |---|---|---|

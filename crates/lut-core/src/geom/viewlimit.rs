@@ -6,7 +6,7 @@
 //! any pitch, then pitch is clamped, then yaw (yaw is free when the coverage spans 360°).
 //! Longitudes are compared modulo 360°, so coverages that straddle the ±180° seam work.
 //!
-//! Geometry (camera of `conventions.md`, focal length 1, `a = tan(hfov/2)`,
+//! Geometry (camera of `docs/conventions.md`, focal length 1, `a = tan(hfov/2)`,
 //! `b = a · height/width`): an image-plane point (x, y) seen at pitch θ has latitude
 //! `atan2(y cos θ + sin θ, √(x² + (cos θ − y sin θ)²))` and longitude relative to yaw
 //! `atan2(x, cos θ − y sin θ)`.

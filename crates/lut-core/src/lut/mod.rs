@@ -14,7 +14,7 @@
 //!   scanlines (and everything beyond the table) fall back to exact evaluation.
 //!
 //! Each entry holds the environment-map indices of its surface point for the map's
-//! projection, `Λ = λ · W / 2π` and `V = profile(φ)` (see [`crate::projection`]), as
+//! projection, `Λ = λ · W / 2π` and `V = profile(φ)` (see [`crate::Projection`]), as
 //! `i32` **Q15.16** fixed point.
 //!
 //! ## One-eighth symmetry (FIG. 6E, region 681)
@@ -43,7 +43,7 @@ use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// Largest sampling-position error, in source pixels (angular metric, see
-/// [`crate::accuracy`]), the table's own bilinear interpolation may add outside the
+/// [`crate::position_error`]), the table's own bilinear interpolation may add outside the
 /// exact zones.
 pub const TABLE_ERROR_BUDGET: f64 = 0.02;
 
@@ -701,7 +701,7 @@ impl BandBounds<'_> {
 }
 
 /// Sampling-position error between an exact (Λ, V, φ) and an interpolated (Λ, V), in the
-/// angular metric of [`crate::accuracy`], after turning both into map (u, v).
+/// angular metric of [`crate::position_error`], after turning both into map (u, v).
 fn entry_error(p: Projection, w: f64, h: f64, exact: (f64, f64, f64), got: (f64, f64)) -> f64 {
     let (el, ev, phi) = exact;
     let (il, iv) = got;

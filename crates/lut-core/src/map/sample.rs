@@ -13,7 +13,7 @@ pub enum Sampler {
     /// The four pixel centers around (u − ½, v − ½), weighted by the fractions.
     Bilinear,
     /// Bilinear on the two pyramid levels around the pixel footprint, blended
-    /// (minification anti-aliasing, see [`crate::pyramid`]). Where no footprint is known
+    /// (minification anti-aliasing, see [`crate::EnvMap::pyramid`]). Where no footprint is known
     /// (single samples, cube maps, partial maps) it is bilinear.
     Trilinear,
 }

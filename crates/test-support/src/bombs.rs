@@ -1,7 +1,5 @@
-//! Header-only image files that claim huge sizes (decompression-bomb tests): shared by
-//! `tests/limits.rs` and the viewer's `max_pixels_cli` test through `#[path]`.
-
-#![allow(dead_code)] // each test uses its own subset
+//! Header-only image files that claim huge sizes (decompression-bomb tests): for
+//! `tests/limits.rs` and the viewer's `max_pixels_cli` test.
 
 fn crc32(data: &[u8]) -> u32 {
     let mut c = 0xFFFF_FFFFu32;
