@@ -11,9 +11,10 @@ use lut_core::{render_exact, Camera, EnvMap, Projection, Sampler, View};
 use lut_core::{CubeError, CubeMap, CubeRenderer, Face, Layout, Naming, Transform};
 use lut_core::{Frame, RenderOptions, Renderer, Scene};
 use std::path::{Path, PathBuf};
+use test_support::pixels::{max_channel_diff, psnr, to_rgb};
 
 fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    test_support::repo_root()
 }
 
 fn courtyard() -> EnvMap {
@@ -31,27 +32,6 @@ fn courtyard() -> EnvMap {
 /// The sample sky box (Sauerbraten naming), downscaled copy committed in tests/data/cube.
 fn skybox_dir() -> PathBuf {
     repo().join("tests/data/cube/skyfantasy")
-}
-
-fn psnr(a: &[u32], b: &[u32]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let mut se = 0.0f64;
-    for (p, q) in a.iter().zip(b) {
-        for sh in [0, 8, 16] {
-            let d = ((p >> sh) & 0xFF) as f64 - ((q >> sh) & 0xFF) as f64;
-            se += d * d;
-        }
-    }
-    let mse = se / (a.len() * 3) as f64;
-    10.0 * (255.0f64 * 255.0 / mse.max(1e-12)).log10()
-}
-
-fn max_channel_diff(a: u32, b: u32) -> u32 {
-    [0, 8, 16]
-        .iter()
-        .map(|s| (((a >> s) & 0xFF) as i32 - ((b >> s) & 0xFF) as i32).unsigned_abs())
-        .max()
-        .unwrap()
 }
 
 /// A cube whose texels are `f(direction of the texel center)`, the direction taken from
@@ -402,14 +382,7 @@ fn cube_equirect_round_trip() {
 // Loading: namings, layouts, orientation, errors.
 
 fn write_png(path: &Path, px: &[u32], w: u32, h: u32) {
-    let mut rgb = Vec::with_capacity(px.len() * 3);
-    for p in px {
-        rgb.extend_from_slice(&[(p >> 16) as u8, (p >> 8) as u8, *p as u8]);
-    }
-    image::RgbImage::from_raw(w, h, rgb)
-        .unwrap()
-        .save(path)
-        .unwrap();
+    to_rgb(px, w, h).save(path).unwrap();
 }
 
 fn skybox_files() -> Vec<PathBuf> {

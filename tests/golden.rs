@@ -16,11 +16,12 @@
 //! hfov 1).
 
 use lut_core::{
-    grid_map, render_exact, CubeMap, CubeRenderer, EnvMap, Frame, Projection, RenderOptions,
-    Renderer, Sampler, Scene, View,
+    grid_map, CubeMap, CubeRenderer, EnvMap, Projection, RenderOptions, Renderer, Sampler, Scene,
+    View,
 };
 use test_support::golden::compare_to_truth;
 use test_support::pixels::{diff, psnr};
+use test_support::render::{exact_frame, render_frame};
 
 /// The LUT render and the exact render (same sampler) of `view`, `w × h`.
 fn lut_and_exact(
@@ -31,23 +32,8 @@ fn lut_and_exact(
     w: u32,
     h: u32,
 ) -> (Vec<u32>, Vec<u32>) {
-    let n = (w * h) as usize;
-    let (mut lut, mut ex) = (vec![0u32; n], vec![0u32; n]);
-    r.render(
-        Scene::Map(map),
-        view,
-        opts,
-        &mut Frame::new(&mut lut, w, h).unwrap(),
-    )
-    .unwrap();
-    render_exact(
-        map,
-        view,
-        opts.sampler,
-        &mut Frame::new(&mut ex, w, h).unwrap(),
-        false,
-    );
-    (lut, ex)
+    let (lut, _) = render_frame(r, Scene::Map(map), view, opts, w, h);
+    (lut, exact_frame(map, view, opts.sampler, w, h))
 }
 
 fn cases() -> Vec<(&'static str, f64, f64, f64, u32, u32)> {
@@ -88,24 +74,32 @@ fn golden_every_projection() {
                 };
                 let (lut, ex) = lut_and_exact(&mut r, &map, view, &opts, w, h);
                 let name = format!("{p}_{}_{case}", sampler.name());
-                let d = diff(&lut, &ex);
-                let n = d.pixels;
-                match sampler {
-                    Sampler::Bilinear | Sampler::Trilinear => assert!(
-                        d.worst <= 20 && d.mean <= 0.5,
-                        "{name}: LUT vs exact worst {} mean {:.3}",
-                        d.worst,
-                        d.mean
-                    ),
-                    Sampler::Nearest => assert!(
-                        d.differ as f64 <= 0.02 * n as f64 + 1.0,
-                        "{name}: LUT vs exact, {} of {n} pixels differ",
-                        d.differ
-                    ),
-                }
+                assert_close_to_exact(&name, sampler, &lut, &ex);
                 compare_to_truth(&name, &lut, w, h);
             }
         }
+    }
+}
+
+/// The LUT image `lut` against the exact one `ex` with the tolerances of the module
+/// docs: bilinear at most 20 levels anywhere and 0.5 on average; nearest at most 2 % of
+/// pixels different.
+fn assert_close_to_exact(name: &str, sampler: Sampler, lut: &[u32], ex: &[u32]) {
+    let d = diff(lut, ex);
+    report(name, "LUT vs exact", format!("{d:?}"));
+    match sampler {
+        Sampler::Bilinear | Sampler::Trilinear => assert!(
+            d.worst <= 20 && d.mean <= 0.5,
+            "{name}: LUT vs exact worst {} mean {:.3}",
+            d.worst,
+            d.mean
+        ),
+        Sampler::Nearest => assert!(
+            d.differ as f64 <= 0.02 * d.pixels as f64 + 1.0,
+            "{name}: LUT vs exact, {} of {} pixels differ",
+            d.differ,
+            d.pixels
+        ),
     }
 }
 
@@ -189,24 +183,9 @@ fn golden_partial() {
             };
             let (lut, ex) = lut_and_exact(&mut r, &map, view, &opts, w, h);
             let name = format!("partial_{}_{case}", sampler.name());
-            let d = diff(&lut, &ex);
-            report(&name, "LUT vs exact", format!("{d:?}"));
             // Both show background outside the crop.
             assert!(lut.contains(&0x203040) && lut.iter().any(|&p| p != 0x203040));
-            match sampler {
-                Sampler::Nearest => assert!(
-                    d.differ as f64 <= 0.02 * d.pixels as f64 + 1.0,
-                    "{name}: {} of {} pixels differ",
-                    d.differ,
-                    d.pixels
-                ),
-                _ => assert!(
-                    d.worst <= 20 && d.mean <= 0.5,
-                    "{name}: LUT vs exact worst {} mean {:.3}",
-                    d.worst,
-                    d.mean
-                ),
-            }
+            assert_close_to_exact(&name, sampler, &lut, &ex);
             compare_to_truth(&name, &lut, w, h);
         }
     }
@@ -226,35 +205,19 @@ fn golden_cube() {
         ("down", 10.0, -80.0, 90.0, 96, 64),
     ] {
         let view = View::new(yaw, pitch, hfov).unwrap();
-        let n = (w * h) as usize;
         let mut imgs = Vec::new();
         for kind in [CubeRenderer::Basic, CubeRenderer::Accelerated] {
-            let mut out = vec![0u32; n];
             let opts = RenderOptions {
                 sampler: Sampler::Bilinear,
                 cube: kind,
                 ..RenderOptions::default()
             };
-            let rep = r
-                .render(
-                    Scene::Cube(&cube),
-                    view,
-                    &opts,
-                    &mut Frame::new(&mut out, w, h).unwrap(),
-                )
-                .unwrap();
+            let (out, rep) = render_frame(&mut r, Scene::Cube(&cube), view, &opts, w, h);
             assert_eq!(rep.path, lut_core::RenderPath::Cube(kind));
             imgs.push(out);
         }
         assert_eq!(imgs[0], imgs[1], "cube renderers differ");
-        let mut ex = vec![0u32; n];
-        render_exact(
-            &map,
-            view,
-            Sampler::Bilinear,
-            &mut Frame::new(&mut ex, w, h).unwrap(),
-            false,
-        );
+        let ex = exact_frame(&map, view, Sampler::Bilinear, w, h);
         let name = format!("cube_bilinear_{case}");
         let (p, d) = (psnr(&imgs[1], &ex), diff(&imgs[1], &ex));
         report(&name, "cube vs exact map", format!("{p:.1} dB {d:?}"));
@@ -298,14 +261,14 @@ fn golden_lit() {
     let mut r = Renderer::new(&map);
     let (w, h) = (96u32, 64u32);
     let view = View::new(30.0, -35.0, 110.0).unwrap();
-    let mut img = vec![0u32; (w * h) as usize];
-    r.render(
+    let (mut img, _) = render_frame(
+        &mut r,
         Scene::Map(&map),
         view,
         &RenderOptions::default(),
-        &mut Frame::new(&mut img, w, h).unwrap(),
-    )
-    .unwrap();
+        w,
+        h,
+    );
     let albedo = img.clone();
     let (rw, rd, rh, cam_h) = (6.0, 8.0, 3.0, 1.5);
     let room = lut_core::Room::new(rw, rd, rh, cam_h).unwrap();

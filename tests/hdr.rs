@@ -3,14 +3,13 @@
 
 use lut_core::tone_map;
 use lut_core::LoadOptions;
+use lut_core::Scene;
 use lut_core::{EnvMap, Projection, RenderOptions, Renderer, Tone, View};
-use lut_core::{Frame, Scene};
 use std::path::PathBuf;
+use test_support::render::render_frame;
 
 fn data(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../tests/data/hdr")
-        .join(name)
+    test_support::test_data("hdr").join(name)
 }
 
 #[test]
@@ -42,14 +41,15 @@ fn sample_exrs_load_clamped_and_toned() {
         }
         // Renders without trouble.
         let mut r = Renderer::new(&map);
-        let mut out = vec![0u32; 64 * 32];
-        r.render(
+        let view = View::new(10.0, 5.0, 90.0).unwrap();
+        render_frame(
+            &mut r,
             Scene::Map(&map),
-            View::new(10.0, 5.0, 90.0).unwrap(),
+            view,
             &RenderOptions::default(),
-            &mut Frame::new(&mut out, 64, 32).unwrap(),
-        )
-        .unwrap();
+            64,
+            32,
+        );
     }
 }
 

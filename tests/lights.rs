@@ -11,9 +11,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 fn data(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../tests/data/ies")
-        .join(name)
+    test_support::test_data("ies").join(name)
 }
 
 /// A type-C (or A/B) file with the given angles and values f(h, v) (horizontal-major).

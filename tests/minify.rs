@@ -8,19 +8,8 @@ use lut_core::{
     View,
 };
 use lut_core::{Frame, Scene};
-
-/// PSNR (dB) of `a` against `b` over all channels.
-fn psnr(a: &[u32], b: &[u32]) -> f64 {
-    let mut se = 0f64;
-    for (p, q) in a.iter().zip(b) {
-        for s in [0, 8, 16] {
-            let d = ((p >> s) & 0xFF) as f64 - ((q >> s) & 0xFF) as f64;
-            se += d * d;
-        }
-    }
-    let mse = se / (a.len() * 3) as f64;
-    10.0 * (255.0f64 * 255.0 / mse.max(1e-12)).log10()
-}
+use test_support::pixels::psnr;
+use test_support::render::render_frame;
 
 /// A map that aliases when minified: 3-pixel black/white checks (not a power of two, so
 /// the pyramid levels do not average them away exactly) over a colour ramp.
@@ -40,20 +29,11 @@ fn fine_map(w: u32, h: u32) -> EnvMap {
 }
 
 fn lut(map: &EnvMap, view: View, sampler: Sampler, w: u32, h: u32) -> Vec<u32> {
-    let mut out = vec![0u32; (w * h) as usize];
     let opts = RenderOptions {
         sampler,
         ..RenderOptions::default()
     };
-    Renderer::new(map)
-        .render(
-            Scene::Map(map),
-            view,
-            &opts,
-            &mut Frame::new(&mut out, w, h).unwrap(),
-        )
-        .unwrap();
-    out
+    render_frame(&mut Renderer::new(map), Scene::Map(map), view, &opts, w, h).0
 }
 
 #[test]

@@ -6,13 +6,14 @@
 
 use lut_core::exact_uv;
 use lut_core::LoadOptions;
+use lut_core::Scene;
 use lut_core::{dir_to_lat_long, Camera};
 use lut_core::{insert_xmp, xmp_packet};
 use lut_core::{
     limit_view, Coverage, CoverageSource, EnvMap, IndexStep, Projection, RenderOptions, Renderer,
     RendererKind, Sampler, View,
 };
-use lut_core::{Frame, Scene};
+use test_support::render::render_frame;
 
 const FULL_W: u32 = 512;
 const FULL_H: u32 = 256;
@@ -81,32 +82,37 @@ fn padded_reference(jpeg: &[u8], left: u32, top: u32) -> EnvMap {
 }
 
 fn load_partial(jpeg: &[u8]) -> EnvMap {
-    let (mut m, src) =
-        lut_core::decode_partial(jpeg, "test.jpg", &LoadOptions::default(), None, &mut |_| {})
-            .unwrap();
+    let (mut m, src) = decode(jpeg, "test.jpg", None).unwrap();
     assert_eq!(src, CoverageSource::Xmp);
     m.set_background(BG);
     m
 }
 
+/// Decode `jpeg` as a possibly partial panorama with the default options.
+fn decode(
+    jpeg: &[u8],
+    what: &str,
+    coverage: Option<Coverage>,
+) -> Result<(EnvMap, CoverageSource), lut_core::CoverageError> {
+    lut_core::decode_partial(jpeg, what, &LoadOptions::default(), coverage, &mut |_| {})
+}
+
 fn render(map: &EnvMap, view: View, renderer: RendererKind, sampler: Sampler) -> Vec<u32> {
-    let (w, h) = (160, 90);
-    let mut out = vec![0u32; w * h];
     let opts = RenderOptions {
         renderer,
         sampler,
         index_step: IndexStep::Fixed(4),
         ..RenderOptions::default()
     };
-    Renderer::new(map)
-        .render(
-            Scene::Map(map),
-            view,
-            &opts,
-            &mut Frame::new(&mut out, w as u32, h as u32).unwrap(),
-        )
-        .unwrap();
-    out
+    render_frame(
+        &mut Renderer::new(map),
+        Scene::Map(map),
+        view,
+        &opts,
+        160,
+        90,
+    )
+    .0
 }
 
 /// Where the exact position of each output pixel lies relative to the crop: its
@@ -266,14 +272,7 @@ fn explicit_coverage_overrides_the_metadata() {
     let jpeg = tagged_jpeg(200, 60, 160, 100, Some("123.5"));
     // the same placement in degrees: 112.5 x 70.3125, west edge -39.375, north 47.8125
     let cov = Coverage::new(112.5, 70.3125, -39.375 + 56.25, 47.8125 - 35.15625).unwrap();
-    let (m, src) = lut_core::decode_partial(
-        &jpeg,
-        "t.jpg",
-        &LoadOptions::default(),
-        Some(cov),
-        &mut |_| {},
-    )
-    .unwrap();
+    let (m, src) = decode(&jpeg, "t.jpg", Some(cov)).unwrap();
     assert_eq!(src, CoverageSource::Explicit);
     let c = m.crop().unwrap();
     assert_eq!(
@@ -282,14 +281,7 @@ fn explicit_coverage_overrides_the_metadata() {
     );
     // a different coverage puts it elsewhere and ignores the XMP
     let cov = "360x90+0+0".parse::<Coverage>().unwrap();
-    let (m, _) = lut_core::decode_partial(
-        &jpeg,
-        "t.jpg",
-        &LoadOptions::default(),
-        Some(cov),
-        &mut |_| {},
-    )
-    .unwrap();
+    let (m, _) = decode(&jpeg, "t.jpg", Some(cov)).unwrap();
     let c = m.crop().unwrap();
     assert_eq!(
         (c.full_width(), c.full_height(), c.left(), c.top()),
@@ -330,28 +322,13 @@ fn bad_metadata_is_a_clear_error_and_coverage_is_the_way_out() {
         ("CroppedAreaImageHeightPixels", "32"),
     ]);
     let bad = insert_xmp(&jpeg, &xmp).unwrap();
-    let e = lut_core::decode_partial(&bad, "bad.jpg", &LoadOptions::default(), None, &mut |_| {})
-        .unwrap_err();
+    let e = decode(&bad, "bad.jpg", None).unwrap_err();
     let msg = e.to_string();
     assert!(msg.contains("bad.jpg") && msg.contains("below"), "{msg}");
     let cov = "180x90+0+0".parse().unwrap();
-    assert!(lut_core::decode_partial(
-        &bad,
-        "bad.jpg",
-        &LoadOptions::default(),
-        Some(cov),
-        &mut |_| {}
-    )
-    .is_ok());
+    assert!(decode(&bad, "bad.jpg", Some(cov)).is_ok());
     // an untagged 2:1 JPEG is an ordinary map
-    let (m, src) = lut_core::decode_partial(
-        &jpeg,
-        "plain.jpg",
-        &LoadOptions::default(),
-        None,
-        &mut |_| {},
-    )
-    .unwrap();
+    let (m, src) = decode(&jpeg, "plain.jpg", None).unwrap();
     assert_eq!(src, CoverageSource::Full);
     assert!(m.crop().is_none());
 }

@@ -11,6 +11,7 @@ use lut_core::{IndexStep, LutChoice, Projection, RenderOptions, Renderer, Sample
 use proptest::prelude::*;
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
+use test_support::render::render_frame;
 
 const BOUND: f64 = 0.05;
 
@@ -232,14 +233,14 @@ fn odd_and_tiny_sizes() {
     let mut r = Renderer::new(&map);
     for (w, h) in [(1, 1), (1, 7), (7, 1), (3, 3), (17, 5), (257, 1), (1, 300)] {
         let view = View::new(33.0, 12.0, 75.0).unwrap();
-        let mut out = vec![0u32; (w * h) as usize];
-        r.render(
+        render_frame(
+            &mut r,
             Scene::Map(&map),
             view,
             &RenderOptions::default(),
-            &mut Frame::new(&mut out, w, h).unwrap(),
-        )
-        .unwrap();
+            w,
+            h,
+        );
         let st = measure(
             512,
             256,

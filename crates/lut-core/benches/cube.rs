@@ -50,19 +50,7 @@ fn pan(c: &mut Criterion) {
                             frame = frame.wrapping_add(1);
                             let yaw = (frame as f64 * 7.3) % 360.0;
                             let view = View::new(yaw, pitch, 90.0).unwrap();
-                            Renderer::default()
-                                .render(
-                                    Scene::Cube(&cube),
-                                    view,
-                                    &RenderOptions {
-                                        sampler,
-                                        cube: r,
-                                        threads: false,
-                                        ..RenderOptions::default()
-                                    },
-                                    &mut Frame::new(&mut out, w, h).unwrap(),
-                                )
-                                .unwrap();
+                            render_cube(&cube, view, sampler, r, &mut out, w, h);
                             black_box(&out);
                         })
                     });
@@ -91,19 +79,7 @@ fn interleaved_min() {
                         .enumerate()
                     {
                         let t = std::time::Instant::now();
-                        Renderer::default()
-                            .render(
-                                Scene::Cube(&cube),
-                                view,
-                                &RenderOptions {
-                                    sampler,
-                                    cube: r,
-                                    threads: false,
-                                    ..RenderOptions::default()
-                                },
-                                &mut Frame::new(&mut out, w, h).unwrap(),
-                            )
-                            .unwrap();
+                        render_cube(&cube, view, sampler, r, &mut out, w, h);
                         black_box(&out);
                         best[k] = best[k].min(t.elapsed().as_secs_f64() * 1e3);
                     }
@@ -129,4 +105,30 @@ fn main() {
     }
     benches();
     Criterion::default().configure_from_args().final_summary();
+}
+
+/// One frame of `cube` on one thread through the render entry.
+fn render_cube(
+    cube: &CubeMap,
+    view: View,
+    sampler: Sampler,
+    renderer: CubeRenderer,
+    out: &mut [u32],
+    w: u32,
+    h: u32,
+) {
+    let opts = RenderOptions {
+        sampler,
+        cube: renderer,
+        threads: false,
+        ..RenderOptions::default()
+    };
+    Renderer::default()
+        .render(
+            Scene::Cube(cube),
+            view,
+            &opts,
+            &mut Frame::new(out, w, h).unwrap(),
+        )
+        .unwrap();
 }

@@ -1,6 +1,7 @@
 //! What every lutpano test binary shares: golden-image comparison against stored truths
 //! ([`golden`]), pixel statistics ([`pixels`]: PSNR, per-channel differences), a counting
-//! global allocator ([`alloc`]) and header-only decompression bombs ([`bombs`]).
+//! global allocator ([`alloc`]), header-only decompression bombs ([`bombs`]) and frames
+//! rendered into new buffers ([`render`]).
 //!
 //! A dev-dependency of `lut-core` and `viewer`; never published.
 
@@ -8,6 +9,7 @@ pub mod alloc;
 pub mod bombs;
 pub mod golden;
 pub mod pixels;
+pub mod render;
 
 use std::path::PathBuf;
 
@@ -15,4 +17,9 @@ use std::path::PathBuf;
 /// it).
 pub fn repo_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// A file of the committed test data, `tests/data/<rel>`.
+pub fn test_data(rel: &str) -> PathBuf {
+    repo_root().join("tests/data").join(rel)
 }

@@ -680,17 +680,7 @@ fn measure_errors(
                 }
                 Config::Cube(s, r) => {
                     let c = ctx.cube.expect("cube configs only with a cube");
-                    Renderer::default().render(
-                        Scene::Cube(c),
-                        view,
-                        &RenderOptions {
-                            sampler: s,
-                            cube: r,
-                            threads: true,
-                            ..RenderOptions::default()
-                        },
-                        &mut Frame::new(&mut img, w, h)?,
-                    )?;
+                    render_cube(c, view, s, r, &mut img, w, h)?;
                 }
                 Config::Gather => gather(ctx.src, &idx, &mut img, w as usize, map.background()),
             }
@@ -843,17 +833,7 @@ fn time_config(
                 }
                 Config::Cube(s, r) => {
                     let c = ctx.cube.expect("cube configs only with a cube");
-                    Renderer::default().render(
-                        Scene::Cube(c),
-                        view,
-                        &RenderOptions {
-                            sampler: s,
-                            cube: r,
-                            threads: true,
-                            ..RenderOptions::default()
-                        },
-                        &mut Frame::new(&mut out, w, h)?,
-                    )?;
+                    render_cube(c, view, s, r, &mut out, w, h)?;
                 }
                 Config::Gather => gather(
                     ctx.src,
@@ -1155,4 +1135,24 @@ fn plot(path: &Path, rows: &[Row]) -> Result<()> {
         }
     }
     write_png_atomic(path, &px, pw, ph)
+}
+
+/// One frame of a cube map through lut-core's render entry (all threads).
+fn render_cube(
+    cube: &CubeMap,
+    view: View,
+    sampler: Sampler,
+    renderer: CubeRenderer,
+    out: &mut [u32],
+    w: u32,
+    h: u32,
+) -> Result<()> {
+    let opts = RenderOptions {
+        sampler,
+        cube: renderer,
+        threads: true,
+        ..RenderOptions::default()
+    };
+    Renderer::default().render(Scene::Cube(cube), view, &opts, &mut Frame::new(out, w, h)?)?;
+    Ok(())
 }

@@ -233,6 +233,31 @@ impl Renderer {
         &self.tables.last().expect("just pushed").2
     }
 
+    /// Per-frame setup for the geometry set last: builds the table `opts` selects (if
+    /// needed) and fills one [`Scan`] per row (see `setup.rs`).
+    fn prepare_frame(
+        &mut self,
+        view: View,
+        opts: &RenderOptions,
+        width: u32,
+        height: u32,
+    ) -> (Setup, RenderReport) {
+        let kind = Self::table_kind(view, opts);
+        let geometry = self.geometry.expect("geometry set before a frame");
+        self.table(opts.surface, kind);
+        let table = find(&self.tables, opts.surface, kind);
+        prepare(
+            table,
+            kind,
+            geometry,
+            &mut self.scans,
+            view,
+            opts,
+            width,
+            height,
+        )
+    }
+
     /// Which table `opts` selects for `view`.
     pub fn table_kind(view: View, opts: &RenderOptions) -> TableKind {
         match opts.lut {
@@ -290,20 +315,8 @@ impl Renderer {
             });
         }
         self.set_geometry(map.width(), map.height(), map.projection());
-        let kind = Self::table_kind(view, opts);
-        let geometry = self.geometry.expect("geometry set above");
-        self.table(opts.surface, kind);
-        let table = find(&self.tables, opts.surface, kind);
-        let (setup, report) = prepare(
-            table,
-            kind,
-            geometry,
-            &mut self.scans,
-            view,
-            opts,
-            width,
-            height,
-        );
+        let (setup, report) = self.prepare_frame(view, opts, width, height);
+        let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
         let w = width as usize;
@@ -367,20 +380,8 @@ impl Renderer {
         check_size(width, height)?;
         check_step(opts.index_step)?;
         self.set_geometry(map_w, map_h, projection);
-        let kind = Self::table_kind(view, opts);
-        let geometry = self.geometry.expect("geometry set above");
-        self.table(opts.surface, kind);
-        let table = find(&self.tables, opts.surface, kind);
-        let (setup, report) = prepare(
-            table,
-            kind,
-            geometry,
-            &mut self.scans,
-            view,
-            opts,
-            width,
-            height,
-        );
+        let (setup, report) = self.prepare_frame(view, opts, width, height);
+        let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
         let mut out = vec![None; width as usize * height as usize];
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
