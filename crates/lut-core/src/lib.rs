@@ -40,6 +40,21 @@
 //! Cube maps ([`CubeMap`], [`load_cube`]) and goniometric lights ([`LightTable`],
 //! [`shade_frame`]) are siblings of the map pipeline.
 //!
+//! ## One render entry
+//! ```
+//! use lut_core::{grid_map, Frame, Projection, RenderOptions, Renderer, Scene, View};
+//! let map = grid_map(512, 256, Projection::Equirect)?;
+//! let mut renderer = Renderer::new(&map);
+//! let mut pixels = vec![0u32; 320 * 200];
+//! let mut frame = Frame::new(&mut pixels, 320, 200)?; // size and length checked once
+//! let view = View::new(30.0, 10.0, 90.0)?;
+//! let opts = RenderOptions::default(); // LUT, bilinear, adaptive step, threads
+//! let report = renderer.render(Scene::Map(&map), view, &opts, &mut frame)?;
+//! assert_eq!(report.pixels, 320 * 200);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//! A cube map goes through the same call as `Scene::Cube(&cube)`.
+//!
 //! ## Conventions (`docs/conventions.md`, followed exactly)
 //! * yaw ψ positive turns right (toward increasing longitude), any real value, reduced
 //!   mod 360°; pitch θ positive looks up, clamped to [−90°, 90°]; hfov is the horizontal
@@ -70,7 +85,10 @@ mod lut;
 mod map;
 mod render;
 
-pub use error::{CoverageError, MapError, SizeProblem, ViewError};
+pub use error::{
+    AngleProblem, CoverageError, CropProblem, GPanoError, MapError, SizeProblem, SyntaxProblem,
+    ViewError,
+};
 
 // Geometry.
 pub use geom::accuracy::{compare_positions, position_error, raw_error, ErrorStats};
@@ -104,9 +122,7 @@ pub use render::{
 
 // Input.
 pub use io::cube::{load_cube, load_face_files, load_layout_image};
-pub use io::gpano::{
-    insert_xmp, jpeg_xmp, read_gpano, xmp_packet, GPano, GPanoError, GPANO_NS, XMP_SIGNATURE,
-};
+pub use io::gpano::{insert_xmp, jpeg_xmp, read_gpano, xmp_packet, GPano, GPANO_NS, XMP_SIGNATURE};
 pub use io::load::{
     check_pixel_limit, decode_map, load_map, map_from_image, resolve_projection, LoadOptions,
     LoadPhase, LoadProgress, DEFAULT_MAX_PIXELS,

@@ -18,11 +18,12 @@ pub fn coverage_error(e: lut_core::CoverageError, coverage: Option<Coverage>) ->
         return crate::cli_common::map_error(m);
     }
     let hint = match (&e, coverage) {
-        (lut_core::CoverageError::Invalid { .. }, None) => {
+        (lut_core::CoverageError::Syntax { .. }, _) | (_, Some(_)) => "",
+        // Bad metadata or a placement that does not fit, and no coverage given.
+        (_, None) => {
             " (give --coverage HFOVxVFOV±YAW±PITCH to place the image yourself, e.g. \
              --coverage 360x180 to show it as a full panorama)"
         }
-        _ => "",
     };
     anyhow::anyhow!("{e}{hint}")
 }

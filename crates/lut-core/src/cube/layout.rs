@@ -22,7 +22,7 @@
 //! * [`Layout::Strip`], 6:1: `px nx py ny pz nz` = right, left, up, down, front, back.
 //! * [`Layout::Grid3x2`], 3:2: `px nx py` over `ny pz nz` = right left up / down front back.
 
-use super::{CubeError, CubeMap, Face};
+use super::{CubeError, CubeMap, Face, UsageProblem};
 
 /// How the six faces are given.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -229,9 +229,7 @@ impl CubeMap {
         let (Some((w, h)), Some(cells)) =
             (layout_dimensions(layout, self.face_size()), layout.cells())
         else {
-            return Err(CubeError::Usage(
-                "layout files is six images, not one".into(),
-            ));
+            return Err(CubeError::Usage(UsageProblem::FilesIsNotOneImage));
         };
         let n = self.face_size() as usize;
         let mut out = vec![0u32; w as usize * h as usize];

@@ -39,10 +39,12 @@
 
 pub(crate) mod layout;
 
+use crate::error::ViewError;
 use crate::geom::camera::{check_size, lat_long_to_dir, View};
 use crate::geom::fixed::{to_fx, FX_BITS, FX_HALF, FX_ONE};
 use crate::map::sample::{lerp_px, Sampler};
 use glam::DVec3;
+use layout::Layout;
 use rayon::prelude::*;
 use std::path::PathBuf;
 
@@ -224,24 +226,24 @@ pub enum CubeError {
         max: u32,
     },
     /// Not exactly one file per face.
-    #[error("{what}: {reason}")]
+    #[error("{what}: {problem}")]
     Faces {
-        /// The folder or the list of inputs.
+        /// The folder, the file or the list of inputs.
         what: String,
         /// Which faces are missing, repeated or unrecognized.
-        reason: String,
+        problem: FacesProblem,
     },
     /// A single image whose size fits no layout, or the wrong layout for it.
-    #[error("{path}: {reason}")]
+    #[error("{path}: {problem}")]
     Layout {
         /// The file.
         path: PathBuf,
         /// Why.
-        reason: String,
+        problem: LayoutProblem,
     },
-    /// An unknown layout or naming name, or inputs that do not fit the request.
+    /// Inputs that do not fit the request, or an output that cannot be made.
     #[error("{0}")]
-    Usage(String),
+    Usage(UsageProblem),
     /// A pixel buffer does not hold `size × size` texels.
     #[error("{what}: buffer holds {len} texels, a {size}x{size} face needs {needed}")]
     Buffer {
@@ -253,6 +255,123 @@ pub enum CubeError {
         size: u32,
         /// size².
         needed: usize,
+    },
+}
+
+/// Why the face files do not make a cube (see [`CubeError::Faces`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FacesProblem {
+    /// A folder without face images.
+    #[error(
+        "no face images found (expected names ending in front/right/back/left/up/down, \
+         ft/rt/bk/lf/up/dn or px/nx/py/ny/pz/nz)"
+    )]
+    NoFaceImages,
+    /// A file whose name names no face.
+    #[error(
+        "the file name does not say which face it is (expected it to end in \
+         front/right/back/left/up/down, ft/rt/bk/lf/up/dn or px/nx/py/ny/pz/nz)"
+    )]
+    UnnamedFace,
+    /// Two files name the same face.
+    #[error("two files for the {} face: {} and {}", face.name(), first.display(), second.display())]
+    Duplicate {
+        /// The face.
+        face: Face,
+        /// The first file.
+        first: PathBuf,
+        /// The second file.
+        second: PathBuf,
+    },
+    /// Fewer than six faces.
+    #[error(
+        "{} face file(s) given, a cube needs six; missing: {}",
+        6 - missing.len(),
+        missing.iter().map(|f| f.name()).collect::<Vec<_>>().join(", ")
+    )]
+    Missing {
+        /// The faces without a file.
+        missing: Vec<Face>,
+    },
+}
+
+/// Why a single image is not the layout asked for (see [`CubeError::Layout`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum LayoutProblem {
+    /// Its aspect ratio is no layout's.
+    #[error(
+        "image is {width}x{height}; a single-image cube map must be 4:3 (cross), 6:1 (strip) or \
+         3:2 (3x2); for six files give a folder or six paths"
+    )]
+    NoLayout {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+    },
+    /// Its size is not whole square faces of the layout asked for.
+    #[error(
+        "image is {width}x{height}, which is not {cols}x{rows} square faces as layout {} needs",
+        layout.name()
+    )]
+    NotFaces {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// Faces across.
+        cols: u32,
+        /// Faces down.
+        rows: u32,
+        /// The layout.
+        layout: Layout,
+    },
+}
+
+/// Inputs that do not fit the request (see [`CubeError::Usage`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum UsageProblem {
+    /// No input at all.
+    #[error("no cube map input given")]
+    NoInput,
+    /// A folder with a single-image layout.
+    #[error("{}: is a folder, but layout {} is a single image", path.display(), layout.name())]
+    FolderForSingleImage {
+        /// The folder.
+        path: PathBuf,
+        /// The layout asked for.
+        layout: Layout,
+    },
+    /// One file with the six-files layout.
+    #[error("{}: layout files needs six face files or a folder, got one file", path.display())]
+    OneFileForFiles {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Several inputs with a single-image layout.
+    #[error("{count} inputs given, but layout {} is a single image", layout.name())]
+    ManyForSingleImage {
+        /// How many inputs.
+        count: usize,
+        /// The layout asked for.
+        layout: Layout,
+    },
+    /// The six-files layout asked of one image.
+    #[error("layout files is six images, not one")]
+    FilesIsNotOneImage,
+    /// An output size that cannot be rendered.
+    #[error("{0}")]
+    Output(ViewError),
+    /// A face that cannot be rendered.
+    #[error("cannot render {} face: {error}", face.name())]
+    FaceRender {
+        /// The face.
+        face: Face,
+        /// Why.
+        error: ViewError,
     },
 }
 
@@ -452,7 +571,7 @@ impl CubeMap {
         height: u32,
         sampler: Sampler,
     ) -> Result<Vec<u32>, CubeError> {
-        check_size(width, height).map_err(|e| CubeError::Usage(e.to_string()))?;
+        check_size(width, height).map_err(|e| CubeError::Usage(UsageProblem::Output(e)))?;
         let (w, h) = (width as usize, height as usize);
         let mut out = vec![0u32; w * h];
         out.par_chunks_mut(w).enumerate().for_each(|(j, row)| {

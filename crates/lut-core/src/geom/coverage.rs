@@ -19,17 +19,10 @@
 //! [`Coverage`] (`HFOVxVFOV[±YAW±PITCH]`, degrees). The view limit (`geom/viewlimit.rs`)
 //! keeps a view inside it.
 
-use crate::error::CoverageError;
+use crate::error::{AngleProblem, CoverageError, CropProblem, SyntaxProblem};
 use crate::geom::camera::wrap_deg;
 use crate::geom::fixed::{Fx, FX_BITS};
 use crate::geom::limits::{MAX_MAP_HEIGHT, MAX_MAP_WIDTH};
-
-fn invalid(what: impl Into<String>, reason: impl Into<String>) -> CoverageError {
-    CoverageError::Invalid {
-        what: what.into(),
-        reason: reason.into(),
-    }
-}
 
 /// The part of the sphere a panorama covers, in degrees: a longitude range `hfov` wide
 /// centred on `yaw`, and a latitude range `vfov` high centred on `pitch`.
@@ -59,36 +52,29 @@ impl Coverage {
     /// value (reduced to (−180, 180]), and `pitch ± vfov/2` inside [−90, 90].
     ///
     /// # Errors
-    /// [`CoverageError::Invalid`] naming the value.
+    /// [`CoverageError::Angles`] saying which angle.
     pub fn new(hfov: f64, vfov: f64, yaw: f64, pitch: f64) -> Result<Coverage, CoverageError> {
         let all = [hfov, vfov, yaw, pitch];
         if all.iter().any(|v| !v.is_finite()) {
-            return Err(invalid(
-                "coverage",
-                format!("angles must be finite, got {hfov}x{vfov} at {yaw}, {pitch}"),
-            ));
+            return Err(CoverageError::Angles(AngleProblem::NonFinite {
+                hfov,
+                vfov,
+                yaw,
+                pitch,
+            }));
         }
         if !(hfov > 0.0 && hfov <= 360.0) {
-            return Err(invalid(
-                "coverage",
-                format!("horizontal extent {hfov} is not in (0, 360] degrees"),
-            ));
+            return Err(CoverageError::Angles(AngleProblem::Hfov(hfov)));
         }
         if !(vfov > 0.0 && vfov <= 180.0) {
-            return Err(invalid(
-                "coverage",
-                format!("vertical extent {vfov} is not in (0, 180] degrees"),
-            ));
+            return Err(CoverageError::Angles(AngleProblem::Vfov(vfov)));
         }
         const EPS: f64 = 1e-9;
         if pitch + vfov / 2.0 > 90.0 + EPS || pitch - vfov / 2.0 < -90.0 - EPS {
-            return Err(invalid(
-                "coverage",
-                format!(
-                    "{vfov} degrees high centred on pitch {pitch} reaches past a pole \
-                     (pitch ± vfov/2 must stay in [-90, 90])"
-                ),
-            ));
+            return Err(CoverageError::Angles(AngleProblem::PastPole {
+                vfov,
+                pitch,
+            }));
         }
         Ok(Coverage {
             hfov,
@@ -148,20 +134,20 @@ impl Coverage {
     /// half a source pixel).
     ///
     /// # Errors
-    /// [`CoverageError::Invalid`] when the full panorama would exceed the supported map
-    /// size, or the image is too small.
+    /// [`CoverageError::FullTooLarge`] when the full panorama would exceed the supported
+    /// map size, [`CoverageError::Crop`] when the image is too small.
     pub fn crop_for_image(&self, image_w: u32, image_h: u32) -> Result<Crop, CoverageError> {
         let fw = (image_w as f64 * 360.0 / self.hfov).round();
         let fh = (image_h as f64 * 180.0 / self.vfov).round();
-        let what = format!("coverage {self}");
         if fw > MAX_MAP_WIDTH as f64 || fh > MAX_MAP_HEIGHT as f64 {
-            return Err(invalid(
-                what,
-                format!(
-                    "a {image_w}x{image_h} image covering it makes a {fw}x{fh} full \
-                     panorama; sides above {MAX_MAP_WIDTH} are not supported"
-                ),
-            ));
+            return Err(CoverageError::FullTooLarge {
+                coverage: self.to_string(),
+                image_width: image_w,
+                image_height: image_h,
+                full_width: fw,
+                full_height: fh,
+                max: MAX_MAP_WIDTH,
+            });
         }
         let (fw, fh) = (fw.max(image_w as f64) as u32, fh.max(image_h as f64) as u32);
         let left = ((self.yaw - self.hfov / 2.0 + 180.0) / 360.0 * fw as f64).round();
@@ -170,7 +156,10 @@ impl Coverage {
         // Rounding may push the last row one pixel past the bottom: pull it back.
         let top = (top.max(0.0) as u32).min(fh - image_h);
         Crop::new(fw, fh, left, top, image_w, image_h).map_err(|e| match e {
-            CoverageError::Invalid { reason, .. } => invalid(format!("coverage {self}"), reason),
+            CoverageError::Crop { problem, .. } => CoverageError::Crop {
+                what: format!("coverage {self}"),
+                problem,
+            },
             other => other,
         })
     }
@@ -191,32 +180,35 @@ impl std::str::FromStr for Coverage {
 
     /// Parse `HFOVxVFOV[±YAW±PITCH]` (see [`Coverage`]).
     fn from_str(s: &str) -> Result<Coverage, CoverageError> {
-        let syntax = |reason: &str| CoverageError::Syntax {
+        let syntax = |problem: SyntaxProblem| CoverageError::Syntax {
             text: s.to_string(),
-            reason: format!(
-                "{reason}; expected HFOVxVFOV or HFOVxVFOV±YAW±PITCH, e.g. 120x60+30-10"
-            ),
+            problem,
         };
         let t = s.trim();
         let (h, rest) = t
             .split_once(['x', 'X'])
-            .ok_or_else(|| syntax("no 'x' between the horizontal and vertical extent"))?;
+            .ok_or_else(|| syntax(SyntaxProblem::NoX))?;
         // VFOV runs up to the first sign; then YAW and PITCH, each starting with a sign.
         let (v, centre) = match rest.find(['+', '-']) {
             Some(i) => (&rest[..i], Some(&rest[i..])),
             None => (rest, None),
         };
-        let num = |x: &str, name: &str, signed: bool| -> Result<f64, CoverageError> {
+        let num = |x: &str, part: &'static str, signed: bool| -> Result<f64, CoverageError> {
+            let bad = || {
+                syntax(SyntaxProblem::NotDecimal {
+                    part,
+                    text: x.to_string(),
+                })
+            };
             let body = if signed { &x[1..] } else { x };
             let ok = !body.is_empty()
                 && body.chars().all(|c| c.is_ascii_digit() || c == '.')
                 && body.chars().filter(|&c| c == '.').count() <= 1
                 && body.chars().any(|c| c.is_ascii_digit());
             if !ok {
-                return Err(syntax(&format!("{name} '{x}' is not a decimal number")));
+                return Err(bad());
             }
-            x.parse::<f64>()
-                .map_err(|_| syntax(&format!("{name} '{x}' is not a decimal number")))
+            x.parse::<f64>().map_err(|_| bad())
         };
         let hfov = num(h, "HFOV", false)?;
         let vfov = num(v, "VFOV", false)?;
@@ -226,15 +218,12 @@ impl std::str::FromStr for Coverage {
                 let j = c[1..]
                     .find(['+', '-'])
                     .map(|j| j + 1)
-                    .ok_or_else(|| syntax("YAW and PITCH must both be given, each with a sign"))?;
+                    .ok_or_else(|| syntax(SyntaxProblem::YawPitchPair))?;
                 (num(&c[..j], "YAW", true)?, num(&c[j..], "PITCH", true)?)
             }
         };
         Coverage::new(hfov, vfov, yaw, pitch).map_err(|e| match e {
-            CoverageError::Invalid { reason, .. } => CoverageError::Syntax {
-                text: s.to_string(),
-                reason,
-            },
+            CoverageError::Angles(a) => syntax(SyntaxProblem::Angles(a)),
             other => other,
         })
     }
@@ -258,7 +247,7 @@ impl Crop {
     /// `top + height ≤ full_height`; `left` is taken modulo `full_width`.
     ///
     /// # Errors
-    /// [`CoverageError::Invalid`] naming the values.
+    /// [`CoverageError::Crop`] naming the values.
     pub fn new(
         full_width: u32,
         full_height: u32,
@@ -271,19 +260,28 @@ impl Crop {
             "crop {width}x{height} at ({left}, {top}) of a {full_width}x{full_height} panorama"
         );
         if full_width < 2 || full_height < 2 || width < 2 || height < 2 {
-            return Err(invalid(what, "every size must be at least 2 pixels"));
+            return Err(CoverageError::Crop {
+                what,
+                problem: CropProblem::TooSmall,
+            });
         }
         if full_width > MAX_MAP_WIDTH || full_height > MAX_MAP_HEIGHT {
-            return Err(invalid(
+            return Err(CoverageError::Crop {
                 what,
-                format!("full panorama sides above {MAX_MAP_WIDTH} are not supported"),
-            ));
+                problem: CropProblem::FullSidesAbove { max: MAX_MAP_WIDTH },
+            });
         }
         if width > full_width {
-            return Err(invalid(what, "the crop is wider than the full panorama"));
+            return Err(CoverageError::Crop {
+                what,
+                problem: CropProblem::Wider,
+            });
         }
         if top as u64 + height as u64 > full_height as u64 {
-            return Err(invalid(what, "the crop runs below the full panorama"));
+            return Err(CoverageError::Crop {
+                what,
+                problem: CropProblem::Below,
+            });
         }
         Ok(Crop {
             full_width,
@@ -469,7 +467,7 @@ mod tests {
         let e = Coverage::new(0.1, 10.0, 0.0, 0.0)
             .unwrap()
             .crop_for_image(1000, 100);
-        assert!(matches!(e, Err(CoverageError::Invalid { .. })));
+        assert!(matches!(e, Err(CoverageError::FullTooLarge { .. })));
     }
 
     #[test]

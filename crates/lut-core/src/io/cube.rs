@@ -12,7 +12,10 @@
 //! | `px nx py ny pz nz` (also `posx negx ...`) | right left up down front back |
 
 use crate::cube::layout::{Layout, Naming};
-use crate::cube::{check_face_size, CubeError, CubeMap, Face, MAX_FACE_SIZE};
+use crate::cube::{
+    check_face_size, CubeError, CubeMap, Face, FacesProblem, LayoutProblem, UsageProblem,
+    MAX_FACE_SIZE,
+};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -114,14 +117,13 @@ pub fn load_cube(
     naming: Option<Naming>,
 ) -> Result<CubeMap, CubeError> {
     match inputs {
-        [] => Err(CubeError::Usage("no cube map input given".into())),
+        [] => Err(CubeError::Usage(UsageProblem::NoInput)),
         [one] if one.is_dir() => {
             if let Some(l) = layout.filter(|l| *l != Layout::Files) {
-                return Err(CubeError::Usage(format!(
-                    "{}: is a folder, but layout {} is a single image",
-                    one.display(),
-                    l.name()
-                )));
+                return Err(CubeError::Usage(UsageProblem::FolderForSingleImage {
+                    path: one.clone(),
+                    layout: l,
+                }));
             }
             let entries = std::fs::read_dir(one).map_err(|e| CubeError::Read {
                 path: one.clone(),
@@ -142,27 +144,23 @@ pub fn load_cube(
             if files.is_empty() {
                 return Err(CubeError::Faces {
                     what: one.display().to_string(),
-                    reason: "no face images found (expected names ending in front/right/back/left/up/down, \
-                             ft/rt/bk/lf/up/dn or px/nx/py/ny/pz/nz)"
-                        .into(),
+                    problem: FacesProblem::NoFaceImages,
                 });
             }
             load_face_files(&one.display().to_string(), &files, naming)
         }
         [one] => match layout {
-            Some(Layout::Files) => Err(CubeError::Usage(format!(
-                "{}: layout files needs six face files or a folder, got one file",
-                one.display()
-            ))),
+            Some(Layout::Files) => Err(CubeError::Usage(UsageProblem::OneFileForFiles {
+                path: one.clone(),
+            })),
             l => load_layout_image(one, l),
         },
         many => {
             if let Some(l) = layout.filter(|l| *l != Layout::Files) {
-                return Err(CubeError::Usage(format!(
-                    "{} inputs given, but layout {} is a single image",
-                    many.len(),
-                    l.name()
-                )));
+                return Err(CubeError::Usage(UsageProblem::ManyForSingleImage {
+                    count: many.len(),
+                    layout: l,
+                }));
             }
             load_face_files("face list", many, naming)
         }
@@ -184,37 +182,29 @@ pub fn load_face_files(
         let Some((face, kind)) = classify(f) else {
             return Err(CubeError::Faces {
                 what: f.display().to_string(),
-                reason: "the file name does not say which face it is (expected it to end in \
-                         front/right/back/left/up/down, ft/rt/bk/lf/up/dn or px/nx/py/ny/pz/nz)"
-                    .into(),
+                problem: FacesProblem::UnnamedFace,
             });
         };
         if let Some((prev, _)) = slots[face.index()] {
             return Err(CubeError::Faces {
                 what: what.into(),
-                reason: format!(
-                    "two files for the {} face: {} and {}",
-                    face.name(),
-                    prev.display(),
-                    f.display()
-                ),
+                problem: FacesProblem::Duplicate {
+                    face,
+                    first: prev.to_path_buf(),
+                    second: f.to_path_buf(),
+                },
             });
         }
         slots[face.index()] = Some((f, kind));
     }
-    let missing: Vec<&str> = Face::ALL
-        .iter()
+    let missing: Vec<Face> = Face::ALL
+        .into_iter()
         .filter(|f| slots[f.index()].is_none())
-        .map(|f| f.name())
         .collect();
     if !missing.is_empty() {
         return Err(CubeError::Faces {
             what: what.into(),
-            reason: format!(
-                "{} face file(s) given, a cube needs six; missing: {}",
-                6 - missing.len(),
-                missing.join(", ")
-            ),
+            problem: FacesProblem::Missing { missing },
         });
     }
     let sky = slots.iter().flatten().any(|(_, k)| *k == NameKind::SkyBox);
@@ -281,20 +271,23 @@ pub fn load_layout_image(path: &Path, layout: Option<Layout>) -> Result<CubeMap,
             Some(l) => l,
             None => Layout::detect(w, h).ok_or_else(|| CubeError::Layout {
                 path: path.to_path_buf(),
-                reason: format!(
-                    "image is {w}x{h}; a single-image cube map must be 4:3 (cross), 6:1 (strip) or \
-                     3:2 (3x2); for six files give a folder or six paths"
-                ),
+                problem: LayoutProblem::NoLayout {
+                    width: w,
+                    height: h,
+                },
             })?,
         };
         let (c, r) = l.grid().unwrap_or((1, 1));
         if !w.is_multiple_of(c) || !h.is_multiple_of(r) || w / c != h / r {
             return Err(CubeError::Layout {
                 path: path.to_path_buf(),
-                reason: format!(
-                    "image is {w}x{h}, which is not {c}x{r} square faces as layout {} needs",
-                    l.name()
-                ),
+                problem: LayoutProblem::NotFaces {
+                    width: w,
+                    height: h,
+                    cols: c,
+                    rows: r,
+                    layout: l,
+                },
             });
         }
         check_face_size(&path.display().to_string(), w / c)?;

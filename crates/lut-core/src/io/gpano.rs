@@ -30,7 +30,7 @@
 //!   `image width / CroppedAreaImageWidthPixels`, provided the height agrees within 1 %;
 //!   otherwise an error.
 
-use crate::error::CoverageError;
+use crate::error::{CoverageError, GPanoError};
 use crate::geom::coverage::Crop;
 use crate::geom::limits::MAX_MAP_WIDTH;
 
@@ -38,31 +38,6 @@ use crate::geom::limits::MAX_MAP_WIDTH;
 pub const GPANO_NS: &str = "http://ns.google.com/photos/1.0/panorama/";
 /// The signature that opens a JPEG APP1 segment holding the main XMP packet.
 pub const XMP_SIGNATURE: &[u8] = b"http://ns.adobe.com/xap/1.0/\0";
-
-/// Why GPano metadata cannot be used.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum GPanoError {
-    /// The XMP packet mentions GPano but is not well-formed XML.
-    #[error("XMP metadata is not well-formed XML: {0}")]
-    Xml(String),
-    /// A field's value is not a usable number.
-    #[error("GPano:{field} = '{value}' is not {expected}")]
-    Value {
-        /// Field name without prefix.
-        field: &'static str,
-        /// The text found.
-        value: String,
-        /// What was expected.
-        expected: &'static str,
-    },
-    /// Some crop fields are present and others are missing.
-    #[error("GPano metadata is incomplete: {0} is missing")]
-    Missing(&'static str),
-    /// The fields do not describe a crop of the full panorama.
-    #[error("GPano metadata is inconsistent: {0}")]
-    Inconsistent(String),
-}
 
 /// The GPano fields of one file (pixel values as written, not yet checked against the
 /// image).
@@ -199,12 +174,10 @@ impl GPano {
     /// (the rules are in the module docs).
     ///
     /// # Errors
-    /// [`CoverageError::Invalid`] naming the field and the values.
+    /// [`CoverageError::GPanoCrop`] naming the field and the values, or the
+    /// [`CoverageError::Crop`] of an impossible crop.
     pub fn crop_for_image(&self, image_w: u32, image_h: u32) -> Result<Crop, CoverageError> {
-        let err = |e: GPanoError| CoverageError::Invalid {
-            what: "GPano XMP".into(),
-            reason: e.to_string(),
-        };
+        let err = CoverageError::GPanoCrop;
         if let Some(t) = &self.projection_type {
             if !t.eq_ignore_ascii_case("equirectangular") {
                 return Err(err(GPanoError::Inconsistent(format!(
@@ -503,7 +476,10 @@ mod tests {
         for (g, (w, h)) in cases {
             let e = g.crop_for_image(w, h);
             assert!(
-                matches!(e, Err(CoverageError::Invalid { .. })),
+                matches!(
+                    e,
+                    Err(CoverageError::GPanoCrop(_) | CoverageError::Crop { .. })
+                ),
                 "{g:?} {w}x{h}: {e:?}"
             );
         }

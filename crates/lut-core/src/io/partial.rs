@@ -9,10 +9,11 @@ use crate::io::load::{decode_map, load_map, LoadOptions, LoadProgress};
 use crate::map::envmap::EnvMap;
 use std::path::Path;
 
-fn invalid(what: impl Into<String>, reason: impl Into<String>) -> CoverageError {
-    CoverageError::Invalid {
-        what: what.into(),
-        reason: reason.into(),
+/// `error` about the file `what`.
+fn in_file(what: &str, error: CoverageError) -> CoverageError {
+    CoverageError::InFile {
+        what: what.to_string(),
+        error: Box::new(error),
     }
 }
 
@@ -92,13 +93,12 @@ fn place_partial(
     let projection = opts.projection;
     let equirect = matches!(projection, None | Some(Projection::Equirect));
     if coverage.is_some() && !equirect {
-        return Err(invalid(
-            what,
-            "a coverage applies to equirectangular panoramas only",
-        ));
+        return Err(CoverageError::NotEquirect {
+            what: what.to_string(),
+        });
     }
     let meta = if coverage.is_none() && equirect {
-        crate::io::gpano::read_gpano(head).map_err(|e| invalid(what, e.to_string()))?
+        crate::io::gpano::read_gpano(head).map_err(|e| in_file(what, CoverageError::Metadata(e)))?
     } else {
         None
     };
@@ -123,7 +123,7 @@ fn place_partial(
         // Not reached (`has_crop` needs one of them); the whole sphere is harmless.
         (None, None) => (Coverage::FULL.crop_for_image(iw, ih), CoverageSource::Full),
     };
-    let crop = crop.map_err(|e| invalid(what, e.to_string()))?;
+    let crop = crop.map_err(|e| in_file(what, e))?;
     m.set_pose_heading_deg(heading);
     let m = m.into_partial(crop)?;
     let source = if m.crop().is_none() {

@@ -9,13 +9,6 @@ use crate::geom::projection::Projection;
 use crate::map::envmap::EnvMap;
 use crate::map::sample::Sampler;
 
-fn invalid(what: impl Into<String>, reason: impl Into<String>) -> CoverageError {
-    CoverageError::Invalid {
-        what: what.into(),
-        reason: reason.into(),
-    }
-}
-
 impl EnvMap {
     /// Where the stored pixels sit in the full panorama, for a partial map.
     pub fn crop(&self) -> Option<Crop> {
@@ -57,19 +50,17 @@ impl EnvMap {
     /// panorama gives an ordinary map.
     ///
     /// # Errors
-    /// [`CoverageError::Invalid`] when the stored size is not the crop's size.
+    /// [`CoverageError::StoredSize`] when the stored size is not the crop's size.
     pub fn into_partial(self, crop: Crop) -> Result<EnvMap, CoverageError> {
         if (self.width, self.height) != (crop.width(), crop.height()) {
-            return Err(invalid(
-                format!(
-                    "crop {}x{} of a {}x{} panorama",
-                    crop.width(),
-                    crop.height(),
-                    crop.full_width(),
-                    crop.full_height()
-                ),
-                format!("the image is {}x{}", self.width, self.height),
-            ));
+            return Err(CoverageError::StoredSize {
+                crop_width: crop.width(),
+                crop_height: crop.height(),
+                full_width: crop.full_width(),
+                full_height: crop.full_height(),
+                width: self.width,
+                height: self.height,
+            });
         }
         // The padding column must repeat column 0 only when the crop spans 360°.
         let wrap = crop.width() == crop.full_width();
@@ -227,6 +218,6 @@ mod tests {
     fn wrong_stored_size_is_an_error() {
         let m = EnvMap::from_pixels(4, 4, &[0; 16], Projection::Cylinder).unwrap();
         let e = m.into_partial(Crop::new(100, 50, 0, 0, 5, 4).unwrap());
-        assert!(matches!(e, Err(CoverageError::Invalid { .. })));
+        assert!(matches!(e, Err(CoverageError::StoredSize { .. })));
     }
 }

@@ -29,7 +29,9 @@
 
 use super::exact::render_exact;
 use super::frame::Frame;
-use crate::cube::{check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face};
+use crate::cube::{
+    check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
+};
 use crate::geom::camera::View;
 use crate::map::envmap::EnvMap;
 use crate::map::sample::Sampler;
@@ -414,7 +416,10 @@ impl CubeMap {
         for (k, face) in Face::ALL.iter().enumerate() {
             let mut buf = vec![0u32; n * n];
             let mut frame = Frame::new(&mut buf, face_size, face_size).map_err(|e| {
-                CubeError::Usage(format!("cannot render {} face: {e}", face.name()))
+                CubeError::Usage(UsageProblem::FaceRender {
+                    face: *face,
+                    error: e,
+                })
             })?;
             render_exact(map, face.view(), sampler, &mut frame, true);
             faces[k] = buf;
