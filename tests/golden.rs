@@ -294,22 +294,7 @@ fn golden_lit() {
     for y in 0..h {
         for x in 0..w {
             let d = cam.world_ray(x as f64 + 0.5, y as f64 + 0.5);
-            // The room box: |x| ≤ rw/2, 0 ≤ y ≤ rh, |z| ≤ rd/2; the nearest wall ahead.
-            let mut t = f64::INFINITY;
-            let mut n = DVec3::ZERO;
-            for (tt, nn) in [
-                ((rw / 2.0 - origin.x) / d.x, DVec3::NEG_X),
-                ((-rw / 2.0 - origin.x) / d.x, DVec3::X),
-                ((rh - origin.y) / d.y, DVec3::NEG_Y),
-                ((0.0 - origin.y) / d.y, DVec3::Y),
-                ((rd / 2.0 - origin.z) / d.z, DVec3::NEG_Z),
-                ((-rd / 2.0 - origin.z) / d.z, DVec3::Z),
-            ] {
-                if tt.is_finite() && tt > 0.0 && tt < t {
-                    (t, n) = (tt, nn);
-                }
-            }
-            let p = origin + d * t;
+            let (p, n) = test_support::geometry::room_hit(origin, d, rw, rd, rh);
             let to = light - p;
             let dist = to.length();
             let e = 800.0 * (n.dot(to) / dist).max(0.0) / (dist * dist);

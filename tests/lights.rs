@@ -9,6 +9,7 @@ use lut_core::{
 use lut_core::{Camera, View};
 use std::path::PathBuf;
 use std::sync::Arc;
+use test_support::geometry::room_hit;
 
 fn data(name: &str) -> PathBuf {
     test_support::test_data("ies").join(name)
@@ -534,29 +535,6 @@ fn distance_series_tends_to_the_far_field_table_for_smooth_light() {
 
 // ---------------------------------------------------------------- lighting
 
-/// Independent ray/box intersection for the tests: the room spans x ±W/2, y 0..H, z ±D/2.
-fn box_hit(o: DVec3, d: DVec3, w: f64, dep: f64, ht: f64) -> (DVec3, DVec3) {
-    let cands = [
-        ((w / 2.0 - o.x) / d.x, DVec3::NEG_X),
-        ((-w / 2.0 - o.x) / d.x, DVec3::X),
-        ((ht - o.y) / d.y, DVec3::NEG_Y),
-        ((0.0 - o.y) / d.y, DVec3::Y),
-        ((dep / 2.0 - o.z) / d.z, DVec3::NEG_Z),
-        ((-dep / 2.0 - o.z) / d.z, DVec3::Z),
-    ];
-    let (t, n) = cands
-        .iter()
-        .filter(|(t, _)| t.is_finite() && *t > 0.0)
-        .fold((f64::INFINITY, DVec3::ZERO), |a, &(t, n)| {
-            if t < a.0 {
-                (t, n)
-            } else {
-                a
-            }
-        });
-    (o + d * t, n)
-}
-
 fn isotropic(candela: f64) -> Arc<LightTable> {
     let f = synth(1, &[0.0, 90.0, 180.0], &[0.0], |_, _| candela, 1.0);
     Arc::new(table(&f))
@@ -585,7 +563,7 @@ fn isotropic_source_gives_i_cos_over_d_squared() {
         for py in (0..48).step_by(5) {
             for px in (0..64).step_by(7) {
                 let (x, y) = (px as f64 + 0.5, py as f64 + 0.5);
-                let (p, n) = box_hit(origin, cam.world_ray(x, y), w, dep, ht);
+                let (p, n) = room_hit(origin, cam.world_ray(x, y), w, dep, ht);
                 let to = light_pos - p;
                 let d = to.length();
                 let cos = (n.dot(to) / d).max(0.0);

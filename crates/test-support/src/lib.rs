@@ -1,12 +1,14 @@
 //! What every lutpano test binary shares: golden-image comparison against stored truths
 //! ([`golden`]), pixel statistics ([`pixels`]: PSNR, per-channel differences), a counting
 //! global allocator ([`alloc`]), header-only decompression bombs ([`bombs`]) and frames
-//! rendered into new buffers ([`render`]).
+//! rendered into new buffers ([`render`]), and geometry computed independently of the
+//! library ([`geometry`]).
 //!
 //! A dev-dependency of `lut-core` and `viewer`; never published.
 
 pub mod alloc;
 pub mod bombs;
+pub mod geometry;
 pub mod golden;
 pub mod pixels;
 pub mod render;
