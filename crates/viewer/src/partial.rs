@@ -30,7 +30,7 @@ pub fn coverage_error(e: lut_core::CoverageError, coverage: Option<Coverage>) ->
 
 /// Load a panorama (`None`: the bundled sample) with the pixel limit, projection and tone
 /// of `opts`, placed by `coverage` when given, else by the GPano XMP in the file (JPEG),
-/// else as a full panorama; `progress` as in `EnvMap::load_with`. Bad metadata is an
+/// else as a full panorama; `progress` as in `lut_core::load_map`. Bad metadata is an
 /// error that says how to override it.
 pub fn load_panorama_partial(
     path: Option<&Path>,
