@@ -4,11 +4,29 @@
 //! partial map (coverage, compass heading).
 
 use crate::args::CubeArgs;
-use anyhow::Result;
-use lut_core::coverage::{compass_heading, compass_point};
-use lut_core::cube::CubeMap;
-use lut_core::{Coverage, CoverageSource, EnvMap, Layout, LoadOptions};
+use anyhow::{anyhow, Result};
+use lut_core::{compass_heading, compass_point};
+use lut_core::{Coverage, CoverageSource, CubeMap, EnvMap, Layout, LoadOptions, MapError};
 use std::path::{Path, PathBuf};
+
+/// The command-line hint for a library map error: which flag changes the outcome.
+pub fn map_error_hint(e: &MapError) -> Option<&'static str> {
+    match e {
+        MapError::TooManyPixels { .. } => Some("raise the limit with --max-pixels"),
+        MapError::UnknownProjection { .. } => {
+            Some("give --projection cylinder|sine|elliptical|diamond")
+        }
+        _ => None,
+    }
+}
+
+/// A library map error as one line, with its command-line hint (see [`map_error_hint`]).
+pub fn map_error(e: MapError) -> anyhow::Error {
+    match map_error_hint(&e) {
+        Some(hint) => anyhow!("{e}; {hint}"),
+        None => anyhow::Error::new(e),
+    }
+}
 
 /// Load the panorama at `path` (the bundled sample when `None`) with `opts`: projection,
 /// tone and the pixel limit (`--max-pixels`, checked from the header before decoding).
@@ -16,31 +34,37 @@ use std::path::{Path, PathBuf};
 /// not read (see [`load_panorama_partial`]).
 pub fn load_panorama(path: Option<&Path>, opts: &LoadOptions) -> Result<EnvMap> {
     Ok(match path {
-        Some(p) => EnvMap::load_with(p, opts, &mut |_| {})?,
-        None => EnvMap::decode_with(
+        Some(p) => lut_core::load_map(p, opts, &mut |_| {}).map_err(map_error)?,
+        None => lut_core::decode_map(
             crate::assets::SAMPLE_JPEG,
             crate::assets::SAMPLE_NAME,
             opts,
             &mut |_| {},
-        )?,
+        )
+        .map_err(map_error)?,
     })
 }
 
-/// Turn a placement error into one line that says how to override bad metadata.
+/// Turn a placement error into one line that says how to override bad metadata (or, for
+/// an image that cannot be read, the hint of [`map_error`]).
 pub fn coverage_error(e: lut_core::CoverageError, coverage: Option<Coverage>) -> anyhow::Error {
+    if let lut_core::CoverageError::Map(m) = e {
+        return map_error(m);
+    }
     let hint = match (&e, coverage) {
-        (lut_core::CoverageError::Invalid { .. }, None) => {
+        (lut_core::CoverageError::Syntax { .. }, _) | (_, Some(_)) => "",
+        // Bad metadata or a placement that does not fit, and no coverage given.
+        (_, None) => {
             " (give --coverage HFOVxVFOV±YAW±PITCH to place the image yourself, e.g. \
              --coverage 360x180 to show it as a full panorama)"
         }
-        _ => "",
     };
     anyhow::anyhow!("{e}{hint}")
 }
 
 /// Load a panorama (`None`: the bundled sample) with the pixel limit, projection and tone
 /// of `opts`, placed by `coverage` when given, else by the GPano XMP in the file (JPEG),
-/// else as a full panorama; `progress` as in `EnvMap::load_with`. Bad metadata is an
+/// else as a full panorama; `progress` as in `lut_core::load_map`. Bad metadata is an
 /// error that says how to override it.
 pub fn load_panorama_partial(
     path: Option<&Path>,
@@ -49,8 +73,8 @@ pub fn load_panorama_partial(
     progress: &mut dyn FnMut(lut_core::LoadProgress),
 ) -> Result<(EnvMap, CoverageSource)> {
     match path {
-        Some(p) => EnvMap::load_partial_with(p, opts, coverage, progress),
-        None => EnvMap::decode_partial_with(
+        Some(p) => lut_core::load_partial(p, opts, coverage, progress),
+        None => lut_core::decode_partial(
             crate::assets::SAMPLE_JPEG,
             crate::assets::SAMPLE_NAME,
             opts,
@@ -91,9 +115,9 @@ pub fn heading_text(map: &EnvMap, yaw: f64) -> Option<String> {
 /// `docs/cube.md`).
 ///
 /// # Errors
-/// Every [`lut_core::cube::CubeError`], with the file named.
+/// Every [`lut_core::CubeError`], with the file named.
 pub fn load_cube(inputs: &[PathBuf], cube: CubeArgs) -> Result<CubeMap> {
-    Ok(lut_core::cube::load_cube(inputs, cube.layout, cube.naming)?)
+    Ok(lut_core::load_cube(inputs, cube.layout, cube.naming)?)
 }
 
 /// True when `inputs` look like a cube map rather than one panorama image: a folder, six

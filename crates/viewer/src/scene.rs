@@ -1,10 +1,9 @@
-//! What the viewer renders — a map through its LUT renderer, or a cube map — and the one
-//! function that renders it, [`render_scene`]. `viewer render`, the window (frames and
-//! "Save view…") and `viewer bench` all render through it, so the choice between the map
-//! and the cube renderer is made in one place.
+//! What the viewer renders — a map with its LUT renderer (which owns the tables), or a
+//! cube map — and the one function that renders it, [`render_scene`], through lut-core's
+//! one render entry. `viewer render`, the window (frames and "Save view…") and `viewer
+//! bench` all render through it.
 
-use lut_core::cube::CubeMap;
-use lut_core::{CubeRenderer, EnvMap, RenderOptions, RenderReport, Renderer, View, ViewError};
+use lut_core::{CubeMap, EnvMap, Frame, RenderOptions, RenderReport, Renderer, View, ViewError};
 
 /// A panorama ready to render, owning its data (and, for a map, its tables).
 pub enum Scene {
@@ -56,100 +55,77 @@ pub enum SceneRef<'a> {
     Cube(&'a CubeMap),
 }
 
-/// How to render a scene: the map options (of which a cube map uses the sampler and the
-/// threads) and the cube renderer.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SceneOptions {
-    /// Options of the map renderer; a cube map reads `sampler` and `threads`.
-    pub render: RenderOptions,
-    /// The cube renderer.
-    pub cube: CubeRenderer,
-}
-
-impl SceneOptions {
-    /// `render` for maps, the default (scanline) renderer for cubes.
-    pub fn new(render: RenderOptions) -> SceneOptions {
-        SceneOptions {
-            render,
-            cube: CubeRenderer::default(),
-        }
-    }
-}
-
-/// What rendered a frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum SceneReport {
-    /// The map renderer's report.
-    Map(RenderReport),
-    /// A cube map, by this renderer.
-    Cube(CubeRenderer),
-}
-
-/// Render `view` of `scene` into `out` (`width × height` 0RGB pixels).
+/// Render `view` of `scene` into `out` (`width × height` 0RGB pixels) through lut-core's
+/// one render entry: a map with its renderer (and tables), a cube map with
+/// `opts.cube`.
 ///
 /// # Errors
-/// As `Renderer::render` and `lut_core::cube::render`: a bad size or buffer, a bad option.
+/// As `Frame::new` and `Renderer::render`: a bad size or buffer, a bad option.
 pub fn render_scene(
     scene: SceneRef<'_>,
     view: View,
-    opts: &SceneOptions,
+    opts: &RenderOptions,
     out: &mut [u32],
     width: u32,
     height: u32,
-) -> Result<SceneReport, ViewError> {
+) -> Result<RenderReport, ViewError> {
+    let mut frame = Frame::new(out, width, height)?;
     match scene {
-        SceneRef::Map { map, renderer } => renderer
-            .render(map, view, &opts.render, out, width, height)
-            .map(SceneReport::Map),
-        SceneRef::Cube(cube) => lut_core::cube::render(
-            cube,
-            view,
-            opts.render.sampler,
-            opts.cube,
-            out,
-            width,
-            height,
-            opts.render.threads,
-        )
-        .map(|()| SceneReport::Cube(opts.cube)),
+        SceneRef::Map { map, renderer } => {
+            renderer.render(lut_core::Scene::Map(map), view, opts, &mut frame)
+        }
+        SceneRef::Cube(cube) => {
+            Renderer::default().render(lut_core::Scene::Cube(cube), view, opts, &mut frame)
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lut_core::{Projection, RenderPath, Sampler};
+    use lut_core::{CubeRenderer, Projection, RenderPath, Sampler};
 
-    /// The map path is `Renderer::render`, the cube path `cube::render`, with the options
-    /// given: same pixels as calling them directly.
+    /// The map path is the map's renderer, the cube path lut-core's cube renderer, with
+    /// the options given: same pixels as calling lut-core directly.
     #[test]
-    fn renders_maps_and_cubes_as_their_renderers_do() {
-        let map = lut_core::synth::grid_map(128, 64, Projection::Equirect).unwrap();
+    fn renders_maps_and_cubes_as_lut_core_does() {
+        let map = lut_core::grid_map(128, 64, Projection::Equirect).unwrap();
         let view = View::new(30.0, 10.0, 90.0).unwrap();
         let (w, h) = (40, 24);
-        let opts = SceneOptions::new(RenderOptions {
+        let opts = RenderOptions {
             sampler: Sampler::Nearest,
             ..RenderOptions::default()
-        });
+        };
         let mut want = vec![0u32; (w * h) as usize];
         let direct = Renderer::new(&map)
-            .render(&map, view, &opts.render, &mut want, w, h)
+            .render(
+                lut_core::Scene::Map(&map),
+                view,
+                &opts,
+                &mut Frame::new(&mut want, w, h).unwrap(),
+            )
             .unwrap();
         let cube = CubeMap::from_envmap(&map, 16, Sampler::Bilinear).unwrap();
         let mut scene = Scene::map(map);
         let mut got = vec![1u32; want.len()];
         let report = render_scene(scene.as_mut(), view, &opts, &mut got, w, h).unwrap();
-        assert_eq!(report, SceneReport::Map(direct));
+        assert_eq!(report, direct);
         assert_eq!(direct.path, RenderPath::LutWide);
         assert_eq!(got, want);
 
         for kind in [CubeRenderer::Basic, CubeRenderer::Accelerated] {
-            let opts = SceneOptions { cube: kind, ..opts };
-            lut_core::cube::render(&cube, view, Sampler::Nearest, kind, &mut want, w, h, true)
+            let opts = RenderOptions { cube: kind, ..opts };
+            Renderer::default()
+                .render(
+                    lut_core::Scene::Cube(&cube),
+                    view,
+                    &opts,
+                    &mut Frame::new(&mut want, w, h).unwrap(),
+                )
                 .unwrap();
             let mut scene = Scene::Cube(cube.clone());
             let report = render_scene(scene.as_mut(), view, &opts, &mut got, w, h).unwrap();
-            assert_eq!(report, SceneReport::Cube(kind));
+            assert_eq!(report.path, RenderPath::Cube(kind));
             assert_eq!(got, want);
             assert!(scene.env_map().is_none());
         }

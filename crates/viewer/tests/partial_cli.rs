@@ -1,7 +1,7 @@
 //! `viewer render` with partial panoramas: GPano XMP in a JPEG, `--coverage`, bad
 //! metadata, `--view-limit`.
 
-use lut_core::gpano::{insert_xmp, xmp_packet};
+use lut_core::{insert_xmp, xmp_packet};
 use std::path::{Path, PathBuf};
 
 mod common;
@@ -216,7 +216,7 @@ fn coverage_places_an_untagged_image_and_overrides_bad_metadata() {
         "render",
         "--projection",
         "cube",
-        "../../tests/data/cube/skyfantasy",
+        s(&test_support::test_data("cube/skyfantasy")),
         "-o",
         s(&out),
         "--coverage",

@@ -78,13 +78,7 @@ fn paint_panel(
     }
     let p =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("window_panel_{ppp}.png"));
-    let rgb: Vec<u8> = frame
-        .iter()
-        .flat_map(|p| [(p >> 16) as u8, (p >> 8) as u8, *p as u8])
-        .collect();
-    if let Some(img) = image::RgbImage::from_raw(W, H, rgb) {
-        let _ = img.save(&p); // for a human look only
-    }
+    let _ = test_support::pixels::to_rgb(&frame, W, H).save(&p); // for a human look only
     Painted { frame, scene }
 }
 

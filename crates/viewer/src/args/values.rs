@@ -22,14 +22,14 @@ fn parse_wxh(s: &str, what: &str, example: &str) -> Result<(u32, u32), String> {
 /// An output size "WxH", each side in 1..=`MAX_OUTPUT_SIDE`.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = parse_wxh(s, "size", "1280x720")?;
-    lut_core::camera::check_size(w, h).map_err(|e| format!("size '{s}': {e}"))?;
+    lut_core::check_size(w, h).map_err(|e| format!("size '{s}': {e}"))?;
     Ok((w, h))
 }
 
 /// The size "WxH" of a generated map, within the map limits.
 pub fn parse_map_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = parse_wxh(s, "map size", "8192x4096")?;
-    lut_core::envmap::check_map_size("generated map", w, h).map_err(|e| e.to_string())?;
+    lut_core::check_map_size("generated map", w, h).map_err(|e| e.to_string())?;
     Ok((w, h))
 }
 

@@ -6,8 +6,8 @@ use crate::output::{rgb24, write_image_atomic, write_png_atomic};
 use crate::panorama::load_cube;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
-use lut_core::cube::{CubeMap, Face};
-use lut_core::{EnvMap, Layout, Named, Sampler};
+use lut_core::{CubeMap, Face};
+use lut_core::{Layout, Named, Sampler};
 use std::path::{Path, PathBuf};
 
 /// What to convert to.
@@ -89,7 +89,7 @@ fn to_cube(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()> {
     let layout = a.cube.layout.unwrap_or(Layout::Files);
     let projection = a.projection.value.map_only("convert --to cube")?;
     let opts = a.limit.options(projection, lut_core::Tone::default());
-    let map = EnvMap::load_with(input, &opts, &mut |_| {})?;
+    let map = lut_core::load_map(input, &opts, &mut |_| {}).map_err(crate::panorama::map_error)?;
     let face_size = a.face_size.unwrap_or((map.width() / 4).max(1));
     let cube = CubeMap::from_envmap(&map, face_size, a.sampler)?;
     write_cube(&cube, layout, output)

@@ -5,7 +5,7 @@
 use crate::args::values::finite;
 use anyhow::Result;
 use clap::Args;
-use lut_core::light::{LightTable, Photometry, PhotometrySource, TableOptions};
+use lut_core::{LightTable, Photometry, PhotometrySource, TableOptions};
 use std::path::PathBuf;
 
 /// Arguments of `viewer ies`.

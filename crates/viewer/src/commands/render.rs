@@ -4,10 +4,12 @@ use crate::args::{named, parse_angle, parse_size, parse_stops, InputArgs, MaxPix
 use crate::lighting::{apply_lights, LightArgs};
 use crate::output::write_png_atomic;
 use crate::panorama::{coverage_text, heading_text, load_cube, load_panorama_partial};
-use crate::scene::{render_scene, Scene, SceneOptions, SceneReport};
+use crate::scene::{render_scene, Scene};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use lut_core::{IndexStep, LutChoice, RenderOptions, RendererKind, Sampler, Surface, View};
+use lut_core::{
+    IndexStep, LutChoice, RenderOptions, RenderReport, RendererKind, Sampler, Surface, View,
+};
 use std::path::PathBuf;
 
 /// Arguments of `viewer render`.
@@ -81,6 +83,7 @@ impl RenderArgs {
             lut: self.lut,
             surface: self.lut_surface,
             threads: !self.single_thread,
+            cube: self.input.cube_renderer,
         }
     }
 
@@ -122,11 +125,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         view = lut_core::limit_view(view, w, h, &map.coverage());
     }
     let mut out = vec![0u32; w as usize * h as usize];
-    let opts = SceneOptions {
-        render: a.options(),
-        cube: a.input.cube_renderer,
-    };
-    let report = render_scene(scene.as_mut(), view, &opts, &mut out, w, h)?;
+    let report = render_scene(scene.as_mut(), view, &a.options(), &mut out, w, h)?;
     if a.verbose {
         print_report(&a, &scene, &report, view);
     }
@@ -136,10 +135,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
 }
 
 /// `-v`: what rendered the frame, on stderr.
-fn print_report(a: &RenderArgs, scene: &Scene, report: &SceneReport, view: View) {
+fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View) {
     let (w, h) = a.size;
-    match (scene, report) {
-        (Scene::Map { map, .. }, SceneReport::Map(report)) => {
+    match scene {
+        Scene::Map { map, .. } => {
             eprintln!(
                 "rendered {}x{} from {}x{} {} map: path {}, table {} bytes, {} of {} pixels exact, index step {}..{}",
                 w,
@@ -169,11 +168,10 @@ fn print_report(a: &RenderArgs, scene: &Scene, report: &SceneReport, view: View)
                 eprintln!("view centre {hd}");
             }
         }
-        (Scene::Cube(cube), _) => eprintln!(
+        Scene::Cube(cube) => eprintln!(
             "rendered {w}x{h} from a cube map of {}px faces",
             cube.face_size()
         ),
-        (Scene::Map { .. }, SceneReport::Cube(_)) => {}
     }
 }
 
@@ -196,6 +194,7 @@ mod tests {
     fn defaults_are_the_documented_ones() {
         let a = render_args(&[]).unwrap();
         assert_eq!(a.options(), lut_core::RenderOptions::default());
+        assert_eq!(a.options().cube, CubeRenderer::Accelerated);
         assert_eq!(a.size, (1280, 720));
         assert_eq!((a.yaw, a.pitch, a.hfov), (0.0, 0.0, 90.0));
         assert_eq!(a.input.cube_renderer, CubeRenderer::Accelerated);

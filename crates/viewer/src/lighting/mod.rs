@@ -12,8 +12,8 @@ pub use state::{
 use crate::args::values::finite;
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
-use lut_core::light::{LightTable, Room, ShadeOptions};
 use lut_core::View;
+use lut_core::{LightTable, Room, ShadeOptions};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -183,7 +183,7 @@ pub fn apply_lights(args: &LightArgs, view: View, frame: &mut [u32], w: u32, h: 
 /// A real IES file of the test data, for the unit tests.
 #[cfg(test)]
 fn sample_path() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/ies/type_b_full.ies")
+    test_support::test_data("ies/type_b_full.ies")
 }
 
 #[cfg(test)]

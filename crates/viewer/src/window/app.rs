@@ -15,9 +15,9 @@ use super::paint::{Compositor, SceneRect};
 use super::ui::{self, PanelModel};
 use super::OpenArgs;
 use crate::lighting::{LightsKey, LightsState};
-use crate::scene::{render_scene, Scene, SceneOptions, SceneReport};
+use crate::scene::render_scene;
 use anyhow::{anyhow, Result};
-use lut_core::{CubeRenderer, IndexStep, LutChoice, RendererKind, Sampler};
+use lut_core::{CubeRenderer, IndexStep, LutChoice, RenderPath, RendererKind, Sampler};
 use std::collections::VecDeque;
 use std::num::NonZeroU32;
 use std::rc::Rc;
@@ -422,13 +422,9 @@ impl App {
             .doc
             .current_mut()
             .ok_or_else(|| "no panorama loaded".to_string())?;
-        let opts = self.ctl.settings.scene_options(false);
-        let opts = SceneOptions {
-            render: lut_core::RenderOptions {
-                sampler: self.ctl.settings.sampler,
-                ..opts.render
-            },
-            ..opts
+        let opts = lut_core::RenderOptions {
+            sampler: self.ctl.settings.sampler,
+            ..self.ctl.settings.render_options(false)
         };
         let view = self.ctl.look().view();
         let mut buf = vec![0u32; w as usize * h as usize];
@@ -444,14 +440,14 @@ impl App {
         let Some(cur) = self.doc.current_mut() else {
             return;
         };
-        let opts = self.ctl.settings.scene_options(fast);
+        let opts = self.ctl.settings.render_options(fast);
         let key = SceneKey {
             look,
             size: (rect.w, rect.h),
-            renderer: opts.render.renderer,
-            sampler: opts.render.sampler,
-            index_step: opts.render.index_step,
-            lut: opts.render.lut,
+            renderer: opts.renderer,
+            sampler: opts.sampler,
+            index_step: opts.index_step,
+            lut: opts.lut,
             cube_renderer: opts.cube,
             map_generation: generation,
             lights: self.lights.key(),
@@ -462,10 +458,6 @@ impl App {
         self.scene.resize(rect.w as usize * rect.h as usize, 0);
         let t0 = Instant::now();
         let view = look.view();
-        let cube_bytes = match &cur.scene {
-            Scene::Cube(cube) => cube.bytes(),
-            Scene::Map { .. } => 0,
-        };
         let result = render_scene(
             cur.scene.as_mut(),
             view,
@@ -477,25 +469,22 @@ impl App {
         match result {
             Ok(report) => {
                 let readouts = &mut self.doc.readouts;
-                let path = match report {
-                    SceneReport::Map(report) => {
-                        readouts.path = Some(report.path);
-                        readouts.table_bytes = report.table_bytes;
-                        readouts.exact_pixels = report.exact_pixels;
-                        readouts.pixels = report.pixels;
-                        readouts.cube = None;
-                        format!("{:?}", report.path)
-                    }
-                    SceneReport::Cube(kind) => {
+                readouts.table_bytes = report.table_bytes;
+                readouts.exact_pixels = report.exact_pixels;
+                readouts.pixels = report.pixels;
+                let path = match report.path {
+                    RenderPath::Cube(kind) => {
                         readouts.path = None;
-                        readouts.table_bytes = cube_bytes;
-                        readouts.exact_pixels = 0;
-                        readouts.pixels = u64::from(rect.w) * u64::from(rect.h);
                         readouts.cube = Some(kind);
                         match kind {
                             CubeRenderer::Basic => "CubeBasic".to_string(),
                             CubeRenderer::Accelerated => "CubeScanline".to_string(),
                         }
+                    }
+                    path => {
+                        readouts.path = Some(path);
+                        readouts.cube = None;
+                        format!("{path:?}")
                     }
                 };
                 self.light_scene(view, rect);
@@ -509,7 +498,7 @@ impl App {
                         look.yaw,
                         look.pitch,
                         look.hfov,
-                        opts.render.sampler.name(),
+                        opts.sampler.name(),
                         fast,
                         rect.w,
                         rect.h,
@@ -542,14 +531,9 @@ impl App {
         look: Look,
     ) -> bool {
         let lux = match (cursor, rect, self.lights.scene()) {
-            (Some((x, y)), Some(r), Ok(Some(scene))) if r.w > 0 && r.h > 0 => {
-                Some(lut_core::light::lux_at(
-                    &scene,
-                    &lut_core::Camera::new(look.view(), r.w, r.h),
-                    x,
-                    y,
-                ))
-            }
+            (Some((x, y)), Some(r), Ok(Some(scene))) if r.w > 0 && r.h > 0 => Some(
+                lut_core::lux_at(&scene, &lut_core::Camera::new(look.view(), r.w, r.h), x, y),
+            ),
             _ => None,
         };
         let changed = lux.map(f64::to_bits) != self.lights.lux_at_cursor.map(f64::to_bits);

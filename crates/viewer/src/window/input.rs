@@ -18,9 +18,8 @@
 //!   than [`FAST_HFOV_PER_S`] is rendered with nearest sampling; [`SETTLE_S`] after the
 //!   motion stops one full-quality frame is due ([`Controller::wake_at`]).
 
-use crate::scene::SceneOptions;
 use glam::DVec3;
-use lut_core::camera::{dir_to_lat_long, wrap_deg};
+use lut_core::{dir_to_lat_long, wrap_deg};
 use lut_core::{
     Camera, CubeRenderer, IndexStep, LutChoice, Named, RenderOptions, RendererKind, Sampler, View,
 };
@@ -209,7 +208,8 @@ impl Settings {
         }
     }
 
-    /// Render options of a frame (the same options `viewer render` takes).
+    /// Render options of a frame of a map or a cube map (the same options `viewer
+    /// render` takes).
     pub fn render_options(&self, fast: bool) -> RenderOptions {
         RenderOptions {
             renderer: self.renderer,
@@ -217,15 +217,8 @@ impl Settings {
             index_step: self.index_step,
             lut: self.lut,
             threads: true,
-            ..RenderOptions::default()
-        }
-    }
-
-    /// Options of a frame of a map or a cube map.
-    pub fn scene_options(&self, fast: bool) -> SceneOptions {
-        SceneOptions {
-            render: self.render_options(fast),
             cube: self.cube_renderer,
+            ..RenderOptions::default()
         }
     }
 }
@@ -950,8 +943,8 @@ mod tests {
 
     #[test]
     fn wheel_crosses_the_lut_switch() {
-        let map = lut_core::synth::grid_map(256, 128, lut_core::Projection::Equirect)
-            .expect("synthetic map");
+        let map =
+            lut_core::grid_map(256, 128, lut_core::Projection::Equirect).expect("synthetic map");
         let mut r = lut_core::Renderer::new(&map);
         let (w, h) = (64, 40);
         let mut out = vec![0u32; w * h];
@@ -961,9 +954,14 @@ mod tests {
         while c.look().hfov > 40.0 {
             let opts = c.settings.render_options(false);
             let report = r
-                .render(&map, c.look().view(), &opts, &mut out, w as u32, h as u32)
+                .render(
+                    lut_core::Scene::Map(&map),
+                    c.look().view(),
+                    &opts,
+                    &mut lut_core::Frame::new(&mut out, w as u32, h as u32).expect("frame"),
+                )
                 .expect("render");
-            let want = if c.look().hfov > lut_core::raster::LUT_SWITCH_HFOV {
+            let want = if c.look().hfov > lut_core::LUT_SWITCH_HFOV {
                 lut_core::RenderPath::LutWide
             } else {
                 lut_core::RenderPath::LutHigh
@@ -1119,8 +1117,7 @@ mod tests {
         // 100° x 50° across the seam (yaw 130 to -130), a 200x100 scene
         let cov = lut_core::Coverage::new(100.0, 50.0, 180.0, 0.0).unwrap();
         let size = (200, 100);
-        let inside =
-            |c: &Controller| lut_core::viewlimit::view_inside(c.look().view(), 200, 100, &cov);
+        let inside = |c: &Controller| lut_core::view_inside(c.look().view(), 200, 100, &cov);
         let mut c = Controller::default();
         c.set_limit(Some((cov, size)));
         // the home view (yaw 0, hfov 90) cannot fit: pulled in, narrowed

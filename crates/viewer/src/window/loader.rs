@@ -199,9 +199,9 @@ pub fn load(
     let mut scene = Scene::map(map);
     if let Scene::Map { map, renderer } = &mut scene {
         let surface = lut_core::RenderOptions::default().surface;
-        renderer.table(surface, lut_core::lut::TableKind::Wide);
+        renderer.table(surface, lut_core::TableKind::Wide);
         progress(LoadStep::Tables, Some(0.3));
-        renderer.table(surface, lut_core::lut::TableKind::High);
+        renderer.table(surface, lut_core::TableKind::High);
         progress(LoadStep::Tables, Some(0.5));
         map.pyramid();
     }
@@ -305,8 +305,7 @@ mod tests {
 
     #[test]
     fn a_cube_folder_loads_as_a_cube() {
-        let dir =
-            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/cube/skyfantasy");
+        let dir = test_support::test_data("cube/skyfantasy");
         let mut steps = Vec::new();
         let loaded = load(
             request(Source::Cube {

@@ -2,7 +2,7 @@
 //! the minification set's views and configurations.
 
 use anyhow::{anyhow, Result};
-use lut_core::lut::TableKind;
+use lut_core::TableKind;
 use lut_core::{
     CubeRenderer, IndexStep, LutChoice, Named, RenderOptions, RendererKind, Sampler, Surface, View,
 };
@@ -156,6 +156,7 @@ pub fn lut_opts(sampler: Sampler, step: IndexStep, table: TableKind) -> RenderOp
         lut: lut_choice(table),
         surface: Surface::Cylinder,
         threads: true,
+        ..RenderOptions::default()
     }
 }
 

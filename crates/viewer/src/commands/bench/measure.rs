@@ -8,12 +8,14 @@ use super::configs::{
 use super::export::Export;
 use super::progress;
 use super::report::{Row, RunInfo};
-use crate::scene::{render_scene, SceneOptions, SceneRef};
+use crate::scene::{render_scene, SceneRef};
 use anyhow::{bail, Context, Result};
-use lut_core::accuracy::position_error;
-use lut_core::cube::CubeMap;
-use lut_core::exact::exact_uv;
-use lut_core::{Camera, EnvMap, Named, Projection, Renderer, RendererKind, Sampler, View};
+use lut_core::exact_uv;
+use lut_core::position_error;
+use lut_core::CubeMap;
+use lut_core::{
+    Camera, EnvMap, Frame, Named, Projection, Renderer, RendererKind, Sampler, Scene, View,
+};
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
@@ -124,7 +126,10 @@ fn render_config(
 ) -> Result<()> {
     let (w, h) = (ctx.w, ctx.h);
     let (scene, opts) = match cfg {
-        Config::Exact(s) => return Ok(lut_core::render_exact(ctx.map, view, s, out, w, h, true)?),
+        Config::Exact(s) => {
+            lut_core::render_exact(ctx.map, view, s, &mut Frame::new(out, w, h)?, true);
+            return Ok(());
+        }
         Config::Gather => {
             gather(ctx.src, idx, out, w as usize, ctx.map.background());
             return Ok(());
@@ -134,18 +139,19 @@ fn render_config(
                 map: ctx.map,
                 renderer,
             },
-            SceneOptions::new(lut_opts(s, st, ctx.set.table)),
+            lut_opts(s, st, ctx.set.table),
         ),
         Config::Cube(s, r) => {
             let Some(cube) = ctx.cube else {
                 bail!("internal: a cube configuration without a cube");
             };
-            let render = lut_core::RenderOptions {
+            let opts = lut_core::RenderOptions {
                 sampler: s,
+                cube: r,
                 threads: true,
                 ..lut_core::RenderOptions::default()
             };
-            (SceneRef::Cube(cube), SceneOptions { render, cube: r })
+            (SceneRef::Cube(cube), opts)
         }
     };
     render_scene(scene, view, &opts, out, w, h)?;
@@ -184,7 +190,13 @@ pub fn measure_errors(
                 }
             });
         for (si, s) in SAMPLERS.iter().enumerate() {
-            lut_core::render_exact(map, view, *s, &mut exact_img[si], w, h, true)?;
+            lut_core::render_exact(
+                map,
+                view,
+                *s,
+                &mut Frame::new(&mut exact_img[si], w, h)?,
+                true,
+            );
         }
         let idx: Vec<u32> = exact
             .par_iter()
@@ -385,7 +397,14 @@ pub fn minify_set(
     let mut truths = Vec::new();
     for (i, v) in views.iter().enumerate() {
         let mut t = vec![0u32; n];
-        lut_core::render_exact_supersampled(map, *v, Sampler::Bilinear, 8, &mut t, w, h, true)?;
+        lut_core::render_exact_supersampled(
+            map,
+            *v,
+            Sampler::Bilinear,
+            8,
+            &mut Frame::new(&mut t, w, h)?,
+            true,
+        );
         truths.push(t);
         progress(&format!("minify: 8x8 truth {}/{}", i + 1, views.len()));
     }
@@ -400,13 +419,13 @@ pub fn minify_set(
         let opts = minify_opts(kind, sampler);
         let (mut err, mut times) = (0u64, Vec::new());
         for (v, truth) in views.iter().zip(&truths) {
-            renderer.render(map, *v, &opts, &mut out, w, h)?;
+            renderer.render(Scene::Map(map), *v, &opts, &mut Frame::new(&mut out, w, h)?)?;
             err += sse(&out, truth);
         }
         for _ in 0..passes {
             for v in &views {
                 let t = Instant::now();
-                renderer.render(map, *v, &opts, &mut out, w, h)?;
+                renderer.render(Scene::Map(map), *v, &opts, &mut Frame::new(&mut out, w, h)?)?;
                 times.push(t.elapsed().as_secs_f64() * 1e3);
             }
         }
@@ -480,11 +499,11 @@ mod tests {
     /// configuration renders, and the bilinear LUT rows share the nearest rows' positions.
     #[test]
     fn errors_of_a_small_set() {
-        let map = lut_core::synth::grid_map(256, 128, Projection::Equirect).unwrap();
+        let map = lut_core::grid_map(256, 128, Projection::Equirect).unwrap();
         let cube = CubeMap::from_envmap(&map, 32, Sampler::Bilinear).unwrap();
         let src = gather_source(&map);
         let set = ViewSet {
-            table: lut_core::lut::TableKind::Wide,
+            table: lut_core::TableKind::Wide,
             hfov: 90.0,
             views: vec![
                 View::new(20.0, 10.0, 90.0).unwrap(),

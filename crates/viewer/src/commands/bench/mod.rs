@@ -29,8 +29,8 @@ use crate::args::{named, parse_map_size, parse_size, MaxPixelsArg, ProjectionOpt
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use configs::{configs, view_sets, ViewsArg};
-use lut_core::cube::CubeMap;
-use lut_core::lut::TableKind;
+use lut_core::CubeMap;
+use lut_core::TableKind;
 use lut_core::{Projection, Renderer, Sampler, Surface};
 use measure::{gather_source, in_pool, measure_errors, time_config, Ctx};
 use report::{row_line, Row, RunInfo, Tables};
@@ -107,7 +107,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
             Some(p),
             &a.limit.options(projection, lut_core::Tone::default()),
         )?,
-        None => lut_core::synth::grid_map(
+        None => lut_core::grid_map(
             a.map_size.0,
             a.map_size.1,
             projection.unwrap_or(Projection::Equirect),

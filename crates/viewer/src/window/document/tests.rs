@@ -12,7 +12,7 @@ fn file(name: &str) -> Source {
 
 /// A loaded equirectangular map of `w × w/2` from `source`.
 fn loaded(source: Source, w: u32, hdr: bool, exposure_ev: f64) -> Box<Loaded> {
-    let map = lut_core::synth::grid_map(w, w / 2, Projection::Equirect).unwrap();
+    let map = lut_core::grid_map(w, w / 2, Projection::Equirect).unwrap();
     Box::new(Loaded {
         scene: Scene::map(map),
         source,
