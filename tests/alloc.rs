@@ -1,33 +1,16 @@
 //! The LUT renderer allocates nothing per frame after the first (single-threaded; with
 //! threads the only allocations are rayon's own job bookkeeping).
 
+use lut_core::{Frame, Scene};
 use lut_core::{Projection, RenderOptions, Renderer, View};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-struct Counting;
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator unchanged; only counts calls.
-#[allow(unsafe_code)]
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(p, l) }
-    }
-}
+use test_support::alloc::Counting;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: Counting = Counting::new();
 
 #[test]
 fn no_allocation_per_frame_after_the_first() {
-    let map = lut_core::synth::grid_map(1024, 512, Projection::Equirect).unwrap();
+    let map = lut_core::grid_map(1024, 512, Projection::Equirect).unwrap();
     let mut r = Renderer::new(&map);
     let (w, h) = (320u32, 200u32);
     let mut out = vec![0u32; (w * h) as usize];
@@ -38,16 +21,14 @@ fn no_allocation_per_frame_after_the_first() {
     // First frames build the tables (both kinds) and size the scratch.
     for hfov in [90.0, 40.0] {
         r.render(
-            &map,
+            Scene::Map(&map),
             View::new(0.0, 0.0, hfov).unwrap(),
             &opts,
-            &mut out,
-            w,
-            h,
+            &mut Frame::new(&mut out, w, h).unwrap(),
         )
         .unwrap();
     }
-    let before = ALLOCS.load(Ordering::Relaxed);
+    let before = GLOBAL.calls();
     // Turning, zooming across the table switch, looking at the poles and the seam.
     for (yaw, pitch, hfov) in [
         (30.0, 10.0, 90.0),
@@ -56,16 +37,14 @@ fn no_allocation_per_frame_after_the_first() {
         (1e6, 45.0, 59.0),
     ] {
         r.render(
-            &map,
+            Scene::Map(&map),
             View::new(yaw, pitch, hfov).unwrap(),
             &opts,
-            &mut out,
-            w,
-            h,
+            &mut Frame::new(&mut out, w, h).unwrap(),
         )
         .unwrap();
     }
-    let after = ALLOCS.load(Ordering::Relaxed);
+    let after = GLOBAL.calls();
     assert_eq!(
         after - before,
         0,

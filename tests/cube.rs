@@ -2,22 +2,29 @@
 //!
 //! Independent references used here: `lut_core::render_exact` on the equirect (the
 //! project's yardstick renderer), `lut_core::Camera` for each face's geometry (the
-//! definition in `conventions.md`: face = hfov-90° view at the face's yaw/pitch), and
+//! definition in `docs/conventions.md`: face = hfov-90° view at the face's yaw/pitch), and
 //! analytic colors of directions. Images are small so the whole file runs in seconds.
 
 use glam::DVec3;
-use lut_core::cube::{self, CubeError, CubeMap, CubeRenderer, Face, Layout, Naming, Transform};
+use lut_core::LoadOptions;
 use lut_core::{render_exact, Camera, EnvMap, Projection, Sampler, View};
+use lut_core::{CubeError, CubeMap, CubeRenderer, Face, Layout, Naming, Transform};
+use lut_core::{Frame, RenderOptions, Renderer, Scene};
 use std::path::{Path, PathBuf};
+use test_support::pixels::{max_channel_diff, psnr, to_rgb};
 
 fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    test_support::repo_root()
 }
 
 fn courtyard() -> EnvMap {
-    EnvMap::load(
+    lut_core::load_map(
         &repo().join("assets/courtyard.jpg"),
-        Some(Projection::Equirect),
+        &LoadOptions {
+            projection: Some(Projection::Equirect),
+            ..LoadOptions::default()
+        },
+        &mut |_| {},
     )
     .expect("courtyard")
 }
@@ -25,27 +32,6 @@ fn courtyard() -> EnvMap {
 /// The sample sky box (Sauerbraten naming), downscaled copy committed in tests/data/cube.
 fn skybox_dir() -> PathBuf {
     repo().join("tests/data/cube/skyfantasy")
-}
-
-fn psnr(a: &[u32], b: &[u32]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let mut se = 0.0f64;
-    for (p, q) in a.iter().zip(b) {
-        for sh in [0, 8, 16] {
-            let d = ((p >> sh) & 0xFF) as f64 - ((q >> sh) & 0xFF) as f64;
-            se += d * d;
-        }
-    }
-    let mse = se / (a.len() * 3) as f64;
-    10.0 * (255.0f64 * 255.0 / mse.max(1e-12)).log10()
-}
-
-fn max_channel_diff(a: u32, b: u32) -> u32 {
-    [0, 8, 16]
-        .iter()
-        .map(|s| (((a >> s) & 0xFF) as i32 - ((b >> s) & 0xFF) as i32).unsigned_abs())
-        .max()
-        .unwrap()
 }
 
 /// A cube whose texels are `f(direction of the texel center)`, the direction taken from
@@ -103,7 +89,19 @@ fn render(
     threads: bool,
 ) -> Vec<u32> {
     let mut out = vec![0u32; (w * h) as usize];
-    cube::render(cube, view, s, r, &mut out, w, h, threads).unwrap();
+    Renderer::default()
+        .render(
+            Scene::Cube(cube),
+            view,
+            &RenderOptions {
+                sampler: s,
+                cube: r,
+                threads,
+                ..RenderOptions::default()
+            },
+            &mut Frame::new(&mut out, w, h).unwrap(),
+        )
+        .unwrap();
     out
 }
 
@@ -144,12 +142,9 @@ fn equirect_cube_view_matches_equirect_view() {
             &map,
             view,
             Sampler::Bilinear,
-            &mut reference,
-            w as u32,
-            h as u32,
+            &mut Frame::new(&mut reference, w as u32, h as u32).unwrap(),
             true,
-        )
-        .unwrap();
+        );
         let got = render(
             &cube,
             view,
@@ -260,7 +255,7 @@ fn accelerated_renderer_really_runs_segments() {
         let view = View::new(yaw, pitch, hfov).unwrap();
         let (mut proven, mut total, mut runs) = (0u32, 0u32, 0u32);
         for y in 0..h {
-            let r = cube::scanline_runs(view, w, h, 64, y);
+            let r = lut_core::scanline_runs(view, w, h, 64, y);
             let mut next = 0;
             for &(a, e, _, ok) in &r {
                 assert_eq!(a, next, "runs must tile the row");
@@ -283,7 +278,7 @@ fn accelerated_renderer_really_runs_segments() {
     // Straight at a corner: rows split into several faces.
     let view = View::new(45.0, 35.26, 90.0).unwrap();
     let faces: std::collections::BTreeSet<Face> = (0..h)
-        .flat_map(|y| cube::scanline_runs(view, w, h, 64, y))
+        .flat_map(|y| lut_core::scanline_runs(view, w, h, 64, y))
         .map(|r| r.2)
         .collect();
     assert_eq!(faces.len(), 3, "a corner view shows three faces: {faces:?}");
@@ -337,8 +332,8 @@ fn edges_and_corners_show_no_seam_nan_or_bad_read() {
                     );
                     worst_clamped = worst_clamped.max(max_channel_diff(bad[i], want));
                     // Face coordinates finite and on the face.
-                    let face = cube::face_of(d);
-                    let (u, v) = cube::face_uv(face, d, n as f64 / 2.0);
+                    let face = lut_core::face_of(d);
+                    let (u, v) = lut_core::face_uv(face, d, n as f64 / 2.0);
                     assert!(u.is_finite() && v.is_finite());
                     let eps = 1e-9;
                     assert!((-eps..=n as f64 + eps).contains(&u), "u {u}");
@@ -377,7 +372,7 @@ fn cube_equirect_round_trip() {
         for i in [0u32, 33, 128, 255] {
             let lambda = (i as f64 + 0.5) / 256.0 * std::f64::consts::TAU - std::f64::consts::PI;
             let phi = std::f64::consts::FRAC_PI_2 - (j as f64 + 0.5) / 128.0 * std::f64::consts::PI;
-            let want = smooth(lut_core::camera::lat_long_to_dir(lambda, phi));
+            let want = smooth(lut_core::lat_long_to_dir(lambda, phi));
             assert!(max_channel_diff(eq[(j * 256 + i) as usize], want) <= 3);
         }
     }
@@ -387,14 +382,7 @@ fn cube_equirect_round_trip() {
 // Loading: namings, layouts, orientation, errors.
 
 fn write_png(path: &Path, px: &[u32], w: u32, h: u32) {
-    let mut rgb = Vec::with_capacity(px.len() * 3);
-    for p in px {
-        rgb.extend_from_slice(&[(p >> 16) as u8, (p >> 8) as u8, *p as u8]);
-    }
-    image::RgbImage::from_raw(w, h, rgb)
-        .unwrap()
-        .save(path)
-        .unwrap();
+    to_rgb(px, w, h).save(path).unwrap();
 }
 
 fn skybox_files() -> Vec<PathBuf> {
@@ -466,7 +454,7 @@ fn edge_mismatch(cube: &CubeMap) -> (f64, f64) {
 
 #[test]
 fn skybox_orientation_by_edge_continuity() {
-    let cube = cube::load_cube(&[skybox_dir()], None, None).unwrap();
+    let cube = lut_core::load_cube(&[skybox_dir()], None, None).unwrap();
     let (worst, inner) = edge_mismatch(&cube);
     eprintln!("sky box edges: worst {worst:.2}, inside {inner:.2}");
     assert!(
@@ -474,7 +462,7 @@ fn skybox_orientation_by_edge_continuity() {
         "sky box (cube2 naming): an edge does not join: worst edge {worst:.2} vs {inner:.2} inside"
     );
     // Taken as conventions naming instead, the same files do not join: the check can fail.
-    let wrong = cube::load_cube(&[skybox_dir()], None, Some(Naming::Conventions)).unwrap();
+    let wrong = lut_core::load_cube(&[skybox_dir()], None, Some(Naming::Conventions)).unwrap();
     let (worst_wrong, _) = edge_mismatch(&wrong);
     eprintln!("sky box as conventions naming: worst edge {worst_wrong:.2}");
     assert!(
@@ -490,14 +478,20 @@ fn skybox_orientation_by_edge_continuity() {
 fn skybox_against_converted_equirect() {
     // The sky box converted to an equirect and viewed there looks like the cube viewed
     // directly, across edges and corners.
-    let cube = cube::load_cube(&[skybox_dir()], None, None).unwrap();
+    let cube = lut_core::load_cube(&[skybox_dir()], None, None).unwrap();
     let n = cube.face_size();
     let eq = cube.to_equirect(8 * n, 4 * n, Sampler::Bilinear).unwrap();
     let map = EnvMap::from_pixels(8 * n, 4 * n, &eq, Projection::Equirect).unwrap();
     for &(yaw, pitch) in EDGE_VIEWS {
         let view = View::new(yaw, pitch, 70.0).unwrap();
         let mut reference = vec![0u32; 80 * 60];
-        render_exact(&map, view, Sampler::Bilinear, &mut reference, 80, 60, false).unwrap();
+        render_exact(
+            &map,
+            view,
+            Sampler::Bilinear,
+            &mut Frame::new(&mut reference, 80, 60).unwrap(),
+            false,
+        );
         let got = render(
             &cube,
             view,
@@ -515,7 +509,7 @@ fn skybox_against_converted_equirect() {
 
 #[test]
 fn every_layout_and_naming_loads_the_same_cube() {
-    let reference = cube::load_cube(&[skybox_dir()], None, None).unwrap();
+    let reference = lut_core::load_cube(&[skybox_dir()], None, None).unwrap();
     let n = reference.face_size();
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
@@ -526,11 +520,11 @@ fn every_layout_and_naming_loads_the_same_cube() {
 
     // The six files as a list, in any order.
     let mut files = skybox_files();
-    check("list", cube::load_cube(&files, None, None));
+    check("list", lut_core::load_cube(&files, None, None));
     files.reverse();
     check(
         "reversed list",
-        cube::load_cube(&files, Some(Layout::Files), Some(Naming::Cube2)),
+        lut_core::load_cube(&files, Some(Layout::Files), Some(Naming::Cube2)),
     );
 
     // Word names and axis names, written in conventions orientation.
@@ -558,9 +552,9 @@ fn every_layout_and_naming_loads_the_same_cube() {
     }
     check(
         "words folder",
-        cube::load_cube(std::slice::from_ref(&words), None, None),
+        lut_core::load_cube(std::slice::from_ref(&words), None, None),
     );
-    check("axes folder", cube::load_cube(&[axes], None, None));
+    check("axes folder", lut_core::load_cube(&[axes], None, None));
 
     // Irrlicht naming: files made by undoing the Irrlicht placement load back.
     let irr = dir.join("irr");
@@ -578,7 +572,7 @@ fn every_layout_and_naming_loads_the_same_cube() {
     }
     check(
         "irrlicht",
-        cube::load_cube(&[irr], None, Some(Naming::Irrlicht)),
+        lut_core::load_cube(&[irr], None, Some(Naming::Irrlicht)),
     );
 
     // Single images, assembled here from the documented cell positions.
@@ -639,12 +633,12 @@ fn every_layout_and_naming_loads_the_same_cube() {
         write_png(&path, &img, w, h);
         check(
             name,
-            cube::load_cube(std::slice::from_ref(&path), None, None),
+            lut_core::load_cube(std::slice::from_ref(&path), None, None),
         );
         let layout: Layout = name.parse().unwrap();
         check(
             name,
-            cube::load_cube(std::slice::from_ref(&path), Some(layout), None),
+            lut_core::load_cube(std::slice::from_ref(&path), Some(layout), None),
         );
         // and the library's own writer produces the same image
         let (lw, lh, lpx) = reference.to_layout(layout).unwrap();
@@ -679,7 +673,7 @@ fn malformed_inputs_give_clear_errors() {
     // Five faces.
     let five = mk("five", ok);
     std::fs::remove_file(five.join("down.png")).unwrap();
-    let e = cube::load_cube(std::slice::from_ref(&five), None, None).unwrap_err();
+    let e = lut_core::load_cube(std::slice::from_ref(&five), None, None).unwrap_err();
     assert!(matches!(e, CubeError::Faces { .. }), "{e:?}");
     let msg = e.to_string();
     assert!(
@@ -690,13 +684,13 @@ fn malformed_inputs_give_clear_errors() {
         .iter()
         .map(|f| five.join(format!("{f}.png")))
         .collect();
-    let e = cube::load_cube(&list, None, None).unwrap_err();
+    let e = lut_core::load_cube(&list, None, None).unwrap_err();
     assert!(e.to_string().contains("missing: down"), "{e}");
 
     // Unequal sizes.
     let mut sizes = ok;
     sizes[3] = (8, 8);
-    let e = cube::load_cube(&[mk("unequal", sizes)], None, None).unwrap_err();
+    let e = lut_core::load_cube(&[mk("unequal", sizes)], None, None).unwrap_err();
     assert!(
         matches!(
             e,
@@ -713,7 +707,7 @@ fn malformed_inputs_give_clear_errors() {
     // Not square.
     let mut sizes = ok;
     sizes[4] = (16, 12);
-    let e = cube::load_cube(&[mk("nonsquare", sizes)], None, None).unwrap_err();
+    let e = lut_core::load_cube(&[mk("nonsquare", sizes)], None, None).unwrap_err();
     assert!(
         matches!(
             e,
@@ -730,7 +724,7 @@ fn malformed_inputs_give_clear_errors() {
     // Unreadable: garbage bytes, and a file that does not exist.
     let bad = mk("garbage", ok);
     std::fs::write(bad.join("back.png"), b"not an image at all").unwrap();
-    let e = cube::load_cube(std::slice::from_ref(&bad), None, None).unwrap_err();
+    let e = lut_core::load_cube(std::slice::from_ref(&bad), None, None).unwrap_err();
     assert!(
         matches!(&e, CubeError::Read { path, .. } if path.ends_with("back.png")),
         "{e:?}"
@@ -740,7 +734,7 @@ fn malformed_inputs_give_clear_errors() {
         .map(|f| bad.join(format!("{}.png", f.name())))
         .collect();
     list[0] = dir.join("missing/front.png");
-    let e = cube::load_cube(&list, None, None).unwrap_err();
+    let e = lut_core::load_cube(&list, None, None).unwrap_err();
     assert!(
         matches!(&e, CubeError::Read { path, .. } if path.ends_with("front.png")),
         "{e:?}"
@@ -749,34 +743,35 @@ fn malformed_inputs_give_clear_errors() {
     // Two files for one face, a name that says no face, an empty folder.
     let dup = mk("dup", ok);
     write_png(&dup.join("ft.png"), &square, 16, 16);
-    let e = cube::load_cube(&[dup], None, None).unwrap_err();
+    let e = lut_core::load_cube(&[dup], None, None).unwrap_err();
     assert!(
         e.to_string().contains("two files for the front face"),
         "{e}"
     );
-    let e =
-        cube::load_cube(&[dir.join("five/front.png"), dir.join("x.png")], None, None).unwrap_err();
+    let e = lut_core::load_cube(&[dir.join("five/front.png"), dir.join("x.png")], None, None)
+        .unwrap_err();
     assert!(matches!(e, CubeError::Faces { .. }), "{e:?}");
     std::fs::create_dir_all(dir.join("empty")).unwrap();
-    assert!(cube::load_cube(&[dir.join("empty")], None, None).is_err());
+    assert!(lut_core::load_cube(&[dir.join("empty")], None, None).is_err());
 
     // A single image that fits no layout, or not the layout asked for.
     let odd = dir.join("odd.png");
     write_png(&odd, &vec![0; 50 * 20], 50, 20);
-    let e = cube::load_cube(&[odd], None, None).unwrap_err();
+    let e = lut_core::load_cube(&[odd], None, None).unwrap_err();
     assert!(
         matches!(e, CubeError::Layout { .. }) && e.to_string().contains("4:3"),
         "{e}"
     );
     let cross = dir.join("cross.png");
     write_png(&cross, &vec![0; 64 * 48], 64, 48);
-    assert!(cube::load_cube(std::slice::from_ref(&cross), None, None).is_ok());
-    let e = cube::load_cube(std::slice::from_ref(&cross), Some(Layout::Strip), None).unwrap_err();
+    assert!(lut_core::load_cube(std::slice::from_ref(&cross), None, None).is_ok());
+    let e =
+        lut_core::load_cube(std::slice::from_ref(&cross), Some(Layout::Strip), None).unwrap_err();
     assert!(matches!(e, CubeError::Layout { .. }), "{e:?}");
-    let e = cube::load_cube(&[cross], Some(Layout::Files), None).unwrap_err();
+    let e = lut_core::load_cube(&[cross], Some(Layout::Files), None).unwrap_err();
     assert!(matches!(e, CubeError::Usage(_)), "{e:?}");
     assert!(matches!(
-        cube::load_cube(&[], None, None),
+        lut_core::load_cube(&[], None, None),
         Err(CubeError::Usage(_))
     ));
 }

@@ -1,14 +1,15 @@
 //! HDR environment maps: the sample EXRs (DWAB-compressed; lossy float16 with negative
 //! values) decode, and every value is clamped and tone-mapped, never propagated.
 
-use lut_core::envmap::tone_map;
+use lut_core::tone_map;
+use lut_core::LoadOptions;
+use lut_core::Scene;
 use lut_core::{EnvMap, Projection, RenderOptions, Renderer, Tone, View};
 use std::path::PathBuf;
+use test_support::render::render_frame;
 
 fn data(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../tests/data/hdr")
-        .join(name)
+    test_support::test_data("hdr").join(name)
 }
 
 #[test]
@@ -16,7 +17,7 @@ fn sample_exrs_load_clamped_and_toned() {
     for name in ["interior.exr", "venice.exr"] {
         let path = data(name);
         let raw = image::open(&path).unwrap().to_rgb32f();
-        let map = EnvMap::load(&path, None).unwrap();
+        let map = lut_core::load_map(&path, &LoadOptions::default(), &mut |_| {}).unwrap();
         assert_eq!((map.width(), map.height()), raw.dimensions(), "{name}");
         assert_eq!(map.projection(), Projection::Equirect);
         let mut negatives = 0;
@@ -40,26 +41,41 @@ fn sample_exrs_load_clamped_and_toned() {
         }
         // Renders without trouble.
         let mut r = Renderer::new(&map);
-        let mut out = vec![0u32; 64 * 32];
-        r.render(
-            &map,
-            View::new(10.0, 5.0, 90.0).unwrap(),
+        let view = View::new(10.0, 5.0, 90.0).unwrap();
+        render_frame(
+            &mut r,
+            Scene::Map(&map),
+            view,
             &RenderOptions::default(),
-            &mut out,
             64,
             32,
-        )
-        .unwrap();
+        );
     }
 }
 
 #[test]
 fn exposure_brightens() {
     let bytes = std::fs::read(data("interior.exr")).unwrap();
-    let dark =
-        EnvMap::decode_toned(&bytes, "interior.exr", None, Tone { exposure_ev: -2.0 }).unwrap();
-    let bright =
-        EnvMap::decode_toned(&bytes, "interior.exr", None, Tone { exposure_ev: 2.0 }).unwrap();
+    let dark = lut_core::decode_map(
+        &bytes,
+        "interior.exr",
+        &LoadOptions {
+            tone: Tone { exposure_ev: -2.0 },
+            ..LoadOptions::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
+    let bright = lut_core::decode_map(
+        &bytes,
+        "interior.exr",
+        &LoadOptions {
+            tone: Tone { exposure_ev: 2.0 },
+            ..LoadOptions::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
     let sum = |m: &EnvMap| -> u64 {
         (0..m.height())
             .flat_map(|y| (0..m.width()).map(move |x| (x, y)))

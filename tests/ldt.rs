@@ -2,15 +2,13 @@
 //! symmetry indicator, relative and absolute photometry, malformed files, choosing the
 //! format by content.
 
-use lut_core::light::{
+use lut_core::{
     detect_format, IesFile, Interpolation, LdtError, LdtFile, LdtSymmetry, LdtType, LightError,
     LightFileFormat, LightTable, Photometry, PhotometrySource, Symmetry, TableOptions,
 };
 use std::path::PathBuf;
 
-#[path = "support/light_fixtures.rs"]
-mod light_fixtures;
-use light_fixtures::sphere;
+use test_support::light_fixtures::sphere;
 
 fn ldt_path(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -2,12 +2,9 @@
 //! (EP 0613099 claim 8) with lookups identical to the uncut table, and the interpolation
 //! between measured angles (linear or Catmull-Rom).
 
-#[path = "support/light_fixtures.rs"]
-mod light_fixtures;
-
-use light_fixtures::{sphere, synth};
-use lut_core::light::{Interpolation, LdtFile, LightTable, Photometry, Symmetry, TableOptions};
+use lut_core::{Interpolation, LdtFile, LightTable, Photometry, Symmetry, TableOptions};
 use std::path::PathBuf;
+use test_support::light_fixtures::{sphere, synth};
 
 fn ldt(name: &str) -> Photometry {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))

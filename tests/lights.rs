@@ -2,22 +2,19 @@
 //! constant ranges, interpolation, distance series) and room lighting.
 
 use glam::DVec3;
-use lut_core::light::{
+use lut_core::{
     lux_at, shade_frame, IesError, IesFile, IesFormat, LightError, LightScene, LightTable,
     Luminaire, PhotometricType, Room, ShadeOptions, Symmetry, TableOptions, Tilt,
 };
 use lut_core::{Camera, View};
 use std::path::PathBuf;
 use std::sync::Arc;
+use test_support::geometry::room_hit;
 
-#[path = "support/light_fixtures.rs"]
-mod light_fixtures;
-use light_fixtures::synth;
+use test_support::light_fixtures::synth;
 
 fn data(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../tests/data/ies")
-        .join(name)
+    test_support::test_data("ies").join(name)
 }
 
 fn table(f: &IesFile) -> LightTable {
@@ -532,29 +529,6 @@ fn distance_series_tends_to_the_far_field_table_for_smooth_light() {
 
 // ---------------------------------------------------------------- lighting
 
-/// Independent ray/box intersection for the tests: the room spans x ±W/2, y 0..H, z ±D/2.
-fn box_hit(o: DVec3, d: DVec3, w: f64, dep: f64, ht: f64) -> (DVec3, DVec3) {
-    let cands = [
-        ((w / 2.0 - o.x) / d.x, DVec3::NEG_X),
-        ((-w / 2.0 - o.x) / d.x, DVec3::X),
-        ((ht - o.y) / d.y, DVec3::NEG_Y),
-        ((0.0 - o.y) / d.y, DVec3::Y),
-        ((dep / 2.0 - o.z) / d.z, DVec3::NEG_Z),
-        ((-dep / 2.0 - o.z) / d.z, DVec3::Z),
-    ];
-    let (t, n) = cands
-        .iter()
-        .filter(|(t, _)| t.is_finite() && *t > 0.0)
-        .fold((f64::INFINITY, DVec3::ZERO), |a, &(t, n)| {
-            if t < a.0 {
-                (t, n)
-            } else {
-                a
-            }
-        });
-    (o + d * t, n)
-}
-
 fn isotropic(candela: f64) -> Arc<LightTable> {
     let f = synth(1, &[0.0, 90.0, 180.0], &[0.0], |_, _| candela, 1.0);
     Arc::new(table(&f))
@@ -583,7 +557,7 @@ fn isotropic_source_gives_i_cos_over_d_squared() {
         for py in (0..48).step_by(5) {
             for px in (0..64).step_by(7) {
                 let (x, y) = (px as f64 + 0.5, py as f64 + 0.5);
-                let (p, n) = box_hit(origin, cam.world_ray(x, y), w, dep, ht);
+                let (p, n) = room_hit(origin, cam.world_ray(x, y), w, dep, ht);
                 let to = light_pos - p;
                 let d = to.length();
                 let cos = (n.dot(to) / d).max(0.0);

@@ -7,19 +7,9 @@ use lut_core::{
     render_exact, render_exact_supersampled, EnvMap, Projection, RenderOptions, Renderer, Sampler,
     View,
 };
-
-/// PSNR (dB) of `a` against `b` over all channels.
-fn psnr(a: &[u32], b: &[u32]) -> f64 {
-    let mut se = 0f64;
-    for (p, q) in a.iter().zip(b) {
-        for s in [0, 8, 16] {
-            let d = ((p >> s) & 0xFF) as f64 - ((q >> s) & 0xFF) as f64;
-            se += d * d;
-        }
-    }
-    let mse = se / (a.len() * 3) as f64;
-    10.0 * (255.0f64 * 255.0 / mse.max(1e-12)).log10()
-}
+use lut_core::{Frame, Scene};
+use test_support::pixels::psnr;
+use test_support::render::render_frame;
 
 /// A map that aliases when minified: 3-pixel black/white checks (not a power of two, so
 /// the pyramid levels do not average them away exactly) over a colour ramp.
@@ -39,15 +29,11 @@ fn fine_map(w: u32, h: u32) -> EnvMap {
 }
 
 fn lut(map: &EnvMap, view: View, sampler: Sampler, w: u32, h: u32) -> Vec<u32> {
-    let mut out = vec![0u32; (w * h) as usize];
     let opts = RenderOptions {
         sampler,
         ..RenderOptions::default()
     };
-    Renderer::new(map)
-        .render(map, view, &opts, &mut out, w, h)
-        .unwrap();
-    out
+    render_frame(&mut Renderer::new(map), Scene::Map(map), view, &opts, w, h).0
 }
 
 #[test]
@@ -62,12 +48,24 @@ fn trilinear_is_closer_to_the_supersampled_truth_when_zoomed_out() {
     ] {
         let view = View::new(yaw, pitch, hfov).unwrap();
         let mut truth = vec![0u32; (w * h) as usize];
-        render_exact_supersampled(&map, view, Sampler::Bilinear, 8, &mut truth, w, h, true)
-            .unwrap();
+        render_exact_supersampled(
+            &map,
+            view,
+            Sampler::Bilinear,
+            8,
+            &mut Frame::new(&mut truth, w, h).unwrap(),
+            true,
+        );
         let bi = lut(&map, view, Sampler::Bilinear, w, h);
         let tri = lut(&map, view, Sampler::Trilinear, w, h);
         let mut tri_exact = vec![0u32; (w * h) as usize];
-        render_exact(&map, view, Sampler::Trilinear, &mut tri_exact, w, h, true).unwrap();
+        render_exact(
+            &map,
+            view,
+            Sampler::Trilinear,
+            &mut Frame::new(&mut tri_exact, w, h).unwrap(),
+            true,
+        );
         let (pb, pt, pe) = (
             psnr(&bi, &truth),
             psnr(&tri, &truth),

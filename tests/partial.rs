@@ -4,13 +4,16 @@
 //! elsewhere, including crops that straddle the ±180° seam or span 360°; the view limit
 //! keeps every border pixel's ray inside a partial panorama at the seam.
 
-use lut_core::camera::{dir_to_lat_long, Camera};
-use lut_core::exact::exact_uv;
-use lut_core::gpano::{insert_xmp, xmp_packet};
+use lut_core::exact_uv;
+use lut_core::LoadOptions;
+use lut_core::Scene;
+use lut_core::{dir_to_lat_long, Camera};
+use lut_core::{insert_xmp, xmp_packet};
 use lut_core::{
     limit_view, Coverage, CoverageSource, EnvMap, IndexStep, Projection, RenderOptions, Renderer,
-    RendererKind, Sampler, Tone, View,
+    RendererKind, Sampler, View,
 };
+use test_support::render::render_frame;
 
 const FULL_W: u32 = 512;
 const FULL_H: u32 = 256;
@@ -79,26 +82,37 @@ fn padded_reference(jpeg: &[u8], left: u32, top: u32) -> EnvMap {
 }
 
 fn load_partial(jpeg: &[u8]) -> EnvMap {
-    let (mut m, src) =
-        EnvMap::decode_partial(jpeg, "test.jpg", None, None, Tone::default()).unwrap();
+    let (mut m, src) = decode(jpeg, "test.jpg", None).unwrap();
     assert_eq!(src, CoverageSource::Xmp);
     m.set_background(BG);
     m
 }
 
+/// Decode `jpeg` as a possibly partial panorama with the default options.
+fn decode(
+    jpeg: &[u8],
+    what: &str,
+    coverage: Option<Coverage>,
+) -> Result<(EnvMap, CoverageSource), lut_core::CoverageError> {
+    lut_core::decode_partial(jpeg, what, &LoadOptions::default(), coverage, &mut |_| {})
+}
+
 fn render(map: &EnvMap, view: View, renderer: RendererKind, sampler: Sampler) -> Vec<u32> {
-    let (w, h) = (160, 90);
-    let mut out = vec![0u32; w * h];
     let opts = RenderOptions {
         renderer,
         sampler,
         index_step: IndexStep::Fixed(4),
         ..RenderOptions::default()
     };
-    Renderer::new(map)
-        .render(map, view, &opts, &mut out, w as u32, h as u32)
-        .unwrap();
-    out
+    render_frame(
+        &mut Renderer::new(map),
+        Scene::Map(map),
+        view,
+        &opts,
+        160,
+        90,
+    )
+    .0
 }
 
 /// Where the exact position of each output pixel lies relative to the crop: its
@@ -258,8 +272,7 @@ fn explicit_coverage_overrides_the_metadata() {
     let jpeg = tagged_jpeg(200, 60, 160, 100, Some("123.5"));
     // the same placement in degrees: 112.5 x 70.3125, west edge -39.375, north 47.8125
     let cov = Coverage::new(112.5, 70.3125, -39.375 + 56.25, 47.8125 - 35.15625).unwrap();
-    let (m, src) =
-        EnvMap::decode_partial(&jpeg, "t.jpg", None, Some(cov), Tone::default()).unwrap();
+    let (m, src) = decode(&jpeg, "t.jpg", Some(cov)).unwrap();
     assert_eq!(src, CoverageSource::Explicit);
     let c = m.crop().unwrap();
     assert_eq!(
@@ -268,7 +281,7 @@ fn explicit_coverage_overrides_the_metadata() {
     );
     // a different coverage puts it elsewhere and ignores the XMP
     let cov = "360x90+0+0".parse::<Coverage>().unwrap();
-    let (m, _) = EnvMap::decode_partial(&jpeg, "t.jpg", None, Some(cov), Tone::default()).unwrap();
+    let (m, _) = decode(&jpeg, "t.jpg", Some(cov)).unwrap();
     let c = m.crop().unwrap();
     assert_eq!(
         (c.full_width(), c.full_height(), c.left(), c.top()),
@@ -277,12 +290,15 @@ fn explicit_coverage_overrides_the_metadata() {
     // the heading comes with the metadata
     assert_eq!(load_partial(&jpeg).pose_heading_deg(), Some(123.5));
     // a coverage for a non-equirect projection is refused
-    let e = EnvMap::decode_partial(
+    let e = lut_core::decode_partial(
         &jpeg,
         "t.jpg",
-        Some(Projection::Cylinder),
+        &LoadOptions {
+            projection: Some(Projection::Cylinder),
+            ..LoadOptions::default()
+        },
         Some(cov),
-        Tone::default(),
+        &mut |_| {},
     );
     assert!(e.is_err());
 }
@@ -306,13 +322,13 @@ fn bad_metadata_is_a_clear_error_and_coverage_is_the_way_out() {
         ("CroppedAreaImageHeightPixels", "32"),
     ]);
     let bad = insert_xmp(&jpeg, &xmp).unwrap();
-    let e = EnvMap::decode_partial(&bad, "bad.jpg", None, None, Tone::default()).unwrap_err();
+    let e = decode(&bad, "bad.jpg", None).unwrap_err();
     let msg = e.to_string();
     assert!(msg.contains("bad.jpg") && msg.contains("below"), "{msg}");
     let cov = "180x90+0+0".parse().unwrap();
-    assert!(EnvMap::decode_partial(&bad, "bad.jpg", None, Some(cov), Tone::default()).is_ok());
+    assert!(decode(&bad, "bad.jpg", Some(cov)).is_ok());
     // an untagged 2:1 JPEG is an ordinary map
-    let (m, src) = EnvMap::decode_partial(&jpeg, "plain.jpg", None, None, Tone::default()).unwrap();
+    let (m, src) = decode(&jpeg, "plain.jpg", None).unwrap();
     assert_eq!(src, CoverageSource::Full);
     assert!(m.crop().is_none());
 }
@@ -365,7 +381,7 @@ fn view_limit_keeps_every_border_ray_inside_at_the_seam() {
 /// stay within the project's 0.05 px bound of the exact ones.
 #[test]
 fn non_square_pixel_geometry_keeps_the_lut_bound() {
-    use lut_core::accuracy::compare_positions;
+    use lut_core::compare_positions;
     for (mw, mh) in [(640u32, 160u32), (400, 400), (300, 600)] {
         let mut r = Renderer::default();
         for (yaw, pitch, hfov) in [

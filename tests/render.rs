@@ -4,12 +4,14 @@
 //! The bound asserted is the product's stated one: **0.05 source pixels** (angular metric,
 //! see `lut_core::accuracy`), everywhere, poles and seam included.
 
-use lut_core::accuracy::{compare_positions, ErrorStats};
-use lut_core::lut::Surface;
+use lut_core::Surface;
+use lut_core::{compare_positions, ErrorStats};
+use lut_core::{Frame, Scene};
 use lut_core::{IndexStep, LutChoice, Projection, RenderOptions, Renderer, Sampler, View};
 use proptest::prelude::*;
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
+use test_support::render::render_frame;
 
 const BOUND: f64 = 0.05;
 
@@ -183,7 +185,7 @@ proptest! {
 /// Single- and multi-threaded output are byte-identical, for every sampler and a seam/pole view.
 #[test]
 fn threads_are_byte_identical() {
-    let map = lut_core::synth::grid_map(1024, 512, Projection::Equirect).unwrap();
+    let map = lut_core::grid_map(1024, 512, Projection::Equirect).unwrap();
     let mut r = Renderer::new(&map);
     for (y, pi, hf) in [(0.0, 0.0, 90.0), (180.0, 80.0, 120.0), (-45.0, -90.0, 40.0)] {
         let view = View::new(y, pi, hf).unwrap();
@@ -201,8 +203,20 @@ fn threads_are_byte_identical() {
                 threads: true,
                 ..RenderOptions::default()
             };
-            r.render(&map, view, &o1, &mut a, w, h).unwrap();
-            r.render(&map, view, &o2, &mut b, w, h).unwrap();
+            r.render(
+                Scene::Map(&map),
+                view,
+                &o1,
+                &mut Frame::new(&mut a, w, h).unwrap(),
+            )
+            .unwrap();
+            r.render(
+                Scene::Map(&map),
+                view,
+                &o2,
+                &mut Frame::new(&mut b, w, h).unwrap(),
+            )
+            .unwrap();
             assert!(
                 a == b,
                 "threads changed the output at view {y},{pi},{hf} {sampler:?}"
@@ -215,13 +229,18 @@ fn threads_are_byte_identical() {
 /// match the exact renderer's positions.
 #[test]
 fn odd_and_tiny_sizes() {
-    let map = lut_core::synth::grid_map(512, 256, Projection::Equirect).unwrap();
+    let map = lut_core::grid_map(512, 256, Projection::Equirect).unwrap();
     let mut r = Renderer::new(&map);
     for (w, h) in [(1, 1), (1, 7), (7, 1), (3, 3), (17, 5), (257, 1), (1, 300)] {
         let view = View::new(33.0, 12.0, 75.0).unwrap();
-        let mut out = vec![0u32; (w * h) as usize];
-        r.render(&map, view, &RenderOptions::default(), &mut out, w, h)
-            .unwrap();
+        render_frame(
+            &mut r,
+            Scene::Map(&map),
+            view,
+            &RenderOptions::default(),
+            w,
+            h,
+        );
         let st = measure(
             512,
             256,
@@ -237,37 +256,39 @@ fn odd_and_tiny_sizes() {
 
 #[test]
 fn bad_requests_are_errors_not_panics() {
-    let map = lut_core::synth::grid_map(64, 32, Projection::Equirect).unwrap();
+    let map = lut_core::grid_map(64, 32, Projection::Equirect).unwrap();
     let mut r = Renderer::new(&map);
     let view = View::default();
     let mut out = vec![0u32; 10];
-    assert!(r
-        .render(&map, view, &RenderOptions::default(), &mut out, 0, 10)
-        .is_err());
-    assert!(r
-        .render(&map, view, &RenderOptions::default(), &mut out, 3, 3)
-        .is_err());
+    // Sizes and buffer lengths are checked when the frame is made.
+    assert!(Frame::new(&mut out, 0, 10).is_err());
+    assert!(Frame::new(&mut out, 3, 3).is_err());
     let bad = RenderOptions {
         index_step: IndexStep::Fixed(3),
         ..RenderOptions::default()
     };
-    assert!(r.render(&map, view, &bad, &mut out, 5, 2).is_err());
+    assert!(r
+        .render(
+            Scene::Map(&map),
+            view,
+            &bad,
+            &mut Frame::new(&mut out, 5, 2).unwrap()
+        )
+        .is_err());
 }
 
 /// The report says which path rendered, and the table switches at 60 degrees.
 #[test]
 fn report_names_the_path() {
-    let map = lut_core::synth::grid_map(1024, 512, Projection::Equirect).unwrap();
+    let map = lut_core::grid_map(1024, 512, Projection::Equirect).unwrap();
     let mut r = Renderer::new(&map);
     let mut out = vec![0u32; 64 * 48];
     let rep = |r: &mut Renderer, out: &mut Vec<u32>, hf: f64| {
         r.render(
-            &map,
+            Scene::Map(&map),
             View::new(0.0, 0.0, hf).unwrap(),
             &RenderOptions::default(),
-            out,
-            64,
-            48,
+            &mut Frame::new(out, 64, 48).unwrap(),
         )
         .unwrap()
     };

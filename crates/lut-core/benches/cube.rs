@@ -9,15 +9,25 @@
 //! paper's "horizontal look-around at constant pitch".
 
 use criterion::{criterion_group, BenchmarkId, Criterion, Throughput};
-use lut_core::cube::{self, CubeMap, CubeRenderer};
-use lut_core::{EnvMap, Projection, Sampler, View};
+use lut_core::LoadOptions;
+use lut_core::{CubeMap, CubeRenderer};
+use lut_core::{Frame, RenderOptions, Renderer, Scene};
+use lut_core::{Projection, Sampler, View};
 use std::hint::black_box;
 use std::path::Path;
 use std::time::Duration;
 
 fn cube_map() -> CubeMap {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/courtyard.jpg");
-    let map = EnvMap::load(&path, Some(Projection::Equirect)).expect("assets/courtyard.jpg");
+    let map = lut_core::load_map(
+        &path,
+        &LoadOptions {
+            projection: Some(Projection::Equirect),
+            ..LoadOptions::default()
+        },
+        &mut |_| {},
+    )
+    .expect("assets/courtyard.jpg");
     // 1024² faces: a realistically large cube (6 × 4 MiB), upsampled from the photograph.
     CubeMap::from_envmap(&map, 1024, Sampler::Bilinear).expect("cube")
 }
@@ -40,7 +50,7 @@ fn pan(c: &mut Criterion) {
                             frame = frame.wrapping_add(1);
                             let yaw = (frame as f64 * 7.3) % 360.0;
                             let view = View::new(yaw, pitch, 90.0).unwrap();
-                            cube::render(&cube, view, sampler, r, &mut out, w, h, false).unwrap();
+                            render_cube(&cube, view, sampler, r, &mut out, w, h);
                             black_box(&out);
                         })
                     });
@@ -69,7 +79,7 @@ fn interleaved_min() {
                         .enumerate()
                     {
                         let t = std::time::Instant::now();
-                        cube::render(&cube, view, sampler, r, &mut out, w, h, false).unwrap();
+                        render_cube(&cube, view, sampler, r, &mut out, w, h);
                         black_box(&out);
                         best[k] = best[k].min(t.elapsed().as_secs_f64() * 1e3);
                     }
@@ -95,4 +105,30 @@ fn main() {
     }
     benches();
     Criterion::default().configure_from_args().final_summary();
+}
+
+/// One frame of `cube` on one thread through the render entry.
+fn render_cube(
+    cube: &CubeMap,
+    view: View,
+    sampler: Sampler,
+    renderer: CubeRenderer,
+    out: &mut [u32],
+    w: u32,
+    h: u32,
+) {
+    let opts = RenderOptions {
+        sampler,
+        cube: renderer,
+        threads: false,
+        ..RenderOptions::default()
+    };
+    Renderer::default()
+        .render(
+            Scene::Cube(cube),
+            view,
+            &opts,
+            &mut Frame::new(out, w, h).unwrap(),
+        )
+        .unwrap();
 }

@@ -7,7 +7,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::DVec3;
-use lut_core::light::{
+use lut_core::{
     shade_frame, IesFile, Interpolation, LightScene, LightTable, Luminaire, Room, ShadeOptions,
     TableOptions,
 };

@@ -10,11 +10,12 @@
 //! is for comparing changes, `viewer bench` is the full report.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use lut_core::lut::{LutTable, Surface, TableKind, TableSpec};
-use lut_core::synth::grid_map;
+use lut_core::grid_map;
+use lut_core::{Frame, Scene};
 use lut_core::{
     IndexStep, LutChoice, Projection, RenderOptions, Renderer, RendererKind, Sampler, View,
 };
+use lut_core::{LutTable, Surface, TableKind, TableSpec};
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -28,6 +29,7 @@ fn opts(sampler: Sampler, threads: bool) -> RenderOptions {
         lut: LutChoice::Wide,
         surface: Surface::Cylinder,
         threads,
+        ..RenderOptions::default()
     }
 }
 
@@ -68,12 +70,10 @@ fn setup_one_scanline(c: &mut Criterion) {
     let mut out = vec![0u32; 1920];
     let o = opts(Sampler::Bilinear, false);
     r.render(
-        &map,
+        Scene::Map(&map),
         View::new(0.0, 0.0, 90.0).unwrap(),
         &o,
-        &mut out,
-        1920,
-        1,
+        &mut Frame::new(&mut out, 1920, 1).unwrap(),
     )
     .expect("warm-up");
     let mut g = c.benchmark_group("scanline");
@@ -85,7 +85,13 @@ fn setup_one_scanline(c: &mut Criterion) {
     g.bench_function("setup_plus_row_1920_8k", |b| {
         b.iter(|| {
             let v = pan_view(&mut frame);
-            r.render(&map, v, &o, &mut out, 1920, 1).expect("render");
+            r.render(
+                Scene::Map(&map),
+                v,
+                &o,
+                &mut Frame::new(&mut out, 1920, 1).unwrap(),
+            )
+            .expect("render");
             black_box(&out);
         })
     });
@@ -121,7 +127,13 @@ fn frames(c: &mut Criterion) {
                         p.install(|| {
                             b.iter(|| {
                                 let v = pan_view(&mut frame);
-                                r.render(&map, v, &o, &mut out, ow, oh).expect("render");
+                                r.render(
+                                    Scene::Map(&map),
+                                    v,
+                                    &o,
+                                    &mut Frame::new(&mut out, ow, oh).unwrap(),
+                                )
+                                .expect("render");
                                 black_box(&out);
                             })
                         })

@@ -16,14 +16,15 @@
 use crate::cli_common::{parse_size, write_png_atomic};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, ValueEnum};
-use lut_core::accuracy::position_error;
-use lut_core::cube::{self, CubeMap, CubeRenderer};
-use lut_core::exact::exact_uv;
-use lut_core::lut::{Surface, TableKind};
+use lut_core::exact_uv;
+use lut_core::position_error;
 use lut_core::{
     Camera, EnvMap, IndexStep, LutChoice, Projection, RenderOptions, Renderer, RendererKind,
     Sampler, View,
 };
+use lut_core::{CubeMap, CubeRenderer};
+use lut_core::{Frame, Scene};
+use lut_core::{Surface, TableKind};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::io::Write;
@@ -104,7 +105,7 @@ fn parse_map_size(s: &str) -> Result<(u32, u32), String> {
         .trim()
         .parse()
         .map_err(|_| format!("map size '{s}': bad height"))?;
-    lut_core::envmap::check_map_size("generated map", w, h).map_err(|e| e.to_string())?;
+    lut_core::check_map_size("generated map", w, h).map_err(|e| e.to_string())?;
     Ok((w, h))
 }
 
@@ -247,7 +248,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
             Some(p),
             &a.limit.options(a.projection, lut_core::Tone::default()),
         )?,
-        None => lut_core::synth::grid_map(
+        None => lut_core::grid_map(
             a.map_size.0,
             a.map_size.1,
             a.projection.unwrap_or(Projection::Equirect),
@@ -402,7 +403,14 @@ fn minify_set(
     let mut truths = Vec::new();
     for (i, v) in views.iter().enumerate() {
         let mut t = vec![0u32; n];
-        lut_core::render_exact_supersampled(map, *v, Sampler::Bilinear, 8, &mut t, w, h, true)?;
+        lut_core::render_exact_supersampled(
+            map,
+            *v,
+            Sampler::Bilinear,
+            8,
+            &mut Frame::new(&mut t, w, h)?,
+            true,
+        );
         truths.push(t);
         progress(a, &format!("minify: 8x8 truth {}/{}", i + 1, views.len()));
     }
@@ -425,13 +433,13 @@ fn minify_set(
         };
         let (mut err, mut times) = (0u64, Vec::new());
         for (v, truth) in views.iter().zip(&truths) {
-            renderer.render(map, *v, &opts, &mut out, w, h)?;
+            renderer.render(Scene::Map(map), *v, &opts, &mut Frame::new(&mut out, w, h)?)?;
             err += sse(&out, truth);
         }
         for _ in 0..a.passes {
             for v in &views {
                 let t = Instant::now();
-                renderer.render(map, *v, &opts, &mut out, w, h)?;
+                renderer.render(Scene::Map(map), *v, &opts, &mut Frame::new(&mut out, w, h)?)?;
                 times.push(t.elapsed().as_secs_f64() * 1e3);
             }
         }
@@ -511,6 +519,7 @@ fn lut_opts(sampler: Sampler, step: IndexStep, table: TableKind) -> RenderOption
         },
         surface: Surface::Cylinder,
         threads: true,
+        ..RenderOptions::default()
     }
 }
 
@@ -616,7 +625,13 @@ fn measure_errors(
                 }
             });
         for (si, s) in SAMPLERS.iter().enumerate() {
-            lut_core::render_exact(map, view, *s, &mut exact_img[si], w, h, true)?;
+            lut_core::render_exact(
+                map,
+                view,
+                *s,
+                &mut Frame::new(&mut exact_img[si], w, h)?,
+                true,
+            );
         }
         let idx: Vec<u32> = exact
             .par_iter()
@@ -656,11 +671,16 @@ fn measure_errors(
                         e.exact_px += rep.exact_pixels;
                         e.px += rep.pixels;
                     }
-                    renderer.render(map, view, &opts, &mut img, w, h)?;
+                    renderer.render(
+                        Scene::Map(map),
+                        view,
+                        &opts,
+                        &mut Frame::new(&mut img, w, h)?,
+                    )?;
                 }
                 Config::Cube(s, r) => {
                     let c = ctx.cube.expect("cube configs only with a cube");
-                    cube::render(c, view, s, r, &mut img, w, h, true)?;
+                    render_cube(c, view, s, r, &mut img, w, h)?;
                 }
                 Config::Gather => gather(ctx.src, &idx, &mut img, w as usize, map.background()),
             }
@@ -800,20 +820,20 @@ fn time_config(
         for (vi, &view) in ctx.set.views.iter().enumerate() {
             let t = Instant::now();
             match cfg {
-                Config::Exact(s) => lut_core::render_exact(ctx.map, view, s, &mut out, w, h, true)?,
+                Config::Exact(s) => {
+                    lut_core::render_exact(ctx.map, view, s, &mut Frame::new(&mut out, w, h)?, true)
+                }
                 Config::Lut(s, st) => {
                     renderer.render(
-                        ctx.map,
+                        Scene::Map(ctx.map),
                         view,
                         &lut_opts(s, st, ctx.set.table),
-                        &mut out,
-                        w,
-                        h,
+                        &mut Frame::new(&mut out, w, h)?,
                     )?;
                 }
                 Config::Cube(s, r) => {
                     let c = ctx.cube.expect("cube configs only with a cube");
-                    cube::render(c, view, s, r, &mut out, w, h, true)?;
+                    render_cube(c, view, s, r, &mut out, w, h)?;
                 }
                 Config::Gather => gather(
                     ctx.src,
@@ -1115,4 +1135,24 @@ fn plot(path: &Path, rows: &[Row]) -> Result<()> {
         }
     }
     write_png_atomic(path, &px, pw, ph)
+}
+
+/// One frame of a cube map through lut-core's render entry (all threads).
+fn render_cube(
+    cube: &CubeMap,
+    view: View,
+    sampler: Sampler,
+    renderer: CubeRenderer,
+    out: &mut [u32],
+    w: u32,
+    h: u32,
+) -> Result<()> {
+    let opts = RenderOptions {
+        sampler,
+        cube: renderer,
+        threads: true,
+        ..RenderOptions::default()
+    };
+    Renderer::default().render(Scene::Cube(cube), view, &opts, &mut Frame::new(out, w, h)?)?;
+    Ok(())
 }

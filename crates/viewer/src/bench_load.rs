@@ -8,8 +8,9 @@ use crate::cli_common::{parse_size, write_image_atomic};
 use crate::max_pixels::MaxPixelsArg;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
-use lut_core::lut::TableKind;
-use lut_core::{EnvMap, LoadPhase, Projection, RenderOptions, Renderer, Sampler, Tone, View};
+use lut_core::TableKind;
+use lut_core::{Frame, Scene};
+use lut_core::{LoadPhase, Projection, RenderOptions, Renderer, Sampler, Tone, View};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -61,7 +62,7 @@ fn parse_width(s: &str) -> Result<u32, String> {
     if w < 4 || w % 2 != 0 {
         return Err(format!("map width '{s}' must be even and at least 4"));
     }
-    lut_core::envmap::check_map_size("map", w, w / 2).map_err(|e| e.to_string())?;
+    lut_core::check_map_size("map", w, w / 2).map_err(|e| e.to_string())?;
     Ok(w)
 }
 
@@ -193,7 +194,7 @@ fn print_table(rows: &[Sample], a: &BenchLoadArgs) {
     }
 }
 
-/// Write the benchmark scene (`lut_core::synth::scene_color`, a latitude/longitude grid
+/// Write the benchmark scene (`lut_core::scene_color`, a latitude/longitude grid
 /// on a colour field) as a `w × h` equirectangular JPEG, atomically. The RGB buffer is
 /// filled row-parallel; the map type is not used, so only the RGB buffer and the encoder
 /// are in memory.
@@ -204,7 +205,7 @@ fn generate_jpeg(path: &Path, w: u32, h: u32, quality: u8) -> Result<()> {
     rgb.par_chunks_mut(wu * 3).enumerate().for_each(|(y, row)| {
         for (x, p) in row.chunks_exact_mut(3).enumerate() {
             let c = match Projection::Equirect.direction(x as f64 + 0.5, y as f64 + 0.5, wf, hf) {
-                Some((l, ph)) => lut_core::synth::scene_color(l, ph),
+                Some((l, ph)) => lut_core::scene_color(l, ph),
                 None => 0,
             };
             p.copy_from_slice(&[(c >> 16) as u8, (c >> 8) as u8, c as u8]);
@@ -247,11 +248,12 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
     let opts = a.limit.options(None, Tone::default());
     let t0 = Instant::now();
     let mut marks: Vec<(LoadPhase, f64)> = Vec::new();
-    let map = EnvMap::load_with(path, &opts, &mut |p| {
+    let map = lut_core::load_map(path, &opts, &mut |p| {
         if marks.last().map(|m| m.0) != Some(p.phase) {
             marks.push((p.phase, t0.elapsed().as_secs_f64()));
         }
-    })?;
+    })
+    .map_err(crate::cli_common::map_error)?;
     let load_s = t0.elapsed().as_secs_f64();
     let peak_after_load = proc_status_bytes("VmHWM:").unwrap_or(0);
     // Phase durations from the first report of each phase to the next one's.
@@ -287,7 +289,7 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
         for i in 0..=n {
             let view = View::new(f64::from(i) * 360.0 / f64::from(n), 10.0, 90.0)?;
             let t = Instant::now();
-            renderer.render(&map, view, &o, &mut out, w, h)?;
+            renderer.render(Scene::Map(&map), view, &o, &mut Frame::new(&mut out, w, h)?)?;
             if i > 0 {
                 // frame 0 warms the caches
                 ms.push(t.elapsed().as_secs_f64() * 1e3);

@@ -18,7 +18,7 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
         .trim()
         .parse()
         .map_err(|_| format!("size '{s}': height '{b}' is not a whole number"))?;
-    lut_core::camera::check_size(w, h).map_err(|e| format!("size '{s}': {e}"))?;
+    lut_core::check_size(w, h).map_err(|e| format!("size '{s}': {e}"))?;
     Ok((w, h))
 }
 
@@ -43,18 +43,38 @@ pub fn parse_projection(s: &str) -> Result<Option<Projection>, String> {
     }
 }
 
+/// The command-line hint for a library map error: which flag changes the outcome.
+pub fn map_error_hint(e: &lut_core::MapError) -> Option<&'static str> {
+    match e {
+        lut_core::MapError::TooManyPixels { .. } => Some("raise the limit with --max-pixels"),
+        lut_core::MapError::UnknownProjection { .. } => {
+            Some("give --projection cylinder|sine|elliptical|diamond")
+        }
+        _ => None,
+    }
+}
+
+/// A library map error as one line, with its command-line hint (see [`map_error_hint`]).
+pub fn map_error(e: lut_core::MapError) -> anyhow::Error {
+    match map_error_hint(&e) {
+        Some(hint) => anyhow!("{e}; {hint}"),
+        None => anyhow::Error::new(e),
+    }
+}
+
 /// Load the panorama at `path` (the bundled sample when `None`) with `opts`: projection,
 /// tone and the pixel limit (`--max-pixels`, checked from the header before decoding).
 /// The file is streamed into the map, never held whole by this function.
 pub fn load_panorama_opts(path: Option<&Path>, opts: &lut_core::LoadOptions) -> Result<EnvMap> {
     Ok(match path {
-        Some(p) => EnvMap::load_with(p, opts, &mut |_| {})?,
-        None => EnvMap::decode_with(
+        Some(p) => lut_core::load_map(p, opts, &mut |_| {}).map_err(map_error)?,
+        None => lut_core::decode_map(
             crate::assets::SAMPLE_JPEG,
             crate::assets::SAMPLE_NAME,
             opts,
             &mut |_| {},
-        )?,
+        )
+        .map_err(map_error)?,
     })
 }
 

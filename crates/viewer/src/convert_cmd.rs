@@ -3,8 +3,8 @@
 use crate::cli_common::{parse_projection, parse_size, write_image_atomic, write_png_atomic};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, ValueEnum};
-use lut_core::cube::{CubeMap, Face, Layout};
-use lut_core::{EnvMap, Projection, Sampler};
+use lut_core::{CubeMap, Face, Layout};
+use lut_core::{Projection, Sampler};
 use std::path::{Path, PathBuf};
 
 /// What to convert to.
@@ -78,7 +78,8 @@ fn to_cube(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()> {
     let projection: Option<Projection> =
         parse_projection(&a.projection).map_err(anyhow::Error::msg)?;
     let opts = a.limit.options(projection, lut_core::Tone::default());
-    let map = EnvMap::load_with(input, &opts, &mut |_| {})?;
+    let map =
+        lut_core::load_map(input, &opts, &mut |_| {}).map_err(crate::cli_common::map_error)?;
     let face_size = a.face_size.unwrap_or((map.width() / 4).max(1));
     let cube = CubeMap::from_envmap(&map, face_size, a.sampler)?;
     write_cube(&cube, layout, output)

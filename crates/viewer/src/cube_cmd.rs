@@ -2,7 +2,8 @@
 //! rendering a view (the entry points `render --projection cube` and the window use).
 
 use anyhow::Result;
-use lut_core::cube::{self, CubeMap, CubeRenderer, Layout, Naming};
+use lut_core::{CubeMap, CubeRenderer, Layout, Naming};
+use lut_core::{Frame, RenderOptions, Renderer, Scene};
 use lut_core::{Sampler, View};
 use std::path::PathBuf;
 
@@ -14,7 +15,7 @@ use std::path::PathBuf;
 /// `docs/cube.md`).
 ///
 /// # Errors
-/// Unknown layout or naming names, and every [`cube::CubeError`], with the file named.
+/// Unknown layout or naming names, and every [`lut_core::CubeError`], with the file named.
 pub fn load_cube(
     inputs: &[PathBuf],
     layout: Option<&str>,
@@ -26,7 +27,7 @@ pub fn load_cube(
     let naming = naming
         .map(|s| s.parse::<Naming>().map_err(anyhow::Error::msg))
         .transpose()?;
-    Ok(cube::load_cube(inputs, layout, naming)?)
+    Ok(lut_core::load_cube(inputs, layout, naming)?)
 }
 
 /// True when `inputs` look like a cube map rather than one panorama image: a folder, six
@@ -59,15 +60,16 @@ pub fn render_view(
     height: u32,
 ) -> Result<Vec<u32>> {
     let mut out = vec![0u32; width as usize * height as usize];
-    cube::render(
-        cube,
+    Renderer::default().render(
+        Scene::Cube(cube),
         view,
-        sampler,
-        CubeRenderer::Accelerated,
-        &mut out,
-        width,
-        height,
-        true,
+        &RenderOptions {
+            sampler,
+            cube: CubeRenderer::Accelerated,
+            threads: true,
+            ..RenderOptions::default()
+        },
+        &mut Frame::new(&mut out, width, height)?,
     )?;
     Ok(out)
 }

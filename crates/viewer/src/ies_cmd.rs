@@ -4,7 +4,7 @@
 
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
-use lut_core::light::{
+use lut_core::{
     shade_frame, LightScene, LightTable, Luminaire, Photometry, PhotometrySource, Room,
     ShadeOptions, TableOptions,
 };
@@ -161,6 +161,8 @@ pub struct LightArgs {
     /// an IES or EULUMDAT (.ldt) file, recognized by content.
     /// World frame: X right, Y up from the floor, Z forward at yaw 0; the camera is at
     /// (0, camera height, 0). Aim defaults to straight down (yaw 0, pitch -90).
+    // The brackets are the option's grammar (shown as is by --help), not a doc link.
+    #[allow(rustdoc::broken_intra_doc_links)]
     #[arg(long = "light", value_parser = parse_light, allow_hyphen_values = true)]
     pub lights: Vec<LightSpec>,
     /// Room size WIDTHxDEPTHxHEIGHT in metres, centred on the camera (default 5x5x2.7).

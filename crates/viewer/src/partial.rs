@@ -2,7 +2,7 @@
 //! the panel and `viewer render -v` show (coverage, compass heading).
 
 use anyhow::Result;
-use lut_core::coverage::{compass_heading, compass_point};
+use lut_core::{compass_heading, compass_point};
 use lut_core::{Coverage, CoverageSource, EnvMap, LoadOptions};
 use std::path::Path;
 
@@ -11,21 +11,26 @@ pub fn parse_coverage(s: &str) -> Result<Coverage, String> {
     s.parse::<Coverage>().map_err(|e| e.to_string())
 }
 
-/// Turn a placement error into one line that says how to override bad metadata.
+/// Turn a placement error into one line that says how to override bad metadata (or, for
+/// an image that cannot be read, the hint of [`crate::cli_common::map_error`]).
 pub fn coverage_error(e: lut_core::CoverageError, coverage: Option<Coverage>) -> anyhow::Error {
+    if let lut_core::CoverageError::Map(m) = e {
+        return crate::cli_common::map_error(m);
+    }
     let hint = match (&e, coverage) {
-        (lut_core::CoverageError::Invalid { .. }, None) => {
+        (lut_core::CoverageError::Syntax { .. }, _) | (_, Some(_)) => "",
+        // Bad metadata or a placement that does not fit, and no coverage given.
+        (_, None) => {
             " (give --coverage HFOVxVFOV±YAW±PITCH to place the image yourself, e.g. \
              --coverage 360x180 to show it as a full panorama)"
         }
-        _ => "",
     };
     anyhow::anyhow!("{e}{hint}")
 }
 
 /// Load a panorama (`None`: the bundled sample) with the pixel limit, projection and tone
 /// of `opts`, placed by `coverage` when given, else by the GPano XMP in the file (JPEG),
-/// else as a full panorama; `progress` as in `EnvMap::load_with`. Bad metadata is an
+/// else as a full panorama; `progress` as in `lut_core::load_map`. Bad metadata is an
 /// error that says how to override it.
 pub fn load_panorama_partial(
     path: Option<&Path>,
@@ -34,8 +39,8 @@ pub fn load_panorama_partial(
     progress: &mut dyn FnMut(lut_core::LoadProgress),
 ) -> Result<(EnvMap, CoverageSource)> {
     match path {
-        Some(p) => EnvMap::load_partial_with(p, opts, coverage, progress),
-        None => EnvMap::decode_partial_with(
+        Some(p) => lut_core::load_partial(p, opts, coverage, progress),
+        None => lut_core::decode_partial(
             crate::assets::SAMPLE_JPEG,
             crate::assets::SAMPLE_NAME,
             opts,

@@ -3,7 +3,8 @@
 use crate::cli_common::{parse_angle, parse_size, write_png_atomic};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use lut_core::lut::Surface;
+use lut_core::Surface;
+use lut_core::{Frame, Scene};
 use lut_core::{
     IndexStep, LutChoice, Projection, RenderOptions, Renderer, RendererKind, Sampler, View,
 };
@@ -212,6 +213,10 @@ impl RenderArgs {
                 SurfaceArg::Plane => Surface::Plane,
             },
             threads: !self.single_thread,
+            cube: match self.input.cube_renderer {
+                CubeRendererArg::Basic => lut_core::CubeRenderer::Basic,
+                CubeRendererArg::Scanline => lut_core::CubeRenderer::Accelerated,
+            },
         }
     }
 }
@@ -228,7 +233,6 @@ pub fn run(a: RenderArgs) -> Result<()> {
         ProjectionArg::Map(_) => false,
     };
     let mut out = vec![0u32; w as usize * h as usize];
-    let sampler = a.options().sampler;
     if cube {
         if a.input.coverage.is_some() {
             anyhow::bail!("--coverage applies to equirectangular panoramas, not cube maps");
@@ -238,11 +242,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
             a.input.layout.as_deref(),
             a.input.naming.as_deref(),
         )?;
-        let kind = match a.input.cube_renderer {
-            CubeRendererArg::Basic => lut_core::cube::CubeRenderer::Basic,
-            CubeRendererArg::Scanline => lut_core::cube::CubeRenderer::Accelerated,
-        };
-        lut_core::cube::render(&cube, view, sampler, kind, &mut out, w, h, !a.single_thread)?;
+        Renderer::default().render(
+            Scene::Cube(&cube),
+            view,
+            &a.options(),
+            &mut Frame::new(&mut out, w, h)?,
+        )?;
         if a.verbose {
             eprintln!(
                 "rendered {w}x{h} from a cube map of {}px faces",
@@ -274,7 +279,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
         }
         let opts = a.options();
         let mut renderer = Renderer::new(&map);
-        let report = renderer.render(&map, view, &opts, &mut out, w, h)?;
+        let report = renderer.render(
+            Scene::Map(&map),
+            view,
+            &opts,
+            &mut Frame::new(&mut out, w, h)?,
+        )?;
         if a.verbose {
             eprintln!(
                 "rendered {}x{} from {}x{} {} map: path {}, table {} bytes, {} of {} pixels exact, index step {}..{}",

@@ -12,9 +12,7 @@ fn tmpdir(name: &str) -> PathBuf {
     common::tmpdir("viewer-maxpx", name)
 }
 
-#[path = "../../../tests/support/bombs.rs"]
-mod bombs;
-use bombs::png_header_only;
+use test_support::bombs::png_header_only;
 
 fn assert_refused(o: &Output, parts: &[&str]) {
     let err = String::from_utf8_lossy(&o.stderr);

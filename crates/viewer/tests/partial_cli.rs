@@ -1,7 +1,7 @@
 //! `viewer render` with partial panoramas: GPano XMP in a JPEG, `--coverage`, bad
 //! metadata, `--view-limit`.
 
-use lut_core::gpano::{insert_xmp, xmp_packet};
+use lut_core::{insert_xmp, xmp_packet};
 use std::path::{Path, PathBuf};
 
 mod common;

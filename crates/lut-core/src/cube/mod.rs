@@ -1,7 +1,7 @@
 //! Cube panoramas (Wei, Gao, Gong 2003, "The technique of browsing virtual world based on
 //! cubic panorama"): six square faces, a per-pixel renderer and a per-scanline-segment one.
 //!
-//! # Geometry (`conventions.md`, cube section)
+//! # Geometry (`docs/conventions.md`, cube section)
 //! Face `k` is exactly the view the project's camera renders with hfov 90° into a square
 //! image at the face's yaw/pitch:
 //!
@@ -26,34 +26,32 @@
 //! each border texel's center. Bilinear sampling then never branches and never clamps at a
 //! face edge, and reads across into the neighbour, so edges and corners show no seam.
 //!
-//! # Renderers
-//! [`render`] with [`CubeRenderer::Basic`] (the paper's section 1: per pixel, ray → face →
+//! # Renderers (`render/cube.rs`)
+//! [`crate::Renderer::render`] of a [`crate::Scene::Cube`] with [`CubeRenderer::Basic`] (the paper's section 1: per pixel, ray → face →
 //! face coordinates → sample) or [`CubeRenderer::Accelerated`] (section 2: each scanline is
 //! a 3-D line, cut into face segments found by binary search, stepped inside each segment
 //! without choosing a face). Both compute every ray and every face coordinate with the
 //! same expressions, and the accelerated path *proves* each segment's face before using
 //! it (falling back to the per-pixel choice where it cannot), so the two images are
-//! byte-identical. See [`render`] and `docs/cube.md`.
+//! byte-identical. See `docs/cube.md`.
+//!
+//! Loading from files is `io/cube.rs`; layouts and namings are `cube/layout.rs`.
 
-mod load;
-mod render;
+pub(crate) mod layout;
 
-pub use load::{
-    layout_dimensions, load_cube, load_face_files, load_layout_image, Layout, Naming, Transform,
-};
-pub use render::{render, scanline_runs, CubeRenderer};
-
-use crate::camera::{lat_long_to_dir, View};
-use crate::envmap::{lerp_px, EnvMap, Sampler};
-use crate::fixed::{to_fx, FX_BITS, FX_HALF, FX_ONE};
+use crate::error::ViewError;
+use crate::geom::camera::{check_size, lat_long_to_dir, View};
+use crate::geom::fixed::{to_fx, FX_BITS, FX_HALF, FX_ONE};
+use crate::map::sample::{lerp_px, Sampler};
 use glam::DVec3;
+use layout::Layout;
 use rayon::prelude::*;
 use std::path::PathBuf;
 
 /// Largest accepted face side: six 8192² faces are 1.6 GB of 0RGB texels.
 pub const MAX_FACE_SIZE: u32 = 8192;
 
-/// One face of a cube map, in the order of `conventions.md` (which is also the tie order).
+/// One face of a cube map, in the order of `docs/conventions.md` (which is also the tie order).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Face {
     /// yaw 0, pitch 0 (+Z).
@@ -228,24 +226,24 @@ pub enum CubeError {
         max: u32,
     },
     /// Not exactly one file per face.
-    #[error("{what}: {reason}")]
+    #[error("{what}: {problem}")]
     Faces {
-        /// The folder or the list of inputs.
+        /// The folder, the file or the list of inputs.
         what: String,
         /// Which faces are missing, repeated or unrecognized.
-        reason: String,
+        problem: FacesProblem,
     },
     /// A single image whose size fits no layout, or the wrong layout for it.
-    #[error("{path}: {reason}")]
+    #[error("{path}: {problem}")]
     Layout {
         /// The file.
         path: PathBuf,
         /// Why.
-        reason: String,
+        problem: LayoutProblem,
     },
-    /// An unknown layout or naming name, or inputs that do not fit the request.
+    /// Inputs that do not fit the request, or an output that cannot be made.
     #[error("{0}")]
-    Usage(String),
+    Usage(UsageProblem),
     /// A pixel buffer does not hold `size × size` texels.
     #[error("{what}: buffer holds {len} texels, a {size}x{size} face needs {needed}")]
     Buffer {
@@ -257,6 +255,123 @@ pub enum CubeError {
         size: u32,
         /// size².
         needed: usize,
+    },
+}
+
+/// Why the face files do not make a cube (see [`CubeError::Faces`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FacesProblem {
+    /// A folder without face images.
+    #[error(
+        "no face images found (expected names ending in front/right/back/left/up/down, \
+         ft/rt/bk/lf/up/dn or px/nx/py/ny/pz/nz)"
+    )]
+    NoFaceImages,
+    /// A file whose name names no face.
+    #[error(
+        "the file name does not say which face it is (expected it to end in \
+         front/right/back/left/up/down, ft/rt/bk/lf/up/dn or px/nx/py/ny/pz/nz)"
+    )]
+    UnnamedFace,
+    /// Two files name the same face.
+    #[error("two files for the {} face: {} and {}", face.name(), first.display(), second.display())]
+    Duplicate {
+        /// The face.
+        face: Face,
+        /// The first file.
+        first: PathBuf,
+        /// The second file.
+        second: PathBuf,
+    },
+    /// Fewer than six faces.
+    #[error(
+        "{} face file(s) given, a cube needs six; missing: {}",
+        6 - missing.len(),
+        missing.iter().map(|f| f.name()).collect::<Vec<_>>().join(", ")
+    )]
+    Missing {
+        /// The faces without a file.
+        missing: Vec<Face>,
+    },
+}
+
+/// Why a single image is not the layout asked for (see [`CubeError::Layout`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum LayoutProblem {
+    /// Its aspect ratio is no layout's.
+    #[error(
+        "image is {width}x{height}; a single-image cube map must be 4:3 (cross), 6:1 (strip) or \
+         3:2 (3x2); for six files give a folder or six paths"
+    )]
+    NoLayout {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+    },
+    /// Its size is not whole square faces of the layout asked for.
+    #[error(
+        "image is {width}x{height}, which is not {cols}x{rows} square faces as layout {} needs",
+        layout.name()
+    )]
+    NotFaces {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// Faces across.
+        cols: u32,
+        /// Faces down.
+        rows: u32,
+        /// The layout.
+        layout: Layout,
+    },
+}
+
+/// Inputs that do not fit the request (see [`CubeError::Usage`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum UsageProblem {
+    /// No input at all.
+    #[error("no cube map input given")]
+    NoInput,
+    /// A folder with a single-image layout.
+    #[error("{}: is a folder, but layout {} is a single image", path.display(), layout.name())]
+    FolderForSingleImage {
+        /// The folder.
+        path: PathBuf,
+        /// The layout asked for.
+        layout: Layout,
+    },
+    /// One file with the six-files layout.
+    #[error("{}: layout files needs six face files or a folder, got one file", path.display())]
+    OneFileForFiles {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Several inputs with a single-image layout.
+    #[error("{count} inputs given, but layout {} is a single image", layout.name())]
+    ManyForSingleImage {
+        /// How many inputs.
+        count: usize,
+        /// The layout asked for.
+        layout: Layout,
+    },
+    /// The six-files layout asked of one image.
+    #[error("layout files is six images, not one")]
+    FilesIsNotOneImage,
+    /// An output size that cannot be rendered.
+    #[error("{0}")]
+    Output(ViewError),
+    /// A face that cannot be rendered.
+    #[error("cannot render {} face: {error}", face.name())]
+    FaceRender {
+        /// The face.
+        face: Face,
+        /// Why.
+        error: ViewError,
     },
 }
 
@@ -308,7 +423,7 @@ fn bilinear_clamped(px: &[u32], n: u32, u: f64, v: f64) -> u32 {
 
 impl CubeMap {
     /// Build a cube map from six `size × size` row-major 0RGB faces in [`Face::ALL`] order,
-    /// each oriented as `conventions.md` requires.
+    /// each oriented as `docs/conventions.md` requires.
     ///
     /// # Errors
     /// [`CubeError::FaceSize`] or [`CubeError::Buffer`].
@@ -355,37 +470,6 @@ impl CubeMap {
             out[k] = data;
         }
         Ok(CubeMap { size, faces: out })
-    }
-
-    /// Render a cube map from a panorama: each face is the exact renderer's hfov-90° view
-    /// at the face's yaw/pitch (the definition in `conventions.md`).
-    ///
-    /// # Errors
-    /// [`CubeError::FaceSize`] for a bad `face_size`.
-    pub fn from_envmap(
-        map: &EnvMap,
-        face_size: u32,
-        sampler: Sampler,
-    ) -> Result<CubeMap, CubeError> {
-        check_face_size("cube map", face_size)?;
-        let n = face_size as usize;
-        let mut faces: [Vec<u32>; 6] = Default::default();
-        for (k, face) in Face::ALL.iter().enumerate() {
-            let mut buf = vec![0u32; n * n];
-            crate::exact::render_exact(
-                map,
-                face.view(),
-                sampler,
-                &mut buf,
-                face_size,
-                face_size,
-                true,
-            )
-            .map_err(|e| CubeError::Usage(format!("cannot render {} face: {e}", face.name())))?;
-            faces[k] = buf;
-        }
-        let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
-        CubeMap::from_faces(face_size, refs)
     }
 
     /// Face side in texels.
@@ -477,7 +561,7 @@ impl CubeMap {
     }
 
     /// Resample to an equirectangular `width × height` image (row-major 0RGB): each pixel
-    /// center's (λ, φ) per `conventions.md`, sampled in that direction.
+    /// center's (λ, φ) per `docs/conventions.md`, sampled in that direction.
     ///
     /// # Errors
     /// [`CubeError::Usage`] for an empty or oversized output.
@@ -487,7 +571,7 @@ impl CubeMap {
         height: u32,
         sampler: Sampler,
     ) -> Result<Vec<u32>, CubeError> {
-        crate::camera::check_size(width, height).map_err(|e| CubeError::Usage(e.to_string()))?;
+        check_size(width, height).map_err(|e| CubeError::Usage(UsageProblem::Output(e)))?;
         let (w, h) = (width as usize, height as usize);
         let mut out = vec![0u32; w * h];
         out.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
@@ -534,7 +618,7 @@ impl CubeMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::Camera;
+    use crate::geom::camera::Camera;
 
     #[test]
     fn faces_are_the_conventions_camera() {

@@ -15,7 +15,7 @@
 //!   shading of a rendered frame: scene point = ray ∩ room, E = I(direction)·cos(incidence)/d²,
 //!   colour = albedo · (ambient + exposure · ΣE), with a false-colour illuminance overlay.
 //!
-//! World frame (conventions.md): X right, Y up, Z forward at yaw 0; metres. The origin is
+//! World frame (docs/conventions.md): X right, Y up, Z forward at yaw 0; metres. The origin is
 //! the floor point below the camera, so the camera sits at (0, camera height, 0).
 //! See `docs/lights.md` for the design.
 

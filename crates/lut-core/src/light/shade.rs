@@ -7,14 +7,14 @@
 //! the shaded colour is albedo · (ambient + exposure · ΣE), computed on linear light
 //! (sRGB decoded, multiplied, encoded again).
 //!
-//! World frame (conventions.md): X right, Y up, Z forward at yaw 0, in metres, with the
+//! World frame (docs/conventions.md): X right, Y up, Z forward at yaw 0, in metres, with the
 //! origin on the floor below the camera: the room spans x ∈ [−W/2, W/2], y ∈ [0, H],
 //! z ∈ [−D/2, D/2] and the camera sits at (0, camera height, 0). The walls are convex
 //! around every light inside, so there are no shadows to trace.
 
 use super::table::LightTable;
 use super::{LightError, PhotometricType};
-use crate::camera::Camera;
+use crate::geom::camera::Camera;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::{Arc, OnceLock};

@@ -13,10 +13,10 @@ use super::ui::{self, LoadStatus, LoadStep, PanelModel, Readouts};
 use super::OpenArgs;
 use crate::render_cmd::{CubeRendererArg, ProjectionArg};
 use anyhow::{anyhow, Result};
-use lut_core::cube::{CubeMap, CubeRenderer};
 use lut_core::{
     Camera, EnvMap, IndexStep, LutChoice, Projection, Renderer, RendererKind, Sampler, Tone,
 };
+use lut_core::{CubeMap, CubeRenderer, Frame, RenderOptions, RenderPath};
 use std::collections::VecDeque;
 use std::num::NonZeroU32;
 use std::path::PathBuf;
@@ -76,6 +76,25 @@ impl Source {
 enum Scene {
     Map { map: EnvMap, renderer: Renderer },
     Cube(CubeMap),
+}
+
+impl Scene {
+    /// Render `view` into `frame` through lut-core's one render entry.
+    fn render(
+        &mut self,
+        view: lut_core::View,
+        opts: &RenderOptions,
+        frame: &mut Frame<'_>,
+    ) -> Result<lut_core::RenderReport, lut_core::ViewError> {
+        match self {
+            Scene::Map { map, renderer } => {
+                renderer.render(lut_core::Scene::Map(map), view, opts, frame)
+            }
+            Scene::Cube(cube) => {
+                Renderer::default().render(lut_core::Scene::Cube(cube), view, opts, frame)
+            }
+        }
+    }
 }
 
 /// A loaded panorama with its renderer (tables built on the loading thread).
@@ -159,9 +178,9 @@ fn load(
     send(LoadStep::Tables, Some(0.0));
     let mut renderer = Renderer::new(&map);
     let surface = lut_core::RenderOptions::default().surface;
-    renderer.table(surface, lut_core::lut::TableKind::Wide);
+    renderer.table(surface, lut_core::TableKind::Wide);
     send(LoadStep::Tables, Some(0.3));
-    renderer.table(surface, lut_core::lut::TableKind::High);
+    renderer.table(surface, lut_core::TableKind::High);
     send(LoadStep::Tables, Some(0.5));
     map.pyramid();
     send(LoadStep::Tables, Some(1.0));
@@ -706,25 +725,12 @@ impl App {
         };
         let view = self.ctl.look().view();
         let mut buf = vec![0u32; w as usize * h as usize];
-        match &mut cur.scene {
-            Scene::Map { map, renderer } => renderer
-                .render(map, view, &opts, &mut buf, w, h)
-                .map(|_| ())
-                .map_err(|e| e.to_string())?,
-            Scene::Cube(cube) => lut_core::cube::render(
-                cube,
-                view,
-                opts.sampler,
-                self.ctl.settings.cube_renderer,
-                &mut buf,
-                w,
-                h,
-                true,
-            )
-            .map_err(|e| e.to_string())?,
-        }
+        let mut frame = Frame::new(&mut buf, w, h).map_err(|e| e.to_string())?;
+        cur.scene
+            .render(view, &opts, &mut frame)
+            .map_err(|e| e.to_string())?;
         if let Some(scene) = self.lights.scene()? {
-            lut_core::light::shade_frame(
+            lut_core::shade_frame(
                 &scene,
                 &Camera::new(view, w, h),
                 &mut buf,
@@ -761,42 +767,28 @@ impl App {
         self.scene.resize(rect.w as usize * rect.h as usize, 0);
         let t0 = Instant::now();
         let view = look.view();
-        let result = match &mut cur.scene {
-            Scene::Map { map, renderer } => renderer
-                .render(map, view, &opts, &mut self.scene, rect.w, rect.h)
-                .map(|report| {
-                    self.readouts.path = Some(report.path);
-                    self.readouts.table_bytes = report.table_bytes;
-                    self.readouts.exact_pixels = report.exact_pixels;
-                    self.readouts.pixels = report.pixels;
-                    self.readouts.cube = None;
-                    format!("{:?}", report.path)
-                }),
-            Scene::Cube(cube) => {
-                let kind = self.ctl.settings.cube_renderer;
-                lut_core::cube::render(
-                    cube,
-                    view,
-                    opts.sampler,
-                    kind,
-                    &mut self.scene,
-                    rect.w,
-                    rect.h,
-                    true,
-                )
-                .map(|()| {
-                    self.readouts.path = None;
-                    self.readouts.table_bytes = cube.bytes();
-                    self.readouts.exact_pixels = 0;
-                    self.readouts.pixels = u64::from(rect.w) * u64::from(rect.h);
-                    self.readouts.cube = Some(kind);
-                    match kind {
-                        CubeRenderer::Basic => "CubeBasic".to_string(),
-                        CubeRenderer::Accelerated => "CubeScanline".to_string(),
+        let result = Frame::new(&mut self.scene, rect.w, rect.h)
+            .and_then(|mut frame| cur.scene.render(view, &opts, &mut frame))
+            .map(|report| {
+                self.readouts.table_bytes = report.table_bytes;
+                self.readouts.exact_pixels = report.exact_pixels;
+                self.readouts.pixels = report.pixels;
+                match report.path {
+                    RenderPath::Cube(kind) => {
+                        self.readouts.path = None;
+                        self.readouts.cube = Some(kind);
+                        match kind {
+                            CubeRenderer::Basic => "CubeBasic".to_string(),
+                            CubeRenderer::Accelerated => "CubeScanline".to_string(),
+                        }
                     }
-                })
-            }
-        };
+                    path => {
+                        self.readouts.path = Some(path);
+                        self.readouts.cube = None;
+                        format!("{path:?}")
+                    }
+                }
+            });
         match result {
             Ok(path) => {
                 self.light_scene(view, rect);
@@ -842,7 +834,7 @@ impl App {
     fn light_scene(&mut self, view: lut_core::View, rect: SceneRect) {
         let result = self.lights.scene().and_then(|scene| match scene {
             None => Ok(()),
-            Some(scene) => lut_core::light::shade_frame(
+            Some(scene) => lut_core::shade_frame(
                 &scene,
                 &Camera::new(view, rect.w, rect.h),
                 &mut self.scene,
@@ -864,7 +856,7 @@ impl App {
     ) -> bool {
         let lux = match (cursor, rect, self.lights.scene()) {
             (Some((x, y)), Some(r), Ok(Some(scene))) if r.w > 0 && r.h > 0 => Some(
-                lut_core::light::lux_at(&scene, &Camera::new(look.view(), r.w, r.h), x, y),
+                lut_core::lux_at(&scene, &Camera::new(look.view(), r.w, r.h), x, y),
             ),
             _ => None,
         };

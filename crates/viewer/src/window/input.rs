@@ -19,8 +19,8 @@
 //!   motion stops one full-quality frame is due ([`Controller::wake_at`]).
 
 use glam::DVec3;
-use lut_core::camera::{dir_to_lat_long, wrap_deg};
-use lut_core::cube::CubeRenderer;
+use lut_core::CubeRenderer;
+use lut_core::{dir_to_lat_long, wrap_deg};
 use lut_core::{Camera, IndexStep, LutChoice, RenderOptions, RendererKind, Sampler, View};
 
 /// Narrowest horizontal field of view the wheel and keys reach, degrees.
@@ -189,6 +189,7 @@ impl Settings {
             index_step: self.index_step,
             lut: self.lut,
             threads: true,
+            cube: self.cube_renderer,
             ..RenderOptions::default()
         }
     }
@@ -914,8 +915,8 @@ mod tests {
 
     #[test]
     fn wheel_crosses_the_lut_switch() {
-        let map = lut_core::synth::grid_map(256, 128, lut_core::Projection::Equirect)
-            .expect("synthetic map");
+        let map =
+            lut_core::grid_map(256, 128, lut_core::Projection::Equirect).expect("synthetic map");
         let mut r = lut_core::Renderer::new(&map);
         let (w, h) = (64, 40);
         let mut out = vec![0u32; w * h];
@@ -925,9 +926,14 @@ mod tests {
         while c.look().hfov > 40.0 {
             let opts = c.settings.render_options(false);
             let report = r
-                .render(&map, c.look().view(), &opts, &mut out, w as u32, h as u32)
+                .render(
+                    lut_core::Scene::Map(&map),
+                    c.look().view(),
+                    &opts,
+                    &mut lut_core::Frame::new(&mut out, w as u32, h as u32).expect("frame"),
+                )
                 .expect("render");
-            let want = if c.look().hfov > lut_core::raster::LUT_SWITCH_HFOV {
+            let want = if c.look().hfov > lut_core::LUT_SWITCH_HFOV {
                 lut_core::RenderPath::LutWide
             } else {
                 lut_core::RenderPath::LutHigh
@@ -1083,8 +1089,7 @@ mod tests {
         // 100° x 50° across the seam (yaw 130 to -130), a 200x100 scene
         let cov = lut_core::Coverage::new(100.0, 50.0, 180.0, 0.0).unwrap();
         let size = (200, 100);
-        let inside =
-            |c: &Controller| lut_core::viewlimit::view_inside(c.look().view(), 200, 100, &cov);
+        let inside = |c: &Controller| lut_core::view_inside(c.look().view(), 200, 100, &cov);
         let mut c = Controller::default();
         c.set_limit(Some((cov, size)));
         // the home view (yaw 0, hfov 90) cannot fit: pulled in, narrowed

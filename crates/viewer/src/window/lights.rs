@@ -2,7 +2,7 @@
 //! `lut_core::light` scene and shading options `viewer render --light ...` uses. Pure
 //! data (no window), so the conversions are unit-tested.
 
-use lut_core::light::{LightScene, LightTable, Luminaire, Room, ShadeOptions};
+use lut_core::{LightScene, LightTable, Luminaire, Room, ShadeOptions};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -269,7 +269,7 @@ mod tests {
         s.load_and_add(&sample_path()).unwrap();
         let scene = s.scene().unwrap().unwrap();
         let cam = Camera::new(View::new(0.0, -90.0, 90.0).unwrap(), 64, 64);
-        let lux = lut_core::light::lux_at(&scene, &cam, 32.0, 32.0);
+        let lux = lut_core::lux_at(&scene, &cam, 32.0, 32.0);
         let direct = scene.illuminance(glam::DVec3::new(0.0, 0.0, 0.0), glam::DVec3::Y);
         assert!(
             (lux - direct).abs() <= 1e-9 * direct.max(1.0),

@@ -4,7 +4,7 @@
 
 use super::input::{AaMode, DragStyle, Held, Look, Settings};
 use super::lights::{format_lux, LightsState};
-use lut_core::cube::CubeRenderer;
+use lut_core::CubeRenderer;
 use lut_core::{IndexStep, LutChoice, Projection, RenderPath, RendererKind, Sampler};
 
 /// Width of the panel, in points.
@@ -257,6 +257,7 @@ pub fn path_label(p: Option<RenderPath>) -> &'static str {
         Some(RenderPath::LutWide) => "wide-FOV LUT",
         Some(RenderPath::LutHigh) => "high-resolution LUT",
         Some(RenderPath::Exact) => "exact (no LUT)",
+        Some(RenderPath::Cube(_)) => "cube map",
         None => "none yet",
     }
 }
@@ -342,10 +343,10 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
         row("pitch", format!("{:8.2}°", m.look.pitch));
         row("hfov", format!("{:8.2}°", m.look.hfov));
         if let Some(p) = r.pose_heading {
-            let h = lut_core::coverage::compass_heading(p, m.look.yaw);
+            let h = lut_core::compass_heading(p, m.look.yaw);
             row(
                 "heading",
-                format!("{h:8.2}° {}", lut_core::coverage::compass_point(h)),
+                format!("{h:8.2}° {}", lut_core::compass_point(h)),
             );
         }
         row("in use", in_use_label(r).into());
@@ -681,7 +682,7 @@ mod tests {
             let mut st = LoadStatus::new("t".into());
             let mut shown = vec![(st.step, st.fraction)];
             let opts = lut_core::LoadOptions::default();
-            lut_core::EnvMap::decode_with(&bytes, "t", &opts, &mut |p| {
+            lut_core::decode_map(&bytes, "t", &opts, &mut |p| {
                 if st.advance(p.phase.into(), p.fraction) {
                     shown.push((st.step, st.fraction));
                 }

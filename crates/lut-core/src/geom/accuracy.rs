@@ -1,0 +1,143 @@
+//! Measuring a renderer's sampling positions against the exact map.
+//!
+//! **The metric.** The sampling-position error of a pixel is the distance, in source
+//! pixels, between the map position (u, v) a renderer sampled and the exact one, with the
+//! u difference taken around the wrap (for 360° maps) and scaled by `cos φ / s(φ)` (`s` is
+//! the projection's row scale, 1 for rectangular maps). The scale turns a longitude error
+//! into the same angle measured in pixels at the map's equator: near a pole a whole map
+//! row is almost one direction, so an unscaled u error there says nothing about the image.
+//! Both the scaled ("angular") and the raw distances are reported.
+
+use crate::geom::camera::{Camera, View};
+use crate::geom::mapping::exact_uv;
+use crate::geom::projection::Projection;
+
+/// Angular-metric position error of `got` against `exact` at latitude `phi`.
+#[inline]
+pub fn position_error(
+    p: Projection,
+    w: f64,
+    _h: f64,
+    phi: f64,
+    exact: (f64, f64),
+    got: (f64, f64),
+) -> f64 {
+    let s = p.row_scale(phi);
+    let du = wrap_du(p, w, s, got.0 - exact.0);
+    let scale = if s > 1e-9 {
+        (phi.cos() / s).min(2.0)
+    } else {
+        1.0
+    };
+    let dv = got.1 - exact.1;
+    ((du * scale).powi(2) + dv * dv).sqrt()
+}
+
+/// A u difference reduced around the row's wrap: W for 360° maps, s(φ)·W for elliptical
+/// and diamond rows (λ = −π and λ = +π are the same direction at opposite row ends).
+#[inline]
+fn wrap_du(p: Projection, w: f64, s: f64, du: f64) -> f64 {
+    let period = if p.wraps() {
+        w
+    } else if p.scaled_rows() {
+        s * w
+    } else {
+        return du;
+    };
+    if period <= 0.0 {
+        return 0.0; // the pole row of a scaled map is a single point
+    }
+    du - (du / period).round() * period
+}
+
+/// Raw (unscaled) position error, wrap-aware.
+#[inline]
+pub fn raw_error(p: Projection, w: f64, phi: f64, exact: (f64, f64), got: (f64, f64)) -> f64 {
+    let du = wrap_du(p, w, p.row_scale(phi), got.0 - exact.0);
+    let dv = got.1 - exact.1;
+    (du * du + dv * dv).sqrt()
+}
+
+/// Summary of sampling-position errors over a frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ErrorStats {
+    /// Pixels compared.
+    pub count: u64,
+    /// Max angular-metric error, source pixels.
+    pub max: f64,
+    /// Mean angular-metric error.
+    pub mean: f64,
+    /// Max raw (unscaled u) error.
+    pub max_raw: f64,
+    /// Pixels where one side had a map position and the other showed background.
+    pub coverage_mismatch: u64,
+    /// Output pixel with the largest error.
+    pub worst_pixel: (u32, u32),
+}
+
+impl ErrorStats {
+    /// Merge another frame's stats into this one.
+    pub fn merge(&mut self, o: &ErrorStats) {
+        let n = self.count + o.count;
+        if n > 0 {
+            self.mean = (self.mean * self.count as f64 + o.mean * o.count as f64) / n as f64;
+        }
+        self.count = n;
+        if o.max > self.max {
+            self.max = o.max;
+            self.worst_pixel = o.worst_pixel;
+        }
+        self.max_raw = self.max_raw.max(o.max_raw);
+        self.coverage_mismatch += o.coverage_mismatch;
+    }
+}
+
+/// Compare per-pixel positions (row-major, `None` = background) against the exact map of
+/// `view` for a map of `map_w × map_h` in projection `p`.
+pub fn compare_positions(
+    positions: &[Option<(f64, f64)>],
+    view: View,
+    width: u32,
+    height: u32,
+    p: Projection,
+    map_w: u32,
+    map_h: u32,
+) -> ErrorStats {
+    let cam = Camera::new(view, width, height);
+    let (w, h) = (map_w as f64, map_h as f64);
+    let mut st = ErrorStats::default();
+    let mut sum = 0.0;
+    for y in 0..height {
+        for x in 0..width {
+            let got = positions[(y * width + x) as usize];
+            let ex = exact_uv(&cam, p, w, h, x, y);
+            match (ex, got) {
+                (Some(e), Some(g)) => {
+                    let (_, phi) = cam.pixel_lat_long(x, y);
+                    let err = position_error(p, w, h, phi, e, g);
+                    let raw = raw_error(p, w, phi, e, g);
+                    st.count += 1;
+                    sum += err;
+                    if err > st.max || !err.is_finite() {
+                        st.max = if err.is_finite() { err } else { f64::INFINITY };
+                        st.worst_pixel = (x, y);
+                    }
+                    st.max_raw = st.max_raw.max(raw);
+                }
+                (None, None) => st.count += 1,
+                (Some(e), None) | (None, Some(e)) => {
+                    // Only a mismatch if the covered side is not right at the edge.
+                    let edge = e.1 < 0.5 || e.1 > h - 0.5;
+                    if !edge {
+                        st.coverage_mismatch += 1;
+                    }
+                    st.count += 1;
+                }
+            }
+        }
+    }
+    if st.count > 0 {
+        st.mean = sum / st.count as f64;
+    }
+    st
+}

@@ -1,0 +1,231 @@
+//! Minification anti-aliasing: a pyramid of the map and the trilinear sampler.
+//!
+//! Zoomed out on a large map, one screen pixel covers several map pixels and bilinear
+//! sampling (four texels) aliases: moiré on fine patterns, sparkle while panning. The
+//! pyramid stores the map again at half, quarter, ... size (a 2×2 box filter per level,
+//! averaged in 8-bit sRGB like the supersampled exact renderer), the same idea as
+//! EP 0613099's series of tables halving in size. The sampler picks the two levels around
+//! the pixel footprint and blends bilinear samples of both (trilinear).
+//!
+//! Geometry: level k pixel j covers level-0 pixels [j·2^k, (j+1)·2^k), so a level-0
+//! position u (pixel i spans [i, i + 1)) is u / 2^k on level k — a shift of the Q.16
+//! coordinate. Levels are built only while both sides stay even (so that relation is exact
+//! and the ±180° seam stays at a level column boundary); a 6000×3000 map gets
+//! 3000×1500, 1500×750 and 750×375.
+//!
+//! The level of detail is `log2(footprint) − ½` in Q.8 ([`lod_q8`]), where the footprint is
+//! the larger side of the pixel's extent in level-0 map pixels. The LUT renderer takes the
+//! horizontal extent from each span's index-interpolation step and the vertical one per
+//! scanline from its angular row spacing (the LUT's per-scanline scale); the exact
+//! renderer differentiates the exact mapping per pixel. Memory: at most one third of the
+//! map more, built on first use. Partial (cropped) maps get no pyramid: they sample
+//! bilinearly.
+
+use crate::geom::fixed::Fx;
+use crate::map::envmap::EnvMap;
+use crate::map::sample::lerp_px;
+use rayon::prelude::*;
+
+/// Smallest level side built.
+const MIN_LEVEL_SIDE: u32 = 2;
+
+/// Level-of-detail bias in levels: blending towards level 1 starts at a footprint of
+/// √2 map pixels instead of 1. Between 1 and √2 bilinear barely aliases, and a frame at
+/// the common zoom (about one map pixel per screen pixel) then costs one bilinear sample
+/// per pixel instead of two.
+pub const LOD_BIAS: f32 = -0.5;
+
+/// Level of detail in Q.8 (256 = one level) for a footprint of `footprint` level-0 map
+/// pixels per screen pixel: log2 of it plus [`LOD_BIAS`], and 0 (level 0, plain bilinear)
+/// below that.
+#[inline]
+pub fn lod_q8(footprint: f64) -> i32 {
+    if footprint > 1.0 {
+        // f32 log2 is plenty: the blend weight has 8 bits.
+        (((footprint as f32).log2() + LOD_BIAS) * 256.0).clamp(0.0, i32::MAX as f32 / 2.0) as i32
+    } else {
+        0
+    }
+}
+
+impl EnvMap {
+    /// The pyramid levels 1, 2, ... (level 0 is the map itself), built on first use
+    /// (rayon) and kept. Empty for partial maps and maps with an odd side.
+    pub fn pyramid(&self) -> &[EnvMap] {
+        self.levels.get_or_init(|| build_levels(self))
+    }
+
+    /// Bytes the pyramid holds (0 until built).
+    pub fn pyramid_bytes(&self) -> usize {
+        self.levels
+            .get()
+            .map_or(0, |l| l.iter().map(EnvMap::bytes).sum())
+    }
+
+    /// Level `k` of the pyramid (0 = this map); clamped to the last level built.
+    pub(crate) fn level(&self, k: usize) -> (&EnvMap, u32) {
+        if k == 0 {
+            return (self, 0);
+        }
+        let levels = self.pyramid();
+        match levels.len() {
+            0 => (self, 0),
+            n => {
+                let k = k.min(n);
+                (&levels[k - 1], k as u32)
+            }
+        }
+    }
+
+    /// Trilinear sample at level-0 position (u, v) (Q.16; u in [0, W) for 360° maps) with
+    /// level of detail `lod` (Q.8, see [`lod_q8`]): bilinear on the two levels around it,
+    /// blended. `lod` ≤ 0 is plain bilinear.
+    pub fn trilinear(&self, u: Fx, v: Fx, lod: i32) -> u32 {
+        if lod <= 0 || self.crop.is_some() {
+            return self.bilinear_any(u, v);
+        }
+        let k = (lod >> 8) as usize;
+        let frac = (lod & 0xFF) as u32;
+        let (a_map, ka) = self.level(k);
+        let a = a_map.bilinear(u >> ka, v >> ka);
+        let (b_map, kb) = self.level(k + 1);
+        if frac == 0 || kb == ka {
+            return a;
+        }
+        lerp_px(a, b_map.bilinear(u >> kb, v >> kb), frac)
+    }
+
+    fn bilinear_any(&self, u: Fx, v: Fx) -> u32 {
+        if self.crop.is_some() {
+            self.bilinear_cropped(u, v)
+        } else {
+            self.bilinear(u, v)
+        }
+    }
+}
+
+/// Levels 1.. of `map` (empty for partial maps).
+fn build_levels(map: &EnvMap) -> Vec<EnvMap> {
+    let mut levels: Vec<EnvMap> = Vec::new();
+    if map.crop.is_some() {
+        return levels;
+    }
+    loop {
+        let prev = levels.last().unwrap_or(map);
+        let (w, h) = (prev.width, prev.height);
+        if w % 2 != 0 || h % 2 != 0 || w / 2 < MIN_LEVEL_SIDE || h / 2 < MIN_LEVEL_SIDE {
+            return levels;
+        }
+        let (nw, nh) = ((w / 2) as usize, (h / 2) as usize);
+        let mut px = vec![0u32; nw * nh];
+        px.par_chunks_mut(nw).enumerate().for_each(|(j, row)| {
+            for (i, p) in row.iter_mut().enumerate() {
+                let (x, y) = (2 * i as u32, 2 * j as u32);
+                *p = average4(
+                    prev.pixel(x, y),
+                    prev.pixel(x + 1, y),
+                    prev.pixel(x, y + 1),
+                    prev.pixel(x + 1, y + 1),
+                );
+            }
+        });
+        match EnvMap::from_pixels(nw as u32, nh as u32, &px, prev.projection) {
+            Ok(mut level) => {
+                level.background = map.background;
+                levels.push(level);
+            }
+            // Cannot happen (sides ≥ 2 and below the map's); stop rather than panic.
+            Err(_) => return levels,
+        }
+    }
+}
+
+/// Rounded average of four 0RGB pixels, per channel.
+#[inline]
+fn average4(a: u32, b: u32, c: u32, d: u32) -> u32 {
+    let ch = |s: u32| {
+        let sum = (a >> s & 0xFF) + (b >> s & 0xFF) + (c >> s & 0xFF) + (d >> s & 0xFF);
+        ((sum + 2) / 4) << s
+    };
+    ch(16) | ch(8) | ch(0)
+}
+
+/// Level-0 Q.16 → level-k Q.16 (documentation helper for tests).
+#[cfg(test)]
+fn to_level(x: Fx, k: u32) -> Fx {
+    x >> k
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::fixed::to_fx;
+    use crate::geom::projection::Projection;
+
+    fn checker(w: u32, h: u32) -> EnvMap {
+        let px: Vec<u32> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| if (x + y) % 2 == 0 { 0xFFFFFF } else { 0 }))
+            .collect();
+        EnvMap::from_pixels(w, h, &px, Projection::Equirect).unwrap()
+    }
+
+    #[test]
+    fn levels_halve_while_even_and_average() {
+        let m = checker(48, 24);
+        let l = m.pyramid();
+        let sides: Vec<_> = l.iter().map(|m| (m.width(), m.height())).collect();
+        assert_eq!(sides, vec![(24, 12), (12, 6), (6, 3)]);
+        // A one-pixel checker averages to mid grey on every level.
+        for lv in l {
+            for y in 0..lv.height() {
+                for x in 0..lv.width() {
+                    assert_eq!(
+                        lv.pixel(x, y),
+                        0x808080,
+                        "level {}x{}",
+                        lv.width(),
+                        lv.height()
+                    );
+                }
+            }
+        }
+        assert_eq!(
+            m.pyramid_bytes(),
+            l.iter().map(EnvMap::bytes).sum::<usize>()
+        );
+        assert!(m.pyramid_bytes() * 3 <= m.bytes() + 3 * 4 * 64);
+    }
+
+    #[test]
+    fn lod_zero_is_bilinear_and_levels_line_up() {
+        let px: Vec<u32> = (0..64 * 32)
+            .map(|i: u32| i.wrapping_mul(2654435761) & 0xFFFFFF)
+            .collect();
+        let m = EnvMap::from_pixels(64, 32, &px, Projection::Equirect).unwrap();
+        for &(u, v) in &[(0.3, 0.7), (13.5, 9.25), (63.9, 31.9)] {
+            let (u, v) = (to_fx(u), to_fx(v));
+            assert_eq!(m.trilinear(u, v, 0), m.bilinear(u, v));
+            assert_eq!(m.trilinear(u, v, -40), m.bilinear(u, v));
+            // Whole levels: exactly the bilinear sample of that level.
+            let l1 = &m.pyramid()[0];
+            assert_eq!(
+                m.trilinear(u, v, 256),
+                l1.bilinear(to_level(u, 1), to_level(v, 1))
+            );
+        }
+        // The centre of level-1 pixel (3, 2) is the corner shared by level-0 pixels
+        // (6..8, 4..6): both give the average of those four.
+        let (u, v) = (to_fx(7.0), to_fx(5.0));
+        assert_eq!(m.trilinear(u, v, 256), m.pyramid()[0].pixel(3, 2));
+    }
+
+    #[test]
+    fn lod_of_footprints() {
+        assert_eq!(lod_q8(0.5), 0);
+        assert_eq!(lod_q8(1.0), 0);
+        assert_eq!(lod_q8(1.4), 0);
+        assert_eq!(lod_q8(2.0), 128);
+        assert_eq!(lod_q8(8.0), 640);
+        assert!((lod_q8(3.0) - 277).abs() <= 1);
+    }
+}

@@ -1,0 +1,170 @@
+//! The per-pixel samplers every renderer shares: nearest and bilinear on the padded map
+//! (FIG. 10 of the patent), their cropped forms for partial maps (`map/crop.rs`), and
+//! the 0RGB blend. The span kernels the LUT renderer runs are in `render/kernel/`.
+
+use crate::geom::fixed::{Fx, FX_BITS, FX_HALF};
+use crate::map::envmap::EnvMap;
+
+/// Pixel interpolation (the patent's FIG. 10).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Sampler {
+    /// The source pixel containing (u, v).
+    Nearest,
+    /// The four pixel centers around (u − ½, v − ½), weighted by the fractions.
+    Bilinear,
+    /// Bilinear on the two pyramid levels around the pixel footprint, blended
+    /// (minification anti-aliasing, see [`crate::EnvMap::pyramid`]). Where no footprint is known
+    /// (single samples, cube maps, partial maps) it is bilinear.
+    Trilinear,
+}
+
+impl Sampler {
+    /// Name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Sampler::Nearest => "nearest",
+            Sampler::Bilinear => "bilinear",
+            Sampler::Trilinear => "trilinear",
+        }
+    }
+}
+
+impl std::str::FromStr for Sampler {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "nearest" => Ok(Sampler::Nearest),
+            "bilinear" => Ok(Sampler::Bilinear),
+            "trilinear" => Ok(Sampler::Trilinear),
+            o => Err(format!(
+                "unknown sampler '{o}' (expected nearest, bilinear or trilinear)"
+            )),
+        }
+    }
+}
+
+impl EnvMap {
+    /// Sample at (u, v) (Q.16 map coordinates; u is expected in [0, W) for wrapping maps
+    /// and is clamped otherwise). For a partial map, (u, v) are full-panorama
+    /// coordinates and uncovered positions give the background.
+    #[inline(always)]
+    pub fn sample(&self, sampler: Sampler, u: Fx, v: Fx) -> u32 {
+        if self.crop.is_some() {
+            return self.sample_cropped(sampler, u, v);
+        }
+        match sampler {
+            Sampler::Nearest => self.nearest(u, v),
+            Sampler::Bilinear | Sampler::Trilinear => self.bilinear(u, v),
+        }
+    }
+
+    /// Nearest: the pixel containing (u, v), clamped into the image. (u, v) are stored
+    /// coordinates: for a partial map use [`EnvMap::nearest_cropped`].
+    #[inline(always)]
+    pub fn nearest(&self, u: Fx, v: Fx) -> u32 {
+        let w = self.width as i64;
+        let h = self.height as i64;
+        let x = (u >> FX_BITS).clamp(0, w - 1);
+        let y = (v >> FX_BITS).clamp(0, h - 1);
+        self.padded().0[y as usize * (w as usize + 1) + x as usize]
+    }
+
+    /// Bilinear over the four pixel centers around (u − ½, v − ½), 8-bit weights;
+    /// wraps in u for 360° maps, clamps otherwise and in v. (u, v) are stored
+    /// coordinates: for a partial map use [`EnvMap::bilinear_cropped`].
+    #[inline(always)]
+    pub fn bilinear(&self, u: Fx, v: Fx) -> u32 {
+        let w = self.width as i64;
+        let h = self.height as i64;
+        let uu = u - FX_HALF;
+        let vv = v - FX_HALF;
+        let mut x0 = uu >> FX_BITS;
+        let mut fx = ((uu >> (FX_BITS - 8)) & 0xFF) as u32;
+        let mut y0 = vv >> FX_BITS;
+        let mut fy = ((vv >> (FX_BITS - 8)) & 0xFF) as u32;
+        if x0 < 0 {
+            if self.projection.wraps() && x0 == -1 {
+                x0 = w - 1; // column W (padding) is column 0
+            } else {
+                x0 = 0;
+                fx = 0;
+            }
+        } else if x0 >= w {
+            if self.projection.wraps() && x0 == w {
+                x0 = 0;
+            } else {
+                x0 = w - 1;
+                fx = 0;
+            }
+        }
+        if y0 < 0 {
+            y0 = 0;
+            fy = 0;
+        } else if y0 >= h - 1 {
+            y0 = h - 1; // row H (padding) repeats row H-1
+            fy = 0;
+        }
+        let stride = w as usize + 1;
+        let i = y0 as usize * stride + x0 as usize;
+        let data = self.padded().0;
+        let row0 = &data[i..i + 2];
+        let row1 = &data[i + stride..i + stride + 2];
+        let top = lerp_px(row0[0], row0[1], fx);
+        let bot = lerp_px(row1[0], row1[1], fx);
+        lerp_px(top, bot, fy)
+    }
+}
+
+/// Blend two 0RGB pixels: `a · (256 − w) + b · w`, rounded, two channels per multiply.
+#[inline(always)]
+pub fn lerp_px(a: u32, b: u32, w: u32) -> u32 {
+    let iw = 256 - w;
+    let rb = (((a & 0x00FF_00FF) * iw + (b & 0x00FF_00FF) * w + 0x0080_0080) >> 8) & 0x00FF_00FF;
+    let g = (((a & 0x0000_FF00) * iw + (b & 0x0000_FF00) * w + 0x0000_8000) >> 8) & 0x0000_FF00;
+    rb | g
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::fixed::to_fx;
+    use crate::geom::projection::Projection;
+
+    fn ramp(w: u32, h: u32, p: Projection) -> EnvMap {
+        let px: Vec<u32> = (0..w * h).map(|i| (i % w) << 16 | (i / w) << 8).collect();
+        EnvMap::from_pixels(w, h, &px, p).unwrap()
+    }
+
+    #[test]
+    fn lerp_endpoints_and_middle() {
+        assert_eq!(lerp_px(0x102030, 0x405060, 0), 0x102030);
+        assert_eq!(lerp_px(0x000000, 0xFFFFFF, 128), 0x808080);
+        assert_eq!(lerp_px(0xFFFFFF, 0xFFFFFF, 255), 0xFFFFFF);
+    }
+
+    #[test]
+    fn bilinear_at_centers_is_the_pixel() {
+        let m = ramp(16, 8, Projection::Equirect);
+        for (x, y) in [(0, 0), (15, 7), (3, 4)] {
+            let s = m.bilinear(to_fx(x as f64 + 0.5), to_fx(y as f64 + 0.5));
+            assert_eq!(s, m.pixel(x, y));
+        }
+    }
+
+    #[test]
+    fn bilinear_wraps_horizontally() {
+        let m = ramp(16, 8, Projection::Equirect);
+        // halfway between column 15 and column 0
+        let s = m.bilinear(to_fx(16.0), to_fx(2.5));
+        assert_eq!(s >> 16, 8); // (15*128 + 0*128 + 128) >> 8 = 8
+        let s0 = m.bilinear(to_fx(0.0), to_fx(2.5));
+        assert_eq!(s, s0);
+    }
+
+    #[test]
+    fn clamp_maps_do_not_wrap() {
+        let m = ramp(16, 8, Projection::Elliptical);
+        assert_eq!(m.bilinear(to_fx(0.1), to_fx(0.1)), m.pixel(0, 0));
+        assert_eq!(m.bilinear(to_fx(15.9), to_fx(7.9)), m.pixel(15, 7));
+    }
+}

@@ -1,0 +1,430 @@
+//! The paper's two cube renderers: basic (per pixel) and accelerated (per scanline segment).
+//!
+//! # Rays
+//! With the rotation `R` of `docs/conventions.md` (pitch about X, then yaw about Y), the ray of
+//! output pixel (x, y) is `R · (dx, dy, f)` with `dx = x + ½ − W/2`, `dy = H/2 − (y + ½)`.
+//! Both renderers evaluate it as `P + dx · B`, where `P = dy · R₁ + f · R₂` (the row part)
+//! and `B = R₀ = (cos ψ, 0, −sin ψ)` (the image's x axis in the world): each scanline is a
+//! straight 3-D line (the paper's formula 6) along a horizontal direction, so its world
+//! Y is constant. The basic renderer recomputes the whole product per pixel; the compiler
+//! may hoist `P`, which changes no bits.
+//!
+//! # Segments
+//! Along a scanline the ray sweeps a great-circle arc shorter than 180°, and each face's
+//! region of the sphere is convex, so the pixels of one face form one run. The accelerated
+//! renderer finds the runs by binary search on the face of [`face_of`] (the same function
+//! the basic renderer uses) and then *verifies* each run: on a face with axes `(a, b, m)`
+//! the margin `min(m − |a|, m − |b|)` is a concave function of `dx` (each term is a linear
+//! function minus an absolute value of one), so if the margin computed at both ends of the
+//! run exceeds a bound `δ` far above floating-point rounding, the exact margin is above
+//! rounding everywhere in between and every pixel's per-pixel face choice is that face,
+//! strictly. Ends that fail the check (a pixel center within `δ` of a face edge, or a
+//! scanline lying in an edge plane) are peeled off and handled per pixel; a run that still
+//! fails is done per pixel. Inside a verified run the loop neither chooses a face nor
+//! branches on one, and the face's axis selection is compiled in.
+//!
+//! The face coordinates come from [`face_uv`] on the bit-identical ray in both renderers,
+//! so the two images are byte-identical (tested over sweeps of views, sizes and both
+//! samplers in `tests/cube.rs`).
+
+use super::exact::render_exact;
+use super::frame::Frame;
+use crate::cube::{
+    check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
+};
+use crate::geom::camera::View;
+use crate::map::envmap::EnvMap;
+use crate::map::sample::Sampler;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Which of the paper's renderers to use. Both give byte-identical images.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum CubeRenderer {
+    /// Section 1: per pixel, ray → face by the largest |coordinate| → face coordinates.
+    Basic,
+    /// Section 2: per scanline, face runs by binary search, no face choice inside a run.
+    #[default]
+    Accelerated,
+}
+
+impl CubeRenderer {
+    /// Name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            CubeRenderer::Basic => "basic",
+            CubeRenderer::Accelerated => "accelerated",
+        }
+    }
+}
+
+impl std::str::FromStr for CubeRenderer {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "basic" => Ok(CubeRenderer::Basic),
+            "accelerated" | "accel" => Ok(CubeRenderer::Accelerated),
+            o => Err(format!(
+                "unknown cube renderer '{o}' (expected basic or accelerated)"
+            )),
+        }
+    }
+}
+
+/// Per-frame constants: the rotation's columns and the image geometry.
+#[derive(Clone, Copy)]
+struct Rays {
+    /// Column 0 of R: world direction of image +x (B in the module docs).
+    b: DVec3,
+    /// Column 1 of R: world direction of image +y (up).
+    r1: DVec3,
+    /// Column 2 of R: world direction of the view axis.
+    r2: DVec3,
+    focal: f64,
+    w: u32,
+    h: u32,
+    half_face: f64,
+    /// Margin a run's ends must exceed to be trusted (see the module docs).
+    delta: f64,
+}
+
+impl Rays {
+    fn new(view: View, w: u32, h: u32, face_size: u32) -> Rays {
+        let focal = (w as f64 / 2.0) / (view.hfov() / 2.0).tan();
+        let (sp, cp) = view.pitch().sin_cos();
+        let (sy, cy) = view.yaw().sin_cos();
+        // R = Ry(yaw) · Rx(pitch) as in `Camera::world_ray`.
+        let b = DVec3::new(cy, 0.0, -sy);
+        let r1 = DVec3::new(-sp * sy, cp, -sp * cy);
+        let r2 = DVec3::new(cp * sy, sp, cp * cy);
+        // Ray components are at most |P| + |dx| ≤ f + W + H; their rounding error is a few
+        // ulps of that (~1e-15 relative). 1e-9 relative is far above it and far below a
+        // pixel's change of margin except within 1e-9 px of an edge.
+        let delta = 1e-9 * (focal + w as f64 + h as f64);
+        Rays {
+            b,
+            r1,
+            r2,
+            focal,
+            w,
+            h,
+            half_face: face_size as f64 / 2.0,
+            delta,
+        }
+    }
+
+    #[inline(always)]
+    fn dy(&self, y: usize) -> f64 {
+        self.h as f64 / 2.0 - (y as f64 + 0.5)
+    }
+
+    #[inline(always)]
+    fn dx(&self, x: usize) -> f64 {
+        x as f64 + 0.5 - self.w as f64 / 2.0
+    }
+
+    /// Row part P = dy · R₁ + f · R₂.
+    #[inline(always)]
+    fn row(&self, dy: f64) -> DVec3 {
+        DVec3::new(
+            dy * self.r1.x + self.focal * self.r2.x,
+            dy * self.r1.y + self.focal * self.r2.y,
+            dy * self.r1.z + self.focal * self.r2.z,
+        )
+    }
+}
+
+/// The ray `P + dx · B`: the one expression both renderers use.
+#[inline(always)]
+fn ray(p: DVec3, b: DVec3, dx: f64) -> DVec3 {
+    DVec3::new(p.x + dx * b.x, p.y + dx * b.y, p.z + dx * b.z)
+}
+
+/// Texel fetch, monomorphized per sampler so the inner loops do not branch on it.
+trait Fetch: Copy + Send + Sync {
+    fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32;
+}
+
+#[derive(Clone, Copy)]
+struct NearestFetch;
+#[derive(Clone, Copy)]
+struct BilinearFetch;
+
+impl Fetch for NearestFetch {
+    #[inline(always)]
+    fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32 {
+        cube.nearest(face, u, v)
+    }
+}
+
+impl Fetch for BilinearFetch {
+    #[inline(always)]
+    fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32 {
+        cube.bilinear(face, u, v)
+    }
+}
+
+/// Render `view` of `cube` into `frame` with the chosen renderer (the entry is
+/// [`crate::Renderer::render`] of a [`crate::Scene::Cube`]). `threads` splits rows into
+/// bands across the rayon pool; the output is identical either way, and identical between
+/// the two renderers.
+pub(crate) fn render_cube(
+    cube: &CubeMap,
+    view: View,
+    sampler: Sampler,
+    renderer: CubeRenderer,
+    frame: &mut Frame<'_>,
+    threads: bool,
+) {
+    let rays = Rays::new(view, frame.width(), frame.height(), cube.face_size());
+    let out = frame.pixels_mut();
+    match sampler {
+        Sampler::Nearest => render_with(cube, &rays, NearestFetch, renderer, out, threads),
+        Sampler::Bilinear | Sampler::Trilinear => {
+            render_with(cube, &rays, BilinearFetch, renderer, out, threads)
+        }
+    }
+}
+
+fn render_with<S: Fetch>(
+    cube: &CubeMap,
+    frame: &Rays,
+    s: S,
+    renderer: CubeRenderer,
+    out: &mut [u32],
+    threads: bool,
+) {
+    let w = frame.w as usize;
+    // Bands of whole rows, at least ~16k pixels each so small frames stay on one thread.
+    let rows_per_band = (16384 / w).clamp(1, frame.h as usize);
+    let band = |(bi, chunk): (usize, &mut [u32])| {
+        let mut segs = Vec::with_capacity(16);
+        for (r, line) in chunk.chunks_exact_mut(w).enumerate() {
+            let y = bi * rows_per_band + r;
+            match renderer {
+                CubeRenderer::Basic => basic_row(cube, frame, s, y, line),
+                CubeRenderer::Accelerated => accel_row(cube, frame, s, y, line, &mut segs),
+            }
+        }
+    };
+    if threads {
+        out.par_chunks_mut(w * rows_per_band)
+            .enumerate()
+            .for_each(band);
+    } else {
+        out.chunks_mut(w * rows_per_band).enumerate().for_each(band);
+    }
+}
+
+/// The per-pixel kernel over `line[x0..x1]` of row `y`: full ray, face choice, coordinates.
+#[inline(always)]
+fn per_pixel<S: Fetch>(
+    cube: &CubeMap,
+    frame: &Rays,
+    s: S,
+    y: usize,
+    line: &mut [u32],
+    x0: usize,
+    x1: usize,
+) {
+    let dy = frame.dy(y);
+    for (x, px) in line.iter_mut().enumerate().take(x1).skip(x0) {
+        // The whole rotation per pixel; bit-identical to the accelerated path's ray.
+        let d = ray(frame.row(dy), frame.b, frame.dx(x));
+        let face = face_of(d);
+        let (u, v) = face_uv(face, d, frame.half_face);
+        *px = s.fetch(cube, face, u, v);
+    }
+}
+
+fn basic_row<S: Fetch>(cube: &CubeMap, frame: &Rays, s: S, y: usize, line: &mut [u32]) {
+    per_pixel(cube, frame, s, y, line, 0, line.len());
+}
+
+/// A run of pixels `[start, end]` (inclusive) guessed to be on one face.
+#[derive(Clone, Copy, Debug)]
+struct Seg {
+    start: usize,
+    end: usize,
+    face: Face,
+}
+
+fn push_seg(segs: &mut Vec<Seg>, start: usize, end: usize, face: Face) {
+    if let Some(last) = segs.last_mut() {
+        if last.face == face && start <= last.end + 1 {
+            last.end = last.end.max(end);
+            return;
+        }
+    }
+    segs.push(Seg { start, end, face });
+}
+
+/// Binary search for face changes between pixels `lo` and `hi` whose faces are known.
+fn split(
+    face_at: &impl Fn(usize) -> Face,
+    lo: usize,
+    hi: usize,
+    flo: Face,
+    fhi: Face,
+    segs: &mut Vec<Seg>,
+) {
+    if flo == fhi {
+        push_seg(segs, lo, hi, flo);
+        return;
+    }
+    if hi <= lo + 1 {
+        push_seg(segs, lo, lo, flo);
+        push_seg(segs, hi, hi, fhi);
+        return;
+    }
+    let mid = lo + (hi - lo) / 2;
+    let fm = face_at(mid);
+    split(face_at, lo, mid, flo, fm, segs);
+    split(face_at, mid, hi, fm, fhi, segs);
+}
+
+/// Concave margin of the face choice (see the module docs): > 0 means strictly this face.
+#[inline(always)]
+fn margin(face: Face, d: DVec3) -> f64 {
+    let (a, b, m) = face_axes(face, d);
+    (m - a.abs()).min(m - b.abs())
+}
+
+fn accel_row<S: Fetch>(
+    cube: &CubeMap,
+    frame: &Rays,
+    s: S,
+    y: usize,
+    line: &mut [u32],
+    segs: &mut Vec<Seg>,
+) {
+    let w = line.len();
+    let p = frame.row(frame.dy(y));
+    let b = frame.b;
+    let face_at = |x: usize| face_of(ray(p, b, frame.dx(x)));
+    segs.clear();
+    split(&face_at, 0, w - 1, face_at(0), face_at(w - 1), segs);
+    for seg in segs.iter() {
+        let ok = |x: usize| margin(seg.face, ray(p, b, frame.dx(x))) > frame.delta;
+        let (mut a, mut e) = (seg.start, seg.end + 1); // half-open [a, e)
+                                                       // Peel at most two unproven pixels from each end.
+        for _ in 0..2 {
+            if a < e && !ok(a) {
+                per_pixel(cube, frame, s, y, line, a, a + 1);
+                a += 1;
+            }
+            if a < e && !ok(e - 1) {
+                per_pixel(cube, frame, s, y, line, e - 1, e);
+                e -= 1;
+            }
+        }
+        if a >= e {
+            continue;
+        }
+        if !(ok(a) && ok(e - 1)) {
+            // Degenerate: the scanline runs along an edge. Decide per pixel.
+            per_pixel(cube, frame, s, y, line, a, e);
+            continue;
+        }
+        match seg.face {
+            Face::Front => run::<0, S>(cube, frame, s, p, line, a, e),
+            Face::Right => run::<1, S>(cube, frame, s, p, line, a, e),
+            Face::Back => run::<2, S>(cube, frame, s, p, line, a, e),
+            Face::Left => run::<3, S>(cube, frame, s, p, line, a, e),
+            Face::Up => run::<4, S>(cube, frame, s, p, line, a, e),
+            Face::Down => run::<5, S>(cube, frame, s, p, line, a, e),
+        }
+    }
+}
+
+/// A verified run on face `F`: step the ray along the scanline, no face choice.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn run<const F: usize, S: Fetch>(
+    cube: &CubeMap,
+    frame: &Rays,
+    s: S,
+    p: DVec3,
+    line: &mut [u32],
+    a: usize,
+    e: usize,
+) {
+    let face = Face::from_index(F);
+    let b = frame.b;
+    let half = frame.half_face;
+    for (x, px) in line[a..e].iter_mut().enumerate() {
+        let d = ray(p, b, frame.dx(a + x));
+        let (u, v) = face_uv(face, d, half);
+        *px = s.fetch(cube, face, u, v);
+    }
+}
+
+/// How the accelerated renderer splits row `y` of a `width × height` view: the runs
+/// `(start, end_exclusive, face, verified)` in order, where unverified runs (and peeled
+/// single pixels) were rendered per pixel. For tests and the docs' statistics.
+pub fn scanline_runs(
+    view: View,
+    width: u32,
+    height: u32,
+    face_size: u32,
+    y: u32,
+) -> Vec<(u32, u32, Face, bool)> {
+    let frame = Rays::new(view, width, height, face_size);
+    let w = width as usize;
+    let p = frame.row(frame.dy(y as usize));
+    let b = frame.b;
+    let face_at = |x: usize| face_of(ray(p, b, frame.dx(x)));
+    let mut segs = Vec::new();
+    split(&face_at, 0, w - 1, face_at(0), face_at(w - 1), &mut segs);
+    let mut out = Vec::new();
+    for seg in segs {
+        let ok = |x: usize| margin(seg.face, ray(p, b, frame.dx(x))) > frame.delta;
+        let (mut a, mut e) = (seg.start, seg.end + 1);
+        let mut tail = Vec::new();
+        for _ in 0..2 {
+            if a < e && !ok(a) {
+                out.push((a as u32, a as u32 + 1, face_at(a), false));
+                a += 1;
+            }
+            if a < e && !ok(e - 1) {
+                tail.push((e as u32 - 1, e as u32, face_at(e - 1), false));
+                e -= 1;
+            }
+        }
+        if a < e {
+            out.push((a as u32, e as u32, seg.face, ok(a) && ok(e - 1)));
+        }
+        out.extend(tail.into_iter().rev());
+    }
+    out
+}
+
+impl CubeMap {
+    /// Render a cube map from a panorama: each face is the exact renderer's hfov-90° view
+    /// at the face's yaw/pitch (the definition in `docs/conventions.md`).
+    ///
+    /// # Errors
+    /// [`CubeError::FaceSize`] for a bad `face_size`.
+    pub fn from_envmap(
+        map: &EnvMap,
+        face_size: u32,
+        sampler: Sampler,
+    ) -> Result<CubeMap, CubeError> {
+        check_face_size("cube map", face_size)?;
+        let n = face_size as usize;
+        let mut faces: [Vec<u32>; 6] = Default::default();
+        for (k, face) in Face::ALL.iter().enumerate() {
+            let mut buf = vec![0u32; n * n];
+            let mut frame = Frame::new(&mut buf, face_size, face_size).map_err(|e| {
+                CubeError::Usage(UsageProblem::FaceRender {
+                    face: *face,
+                    error: e,
+                })
+            })?;
+            render_exact(map, face.view(), sampler, &mut frame, true);
+            faces[k] = buf;
+        }
+        let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
+        CubeMap::from_faces(face_size, refs)
+    }
+}

@@ -1,0 +1,155 @@
+//! The exact renderer: per output pixel, f64 ray → (λ, φ) → (u, v) → sample.
+//!
+//! Plain and obviously right on purpose: it is the yardstick every fast path is measured
+//! against. It shares only the sampler with the LUT renderer (so image differences are
+//! geometry differences).
+
+use super::frame::Frame;
+use super::rows::for_each_row;
+use crate::geom::camera::{Camera, View};
+use crate::geom::fixed::to_fx;
+use crate::geom::mapping::{exact_uv, exact_uv_at};
+use crate::geom::projection::Projection;
+use crate::map::envmap::EnvMap;
+use crate::map::pyramid::lod_q8;
+use crate::map::sample::Sampler;
+
+/// Sample `map` at an f64 position, wrapping u for 360° maps (background if uncovered).
+#[inline]
+pub fn sample_at(map: &EnvMap, sampler: Sampler, uv: Option<(f64, f64)>) -> u32 {
+    match uv {
+        None => map.background(),
+        Some((u, v)) => map.sample(sampler, to_fx(wrap_u(map, u)), to_fx(v)),
+    }
+}
+
+/// Wrap u into [0, W) for 360° maps (f64 rounding can give W itself: that is 0).
+fn wrap_u(map: &EnvMap, u: f64) -> f64 {
+    let w = map.width() as f64;
+    if map.projection().wraps() {
+        let r = u.rem_euclid(w);
+        if r >= w {
+            0.0
+        } else {
+            r
+        }
+    } else {
+        u
+    }
+}
+
+/// [`sample_at`] with the trilinear sampler at level of detail `lod` (Q.8, see
+/// `map/pyramid.rs`).
+#[inline]
+pub fn sample_at_lod(map: &EnvMap, uv: Option<(f64, f64)>, lod: i32) -> u32 {
+    match uv {
+        None => map.background(),
+        Some((u, v)) => map.trilinear(to_fx(wrap_u(map, u)), to_fx(v), lod),
+    }
+}
+
+/// Exact pixel footprint at (x, y): the larger of the map-pixel distances to the exact
+/// positions of the next pixel to the right and below (u differences taken the short way
+/// round the seam). `None` where the map does not cover the pixel.
+fn exact_footprint(
+    cam: &Camera,
+    proj: Projection,
+    mw: f64,
+    mh: f64,
+    x: f64,
+    y: f64,
+    at: (f64, f64),
+) -> f64 {
+    let (u0, v0) = at;
+    let mut f: f64 = 0.0;
+    for (dx, dy) in [(1.0, 0.0), (0.0, 1.0)] {
+        if let Some((u, v)) = exact_uv_at(cam, proj, mw, mh, x + dx, y + dy) {
+            let mut du = (u - u0).abs();
+            if proj.wraps() && du > mw * 0.5 {
+                du = mw - du;
+            }
+            f = f.max(du).max((v - v0).abs());
+        }
+    }
+    f
+}
+
+/// Render `view` of `map` into `frame`, exactly (also reached through
+/// [`crate::Renderer::render`] with [`crate::RendererKind::Exact`]). With
+/// [`Sampler::Trilinear`] the level of detail comes from the exact footprint of each pixel
+/// (differences of the exact mapping to the next pixel right and below).
+///
+/// `threads`: split rows across the rayon pool when true; output is identical either way.
+pub fn render_exact(
+    map: &EnvMap,
+    view: View,
+    sampler: Sampler,
+    frame: &mut Frame<'_>,
+    threads: bool,
+) {
+    let (width, height) = (frame.width(), frame.height());
+    let out = frame.pixels_mut();
+    let cam = Camera::new(view, width, height);
+    let (mw, mh) = (map.width() as f64, map.height() as f64);
+    let proj = map.projection();
+    if sampler == Sampler::Trilinear && map.crop().is_none() {
+        map.pyramid();
+        for_each_row(out, width as usize, threads, |y, line| {
+            for (x, px) in line.iter_mut().enumerate() {
+                let (xf, yf) = (x as f64 + 0.5, y as f64 + 0.5);
+                let uv = exact_uv_at(&cam, proj, mw, mh, xf, yf);
+                let lod = uv.map_or(0, |at| {
+                    lod_q8(exact_footprint(&cam, proj, mw, mh, xf, yf, at))
+                });
+                *px = sample_at_lod(map, uv, lod);
+            }
+        });
+        return;
+    }
+    for_each_row(out, width as usize, threads, |y, line| {
+        for (x, px) in line.iter_mut().enumerate() {
+            *px = sample_at(
+                map,
+                sampler,
+                exact_uv(&cam, proj, mw, mh, x as u32, y as u32),
+            );
+        }
+    });
+}
+
+/// Render `view` supersampled `n × n` per output pixel (exact geometry, box filter over
+/// the sub-samples, in 8-bit sRGB as stored): the reference for minification quality.
+pub fn render_exact_supersampled(
+    map: &EnvMap,
+    view: View,
+    sampler: Sampler,
+    n: u32,
+    frame: &mut Frame<'_>,
+    threads: bool,
+) {
+    let (width, height) = (frame.width(), frame.height());
+    let out = frame.pixels_mut();
+    let n = n.max(1);
+    let cam = Camera::new(view, width, height);
+    let (mw, mh) = (map.width() as f64, map.height() as f64);
+    let proj = map.projection();
+    let inv = 1.0 / n as f64;
+    for_each_row(out, width as usize, threads, |y, line| {
+        for (x, px) in line.iter_mut().enumerate() {
+            let (mut r, mut g, mut b) = (0u32, 0u32, 0u32);
+            for sy in 0..n {
+                for sx in 0..n {
+                    let pxf = x as f64 + (sx as f64 + 0.5) * inv;
+                    let pyf = y as f64 + (sy as f64 + 0.5) * inv;
+                    let c = sample_at(map, sampler, exact_uv_at(&cam, proj, mw, mh, pxf, pyf));
+                    r += c >> 16 & 0xFF;
+                    g += c >> 8 & 0xFF;
+                    b += c & 0xFF;
+                }
+            }
+            let nn = n * n;
+            let half = nn / 2;
+            *px = (((r + half) / nn) << 16) | (((g + half) / nn) << 8) | ((b + half) / nn);
+        }
+    });
+}

@@ -1,0 +1,394 @@
+//! Rendering: the frame type, the [`Scene`] (a map or a cube map) and the one render
+//! entry, [`Renderer::render`].
+//!
+//! The LUT renderer (US 5,748,194) is split by what runs how often:
+//! * per frame, `setup.rs`: each scanline's table rows, column scale, index steps (from
+//!   the analytic bounds of `steps.rs`) and exact-pixel ranges; nothing else is
+//!   recomputed when the view turns;
+//! * per scanline, `scanline.rs`: the table read every Nth pixel, map coordinates stepped
+//!   in Q.16 fixed point between reads, longitude unwrapped across each span (a span over
+//!   the ±180° seam steps continuously and wraps per pixel instead of smearing across the
+//!   whole map); `rows.rs` runs the rows on one thread or in bands on rayon;
+//! * per pixel, `kernel/`: the span kernels, with the rules they keep;
+//! * `sink.rs`: where a scanline writes (pixels per sampler, or positions).
+//!
+//! `exact.rs` is the per-pixel reference renderer, `cube.rs` the cube renderers.
+
+pub(crate) mod cube;
+pub(crate) mod exact;
+pub(crate) mod frame;
+pub(crate) mod kernel;
+pub(crate) mod rows;
+pub(crate) mod scanline;
+pub(crate) mod setup;
+pub(crate) mod sink;
+pub(crate) mod steps;
+
+use crate::cube::CubeMap;
+use crate::error::ViewError;
+use crate::geom::camera::{check_size, View};
+use crate::geom::projection::Projection;
+use crate::lut::{LutTable, Surface, TableKind, TableSpec};
+use crate::map::envmap::EnvMap;
+use crate::map::pyramid::lod_q8;
+use crate::map::sample::Sampler;
+use cube::{render_cube, CubeRenderer};
+use exact::render_exact;
+use frame::Frame;
+use rows::for_each_row;
+use scanline::{render_row, ROW_SCALE_ONE};
+use setup::{check_step, prepare, Scan, Setup};
+use sink::{PixelSink, PosSink, TriSink};
+
+/// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
+pub const LUT_SWITCH_HFOV: f64 = 60.0;
+
+/// What to render: a map (any projection, full or partial) or a cube map.
+#[derive(Debug, Clone, Copy)]
+pub enum Scene<'a> {
+    /// An environment map, drawn by the LUT or the exact renderer.
+    Map(&'a EnvMap),
+    /// A cube map, drawn by one of the cube renderers.
+    Cube(&'a CubeMap),
+}
+
+impl<'a> From<&'a EnvMap> for Scene<'a> {
+    fn from(m: &'a EnvMap) -> Self {
+        Scene::Map(m)
+    }
+}
+
+impl<'a> From<&'a CubeMap> for Scene<'a> {
+    fn from(c: &'a CubeMap) -> Self {
+        Scene::Cube(c)
+    }
+}
+
+/// Which renderer draws the frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum RendererKind {
+    /// The scanline-coherent LUT renderer.
+    Lut,
+    /// The exact per-pixel renderer.
+    Exact,
+}
+
+/// Which table the LUT renderer reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum LutChoice {
+    /// Wide above [`LUT_SWITCH_HFOV`], high-resolution at or below it.
+    Auto,
+    /// Always the wide-FOV table.
+    Wide,
+    /// Always the high-resolution table (pixels beyond it are evaluated exactly).
+    High,
+}
+
+/// Index interpolation step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum IndexStep {
+    /// Read the table every N pixels, N in {1, 2, 4, 8, 16}; shortened per scanline where
+    /// the error bound requires it (near the poles).
+    Fixed(u32),
+    /// The longest power-of-two step (up to [`crate::ADAPTIVE_MAX_STEP`]) whose error
+    /// bound stays within [`crate::SPAN_ERROR_BUDGET`], per region of each scanline.
+    Adaptive,
+}
+
+/// Options of one frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderOptions {
+    /// LUT or exact.
+    pub renderer: RendererKind,
+    /// Pixel interpolation.
+    pub sampler: Sampler,
+    /// Index interpolation.
+    pub index_step: IndexStep,
+    /// Table choice.
+    pub lut: LutChoice,
+    /// The surface the tables are built on.
+    pub surface: Surface,
+    /// Render row bands on the rayon pool (output identical either way).
+    pub threads: bool,
+    /// The cube renderer, for a [`Scene::Cube`] (both give the same pixels).
+    pub cube: CubeRenderer,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            renderer: RendererKind::Lut,
+            sampler: Sampler::Bilinear,
+            index_step: IndexStep::Adaptive,
+            lut: LutChoice::Auto,
+            surface: Surface::Cylinder,
+            threads: true,
+            cube: CubeRenderer::Accelerated,
+        }
+    }
+}
+
+/// Which path rendered a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum RenderPath {
+    /// The wide-FOV table (plus exact pixels where it cannot be trusted).
+    LutWide,
+    /// The high-resolution table (plus exact pixels where it cannot be trusted).
+    LutHigh,
+    /// The exact renderer.
+    Exact,
+    /// A cube map, with the given renderer.
+    Cube(CubeRenderer),
+}
+
+impl RenderPath {
+    /// Short name.
+    pub fn name(self) -> &'static str {
+        match self {
+            RenderPath::LutWide => "lut-wide",
+            RenderPath::LutHigh => "lut-high",
+            RenderPath::Exact => "exact",
+            RenderPath::Cube(CubeRenderer::Basic) => "cube-basic",
+            RenderPath::Cube(CubeRenderer::Accelerated) => "cube-accelerated",
+        }
+    }
+}
+
+/// What rendered a frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderReport {
+    /// The path.
+    pub path: RenderPath,
+    /// Pixels the LUT path evaluated exactly (pole zones, beyond the table). Equal to
+    /// `pixels` for the exact path, 0 for a cube map.
+    pub exact_pixels: u64,
+    /// Pixels in the frame.
+    pub pixels: u64,
+    /// Bytes of the table used (0 for exact; the texels for a cube map).
+    pub table_bytes: usize,
+    /// Largest index step used on any scanline.
+    pub max_step: u32,
+    /// Smallest index step used on any scanline.
+    pub min_step: u32,
+}
+
+/// Sampling positions of a frame, row-major; `None` where the background shows.
+pub type Positions = Vec<Option<(f64, f64)>>;
+
+/// The renderer: owns the tables for one map geometry and per-frame scratch.
+#[derive(Debug, Default)]
+pub struct Renderer {
+    tables: Vec<(Surface, TableKind, LutTable)>,
+    geometry: Option<(u32, u32, Projection)>,
+    scans: Vec<Scan>,
+    /// Row scale per map row (Q.30: multiplied by Λ up to W/2, so Q.16 would lose up to
+    /// 0.06 px), for elliptical and diamond maps.
+    row_scale: Vec<i64>,
+}
+
+/// The table of `surface` and `kind` among `tables` (built by [`Renderer::table`]).
+fn find(tables: &[(Surface, TableKind, LutTable)], surface: Surface, kind: TableKind) -> &LutTable {
+    &tables
+        .iter()
+        .find(|(s, k, _)| *s == surface && *k == kind)
+        .expect("table built before it is looked up")
+        .2
+}
+
+impl Renderer {
+    /// A renderer for `map`'s geometry. Tables are built on first use and kept.
+    pub fn new(map: &EnvMap) -> Renderer {
+        let mut r = Renderer::default();
+        r.set_geometry(map.width(), map.height(), map.projection());
+        r
+    }
+
+    fn set_geometry(&mut self, w: u32, h: u32, p: Projection) {
+        if self.geometry == Some((w, h, p)) {
+            return;
+        }
+        self.geometry = Some((w, h, p));
+        self.tables.clear();
+        self.row_scale.clear();
+        if p.scaled_rows() {
+            self.row_scale = (0..=h)
+                .map(|j| (p.row_scale_at_v(j as f64, h as f64) * ROW_SCALE_ONE).round() as i64)
+                .collect();
+        }
+    }
+
+    /// Build (if needed) and return the table of the given kind.
+    pub fn table(&mut self, surface: Surface, kind: TableKind) -> &LutTable {
+        let (w, h, p) = self.geometry.expect("geometry set in new()");
+        if let Some(i) = self
+            .tables
+            .iter()
+            .position(|(s, k, _)| *s == surface && *k == kind)
+        {
+            return &self.tables[i].2;
+        }
+        let spec = TableSpec::default_for(surface, kind, w);
+        self.tables
+            .push((surface, kind, LutTable::build(spec, p, w, h)));
+        &self.tables.last().expect("just pushed").2
+    }
+
+    /// Per-frame setup for the geometry set last: builds the table `opts` selects (if
+    /// needed) and fills one [`Scan`] per row (see `setup.rs`).
+    fn prepare_frame(
+        &mut self,
+        view: View,
+        opts: &RenderOptions,
+        width: u32,
+        height: u32,
+    ) -> (Setup, RenderReport) {
+        let kind = Self::table_kind(view, opts);
+        let geometry = self.geometry.expect("geometry set before a frame");
+        self.table(opts.surface, kind);
+        let table = find(&self.tables, opts.surface, kind);
+        prepare(
+            table,
+            kind,
+            geometry,
+            &mut self.scans,
+            view,
+            opts,
+            width,
+            height,
+        )
+    }
+
+    /// Which table `opts` selects for `view`.
+    pub fn table_kind(view: View, opts: &RenderOptions) -> TableKind {
+        match opts.lut {
+            LutChoice::Wide => TableKind::Wide,
+            LutChoice::High => TableKind::High,
+            LutChoice::Auto => {
+                if view.hfov_deg() > LUT_SWITCH_HFOV {
+                    TableKind::Wide
+                } else {
+                    TableKind::High
+                }
+            }
+        }
+    }
+
+    /// Render `view` of `scene` into `frame`: the one render entry for maps (LUT or exact,
+    /// as `opts.renderer` says) and cube maps (with `opts.cube`).
+    ///
+    /// # Errors
+    /// [`ViewError::BadIndexStep`] for an index step not in {1, 2, 4, 8, 16} (the frame's
+    /// size was checked when it was made).
+    pub fn render(
+        &mut self,
+        scene: Scene<'_>,
+        view: View,
+        opts: &RenderOptions,
+        frame: &mut Frame<'_>,
+    ) -> Result<RenderReport, ViewError> {
+        check_step(opts.index_step)?;
+        let (width, height) = (frame.width(), frame.height());
+        let pixels = width as u64 * height as u64;
+        let map = match scene {
+            Scene::Map(map) => map,
+            Scene::Cube(cube) => {
+                render_cube(cube, view, opts.sampler, opts.cube, frame, opts.threads);
+                return Ok(RenderReport {
+                    path: RenderPath::Cube(opts.cube),
+                    exact_pixels: 0,
+                    pixels,
+                    table_bytes: cube.bytes(),
+                    max_step: 1,
+                    min_step: 1,
+                });
+            }
+        };
+        if opts.renderer == RendererKind::Exact {
+            render_exact(map, view, opts.sampler, frame, opts.threads);
+            return Ok(RenderReport {
+                path: RenderPath::Exact,
+                exact_pixels: pixels,
+                pixels,
+                table_bytes: 0,
+                max_step: 1,
+                min_step: 1,
+            });
+        }
+        self.set_geometry(map.width(), map.height(), map.projection());
+        let (setup, report) = self.prepare_frame(view, opts, width, height);
+        let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
+        let scans = &self.scans;
+        let row_scale = &self.row_scale[..];
+        let w = width as usize;
+        let out = frame.pixels_mut();
+        let bilinear = opts.sampler != Sampler::Nearest;
+        if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
+            map.pyramid(); // built once, before the rows run in parallel
+            for_each_row(out, w, opts.threads, |y, row| {
+                let scan = &scans[y];
+                let mut s = TriSink {
+                    row,
+                    map,
+                    fy: scan.fy,
+                    lod: lod_q8(scan.fy[0] as f64),
+                };
+                render_row(scan, table, &setup, row_scale, &mut s);
+            });
+            return Ok(report);
+        }
+        // One monomorphized kernel per (sampler, partial map): no per-pixel dispatch.
+        fn rows<const BILINEAR: bool, const CROP: bool>(
+            out: &mut [u32],
+            w: usize,
+            threads: bool,
+            k: (&[Scan], &LutTable, &Setup, &[i64]),
+            map: &EnvMap,
+        ) {
+            let (scans, table, setup, row_scale) = k;
+            for_each_row(out, w, threads, |y, row| {
+                let mut s = PixelSink::<BILINEAR, CROP> { row, map };
+                render_row(&scans[y], table, setup, row_scale, &mut s);
+            });
+        }
+        let k = (&scans[..], table, &setup, row_scale);
+        match (bilinear, map.crop().is_some()) {
+            (true, false) => rows::<true, false>(out, w, opts.threads, k, map),
+            (false, false) => rows::<false, false>(out, w, opts.threads, k, map),
+            (true, true) => rows::<true, true>(out, w, opts.threads, k, map),
+            (false, true) => rows::<false, true>(out, w, opts.threads, k, map),
+        }
+        Ok(report)
+    }
+
+    /// The map positions the LUT renderer samples for `view` (row-major, `None` =
+    /// background): the same kernel as [`Renderer::render`], writing positions instead of
+    /// pixels. Used to measure the sampling-position error against the exact map.
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn positions(
+        &mut self,
+        map_w: u32,
+        map_h: u32,
+        projection: Projection,
+        view: View,
+        opts: &RenderOptions,
+        width: u32,
+        height: u32,
+    ) -> Result<(Positions, RenderReport), ViewError> {
+        check_size(width, height)?;
+        check_step(opts.index_step)?;
+        self.set_geometry(map_w, map_h, projection);
+        let (setup, report) = self.prepare_frame(view, opts, width, height);
+        let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
+        let mut out = vec![None; width as usize * height as usize];
+        let scans = &self.scans;
+        let row_scale = &self.row_scale[..];
+        for_each_row(&mut out, width as usize, true, |y, row| {
+            let mut s = PosSink { row };
+            render_row(&scans[y], table, &setup, row_scale, &mut s);
+        });
+        Ok((out, report))
+    }
+}

@@ -1,0 +1,202 @@
+//! The scanline walk: per output row, the pixels the table covers are stepped span by
+//! span (a table read every 2^shift pixels, Q.16 steps between, longitude unwrapped across
+//! each span so a span over the ±180° seam steps continuously), and the rest (pole zones,
+//! beyond the table) are evaluated exactly. Spans go to a [`Sink`].
+
+use super::setup::{Scan, Setup};
+use super::sink::Sink;
+use super::steps::STEP_REGIONS;
+use crate::geom::fixed::{Fx, FX_BITS};
+use crate::lut::LutTable;
+
+/// Render one scanline into `sink`.
+#[inline]
+pub(crate) fn render_row<S: Sink>(
+    scan: &Scan,
+    table: &LutTable,
+    fr: &Setup,
+    row_scale: &[i64],
+    sink: &mut S,
+) {
+    let w = fr.w_out as i64;
+    if !scan.lut || scan.lut_lo > scan.lut_hi {
+        exact_run(scan, fr, 0, w - 1, sink);
+        return;
+    }
+    exact_run(scan, fr, 0, scan.lut_lo - 1, sink);
+    let zl = scan.zone_lo.max(scan.lut_lo);
+    let zh = scan.zone_hi.min(scan.lut_hi);
+    if zl <= zh {
+        lut_run(scan, table, fr, row_scale, scan.lut_lo, zl - 1, sink);
+        exact_run(scan, fr, zl, zh, sink);
+        lut_run(scan, table, fr, row_scale, zh + 1, scan.lut_hi, sink);
+    } else {
+        lut_run(scan, table, fr, row_scale, scan.lut_lo, scan.lut_hi, sink);
+    }
+    exact_run(scan, fr, scan.lut_hi + 1, w - 1, sink);
+}
+
+/// Exact evaluation of pixels x0..=x1 of a scanline (pole zones, beyond the table).
+#[inline(never)]
+fn exact_run<S: Sink>(scan: &Scan, fr: &Setup, x0: i64, x1: i64, sink: &mut S) {
+    let half_w = fr.w_out as f64 * 0.5;
+    let c2 = scan.ca * scan.ca;
+    for x in x0.max(0)..=x1 {
+        let t = (x as f64 + 0.5 - half_w) * scan.t_per_x;
+        let lambda = t.atan2(scan.ca) + fr.yaw;
+        let phi = scan.sa.atan2((t * t + c2).sqrt());
+        sink.exact(x as usize, fr.proj.uv(lambda, phi, fr.mw, fr.mh));
+    }
+}
+
+/// Unfolded table read at pixel x: (Λ, V) in Q.16 for the yaw-0 frame.
+#[inline(always)]
+pub(crate) fn read(scan: &Scan, table: &LutTable, fr: &Setup, x: i64) -> (Fx, Fx) {
+    let big_x = x as f64 + 0.5 - fr.w_out as f64 * 0.5;
+    let (mut l, mut v) = table.lookup(scan.band, scan.wa, big_x.abs() * scan.col_per_x);
+    if scan.back {
+        l = fr.half_map_w_fx - l;
+    }
+    if big_x < 0.0 {
+        l = -l;
+    }
+    if scan.neg_v {
+        v = -v;
+    }
+    (l, v)
+}
+
+/// LUT evaluation of pixels x0..=x1: table reads every 2^shift pixels (the shift of the
+/// region the span starts in), fixed-point steps between.
+#[inline(always)]
+fn lut_run<S: Sink>(
+    scan: &Scan,
+    table: &LutTable,
+    fr: &Setup,
+    row_scale: &[i64],
+    x0: i64,
+    x1: i64,
+    sink: &mut S,
+) {
+    if x0 > x1 {
+        return;
+    }
+    let half_w = fr.w_out as f64 * 0.5;
+    let last_region = STEP_REGIONS - 1;
+    let mut xs = x0;
+    let (mut l0, mut v0) = read(scan, table, fr, xs);
+    loop {
+        let big_x = (xs as f64 + 0.5 - half_w).abs();
+        let region = ((big_x * scan.region_per_x) as usize).min(last_region);
+        let shift = scan.shifts[region] as u32;
+        let n = 1i64 << shift;
+        let xe = (xs + n).min(x1);
+        if xe == xs {
+            emit(fr, row_scale, xs, 1, (l0, v0), (0, 0), sink);
+            return;
+        }
+        let (mut l1, v1) = read(scan, table, fr, xe);
+        // Unwrap longitude across the span: a ±180° seam is a jump of one map width.
+        let d = l1 - l0;
+        if d > fr.half_map_w_fx {
+            l1 -= fr.map_w_fx;
+        } else if d < -fr.half_map_w_fx {
+            l1 += fr.map_w_fx;
+        }
+        let m = xe - xs;
+        let (dl, dv) = if m == n {
+            ((l1 - l0) >> shift, (v1 - v0) >> shift)
+        } else {
+            ((l1 - l0) / m, (v1 - v0) / m)
+        };
+        sink.footprint(dl, dv, region);
+        if xe == x1 {
+            // Last span: emit through x1 inclusive, ending exactly on the read value.
+            emit(fr, row_scale, xs, m, (l0, v0), (dl, dv), sink);
+            emit(fr, row_scale, x1, 1, (l1, v1), (0, 0), sink);
+            return;
+        }
+        emit(fr, row_scale, xs, m, (l0, v0), (dl, dv), sink);
+        xs = xe;
+        l0 = l1;
+        v0 = v1;
+    }
+}
+
+/// Emit `m` pixels from `x` on, starting at (Λ, V) and stepping by (dΛ, dV).
+#[inline(always)]
+fn emit<S: Sink>(
+    fr: &Setup,
+    row_scale: &[i64],
+    x: i64,
+    m: i64,
+    start: (Fx, Fx),
+    step: (Fx, Fx),
+    sink: &mut S,
+) {
+    let (l, vv) = start;
+    let (dl, dvv) = step;
+    // v = H/2 − V
+    let mut v = fr.half_map_h_fx - vv;
+    let dv = -dvv;
+    let x = x as usize;
+    let m = m as usize;
+    if fr.scaled {
+        let mut lw = l + fr.yaw_fx;
+        for i in 0..m {
+            // wrap Λ + yaw into (−W/2, W/2], as λ into (−π, π]
+            let mut a = lw;
+            if a > fr.half_map_w_fx || a <= -fr.half_map_w_fx {
+                a = fr.half_map_w_fx - (fr.half_map_w_fx - a).rem_euclid(fr.map_w_fx);
+            }
+            let s = row_scale_at(row_scale, v, fr.mh as usize);
+            let u = fr.half_map_w_fx + ((s * a) >> ROW_SCALE_BITS);
+            sink.put(x + i, u, v);
+            lw += dl;
+            v += dv;
+        }
+        return;
+    }
+    let wfx = fr.map_w_fx;
+    let mut u = wrap_u(l + fr.off_fx, wfx);
+    if !(0..wfx).contains(&u) {
+        u = u.rem_euclid(wfx);
+    }
+    if fr.coverage {
+        for i in 0..m {
+            let uu = wrap_u(u, wfx);
+            if v < 0 || v > fr.map_h_fx {
+                sink.background(x + i);
+            } else {
+                sink.put(x + i, uu, v);
+            }
+            u += dl;
+            v += dv;
+        }
+    } else {
+        sink.span(x, m, u, v, dl, dv, wfx);
+    }
+}
+
+#[inline(always)]
+pub(crate) fn wrap_u(u: Fx, w: Fx) -> Fx {
+    if u >= w {
+        u - w
+    } else if u < 0 {
+        u + w
+    } else {
+        u
+    }
+}
+
+/// Fractional bits of the row scale s.
+const ROW_SCALE_BITS: u32 = 30;
+pub(crate) const ROW_SCALE_ONE: f64 = (1u64 << ROW_SCALE_BITS) as f64;
+
+/// Row scale s(v) (Q.30), linear between map rows.
+#[inline(always)]
+fn row_scale_at(rs: &[i64], v: Fx, h: usize) -> i64 {
+    let vi = (v >> FX_BITS).clamp(0, h as i64 - 1) as usize;
+    let fr = (v - ((vi as i64) << FX_BITS)).clamp(0, 1 << FX_BITS);
+    rs[vi] + (((rs[vi + 1] - rs[vi]) * fr) >> FX_BITS)
+}

@@ -1,0 +1,277 @@
+//! Per-frame setup: everything the LUT renderer computes once per frame and never per
+//! pixel. Each output scanline gets its table rows (band and blend weight, from pitch),
+//! its column scale (from zoom), its index step per region (from the step bounds of
+//! `render/steps.rs`), the pixel ranges the table covers and those evaluated exactly
+//! (near a pole, or beyond the table's field of view), and for trilinear sampling its
+//! vertical footprint. Yaw is one column offset added to u.
+
+use super::scanline::read;
+use super::steps::{step_for, StepBounds, ADAPTIVE_MAX_STEP, STEP_REGIONS};
+use super::{IndexStep, RenderOptions, RenderPath, RenderReport};
+use crate::error::ViewError;
+use crate::geom::camera::{Camera, View};
+use crate::geom::fixed::{to_fx, Fx, FX_BITS, FX_ONE};
+use crate::geom::projection::Projection;
+use crate::lut::{LutTable, Surface, TableKind};
+use crate::map::sample::Sampler;
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+/// Per-scanline setup, computed once per frame.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Scan {
+    /// The table covers part of this row.
+    pub(crate) lut: bool,
+    pub(crate) band: usize,
+    pub(crate) wa: i64,
+    pub(crate) neg_v: bool,
+    pub(crate) back: bool,
+    /// Column coordinate per unit of X (X = x + ½ − W/2).
+    pub(crate) col_per_x: f64,
+    /// t per unit of X (1/ρ).
+    pub(crate) t_per_x: f64,
+    /// sin and cos of the (unfolded) scanline angle.
+    pub(crate) sa: f64,
+    pub(crate) ca: f64,
+    /// log2 of the index step per region of |X| (see [`STEP_REGIONS`]).
+    pub(crate) shifts: [u8; STEP_REGIONS],
+    /// Regions per unit of |X|.
+    pub(crate) region_per_x: f64,
+    /// Angle between this scanline and the next at the centre column (radians).
+    pub(crate) row_angle: f64,
+    /// Vertical pixel footprint per region (level-0 map pixels; trilinear only): the
+    /// distance between this scanline's and the next one's table positions.
+    pub(crate) fy: [f32; STEP_REGIONS],
+    pub(crate) lut_lo: i64,
+    pub(crate) lut_hi: i64,
+    pub(crate) zone_lo: i64,
+    pub(crate) zone_hi: i64,
+}
+
+/// Per-frame constants shared by all rows.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Setup {
+    pub(crate) w_out: usize,
+    pub(crate) proj: Projection,
+    pub(crate) mw: f64,
+    pub(crate) mh: f64,
+    pub(crate) map_w_fx: Fx,
+    pub(crate) half_map_w_fx: Fx,
+    pub(crate) map_h_fx: Fx,
+    pub(crate) half_map_h_fx: Fx,
+    /// W/2 + yaw, in map pixels, Q.16 (rectangular maps: u = Λ + off).
+    pub(crate) off_fx: Fx,
+    /// yaw in map pixels, Q.16 (scaled rows: u = W/2 + s · wrap(Λ + yaw)).
+    pub(crate) yaw_fx: Fx,
+    pub(crate) yaw: f64,
+    pub(crate) coverage: bool,
+    pub(crate) scaled: bool,
+}
+
+/// Per-frame setup: one [`Scan`] per output row.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn prepare(
+    table: &LutTable,
+    kind: TableKind,
+    (mw, mh, proj): (u32, u32, Projection),
+    scans: &mut Vec<Scan>,
+    view: View,
+    opts: &RenderOptions,
+    width: u32,
+    height: u32,
+) -> (Setup, RenderReport) {
+    let cam = Camera::new(view, width, height);
+    let f = cam.focal;
+    let (mwf, mhf) = (mw as f64, mh as f64);
+    let yaw = view.yaw();
+    let yaw_px = yaw / TAU * mwf;
+    let frame = Setup {
+        w_out: width as usize,
+        proj,
+        mw: mwf,
+        mh: mhf,
+        map_w_fx: (mw as i64) << FX_BITS,
+        half_map_w_fx: (mw as i64) << (FX_BITS - 1),
+        map_h_fx: (mh as i64) << FX_BITS,
+        half_map_h_fx: to_fx(mhf * 0.5),
+        off_fx: to_fx(mwf * 0.5 + yaw_px),
+        yaw_fx: to_fx(yaw_px),
+        yaw,
+        coverage: !proj.full_sphere(),
+        scaled: proj.scaled_rows(),
+    };
+    let nominal = match opts.index_step {
+        IndexStep::Fixed(n) => n,
+        IndexStep::Adaptive => ADAPTIVE_MAX_STEP,
+    };
+    // Second-derivative bound factors of the map coordinates (see step_for()).
+    let (v1, v2) = proj.profile_derivative_bounds(mwf, mhf);
+    let coupling = proj.row_scale_coupling(mwf, mhf);
+    let bounds = StepBounds {
+        lam_px: mwf / TAU,
+        v1,
+        v2,
+        coupling,
+    };
+    let pitch = view.pitch();
+    let half_w = width as f64 * 0.5;
+    scans.clear();
+    let mut exact_pixels = 0u64;
+    let (mut max_step, mut min_step) = (0u32, u32::MAX);
+    for y in 0..height {
+        let yc = height as f64 * 0.5 - (y as f64 + 0.5);
+        let rho = yc.hypot(f);
+        let alpha = pitch + yc.atan2(f);
+        let (sa, ca) = alpha.sin_cos();
+        let neg_v = alpha < 0.0;
+        let mut a = alpha.abs();
+        let back = a > FRAC_PI_2;
+        if back {
+            a = PI - a;
+        }
+        let mut scan = Scan {
+            neg_v,
+            back,
+            sa,
+            ca,
+            t_per_x: 1.0 / rho,
+            row_angle: f / (f * f + yc * yc),
+            lut_lo: 0,
+            lut_hi: -1,
+            zone_lo: 0,
+            zone_hi: -1,
+            ..Scan::default()
+        };
+        let row_coord = match opts.surface {
+            Surface::Cylinder => {
+                scan.col_per_x = 1.0 / rho;
+                Some(a)
+            }
+            Surface::Plane => {
+                if back || a >= table.row_max() {
+                    None
+                } else {
+                    scan.col_per_x = 1.0 / (rho * a.cos());
+                    Some(a.tan())
+                }
+            }
+        };
+        if let Some(rc) = row_coord.filter(|rc| *rc <= table.row_max()) {
+            let (band, wa) = table.row_position(rc);
+            scan.lut = true;
+            scan.band = band;
+            scan.wa = wa;
+            let xc = table.col_max() / scan.col_per_x;
+            let (lo, hi) = x_range(half_w, xc, width);
+            scan.lut_lo = lo;
+            scan.lut_hi = hi;
+            let zone = table.zone(band);
+            let mut t_min = 0.0;
+            if zone >= 0.0 {
+                let xz = zone / scan.col_per_x;
+                let (zl, zh) = x_range(half_w, xz, width);
+                scan.zone_lo = zl;
+                scan.zone_hi = zh;
+                t_min = xz * scan.t_per_x;
+            }
+            let (sn, c) = (a.sin().abs(), a.cos().abs());
+            let reg_x = half_w / STEP_REGIONS as f64;
+            scan.region_per_x = 1.0 / reg_x;
+            for (r, shift) in scan.shifts.iter_mut().enumerate() {
+                let (x_lo, x_hi) = (r as f64 * reg_x, (r + 1) as f64 * reg_x);
+                let n = step_for(&bounds, (sn, c), t_min, x_lo, x_hi, scan.t_per_x, nominal);
+                *shift = n.trailing_zeros() as u8;
+                max_step = max_step.max(n);
+                min_step = min_step.min(n);
+            }
+        }
+        exact_pixels += exact_count(&scan, width as i64);
+        scans.push(scan);
+    }
+    if min_step == u32::MAX {
+        min_step = 1;
+        max_step = max_step.max(1);
+    }
+    if opts.sampler == Sampler::Trilinear {
+        vertical_footprints(scans, table, &frame);
+    }
+    let report = RenderReport {
+        path: match kind {
+            TableKind::Wide => RenderPath::LutWide,
+            TableKind::High => RenderPath::LutHigh,
+        },
+        exact_pixels,
+        pixels: width as u64 * height as u64,
+        table_bytes: table.bytes(),
+        max_step,
+        min_step,
+    };
+    (frame, report)
+}
+
+/// The vertical footprint of every scanline per region (see [`Scan::fy`]): table positions
+/// of the region's centre column on this scanline and the next (the previous one for the
+/// last row), Λ taken the short way round the seam; where the table does not cover both,
+/// the scanline's angular spacing in map pixels.
+fn vertical_footprints(scans: &mut [Scan], table: &LutTable, fr: &Setup) {
+    let n = scans.len();
+    let half_w = fr.w_out as f64 * 0.5;
+    let reg_x = half_w / STEP_REGIONS as f64;
+    let px_per_rad = fr.mw / TAU;
+    for y in 0..n {
+        let other = if y + 1 < n {
+            y + 1
+        } else {
+            y.saturating_sub(1)
+        };
+        let mut fy = [0f32; STEP_REGIONS];
+        for (r, f) in fy.iter_mut().enumerate() {
+            let x = ((half_w + (r as f64 + 0.5) * reg_x - 0.5).round() as i64)
+                .clamp(0, fr.w_out as i64 - 1);
+            let usable = |s: &Scan| {
+                s.lut && x >= s.lut_lo && x <= s.lut_hi && !(x >= s.zone_lo && x <= s.zone_hi)
+            };
+            *f = if other != y && usable(&scans[y]) && usable(&scans[other]) {
+                let (l0, v0) = read(&scans[y], table, fr, x);
+                let (l1, v1) = read(&scans[other], table, fr, x);
+                let mut dl = (l1 - l0).unsigned_abs() as i64;
+                if dl > fr.half_map_w_fx {
+                    dl = (fr.map_w_fx - dl).abs();
+                }
+                (dl.max((v1 - v0).abs()) as f64 / FX_ONE as f64) as f32
+            } else {
+                (scans[y].row_angle * px_per_rad) as f32
+            };
+        }
+        scans[y].fy = fy;
+    }
+}
+
+pub(crate) fn check_step(s: IndexStep) -> Result<(), ViewError> {
+    match s {
+        IndexStep::Fixed(n) if !matches!(n, 1 | 2 | 4 | 8 | 16) => Err(ViewError::BadIndexStep(n)),
+        _ => Ok(()),
+    }
+}
+
+/// Inclusive pixel range with |x + ½ − W/2| ≤ r, clamped to the row (empty: lo > hi).
+fn x_range(half_w: f64, r: f64, width: u32) -> (i64, i64) {
+    if r.is_nan() || r < 0.0 {
+        return (0, -1);
+    }
+    let r = r.min(1e12);
+    let lo = (half_w - 0.5 - r).ceil().max(0.0) as i64;
+    let hi = (half_w - 0.5 + r).floor().min(width as f64 - 1.0) as i64;
+    (lo, hi)
+}
+
+/// Pixels of a row the LUT path evaluates exactly.
+fn exact_count(s: &Scan, w: i64) -> u64 {
+    if !s.lut || s.lut_lo > s.lut_hi {
+        return w as u64;
+    }
+    let outside = s.lut_lo + (w - 1 - s.lut_hi);
+    let zl = s.zone_lo.max(s.lut_lo);
+    let zh = s.zone_hi.min(s.lut_hi);
+    let zone = if zl <= zh { zh - zl + 1 } else { 0 };
+    (outside + zone) as u64
+}

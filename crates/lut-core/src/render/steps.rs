@@ -1,0 +1,89 @@
+//! Step bounds: the longest index-interpolation step per region of a scanline whose
+//! linear-interpolation error stays within [`SPAN_ERROR_BUDGET`], from an analytic bound on
+//! the second derivative of the map coordinates along the scanline.
+
+/// Largest sampling-position error, in source pixels, index interpolation may add to a
+/// span (on top of the table's own budget, [`crate::TABLE_ERROR_BUDGET`]).
+pub const SPAN_ERROR_BUDGET: f64 = 0.02;
+
+/// Largest step the adaptive mode takes.
+pub const ADAPTIVE_MAX_STEP: u32 = 64;
+
+/// Each scanline is cut into this many regions of |X| (distance from the screen's
+/// centre column), each with its own index step: the curvature of the map coordinates
+/// peaks in one region and is small elsewhere, so a per-region step is several times
+/// longer on average than one step per scanline, at the same error bound.
+pub(crate) const STEP_REGIONS: usize = 8;
+
+/// Factors of the second-derivative bound of the map coordinates along a scanline.
+pub(crate) struct StepBounds {
+    /// W / 2π: Λ pixels per radian of longitude.
+    pub(crate) lam_px: f64,
+    /// max |dV/dφ| and |d²V/dφ²| over the covered latitudes.
+    pub(crate) v1: f64,
+    pub(crate) v2: f64,
+    /// How a V error turns into a u error through the row scale.
+    pub(crate) coupling: f64,
+}
+
+/// The longest power-of-two step ≤ `nominal` whose linear-interpolation error is bounded
+/// by [`SPAN_ERROR_BUDGET`] for every span that starts at |X| ∈ [x_lo, x_hi] (pixels from
+/// the screen's centre column) on this scanline.
+///
+/// Along a scanline at folded angle `a` (s = sin a, c = cos a) the direction is
+/// (t, s, c), λ = atan2(t, c), φ = atan2(s, ρ) with ρ = √(t²+c²), and t = X/ρ_screen
+/// linear in the pixel (`dt` per pixel). |λ_tt| = 2|t|c/ρ⁴ exactly: unimodal in |t|
+/// with its peak 0.6495/c² at |t| = c/√3, so its maximum over an interval is at the point
+/// of the interval nearest the peak. φ_t = −s·t/(ρ(1+t²)) and
+/// φ_tt = −s·(c²(1+t²) − 2t²ρ²)/(ρ³(1+t²)²), whose second factor is at most 1/ρ in size
+/// (checked on a dense grid of t and c): |φ_tt| ≤ s/ρ, largest at the smallest |t|, and
+/// |φ_t| ≤ s. Pixels with |t| < `t_min` are evaluated exactly (pole zone) and bound no
+/// span. A span of n pixels from |X| in [x_lo, x_hi] covers |X| ∈ [x_lo − n, x_hi + n];
+/// linear interpolation over it errs by at most (n·dt)²/8 · max|f''| there. (Bounds
+/// checked numerically; 10 % margin added.)
+pub(crate) fn step_for(
+    b: &StepBounds,
+    sc: (f64, f64),
+    t_min: f64,
+    x_lo: f64,
+    x_hi: f64,
+    dt: f64,
+    nominal: u32,
+) -> u32 {
+    let mut n = nominal.max(1);
+    loop {
+        let reach = n as f64;
+        let t_lo = ((x_lo - reach) * dt).max(t_min).max(0.0);
+        let t_hi = ((x_hi + reach) * dt).max(t_lo);
+        let bound = span_bound(b, sc, t_lo, t_hi);
+        let len = reach * dt;
+        if n == 1 || (bound.is_finite() && len * len / 8.0 * bound <= SPAN_ERROR_BUDGET) {
+            return n;
+        }
+        n >>= 1;
+    }
+}
+
+/// Bound on the second derivative (in source pixels per unit t²) of the map position
+/// along a scanline over |t| ∈ [t_lo, t_hi] (see [`step_for`]).
+fn span_bound(b: &StepBounds, (s, c): (f64, f64), t_lo: f64, t_hi: f64) -> f64 {
+    let lam_tt = if c <= 0.0 {
+        if t_lo > 0.0 {
+            0.0
+        } else {
+            f64::INFINITY
+        }
+    } else {
+        let t = (c / 3f64.sqrt()).clamp(t_lo, t_hi);
+        let r2 = t * t + c * c;
+        2.0 * t * c / (r2 * r2)
+    };
+    let rho_min = (t_lo * t_lo + c * c).sqrt();
+    let phi_tt = if rho_min > 0.0 {
+        1.125 * s / rho_min
+    } else {
+        f64::INFINITY
+    };
+    let v_tt = b.v1 * phi_tt + b.v2 * s * s;
+    1.1 * (b.lam_px * lam_tt + (1.0 + b.coupling) * v_tt)
+}
