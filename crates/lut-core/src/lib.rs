@@ -83,12 +83,16 @@ mod io;
 mod light;
 mod lut;
 mod map;
+mod named;
 mod render;
 
 pub use error::{
     AngleProblem, CoverageError, CropProblem, GPanoError, MapError, SizeProblem, SyntaxProblem,
     ViewError,
 };
+
+// Names of the option enums (one list each, for the CLI, a panel, JSON and messages).
+pub use named::{name_list, parse_name, Named};
 
 // Geometry.
 pub use geom::accuracy::{compare_positions, position_error, raw_error, ErrorStats};
@@ -154,11 +158,12 @@ mod layout {
     /// nothing uses it.
     const ALLOWED: &[(&str, &[&str])] = &[
         ("error", &[]),
-        ("geom", &["error"]),
-        ("map", &["geom", "error"]),
-        ("lut", &["geom", "error"]),
-        ("cube", &["geom", "map", "error"]),
-        ("render", &["geom", "map", "lut", "cube", "error"]),
+        ("named", &[]),
+        ("geom", &["error", "named"]),
+        ("map", &["geom", "error", "named"]),
+        ("lut", &["geom", "error", "named"]),
+        ("cube", &["geom", "map", "error", "named"]),
+        ("render", &["geom", "map", "lut", "cube", "error", "named"]),
         ("light", &["geom", "render", "error"]),
         ("io", &["geom", "map", "lut", "cube", "render", "error"]),
     ];

@@ -1,8 +1,9 @@
 //! What every lutpano test binary shares: golden-image comparison against stored truths
 //! ([`golden`]), pixel statistics ([`pixels`]: PSNR, per-channel differences), a counting
 //! global allocator ([`alloc`]), header-only decompression bombs ([`bombs`]) and frames
-//! rendered into new buffers ([`render`]), and geometry computed independently of the
-//! library ([`geometry`]).
+//! rendered into new buffers ([`render`]), geometry computed independently of the
+//! library ([`geometry`]), and synthetic photometric files and sphere directions for the
+//! light tests ([`light_fixtures`]).
 //!
 //! A dev-dependency of `lut-core` and `viewer`; never published.
 

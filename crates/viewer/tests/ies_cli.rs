@@ -5,9 +5,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../tests/data/ies")
-        .join(name)
+    test_support::test_data("ies").join(name)
 }
 
 #[test]
@@ -78,9 +76,7 @@ fn failure(file: &std::path::Path) -> String {
 }
 
 fn ldt_fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../tests/data/ldt")
-        .join(name)
+    test_support::test_data("ldt").join(name)
 }
 
 /// `viewer ies FILE --json` with samples, parsed.

@@ -216,7 +216,7 @@ fn coverage_places_an_untagged_image_and_overrides_bad_metadata() {
         "render",
         "--projection",
         "cube",
-        "../../tests/data/cube/skyfantasy",
+        s(&test_support::test_data("cube/skyfantasy")),
         "-o",
         s(&out),
         "--coverage",

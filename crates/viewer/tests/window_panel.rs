@@ -2,24 +2,10 @@
 //! display: it shows up on the right, the scene to its left is untouched, and its pixels
 //! are the panel's colours with text and widgets on them.
 
-// The window's modules live in the binary crate; compile the display-free ones here
-// (at the crate root, so their `super::input` paths resolve as in the binary).
-#[allow(dead_code)]
-#[path = "../src/window/input.rs"]
-mod input;
-#[allow(dead_code)]
-#[path = "../src/window/lights.rs"]
-mod lights;
-#[allow(dead_code)]
-#[path = "../src/window/paint.rs"]
-mod paint;
-#[allow(dead_code)]
-#[path = "../src/window/ui.rs"]
-mod ui;
-
-use input::{Look, Settings};
-use paint::{Compositor, SceneRect, BACKGROUND};
-use ui::{LoadStatus, PanelModel, Readouts, BUTTON_LABELS, PANEL_WIDTH};
+use viewer::lighting::LightsState;
+use viewer::window::input::{Look, Settings};
+use viewer::window::paint::{Compositor, SceneRect, BACKGROUND};
+use viewer::window::ui::{self, LoadStatus, PanelModel, Readouts, BUTTON_LABELS, PANEL_WIDTH};
 
 const W: u32 = 800;
 const H: u32 = 500;
@@ -42,7 +28,7 @@ fn paint_panel(
     let mut compositor = Compositor::new();
     let mut settings = Settings::default();
     let mut projection = None;
-    let mut lights = lights::LightsState::default();
+    let mut lights = LightsState::default();
     let readouts = Readouts {
         map: "test map (256×128, equirect)".into(),
         render_ms: 3.5,
@@ -92,13 +78,7 @@ fn paint_panel(
     }
     let p =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("window_panel_{ppp}.png"));
-    let rgb: Vec<u8> = frame
-        .iter()
-        .flat_map(|p| [(p >> 16) as u8, (p >> 8) as u8, *p as u8])
-        .collect();
-    if let Some(img) = image::RgbImage::from_raw(W, H, rgb) {
-        let _ = img.save(&p); // for a human look only
-    }
+    let _ = test_support::pixels::to_rgb(&frame, W, H).save(&p); // for a human look only
     Painted { frame, scene }
 }
 

@@ -23,6 +23,7 @@
 //! * [`Layout::Grid3x2`], 3:2: `px nx py` over `ny pz nz` = right left up / down front back.
 
 use super::{CubeError, CubeMap, Face, UsageProblem};
+use crate::named::{parse_name, unknown_name, Named};
 
 /// How the six faces are given.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -41,14 +42,9 @@ impl Layout {
     /// All layouts.
     pub const ALL: [Layout; 4] = [Layout::Files, Layout::Cross, Layout::Strip, Layout::Grid3x2];
 
-    /// Name used on the command line.
+    /// Name used on the command line (see [`crate::Named`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Layout::Files => "files",
-            Layout::Cross => "cross",
-            Layout::Strip => "strip",
-            Layout::Grid3x2 => "3x2",
-        }
+        Named::name(self)
     }
 
     /// Grid of a single-image layout in face cells: (columns, rows); `None` for files.
@@ -86,14 +82,26 @@ impl Layout {
 impl std::str::FromStr for Layout {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "files" => Ok(Layout::Files),
-            "cross" => Ok(Layout::Cross),
-            "strip" => Ok(Layout::Strip),
-            "3x2" => Ok(Layout::Grid3x2),
-            o => Err(format!(
-                "unknown layout '{o}' (expected files, cross, strip or 3x2)"
-            )),
+        parse_name(s).ok_or_else(|| unknown_name::<Layout>("layout", s))
+    }
+}
+
+impl Named for Layout {
+    const ALL: &'static [Self] = &Layout::ALL;
+    fn name(self) -> &'static str {
+        match self {
+            Layout::Files => "files",
+            Layout::Cross => "cross",
+            Layout::Strip => "strip",
+            Layout::Grid3x2 => "3x2",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            Layout::Files => "Six files (a folder or a list)",
+            Layout::Cross => "One 4:3 image, horizontal cross",
+            Layout::Strip => "One 6:1 image: px nx py ny pz nz",
+            Layout::Grid3x2 => "One 3:2 image: px nx py over ny pz nz",
         }
     }
 }
@@ -172,13 +180,9 @@ pub enum Naming {
 }
 
 impl Naming {
-    /// Name used on the command line.
+    /// Name used on the command line (see [`crate::Named`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Naming::Conventions => "conventions",
-            Naming::Cube2 => "cube2",
-            Naming::Irrlicht => "irrlicht",
-        }
+        Named::name(self)
     }
 
     /// Where the image a file name calls `named` goes, and how it is turned.
@@ -209,13 +213,31 @@ impl Naming {
 impl std::str::FromStr for Naming {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "conventions" | "plain" | "opengl" | "gl" => Ok(Naming::Conventions),
-            "cube2" | "sauerbraten" => Ok(Naming::Cube2),
-            "irrlicht" => Ok(Naming::Irrlicht),
-            o => Err(format!(
-                "unknown naming '{o}' (expected conventions, cube2 or irrlicht)"
-            )),
+        // The names, and a few aliases.
+        parse_name(s)
+            .or(match s {
+                "plain" | "opengl" | "gl" => Some(Naming::Conventions),
+                "sauerbraten" => Some(Naming::Cube2),
+                _ => None,
+            })
+            .ok_or_else(|| unknown_name::<Naming>("naming", s))
+    }
+}
+
+impl Named for Naming {
+    const ALL: &'static [Self] = &[Naming::Conventions, Naming::Cube2, Naming::Irrlicht];
+    fn name(self) -> &'static str {
+        match self {
+            Naming::Conventions => "conventions",
+            Naming::Cube2 => "cube2",
+            Naming::Irrlicht => "irrlicht",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            Naming::Conventions => "Names mean what they say, images oriented as the conventions",
+            Naming::Cube2 => "Sauerbraten / Cube 2 sky boxes (ft rt bk lf up dn)",
+            Naming::Irrlicht => "Irrlicht sky boxes",
         }
     }
 }

@@ -15,6 +15,7 @@
 //! rectangular maps). The LUT stores `(Λ, V)`; both are odd in their angle, which is what
 //! makes the patent's one-eighth symmetry work for every projection here.
 
+use crate::named::{parse_name, unknown_name, Named};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::fmt;
 use std::str::FromStr;
@@ -44,15 +45,9 @@ impl Projection {
         Projection::Diamond,
     ];
 
-    /// The lower-case name used on the command line.
+    /// The lower-case name used on the command line (see [`crate::Named`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Projection::Equirect => "equirect",
-            Projection::Cylinder => "cylinder",
-            Projection::Sine => "sine",
-            Projection::Elliptical => "elliptical",
-            Projection::Diamond => "diamond",
-        }
+        Named::name(self)
     }
 
     /// True when map rows are 360° of longitude end to end, so sampling wraps in u.
@@ -183,15 +178,37 @@ impl fmt::Display for Projection {
 impl FromStr for Projection {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.to_ascii_lowercase().as_str() {
-            "equirect" | "equirectangular" | "spherical" | "sphere" => Ok(Projection::Equirect),
-            "cylinder" | "cylindrical" => Ok(Projection::Cylinder),
-            "sine" => Ok(Projection::Sine),
-            "elliptical" | "sinusoidal" => Ok(Projection::Elliptical),
-            "diamond" => Ok(Projection::Diamond),
-            other => Err(format!(
-                "unknown projection '{other}' (expected equirect, cylinder, sine, elliptical or diamond)"
-            )),
+        // The names in any case, and a few aliases.
+        let s = s.to_ascii_lowercase();
+        parse_name(&s)
+            .or(match s.as_str() {
+                "equirectangular" | "spherical" | "sphere" => Some(Projection::Equirect),
+                "cylindrical" => Some(Projection::Cylinder),
+                "sinusoidal" => Some(Projection::Elliptical),
+                _ => None,
+            })
+            .ok_or_else(|| unknown_name::<Projection>("projection", &s))
+    }
+}
+
+impl Named for Projection {
+    const ALL: &'static [Self] = &Projection::ALL;
+    fn name(self) -> &'static str {
+        match self {
+            Projection::Equirect => "equirect",
+            Projection::Cylinder => "cylinder",
+            Projection::Sine => "sine",
+            Projection::Elliptical => "elliptical",
+            Projection::Diamond => "diamond",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            Projection::Equirect => "Spherical, latitude/longitude (2:1)",
+            Projection::Cylinder => "Cylindrical: limited vertical coverage",
+            Projection::Sine => "Sine distribution (equal-area)",
+            Projection::Elliptical => "Elliptical (sinusoidal): rows scaled by cos(latitude)",
+            Projection::Diamond => "Diamond: rows scaled linearly to 0 at the poles",
         }
     }
 }

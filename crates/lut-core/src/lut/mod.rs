@@ -39,6 +39,7 @@
 //! high table's are measured.
 
 use crate::geom::projection::Projection;
+use crate::named::Named;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -57,11 +58,24 @@ pub enum Surface {
 }
 
 impl Surface {
-    /// Name used on the command line.
+    /// Name used on the command line (see [`crate::Named`]).
     pub fn name(self) -> &'static str {
+        Named::name(self)
+    }
+}
+
+impl Named for Surface {
+    const ALL: &'static [Self] = &[Surface::Cylinder, Surface::Plane];
+    fn name(self) -> &'static str {
         match self {
             Surface::Cylinder => "cylinder",
             Surface::Plane => "plane",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            Surface::Cylinder => "Cylinder (FIGS. 5-7)",
+            Surface::Plane => "Plane (FIG. 8A)",
         }
     }
 }

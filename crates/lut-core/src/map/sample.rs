@@ -4,6 +4,7 @@
 
 use crate::geom::fixed::{Fx, FX_BITS, FX_HALF};
 use crate::map::envmap::EnvMap;
+use crate::named::{parse_name, unknown_name, Named};
 
 /// Pixel interpolation (the patent's FIG. 10).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -19,26 +20,36 @@ pub enum Sampler {
 }
 
 impl Sampler {
-    /// Name used on the command line.
+    /// Name used on the command line (see [`crate::Named`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Sampler::Nearest => "nearest",
-            Sampler::Bilinear => "bilinear",
-            Sampler::Trilinear => "trilinear",
-        }
+        Named::name(self)
     }
 }
 
 impl std::str::FromStr for Sampler {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "nearest" => Ok(Sampler::Nearest),
-            "bilinear" => Ok(Sampler::Bilinear),
-            "trilinear" => Ok(Sampler::Trilinear),
-            o => Err(format!(
-                "unknown sampler '{o}' (expected nearest, bilinear or trilinear)"
-            )),
+        parse_name(s).ok_or_else(|| unknown_name::<Sampler>("sampler", s))
+    }
+}
+
+impl Named for Sampler {
+    const ALL: &'static [Self] = &[Sampler::Nearest, Sampler::Bilinear, Sampler::Trilinear];
+    fn name(self) -> &'static str {
+        match self {
+            Sampler::Nearest => "nearest",
+            Sampler::Bilinear => "bilinear",
+            Sampler::Trilinear => "trilinear",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            Sampler::Nearest => "Nearest source pixel",
+            Sampler::Bilinear => "Bilinear",
+            Sampler::Trilinear => {
+                "Trilinear: bilinear on the two pyramid levels around the pixel footprint \
+                 (anti-aliased when zoomed out; the pyramid takes up to 1/3 more memory)"
+            }
         }
     }
 }

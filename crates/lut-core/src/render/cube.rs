@@ -35,6 +35,7 @@ use crate::cube::{
 use crate::geom::camera::View;
 use crate::map::envmap::EnvMap;
 use crate::map::sample::Sampler;
+use crate::named::{parse_name, unknown_name, Named};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -49,24 +50,37 @@ pub enum CubeRenderer {
 }
 
 impl CubeRenderer {
-    /// Name used on the command line.
+    /// Name used on the command line (see [`crate::Named`]): `basic` or `scanline`.
     pub fn name(self) -> &'static str {
-        match self {
-            CubeRenderer::Basic => "basic",
-            CubeRenderer::Accelerated => "accelerated",
-        }
+        Named::name(self)
     }
 }
 
 impl std::str::FromStr for CubeRenderer {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "basic" => Ok(CubeRenderer::Basic),
-            "accelerated" | "accel" => Ok(CubeRenderer::Accelerated),
-            o => Err(format!(
-                "unknown cube renderer '{o}' (expected basic or accelerated)"
-            )),
+        // The names, and the paper's word for the scanline renderer.
+        parse_name(s)
+            .or(match s {
+                "accelerated" | "accel" => Some(CubeRenderer::Accelerated),
+                _ => None,
+            })
+            .ok_or_else(|| unknown_name::<CubeRenderer>("cube renderer", s))
+    }
+}
+
+impl Named for CubeRenderer {
+    const ALL: &'static [Self] = &[CubeRenderer::Basic, CubeRenderer::Accelerated];
+    fn name(self) -> &'static str {
+        match self {
+            CubeRenderer::Basic => "basic",
+            CubeRenderer::Accelerated => "scanline",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            CubeRenderer::Basic => "Per pixel: face by the largest coordinate",
+            CubeRenderer::Accelerated => "Per scanline: face segments split by binary search",
         }
     }
 }

@@ -32,6 +32,7 @@ use crate::lut::{LutTable, Surface, TableKind, TableSpec};
 use crate::map::envmap::EnvMap;
 use crate::map::pyramid::lod_q8;
 use crate::map::sample::Sampler;
+use crate::named::Named;
 use cube::{render_cube, CubeRenderer};
 use exact::render_exact;
 use frame::Frame;
@@ -124,6 +125,75 @@ impl Default for RenderOptions {
             surface: Surface::Cylinder,
             threads: true,
             cube: CubeRenderer::Accelerated,
+        }
+    }
+}
+
+impl Named for RendererKind {
+    const ALL: &'static [Self] = &[RendererKind::Lut, RendererKind::Exact];
+    fn name(self) -> &'static str {
+        match self {
+            RendererKind::Lut => "lut",
+            RendererKind::Exact => "exact",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            RendererKind::Lut => "The scanline-coherent LUT renderer",
+            RendererKind::Exact => "The exact per-pixel renderer",
+        }
+    }
+}
+
+impl Named for LutChoice {
+    const ALL: &'static [Self] = &[LutChoice::Auto, LutChoice::Wide, LutChoice::High];
+    fn name(self) -> &'static str {
+        match self {
+            LutChoice::Auto => "auto",
+            LutChoice::Wide => "wide",
+            LutChoice::High => "high",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            LutChoice::Auto => "Wide above 60 degrees hfov, high-resolution at or below",
+            LutChoice::Wide => "The wide-FOV table",
+            LutChoice::High => "The high-resolution table",
+        }
+    }
+}
+
+/// The steps rendering accepts, the adaptive one first (the default). A `Fixed` step
+/// outside {1, 2, 4, 8, 16}, which rendering refuses, is named `invalid`.
+impl Named for IndexStep {
+    const ALL: &'static [Self] = &[
+        IndexStep::Adaptive,
+        IndexStep::Fixed(1),
+        IndexStep::Fixed(2),
+        IndexStep::Fixed(4),
+        IndexStep::Fixed(8),
+        IndexStep::Fixed(16),
+    ];
+    fn name(self) -> &'static str {
+        match self {
+            IndexStep::Adaptive => "adaptive",
+            IndexStep::Fixed(1) => "1",
+            IndexStep::Fixed(2) => "2",
+            IndexStep::Fixed(4) => "4",
+            IndexStep::Fixed(8) => "8",
+            IndexStep::Fixed(16) => "16",
+            IndexStep::Fixed(_) => "invalid",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            IndexStep::Adaptive => "The longest step the error bound allows, per scanline region",
+            IndexStep::Fixed(1) => "Read the table at every pixel",
+            IndexStep::Fixed(2) => "Read the table every 2nd pixel, interpolate between",
+            IndexStep::Fixed(4) => "Read the table every 4th pixel, interpolate between",
+            IndexStep::Fixed(8) => "Read the table every 8th pixel, interpolate between",
+            IndexStep::Fixed(16) => "Read the table every 16th pixel, interpolate between",
+            IndexStep::Fixed(_) => "Not a step rendering accepts",
         }
     }
 }

@@ -1,25 +1,25 @@
 //! The event loop: winit window, softbuffer surface, egui input and panel, lut-core
-//! renders, background loads. Event-driven: a frame is drawn only when input arrives,
-//! egui asks for one (its `repaint_delay`, never the `RedrawRequested` echo), something
-//! animates, or the full-quality frame after fast motion is due.
+//! renders. Event-driven: a frame is drawn only when input arrives, egui asks for one
+//! (its `repaint_delay`, never the `RedrawRequested` echo), something animates, or the
+//! full-quality frame after fast motion is due. What is shown and loading is the
+//! [`Document`]'s (pure, unit-tested); this module carries out its effects (loading
+//! threads, the title, printing) and draws.
 
+use super::document::{Document, Effect, LoadEvent};
 use super::input::{
     key_action, wheel_notches, Controller, Held, KeyAction, Look, Turn, EXPOSURE_KEY_STEP_EV,
     TURN_KEYS,
 };
-use super::lights::{LightsKey, LightsState};
+use super::loader::{self, LoadRequest, Source};
 use super::paint::{Compositor, SceneRect};
-use super::ui::{self, LoadStatus, LoadStep, PanelModel, Readouts};
+use super::ui::{self, PanelModel};
 use super::OpenArgs;
-use crate::render_cmd::{CubeRendererArg, ProjectionArg};
+use crate::lighting::{LightsKey, LightsState};
+use crate::scene::render_scene;
 use anyhow::{anyhow, Result};
-use lut_core::{
-    Camera, EnvMap, IndexStep, LutChoice, Projection, Renderer, RendererKind, Sampler, Tone,
-};
-use lut_core::{CubeMap, CubeRenderer, Frame, RenderOptions, RenderPath};
+use lut_core::{CubeRenderer, IndexStep, LutChoice, RenderPath, RendererKind, Sampler};
 use std::collections::VecDeque;
 use std::num::NonZeroU32;
-use std::path::PathBuf;
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 use winit::application::ApplicationHandler;
@@ -28,170 +28,6 @@ use winit::event_loop::{
     ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy, OwnedDisplayHandle,
 };
 use winit::window::{Fullscreen, Window, WindowId};
-
-/// Where a panorama comes from.
-#[derive(Debug, Clone, PartialEq)]
-enum Source {
-    Sample,
-    File(PathBuf),
-    /// A cube map: a folder, face files or one layout image, with the layout if given.
-    Cube {
-        paths: Vec<PathBuf>,
-        layout: Option<String>,
-    },
-}
-
-impl Source {
-    fn name(&self) -> String {
-        match self {
-            Source::Sample => crate::assets::SAMPLE_NAME.to_string(),
-            Source::File(p) => p.display().to_string(),
-            Source::Cube { paths, .. } => match paths.as_slice() {
-                [one] => one.display().to_string(),
-                many => format!(
-                    "{} cube faces in {}",
-                    many.len(),
-                    many.first()
-                        .and_then(|p| p.parent())
-                        .map_or_else(|| ".".into(), |d| d.display().to_string())
-                ),
-            },
-        }
-    }
-
-    /// The source that opens what `paths` were dropped or given as: a folder or several
-    /// files are a cube map; one image is a cube map when its aspect ratio is a cube
-    /// layout's (4:3, 6:1, 3:2) or a layout is forced.
-    fn of_paths(paths: Vec<PathBuf>, cube: bool, layout: Option<String>) -> Option<Source> {
-        let cube = cube || layout.is_some() || crate::cube_cmd::looks_like_cube(&paths);
-        match paths.as_slice() {
-            [] => None,
-            [one] if !cube => Some(Source::File(one.clone())),
-            _ => Some(Source::Cube { paths, layout }),
-        }
-    }
-}
-
-/// What is shown: a map on a surface of revolution with its LUT renderer, or a cube map.
-enum Scene {
-    Map { map: EnvMap, renderer: Renderer },
-    Cube(CubeMap),
-}
-
-impl Scene {
-    /// Render `view` into `frame` through lut-core's one render entry.
-    fn render(
-        &mut self,
-        view: lut_core::View,
-        opts: &RenderOptions,
-        frame: &mut Frame<'_>,
-    ) -> Result<lut_core::RenderReport, lut_core::ViewError> {
-        match self {
-            Scene::Map { map, renderer } => {
-                renderer.render(lut_core::Scene::Map(map), view, opts, frame)
-            }
-            Scene::Cube(cube) => {
-                Renderer::default().render(lut_core::Scene::Cube(cube), view, opts, frame)
-            }
-        }
-    }
-}
-
-/// A loaded panorama with its renderer (tables built on the loading thread).
-struct Loaded {
-    scene: Scene,
-    source: Source,
-    projection: Option<Projection>,
-    /// An HDR file (`.hdr`, `.exr`): shown through the panel's exposure.
-    hdr: bool,
-    /// The exposure it was decoded with (stops).
-    exposure_ev: f64,
-}
-
-impl Loaded {
-    /// Size and projection for the readout and `--print-view`: "W×H projection".
-    fn describe(&self) -> (u32, u32, &'static str) {
-        match &self.scene {
-            Scene::Map { map, .. } => (map.width(), map.height(), map.projection().name()),
-            Scene::Cube(c) => (c.face_size(), c.face_size(), "cube"),
-        }
-    }
-}
-
-/// Messages from the loading thread.
-enum UserEvent {
-    Progress {
-        id: u64,
-        step: LoadStep,
-        fraction: Option<f32>,
-    },
-    Done {
-        id: u64,
-        result: Result<Box<Loaded>, String>,
-    },
-}
-
-/// The loading thread's work: read, decode, convert, build tables, reporting each step
-/// (see `lut_core::load` for which decoders measure their progress).
-fn load(
-    proxy: &EventLoopProxy<UserEvent>,
-    id: u64,
-    source: Source,
-    opts: &lut_core::LoadOptions,
-    naming: Option<&str>,
-    coverage: Option<lut_core::Coverage>,
-) -> Result<Box<Loaded>, String> {
-    let hdr = matches!(&source, Source::File(p) if super::export::is_hdr_path(p));
-    let send = |step: LoadStep, fraction: Option<f32>| {
-        let _ = proxy.send_event(UserEvent::Progress { id, step, fraction });
-    };
-    let mut on_progress = |p: lut_core::LoadProgress| send(p.phase.into(), p.fraction);
-    let map = match &source {
-        Source::Cube { paths, layout } => {
-            send(LoadStep::Decoding, None);
-            let cube = crate::cube_cmd::load_cube(paths, layout.as_deref(), naming)
-                .map_err(|e| format!("{e:#}"))?;
-            return Ok(Box::new(Loaded {
-                scene: Scene::Cube(cube),
-                source,
-                projection: opts.projection,
-                hdr: false,
-                exposure_ev: opts.tone.exposure_ev,
-            }));
-        }
-        // The same loading as `viewer render` (streamed from the file, the pixel limit
-        // checked from the header first; partial panoramas placed by GPano XMP or the
-        // command line's --coverage); 8-bit images ignore the tone.
-        Source::Sample => {
-            crate::partial::load_panorama_partial(None, opts, coverage, &mut on_progress)
-                .map_err(|e| format!("{e:#}"))?
-                .0
-        }
-        Source::File(p) => {
-            crate::partial::load_panorama_partial(Some(p), opts, coverage, &mut on_progress)
-                .map_err(|e| format!("{e:#}"))?
-                .0
-        }
-    };
-    // Build both tables and the pyramid (the window's default sampler is trilinear) now,
-    // so the first frames do not wait for them.
-    send(LoadStep::Tables, Some(0.0));
-    let mut renderer = Renderer::new(&map);
-    let surface = lut_core::RenderOptions::default().surface;
-    renderer.table(surface, lut_core::TableKind::Wide);
-    send(LoadStep::Tables, Some(0.3));
-    renderer.table(surface, lut_core::TableKind::High);
-    send(LoadStep::Tables, Some(0.5));
-    map.pyramid();
-    send(LoadStep::Tables, Some(1.0));
-    Ok(Box::new(Loaded {
-        scene: Scene::Map { map, renderer },
-        source,
-        projection: opts.projection,
-        hdr,
-        exposure_ev: opts.tone.exposure_ev,
-    }))
-}
 
 /// What a cached scene was rendered from: when it matches, the scene is reused.
 #[derive(Debug, Clone, PartialEq)]
@@ -229,50 +65,28 @@ struct FrameRequests {
 struct App {
     print_view: bool,
     initial_size: (u32, u32),
-    proxy: EventLoopProxy<UserEvent>,
+    proxy: EventLoopProxy<LoadEvent>,
     softbuffer: softbuffer::Context<OwnedDisplayHandle>,
     start: Instant,
     gfx: Option<Gfx>,
     egui_ctx: egui::Context,
     compositor: Compositor,
     ctl: Controller,
-    current: Option<Box<Loaded>>,
-    map_generation: u64,
-    /// Projection chosen in the panel for the current (or failed) file.
-    projection: Option<Projection>,
-    /// The source the projection choice applies to: the current one, or a failed one.
-    projection_source: Option<Source>,
-    loading: Option<(u64, Source, LoadStatus)>,
-    next_load_id: u64,
-    error: Option<String>,
-    /// The running load is the fallback after a failed one: its success keeps the error.
-    keep_error: bool,
+    /// What is shown and loading.
+    doc: Document,
     show_panel: bool,
     scene: Vec<u32>,
     scene_key: Option<SceneKey>,
-    readouts: Readouts,
     next_frame_at: Option<Instant>,
     frame_times: VecDeque<Instant>,
     fatal: Option<anyhow::Error>,
-    /// `--max-pixels`: the pixel limit for every panorama opened.
-    max_pixels: u64,
-    /// Cube face naming from the command line (for every cube opened).
-    naming: Option<String>,
     /// The luminaires (panel state).
     lights: LightsState,
-    /// Paths dropped since the last event batch: one drop of several items arrives as one
-    /// event per item, and they open together (six face files are one cube map).
-    pending_drops: Vec<PathBuf>,
-    /// `--coverage`, for the source given on the command line only.
-    coverage: Option<(Source, lut_core::Coverage)>,
 }
 
 /// Open the window and run until it is closed.
 pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
-    let projection = match args.input.projection {
-        ProjectionArg::Map(p) => Some(p),
-        ProjectionArg::Auto | ProjectionArg::Cube => None,
-    };
+    let input = &args.input;
     let event_loop = create_event_loop()?;
     let softbuffer = softbuffer::Context::new(event_loop.owned_display_handle())
         .map_err(|e| anyhow!("cannot use the display for software drawing: {e}"))?;
@@ -287,47 +101,35 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         egui_ctx: egui::Context::default(),
         compositor: Compositor::new(),
         ctl: Controller::default(),
-        current: None,
-        map_generation: 0,
-        projection,
-        projection_source: None,
-        loading: None,
-        next_load_id: 0,
-        error: None,
-        keep_error: false,
+        doc: Document::new(
+            input.projection.value.map(),
+            args.limit.max_pixels,
+            input.cube.naming,
+        ),
         show_panel: true,
         scene: Vec::new(),
         scene_key: None,
-        readouts: Readouts::default(),
         next_frame_at: None,
         frame_times: VecDeque::new(),
         fatal: None,
-        max_pixels: args.limit.max_pixels,
-        naming: args.input.naming.clone(),
         lights,
-        pending_drops: Vec::new(),
-        coverage: None,
     };
     app.ctl.settings.view_limit = !args.no_view_limit;
-    app.ctl.settings.cube_renderer = match args.input.cube_renderer {
-        CubeRendererArg::Basic => CubeRenderer::Basic,
-        CubeRendererArg::Scanline => CubeRenderer::Accelerated,
-    };
-    let cube = match args.input.projection {
-        ProjectionArg::Cube => true,
-        ProjectionArg::Map(_) => false,
-        ProjectionArg::Auto => args.panorama.len() > 1 || args.panorama.iter().any(|p| p.is_dir()),
-    };
+    app.ctl.settings.cube_renderer = input.cube_renderer;
     // One image in auto is a map (as `viewer render` takes it); `--projection cube` or
     // `--layout` makes it a cube.
-    let source = if cube || args.input.layout.is_some() {
-        Source::of_paths(args.panorama, true, args.input.layout)
+    let source = if input.projection.value.reads_cube(&args.panorama) || input.cube.layout.is_some()
+    {
+        Source::of_paths(args.panorama.clone(), true, input.cube.layout)
     } else {
         args.panorama.first().cloned().map(Source::File)
     };
-    let source = source.unwrap_or(Source::Sample);
-    app.coverage = args.input.coverage.map(|c| (source.clone(), c));
-    app.start_load(source, projection);
+    let open = app.doc.open(
+        source.unwrap_or(Source::Sample),
+        input.coverage,
+        app.ctl.settings.exposure_ev,
+    );
+    app.apply(vec![open]);
     event_loop
         .run_app(&mut app)
         .map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
@@ -339,10 +141,10 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
 
 /// Create the event loop, turning a missing display (an error, or a panic deep in a
 /// platform backend) into a clear error.
-fn create_event_loop() -> Result<EventLoop<UserEvent>> {
+fn create_event_loop() -> Result<EventLoop<LoadEvent>> {
     let hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
-    let built = std::panic::catch_unwind(|| EventLoop::<UserEvent>::with_user_event().build());
+    let built = std::panic::catch_unwind(|| EventLoop::<LoadEvent>::with_user_event().build());
     std::panic::set_hook(hook);
     let no_display = "cannot open a window: no usable display (is DISPLAY or WAYLAND_DISPLAY set \
                       and the X11/Wayland libraries installed? `viewer render` works without one)";
@@ -367,123 +169,48 @@ impl App {
         }
     }
 
-    /// Load `source` on a background thread; the current panorama stays until it is done.
-    fn start_load(&mut self, source: Source, projection: Option<Projection>) {
-        self.next_load_id += 1;
-        let id = self.next_load_id;
-        let status = LoadStatus::new(source.name());
-        self.loading = Some((id, source.clone(), status));
-        self.keep_error = false;
-        let proxy = self.proxy.clone();
-        let naming = self.naming.clone();
-        let opts = lut_core::LoadOptions {
-            projection,
-            tone: Tone {
-                exposure_ev: self.ctl.settings.exposure_ev,
-            },
-            max_pixels: self.max_pixels,
-        };
-        let coverage = self
-            .coverage
-            .as_ref()
-            .filter(|(s, _)| *s == source)
-            .map(|(_, c)| *c);
+    /// Carry out what the document asks, then redraw.
+    fn apply(&mut self, effects: Vec<Effect>) {
+        for e in effects {
+            match e {
+                Effect::Load(req) => self.spawn_load(req),
+                Effect::AddLights(paths) => {
+                    for p in &paths {
+                        // The error (if any) is shown in the Lights section.
+                        let _ = self.lights.load_and_add(p);
+                    }
+                }
+                Effect::Title(t) => {
+                    if let Some(g) = &self.gfx {
+                        g.window.set_title(&t);
+                    }
+                }
+                Effect::PrintView(line) => {
+                    if self.print_view {
+                        println!("{line}");
+                    }
+                }
+                Effect::Stderr(line) => eprintln!("{line}"),
+                Effect::ShowPanel => self.show_panel = true,
+            }
+        }
+        self.request_redraw();
+    }
+
+    /// Run `req` on a loading thread that reports to the event loop.
+    fn spawn_load(&mut self, req: LoadRequest) {
+        let (id, proxy) = (req.id, self.proxy.clone());
         let spawned = std::thread::Builder::new()
             .name("viewer-load".into())
             .spawn(move || {
-                let result = load(&proxy, id, source, &opts, naming.as_deref(), coverage);
-                let _ = proxy.send_event(UserEvent::Done { id, result });
+                let result = loader::load(req, &mut |step, fraction| {
+                    let _ = proxy.send_event(LoadEvent::Progress { id, step, fraction });
+                });
+                let _ = proxy.send_event(LoadEvent::Done { id, result });
             });
         if let Err(e) = spawned {
-            self.loading = None;
-            self.error = Some(format!("cannot start loading: {e}"));
+            self.doc.load_not_started(id, &e.to_string());
         }
-        self.request_redraw();
-    }
-
-    fn on_load_event(&mut self, ev: UserEvent) {
-        let current_id = self.loading.as_ref().map(|l| l.0);
-        match ev {
-            UserEvent::Progress { id, step, fraction } if Some(id) == current_id => {
-                if let Some((_, _, st)) = &mut self.loading {
-                    st.advance(step, fraction);
-                }
-            }
-            UserEvent::Done { id, result } if Some(id) == current_id => {
-                let source = self.loading.take().map(|l| l.1);
-                match result {
-                    Ok(loaded) => {
-                        let (mw, mh, proj) = loaded.describe();
-                        if self.print_view {
-                            println!("loaded {} {mw}x{mh} {proj}", loaded.source.name());
-                        }
-                        self.readouts.map = match loaded.scene {
-                            Scene::Cube(_) => {
-                                format!("{} (cube, {mw}px faces)", short_name(&loaded.source))
-                            }
-                            Scene::Map { ref map, .. } => format!(
-                                "{} ({mw}×{mh}, {proj}, {} in memory)",
-                                short_name(&loaded.source),
-                                format_bytes(map.bytes())
-                            ),
-                        };
-                        if let Some(g) = &self.gfx {
-                            g.window
-                                .set_title(&format!("viewer: {}", short_name(&loaded.source)));
-                        }
-                        if !std::mem::take(&mut self.keep_error) {
-                            self.error = None;
-                            self.projection = loaded.projection;
-                            self.projection_source = Some(loaded.source.clone());
-                        }
-                        self.readouts.hdr = loaded.hdr;
-                        let map = match &loaded.scene {
-                            Scene::Map { map, .. } => Some(map),
-                            Scene::Cube(_) => None,
-                        };
-                        self.readouts.partial = map.and_then(crate::partial::coverage_text);
-                        self.readouts.pose_heading = map.and_then(EnvMap::pose_heading_deg);
-                        if self.print_view {
-                            if let Some(p) = &self.readouts.partial {
-                                println!("partial {p}");
-                            }
-                        }
-                        self.current = Some(loaded);
-                        self.map_generation += 1;
-                    }
-                    Err(e) => {
-                        eprintln!("viewer: {e}");
-                        self.error = Some(e);
-                        self.show_panel = true;
-                        // A projection chosen next retries this file.
-                        self.projection_source = source;
-                        if self.current.is_none() {
-                            // Nothing to keep showing: fall back to the bundled sample.
-                            self.start_load(Source::Sample, None);
-                            self.keep_error = true;
-                        }
-                    }
-                }
-            }
-            _ => {} // from a superseded load
-        }
-        self.request_redraw();
-    }
-
-    /// Open what was dropped: `.ies` files add lights, the rest is one panorama or cube.
-    fn open_dropped(&mut self) {
-        let (ies, rest): (Vec<PathBuf>, Vec<PathBuf>) = std::mem::take(&mut self.pending_drops)
-            .into_iter()
-            .partition(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("ies")));
-        for p in &ies {
-            // The error (if any) is shown in the Lights section.
-            let _ = self.lights.load_and_add(p);
-            self.show_panel = true;
-        }
-        if let Some(source) = Source::of_paths(rest, false, None) {
-            self.start_load(source, None);
-        }
-        self.request_redraw();
     }
 
     /// Build this frame's UI and collect what the user did.
@@ -524,23 +251,23 @@ impl App {
             });
         }
         if self.show_panel {
-            let loading = self.loading.as_ref().map(|l| &l.2);
             let look = self.ctl.look();
+            let doc = self.doc.panel_parts();
             req.panel = ui::side_panel(
                 ui,
                 PanelModel {
                     settings: &mut self.ctl.settings,
-                    projection: &mut self.projection,
+                    projection: doc.projection,
                     look,
-                    readouts: &self.readouts,
-                    loading,
-                    error: self.error.as_deref(),
+                    readouts: doc.readouts,
+                    loading: doc.loading,
+                    error: doc.error,
                     lights: &mut self.lights,
                 },
             );
         }
-        if let Some((_, _, l)) = &self.loading {
-            if !self.show_panel || self.current.is_none() {
+        if let Some(l) = self.doc.loading() {
+            if !self.show_panel || self.doc.current().is_none() {
                 // Nothing else shows the load: a box over the scene.
                 ui::loading_overlay(ui.ctx(), l);
             }
@@ -604,32 +331,20 @@ impl App {
 
     fn apply_requests(&mut self, req: &FrameRequests, t: f64, el: &ActiveEventLoop) {
         self.ctl.set_held(req.held.or(req.panel.held), t);
+        let ev = self.ctl.settings.exposure_ev;
         if req.panel.reset {
             self.ctl.key(KeyAction::Reset);
         }
         if req.panel.dismiss_error {
-            self.error = None;
-            self.projection_source = self.current.as_ref().map(|c| c.source.clone());
-            self.projection = self.current.as_ref().and_then(|c| c.projection);
+            self.doc.dismiss_error();
         }
         if req.panel.projection_changed {
-            let source = self
-                .projection_source
-                .clone()
-                .or_else(|| self.current.as_ref().map(|c| c.source.clone()));
-            // A projection chosen for a cube's single layout image opens it as a map.
-            let source = source.map(|s| match s {
-                Source::Cube { paths, .. } if paths.len() == 1 && !paths[0].is_dir() => {
-                    Source::File(paths[0].clone())
-                }
-                other => other,
-            });
-            if let Some(s) = source {
-                self.start_load(s, self.projection);
-            }
+            let fx = self.doc.projection_changed(ev);
+            self.apply(fx.into_iter().collect());
         }
         if req.panel.exposure_commit {
-            self.reload_exposure();
+            let fx = self.doc.reload_exposure(ev);
+            self.apply(fx.into_iter().collect());
         }
         if req.panel.save_view {
             self.save_view();
@@ -644,9 +359,10 @@ impl App {
                     };
                     let s = &mut self.ctl.settings;
                     let ev = super::export::step_exposure(s.exposure_ev, d);
-                    if ev != s.exposure_ev && self.readouts.hdr {
+                    if ev != s.exposure_ev && self.doc.readouts.hdr {
                         s.exposure_ev = ev;
-                        self.reload_exposure();
+                        let fx = self.doc.reload_exposure(ev);
+                        self.apply(fx.into_iter().collect());
                     }
                 }
                 KeyAction::SaveView => self.save_view(),
@@ -669,24 +385,11 @@ impl App {
         }
     }
 
-    /// Decode the current HDR file again with the panel's exposure (on the loading
-    /// thread; the view and the current picture stay until it is ready).
-    fn reload_exposure(&mut self) {
-        let Some(cur) = self.current.as_ref().filter(|c| c.hdr) else {
-            return;
-        };
-        if cur.exposure_ev == self.ctl.settings.exposure_ev && self.loading.is_none() {
-            return;
-        }
-        let (source, projection) = (cur.source.clone(), cur.projection);
-        self.start_load(source, projection);
-    }
-
     /// "Save view…" / P: render the current view at the scene's size times the export
     /// scale, full quality (the chosen sampler, trilinear by default, never the fast
     /// nearest), lit as shown, and write it to `view-N.png` in the current directory.
     fn save_view(&mut self) {
-        let scene = match self.readouts.scene {
+        let scene = match self.doc.readouts.scene {
             (w, h) if w > 0 && h > 0 => (w, h),
             _ => self.gfx.as_ref().map_or((1024, 640), |g| {
                 let s = g.window.inner_size();
@@ -697,7 +400,7 @@ impl App {
         let status = match self.render_export(w, h) {
             Ok(pixels) => {
                 let path = super::export::next_view_path(std::path::Path::new("."), |p| p.exists());
-                match crate::cli_common::write_png_atomic(&path, &pixels, w, h) {
+                match crate::output::write_png_atomic(&path, &pixels, w, h) {
                     Ok(()) => format!("saved {} ({w}×{h})", path.display()),
                     Err(e) => format!("save failed: {e:#}"),
                 }
@@ -707,7 +410,7 @@ impl App {
         if self.print_view {
             println!("{status}");
         }
-        self.readouts.export_status = Some(status);
+        self.doc.readouts.export_status = Some(status);
         self.show_panel = true;
         self.request_redraw();
     }
@@ -716,8 +419,8 @@ impl App {
     /// and options at full quality, then lit as the scene is.
     fn render_export(&mut self, w: u32, h: u32) -> Result<Vec<u32>, String> {
         let cur = self
-            .current
-            .as_mut()
+            .doc
+            .current_mut()
             .ok_or_else(|| "no panorama loaded".to_string())?;
         let opts = lut_core::RenderOptions {
             sampler: self.ctl.settings.sampler,
@@ -725,28 +428,16 @@ impl App {
         };
         let view = self.ctl.look().view();
         let mut buf = vec![0u32; w as usize * h as usize];
-        let mut frame = Frame::new(&mut buf, w, h).map_err(|e| e.to_string())?;
-        cur.scene
-            .render(view, &opts, &mut frame)
-            .map_err(|e| e.to_string())?;
-        if let Some(scene) = self.lights.scene()? {
-            lut_core::shade_frame(
-                &scene,
-                &Camera::new(view, w, h),
-                &mut buf,
-                w,
-                h,
-                &self.lights.shade_options(),
-            )
-            .map_err(|e| e.to_string())?;
-        }
+        render_scene(cur.scene.as_mut(), view, &opts, &mut buf, w, h).map_err(|e| e.to_string())?;
+        self.lights.light_frame(view, &mut buf, w, h)?;
         Ok(buf)
     }
 
     /// Render the scene for `rect` unless the cached one already shows it, then light it
     /// when there are luminaires.
     fn render_scene(&mut self, rect: SceneRect, look: Look, fast: bool) {
-        let Some(cur) = self.current.as_mut() else {
+        let generation = self.doc.generation();
+        let Some(cur) = self.doc.current_mut() else {
             return;
         };
         let opts = self.ctl.settings.render_options(fast);
@@ -757,8 +448,8 @@ impl App {
             sampler: opts.sampler,
             index_step: opts.index_step,
             lut: opts.lut,
-            cube_renderer: self.ctl.settings.cube_renderer,
-            map_generation: self.map_generation,
+            cube_renderer: opts.cube,
+            map_generation: generation,
             lights: self.lights.key(),
         };
         if self.scene_key.as_ref() == Some(&key) {
@@ -767,33 +458,39 @@ impl App {
         self.scene.resize(rect.w as usize * rect.h as usize, 0);
         let t0 = Instant::now();
         let view = look.view();
-        let result = Frame::new(&mut self.scene, rect.w, rect.h)
-            .and_then(|mut frame| cur.scene.render(view, &opts, &mut frame))
-            .map(|report| {
-                self.readouts.table_bytes = report.table_bytes;
-                self.readouts.exact_pixels = report.exact_pixels;
-                self.readouts.pixels = report.pixels;
-                match report.path {
+        let result = render_scene(
+            cur.scene.as_mut(),
+            view,
+            &opts,
+            &mut self.scene,
+            rect.w,
+            rect.h,
+        );
+        match result {
+            Ok(report) => {
+                let readouts = &mut self.doc.readouts;
+                readouts.table_bytes = report.table_bytes;
+                readouts.exact_pixels = report.exact_pixels;
+                readouts.pixels = report.pixels;
+                let path = match report.path {
                     RenderPath::Cube(kind) => {
-                        self.readouts.path = None;
-                        self.readouts.cube = Some(kind);
+                        readouts.path = None;
+                        readouts.cube = Some(kind);
                         match kind {
                             CubeRenderer::Basic => "CubeBasic".to_string(),
                             CubeRenderer::Accelerated => "CubeScanline".to_string(),
                         }
                     }
                     path => {
-                        self.readouts.path = Some(path);
-                        self.readouts.cube = None;
+                        readouts.path = Some(path);
+                        readouts.cube = None;
                         format!("{path:?}")
                     }
-                }
-            });
-        match result {
-            Ok(path) => {
+                };
                 self.light_scene(view, rect);
-                self.readouts.render_ms = t0.elapsed().as_secs_f64() * 1e3;
-                self.readouts.scene = (rect.w, rect.h);
+                let readouts = &mut self.doc.readouts;
+                readouts.render_ms = t0.elapsed().as_secs_f64() * 1e3;
+                readouts.scene = (rect.w, rect.h);
                 self.scene_key = Some(key);
                 if self.print_view {
                     println!(
@@ -810,21 +507,9 @@ impl App {
                 }
             }
             Err(e) => {
-                self.error = Some(format!("render failed: {e}"));
+                self.doc.set_error(format!("render failed: {e}"));
                 self.scene_key = None;
             }
-        }
-    }
-
-    /// The view limit for this frame: a partial map's coverage at the scene's size, when
-    /// the panel's "Keep the view inside" is on.
-    fn view_limit(&self, rect: Option<SceneRect>) -> Option<(lut_core::Coverage, (u32, u32))> {
-        let r = rect?;
-        match &self.current.as_ref()?.scene {
-            Scene::Map { map, .. } if self.ctl.settings.view_limit && map.crop().is_some() => {
-                Some((map.coverage(), (r.w, r.h)))
-            }
-            _ => None,
         }
     }
 
@@ -832,18 +517,9 @@ impl App {
     /// that cannot be built (a light outside the room) is reported in the panel and the
     /// frame is left unlit.
     fn light_scene(&mut self, view: lut_core::View, rect: SceneRect) {
-        let result = self.lights.scene().and_then(|scene| match scene {
-            None => Ok(()),
-            Some(scene) => lut_core::shade_frame(
-                &scene,
-                &Camera::new(view, rect.w, rect.h),
-                &mut self.scene,
-                rect.w,
-                rect.h,
-                &self.lights.shade_options(),
-            )
-            .map_err(|e| e.to_string()),
-        });
+        let result = self
+            .lights
+            .light_frame(view, &mut self.scene, rect.w, rect.h);
         self.lights.scene_error = result.err();
     }
 
@@ -856,7 +532,7 @@ impl App {
     ) -> bool {
         let lux = match (cursor, rect, self.lights.scene()) {
             (Some((x, y)), Some(r), Ok(Some(scene))) if r.w > 0 && r.h > 0 => Some(
-                lut_core::lux_at(&scene, &Camera::new(look.view(), r.w, r.h), x, y),
+                lut_core::lux_at(&scene, &lut_core::Camera::new(look.view(), r.w, r.h), x, y),
             ),
             _ => None,
         };
@@ -884,7 +560,13 @@ impl App {
         let mut req = FrameRequests::default();
         let full = ctx.run_ui(raw, |ui| req = self.build_ui(ui, t, (w, h)));
         self.apply_requests(&req, t, el);
-        self.ctl.set_limit(self.view_limit(req.scene_rect));
+        // The view limit: a partial map's coverage at the scene's size, when the panel's
+        // "Keep the view inside" is on.
+        let limit = match (req.scene_rect, self.doc.partial_coverage()) {
+            (Some(r), Some(c)) if self.ctl.settings.view_limit => Some((c, (r.w, r.h))),
+            _ => None,
+        };
+        self.ctl.set_limit(limit);
         let frame = self.ctl.frame(t);
         let mut ui_ms = ui_t0.elapsed().as_secs_f64() * 1e3;
         if let Some(r) = req.scene_rect {
@@ -925,7 +607,7 @@ impl App {
         buffer
             .present()
             .map_err(|e| anyhow!("cannot show the frame: {e}"))?;
-        self.readouts.ui_ms = ui_ms;
+        self.doc.readouts.ui_ms = ui_ms;
 
         let now = Instant::now();
         self.frame_times.push_back(now);
@@ -936,7 +618,7 @@ impl App {
         {
             self.frame_times.pop_front();
         }
-        self.readouts.fps = match (self.frame_times.front(), self.frame_times.len()) {
+        self.doc.readouts.fps = match (self.frame_times.front(), self.frame_times.len()) {
             (Some(&f), n) if n >= 2 => (n - 1) as f64 / now.duration_since(f).as_secs_f64(),
             _ => 0.0,
         };
@@ -963,34 +645,7 @@ impl App {
     }
 }
 
-/// A byte count for the readout: "2.00 GiB", "12.3 MiB".
-fn format_bytes(b: usize) -> String {
-    let b = b as f64;
-    if b >= f64::from(1u32 << 30) {
-        format!("{:.2} GiB", b / f64::from(1u32 << 30))
-    } else {
-        format!("{:.1} MiB", b / f64::from(1u32 << 20))
-    }
-}
-
-fn short_name(s: &Source) -> String {
-    match s {
-        Source::Sample => "courtyard (bundled sample)".into(),
-        Source::File(p) => p.file_name().map_or_else(
-            || p.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        ),
-        Source::Cube { paths, .. } => match paths.as_slice() {
-            [one] => one.file_name().map_or_else(
-                || one.display().to_string(),
-                |n| n.to_string_lossy().into_owned(),
-            ),
-            many => format!("{} cube faces", many.len()),
-        },
-    }
-}
-
-impl ApplicationHandler<UserEvent> for App {
+impl ApplicationHandler<LoadEvent> for App {
     fn resumed(&mut self, el: &ActiveEventLoop) {
         if self.gfx.is_some() {
             return;
@@ -1032,8 +687,9 @@ impl ApplicationHandler<UserEvent> for App {
         });
     }
 
-    fn user_event(&mut self, _el: &ActiveEventLoop, ev: UserEvent) {
-        self.on_load_event(ev);
+    fn user_event(&mut self, _el: &ActiveEventLoop, ev: LoadEvent) {
+        let fx = self.doc.on_event(ev, self.ctl.settings.exposure_ev);
+        self.apply(fx);
     }
 
     fn window_event(&mut self, el: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
@@ -1051,7 +707,7 @@ impl ApplicationHandler<UserEvent> for App {
                     el.exit();
                 }
             }
-            WindowEvent::DroppedFile(path) => self.pending_drops.push(path),
+            WindowEvent::DroppedFile(path) => self.doc.drop_path(path),
             WindowEvent::Resized(_) | WindowEvent::ScaleFactorChanged { .. } => {
                 g.window.request_redraw()
             }
@@ -1064,8 +720,9 @@ impl ApplicationHandler<UserEvent> for App {
     }
 
     fn about_to_wait(&mut self, el: &ActiveEventLoop) {
-        if !self.pending_drops.is_empty() {
-            self.open_dropped();
+        if self.doc.has_drops() {
+            let fx = self.doc.open_drops(self.ctl.settings.exposure_ev);
+            self.apply(fx);
         }
         match self.next_frame_at {
             Some(at) if at <= Instant::now() => {

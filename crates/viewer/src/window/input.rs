@@ -19,9 +19,10 @@
 //!   motion stops one full-quality frame is due ([`Controller::wake_at`]).
 
 use glam::DVec3;
-use lut_core::CubeRenderer;
 use lut_core::{dir_to_lat_long, wrap_deg};
-use lut_core::{Camera, IndexStep, LutChoice, RenderOptions, RendererKind, Sampler, View};
+use lut_core::{
+    Camera, CubeRenderer, IndexStep, LutChoice, Named, RenderOptions, RendererKind, Sampler, View,
+};
 
 /// Narrowest horizontal field of view the wheel and keys reach, degrees.
 pub const HFOV_MIN: f64 = 1.0;
@@ -111,13 +112,39 @@ pub enum AaMode {
     Off,
 }
 
-impl AaMode {
-    /// Label in the panel and docs.
-    pub fn label(self) -> &'static str {
+impl Named for DragStyle {
+    const ALL: &'static [Self] = &[DragStyle::Grab, DragStyle::Qtvr];
+    fn name(self) -> &'static str {
+        match self {
+            DragStyle::Grab => "grab",
+            DragStyle::Qtvr => "QTVR",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            DragStyle::Grab => "The scene point under the cursor stays under the cursor",
+            DragStyle::Qtvr => "Turning speed proportional to the distance from the press point",
+        }
+    }
+}
+
+/// The labels in the panel and docs.
+impl Named for AaMode {
+    const ALL: &'static [Self] = &[AaMode::Always, AaMode::StillOnly, AaMode::Off];
+    fn name(self) -> &'static str {
         match self {
             AaMode::Always => "Always",
             AaMode::StillOnly => "Still only",
             AaMode::Off => "Off",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            AaMode::Always => "Always the chosen sampler",
+            AaMode::StillOnly => {
+                "Nearest sampling while the view turns fast, full quality once it stops"
+            }
+            AaMode::Off => "Always nearest sampling",
         }
     }
 }
@@ -181,7 +208,8 @@ impl Settings {
         }
     }
 
-    /// Render options of a frame (the same options `viewer render` takes).
+    /// Render options of a frame of a map or a cube map (the same options `viewer
+    /// render` takes).
     pub fn render_options(&self, fast: bool) -> RenderOptions {
         RenderOptions {
             renderer: self.renderer,

@@ -1,22 +1,28 @@
 //! The interactive window: `viewer [PANORAMA]`.
 //!
 //! * [`input`]: drag, wheel, keys and held buttons → the view (pure, unit-tested).
+//! * [`document`]: what is shown, loading, the last error, drops (pure state machine,
+//!   unit-tested); [`loader`]: what is opened and the loading thread's work.
 //! * [`ui`]: the egui panel (pure immediate-mode drawing from plain data).
 //! * [`paint`]: the scene and the panel composed on the CPU into one 0RGB buffer.
 //! * [`export`]: HDR exposure steps and the "Save view…" size and file name (pure).
-//! * `app`: the winit event loop, softbuffer surface and background loading.
+//! * `app`: the winit event loop and softbuffer surface; it runs the document's effects.
 //!
-//! Every frame's scene is rendered by `lut_core::Renderer::render`, the same call with the
-//! same options `viewer render` makes, so the window shows what `viewer render` writes.
+//! The luminaires the panel edits are [`crate::lighting::LightsState`].
+//!
+//! Every frame's scene is rendered by [`crate::scene::render_scene`], the same call with
+//! the same options `viewer render` makes, so the window shows what `viewer render` writes.
 
 mod app;
+pub mod document;
 pub mod export;
 pub mod input;
-pub mod lights;
+pub mod loader;
 pub mod paint;
 pub mod ui;
 
-use crate::render_cmd::ProjectionArg;
+use crate::args::{parse_size, InputArgs, MaxPixelsArg, ProjectionArg};
+use crate::lighting::LightArgs;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -29,9 +35,9 @@ pub struct OpenArgs {
     pub panorama: Vec<PathBuf>,
     /// How to read the panorama (the same options as `viewer render`).
     #[command(flatten)]
-    pub input: crate::render_cmd::InputArgs,
+    pub input: InputArgs,
     /// Initial window size in logical pixels, WIDTHxHEIGHT.
-    #[arg(long, value_name = "WxH", default_value = "1024x640", value_parser = crate::cli_common::parse_size)]
+    #[arg(long, value_name = "WxH", default_value = "1024x640", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Print the view of every rendered frame to stdout (for scripts and tests).
     #[arg(long)]
@@ -42,10 +48,10 @@ pub struct OpenArgs {
     pub no_view_limit: bool,
     /// The pixel limit for panoramas opened or dropped.
     #[command(flatten)]
-    pub limit: crate::max_pixels::MaxPixelsArg,
+    pub limit: MaxPixelsArg,
     /// Luminaires lighting the scene (also added, moved and removed in the panel).
     #[command(flatten)]
-    pub lights: crate::ies_cmd::LightArgs,
+    pub lights: LightArgs,
 }
 
 /// Open the window on the panorama (or the sample) and run until it is closed.
@@ -59,7 +65,7 @@ pub fn run(a: OpenArgs) -> anyhow::Result<()> {
         // exists but does not decode is reported in the window instead.
         std::fs::metadata(p).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
     }
-    if a.panorama.len() > 1 && matches!(a.input.projection, ProjectionArg::Map(_)) {
+    if a.panorama.len() > 1 && matches!(a.input.projection.value, ProjectionArg::Map(_)) {
         anyhow::bail!(
             "{} files given: a single panorama takes one file (six faces are a cube map)",
             a.panorama.len()
@@ -67,7 +73,7 @@ pub fn run(a: OpenArgs) -> anyhow::Result<()> {
     }
     // Lights given on the command line: loaded now, so a bad file or position is
     // reported before any window opens (as `viewer render` reports it).
-    let lights = lights_from_args(&a.lights)?;
+    let lights = a.lights.state()?;
     let has_display = ["DISPLAY", "WAYLAND_DISPLAY"]
         .iter()
         .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()));
@@ -78,35 +84,4 @@ pub fn run(a: OpenArgs) -> anyhow::Result<()> {
         );
     }
     app::run(a, lights)
-}
-
-/// The panel's light state for `--light ...` and the other light options.
-///
-/// # Errors
-/// As `ies_cmd::build_scene`: an unreadable IES file, a light outside the room.
-fn lights_from_args(a: &crate::ies_cmd::LightArgs) -> anyhow::Result<lights::LightsState> {
-    let opts = crate::ies_cmd::shade_options(a)?;
-    let scene = crate::ies_cmd::build_scene(a)?;
-    let mut st = lights::LightsState {
-        room: a.room.unwrap_or(lights::DEFAULT_ROOM),
-        camera_height: a.camera_height.unwrap_or(lights::DEFAULT_CAMERA_HEIGHT),
-        multiplier: a.light_multiplier.unwrap_or(1.0),
-        exposure_lux: a.exposure_lux.unwrap_or(lights::DEFAULT_EXPOSURE_LUX),
-        ambient: opts.ambient,
-        false_color: opts.false_color,
-        false_color_max: opts.false_color_max_lux,
-        ..lights::LightsState::default()
-    };
-    if let Some(scene) = scene {
-        for (spec, l) in a.lights.iter().zip(scene.luminaires()) {
-            st.lights.push(lights::LightEntry {
-                path: spec.file.clone(),
-                table: l.table.clone(),
-                position: spec.position,
-                yaw: spec.aim.0,
-                pitch: spec.aim.1,
-            });
-        }
-    }
-    Ok(st)
 }

@@ -2,10 +2,9 @@
 //! the readouts, and the load status. Immediate mode: drawn from plain data each frame,
 //! so a test can paint it offscreen without a window.
 
-use super::input::{AaMode, DragStyle, Held, Look, Settings};
-use super::lights::{format_lux, LightsState};
-use lut_core::CubeRenderer;
-use lut_core::{IndexStep, LutChoice, Projection, RenderPath, RendererKind, Sampler};
+use super::input::{Held, Look, Settings};
+use crate::lighting::{format_lux, LightsState};
+use lut_core::{CubeRenderer, Named, Projection, RenderPath};
 
 /// Width of the panel, in points.
 pub const PANEL_WIDTH: f32 = 230.0;
@@ -235,19 +234,12 @@ pub struct PanelOutput {
     pub save_view: bool,
 }
 
-/// The "in use" readout: the cube renderer for a cube map, else the LUT path.
-pub fn in_use_label(r: &Readouts) -> &'static str {
+/// The "in use" readout: the cube renderer for a cube map ("cube (scanline)"), else the
+/// LUT path.
+pub fn in_use_label(r: &Readouts) -> String {
     match r.cube {
-        Some(k) => cube_label(k),
-        None => path_label(r.path),
-    }
-}
-
-/// Name of a cube renderer (the panel's choice and the "in use" readout).
-pub fn cube_label(k: CubeRenderer) -> &'static str {
-    match k {
-        CubeRenderer::Basic => "cube (basic)",
-        CubeRenderer::Accelerated => "cube (scanline)",
+        Some(k) => format!("cube ({})", k.name()),
+        None => path_label(r.path).into(),
     }
 }
 
@@ -262,11 +254,19 @@ pub fn path_label(p: Option<RenderPath>) -> &'static str {
     }
 }
 
-fn step_label(s: IndexStep) -> String {
-    match s {
-        IndexStep::Adaptive => "adaptive".into(),
-        IndexStep::Fixed(n) => n.to_string(),
-    }
+/// A combo box of every value of `T`, by name, each with its help as the tooltip.
+fn named_combo<T: Named + PartialEq>(ui: &mut egui::Ui, id: &str, value: &mut T) -> egui::Response {
+    egui::ComboBox::from_id_salt(id)
+        .selected_text(value.name())
+        .show_ui(ui, |ui| {
+            for &x in T::ALL {
+                let item = ui.selectable_value(value, x, x.name());
+                if !x.help().is_empty() {
+                    item.on_hover_text(x.help());
+                }
+            }
+        })
+        .response
 }
 
 fn kib(bytes: usize) -> String {
@@ -349,7 +349,7 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
                 format!("{h:8.2}° {}", lut_core::compass_point(h)),
             );
         }
-        row("in use", in_use_label(r).into());
+        row("in use", in_use_label(r));
         row("table", kib(r.table_bytes));
         if r.pixels > 0 && r.exact_pixels > 0 {
             row(
@@ -376,48 +376,19 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
     let s = &mut *m.settings;
     egui::Grid::new("settings").num_columns(2).show(ui, |ui| {
         ui.label("Anti-aliasing");
-        egui::ComboBox::from_id_salt("aa")
-            .selected_text(s.aa.label())
-            .show_ui(ui, |ui| {
-                for a in [AaMode::Always, AaMode::StillOnly, AaMode::Off] {
-                    ui.selectable_value(&mut s.aa, a, a.label());
-                }
-            });
+        named_combo(ui, "aa", &mut s.aa);
         ui.end_row();
 
         ui.label("Sampler");
-        egui::ComboBox::from_id_salt("sampler")
-            .selected_text(s.sampler.name())
-            .show_ui(ui, |ui| {
-                for x in [Sampler::Trilinear, Sampler::Bilinear, Sampler::Nearest] {
-                    ui.selectable_value(&mut s.sampler, x, x.name());
-                }
-            });
+        named_combo(ui, "sampler", &mut s.sampler);
         ui.end_row();
 
         ui.label("Index step");
-        egui::ComboBox::from_id_salt("step")
-            .selected_text(step_label(s.index_step))
-            .show_ui(ui, |ui| {
-                let steps = [IndexStep::Adaptive]
-                    .into_iter()
-                    .chain([1, 2, 4, 8, 16].map(IndexStep::Fixed));
-                for x in steps {
-                    ui.selectable_value(&mut s.index_step, x, step_label(x));
-                }
-            });
+        named_combo(ui, "step", &mut s.index_step);
         ui.end_row();
 
         ui.label("Drag");
-        egui::ComboBox::from_id_salt("drag")
-            .selected_text(match s.drag {
-                DragStyle::Grab => "grab",
-                DragStyle::Qtvr => "QTVR",
-            })
-            .show_ui(ui, |ui| {
-                ui.selectable_value(&mut s.drag, DragStyle::Grab, "grab");
-                ui.selectable_value(&mut s.drag, DragStyle::Qtvr, "QTVR");
-            });
+        named_combo(ui, "drag", &mut s.drag);
         ui.end_row();
 
         ui.label("Inertia");
@@ -425,37 +396,16 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
         ui.end_row();
 
         ui.label("Renderer");
-        egui::ComboBox::from_id_salt("renderer")
-            .selected_text(match s.renderer {
-                RendererKind::Lut => "LUT",
-                RendererKind::Exact => "exact",
-            })
-            .show_ui(ui, |ui| {
-                ui.selectable_value(&mut s.renderer, RendererKind::Lut, "LUT");
-                ui.selectable_value(&mut s.renderer, RendererKind::Exact, "exact");
-            });
+        named_combo(ui, "renderer", &mut s.renderer);
         ui.end_row();
 
         ui.label("Cube");
-        egui::ComboBox::from_id_salt("cube_renderer")
-            .selected_text(cube_label(s.cube_renderer))
-            .show_ui(ui, |ui| {
-                for k in [CubeRenderer::Basic, CubeRenderer::Accelerated] {
-                    ui.selectable_value(&mut s.cube_renderer, k, cube_label(k));
-                }
-            })
-            .response
+        named_combo(ui, "cube_renderer", &mut s.cube_renderer)
             .on_hover_text("Renderer for cube maps: basic (per pixel) or scanline");
         ui.end_row();
 
         ui.label("LUT");
-        egui::ComboBox::from_id_salt("lut")
-            .selected_text(lut_label(s.lut))
-            .show_ui(ui, |ui| {
-                for x in [LutChoice::Auto, LutChoice::Wide, LutChoice::High] {
-                    ui.selectable_value(&mut s.lut, x, lut_label(x));
-                }
-            });
+        named_combo(ui, "lut", &mut s.lut);
         ui.end_row();
 
         ui.label("Projection");
@@ -465,7 +415,8 @@ fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
             .show_ui(ui, |ui| {
                 ui.selectable_value(m.projection, None, "auto");
                 for p in Projection::ALL {
-                    ui.selectable_value(m.projection, Some(p), p.name());
+                    ui.selectable_value(m.projection, Some(p), p.name())
+                        .on_hover_text(Named::help(p));
                 }
             })
             .response
@@ -634,14 +585,6 @@ fn lights_section(ui: &mut egui::Ui, l: &mut LightsState) {
                 );
             });
         });
-}
-
-fn lut_label(l: LutChoice) -> &'static str {
-    match l {
-        LutChoice::Auto => "auto (by hfov)",
-        LutChoice::Wide => "wide-FOV",
-        LutChoice::High => "high-res",
-    }
 }
 
 #[cfg(test)]

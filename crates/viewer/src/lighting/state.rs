@@ -1,12 +1,13 @@
-//! The window's luminaires: what the panel's "Lights" section edits, turned into the
-//! `lut_core::light` scene and shading options `viewer render --light ...` uses. Pure
-//! data (no window), so the conversions are unit-tested.
+//! The luminaires lighting a scene: what the window's "Lights" section edits and what
+//! `viewer render --light ...` builds from its options, turned into the `lut_core::light`
+//! scene and shading options. Pure data (no window), so the conversions are unit-tested.
 
-use lut_core::{LightScene, LightTable, Luminaire, Room, ShadeOptions};
+use lut_core::{shade_frame, LightScene, LightTable, Luminaire, Room, ShadeOptions};
+use lut_core::{Camera, View};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// Default room (width × depth × height, metres) and camera height: as `viewer render`.
+/// Default room (width × depth × height, metres).
 pub const DEFAULT_ROOM: (f64, f64, f64) = (5.0, 5.0, 2.7);
 /// Default camera height above the floor in metres.
 pub const DEFAULT_CAMERA_HEIGHT: f64 = 1.6;
@@ -38,7 +39,7 @@ impl LightEntry {
     }
 }
 
-/// Everything the "Lights" section shows and edits.
+/// The luminaires and their shading: everything the "Lights" section shows and edits.
 #[derive(Debug, Clone)]
 pub struct LightsState {
     /// The luminaires.
@@ -189,6 +190,26 @@ impl LightsState {
         }
     }
 
+    /// Light a rendered `width × height` frame of `view` in place; a no-op with no
+    /// luminaire.
+    ///
+    /// # Errors
+    /// As [`LightsState::scene`], or a frame that is not `width × height`.
+    pub fn light_frame(
+        &self,
+        view: View,
+        frame: &mut [u32],
+        width: u32,
+        height: u32,
+    ) -> Result<(), String> {
+        let Some(scene) = self.scene()? else {
+            return Ok(());
+        };
+        let cam = Camera::new(view, width, height);
+        shade_frame(&scene, &cam, frame, width, height, &self.shade_options())
+            .map_err(|e| e.to_string())
+    }
+
     /// What the lit frame depends on.
     pub fn key(&self) -> LightsKey {
         LightsKey {
@@ -225,11 +246,7 @@ pub fn format_lux(lux: Option<f64>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lut_core::{Camera, View};
-
-    fn sample_path() -> PathBuf {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/ies/type_b_full.ies")
-    }
+    use crate::lighting::sample_path;
 
     #[test]
     fn no_light_no_scene() {
@@ -316,6 +333,19 @@ mod tests {
         let mut t = s.clone();
         t.path_input = "x".into();
         assert_eq!(k, t.key());
+    }
+
+    #[test]
+    fn no_light_leaves_the_frame_alone_and_a_light_shades_it() {
+        let mut s = LightsState::default();
+        let view = View::new(0.0, -30.0, 90.0).unwrap();
+        let mut f = vec![0x0080_8080u32; 16 * 12];
+        s.light_frame(view, &mut f, 16, 12).unwrap();
+        assert!(f.iter().all(|&p| p == 0x0080_8080));
+        s.load_and_add(&sample_path()).unwrap();
+        s.light_frame(view, &mut f, 16, 12).unwrap();
+        assert!(f.iter().any(|&p| p != 0x0080_8080));
+        assert!(s.light_frame(view, &mut f, 16, 13).is_err());
     }
 
     #[test]

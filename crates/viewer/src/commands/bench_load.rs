@@ -4,8 +4,9 @@
 //! (decode + convert, with the phase split), table build time, the median frame time of a
 //! 1920×1080 pan (LUT, bilinear and nearest) and the peak resident memory (`VmHWM`).
 
-use crate::cli_common::{parse_size, write_image_atomic};
-use crate::max_pixels::MaxPixelsArg;
+use super::bench::measure::median;
+use crate::args::{parse_size, MaxPixelsArg};
+use crate::output::write_image_atomic;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use lut_core::TableKind;
@@ -231,15 +232,6 @@ fn proc_status_bytes(field: &str) -> Option<u64> {
     Some(kb * 1024)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => 0.0,
-        n if n % 2 == 1 => v[n / 2],
-        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
-
 /// The child's work: load one file, build the tables, pan, report.
 fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
     let file_bytes = std::fs::metadata(path)
@@ -253,7 +245,7 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
             marks.push((p.phase, t0.elapsed().as_secs_f64()));
         }
     })
-    .map_err(crate::cli_common::map_error)?;
+    .map_err(crate::panorama::map_error)?;
     let load_s = t0.elapsed().as_secs_f64();
     let peak_after_load = proc_status_bytes("VmHWM:").unwrap_or(0);
     // Phase durations from the first report of each phase to the next one's.
@@ -295,7 +287,7 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
                 ms.push(t.elapsed().as_secs_f64() * 1e3);
             }
         }
-        Ok(median(ms))
+        Ok(median(&ms))
     };
     let frame_ms_bilinear = pan(Sampler::Bilinear)?;
     let frame_ms_nearest = pan(Sampler::Nearest)?;
@@ -336,11 +328,5 @@ mod tests {
         assert!(parse_width("7").is_err());
         assert!(parse_width("128k").is_err()); // above the map limits
         assert!(parse_width("x").is_err());
-    }
-
-    #[test]
-    fn median_of_odd_and_even() {
-        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
     }
 }

@@ -1,19 +1,38 @@
 //! `viewer convert INPUT... OUTPUT --to cube|equirect`: equirect → cube faces (six files in
 //! a folder, or one layout image) and cube → equirect. Every file is written atomically.
-use crate::cli_common::{parse_projection, parse_size, write_image_atomic, write_png_atomic};
+
+use crate::args::{named, parse_size, CubeArgs, MaxPixelsArg, ProjectionOpt};
+use crate::output::{rgb24, write_image_atomic, write_png_atomic};
+use crate::panorama::load_cube;
 use anyhow::{anyhow, bail, Context, Result};
-use clap::{Args, ValueEnum};
-use lut_core::{CubeMap, Face, Layout};
-use lut_core::{Projection, Sampler};
+use clap::Args;
+use lut_core::{CubeMap, Face};
+use lut_core::{Layout, Named, Sampler};
 use std::path::{Path, PathBuf};
 
 /// What to convert to.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Target {
     /// Six cube faces (a folder of files, or one layout image with --layout).
     Cube,
     /// One equirectangular (2:1) image.
     Equirect,
+}
+
+impl Named for Target {
+    const ALL: &'static [Self] = &[Target::Cube, Target::Equirect];
+    fn name(self) -> &'static str {
+        match self {
+            Target::Cube => "cube",
+            Target::Equirect => "equirect",
+        }
+    }
+    fn help(self) -> &'static str {
+        match self {
+            Target::Cube => "Six cube faces (a folder of files, or one layout image with --layout)",
+            Target::Equirect => "One equirectangular (2:1) image",
+        }
+    }
 }
 
 /// Arguments of `viewer convert`.
@@ -25,31 +44,27 @@ pub struct ConvertArgs {
     #[arg(required = true, num_args = 2.., value_name = "INPUT... OUTPUT")]
     pub paths: Vec<PathBuf>,
     /// Target format.
-    #[arg(long)]
+    #[arg(long, value_parser = named::<Target>())]
     pub to: Target,
     /// Cube face side in pixels (`--to cube`; default: input width / 4).
     #[arg(long)]
     pub face_size: Option<u32>,
-    /// `--to cube`: the output layout (files, cross, strip, 3x2; default files).
-    /// `--to equirect`: the input's layout, overriding detection.
-    #[arg(long)]
-    pub layout: Option<String>,
+    /// `--layout` (`--to cube`: the output layout, default files; `--to equirect`: the
+    /// input's layout, overriding detection) and `--naming` (of the input's face files).
+    #[command(flatten)]
+    pub cube: CubeArgs,
     /// Output size WxH (`--to equirect`; default 4N x 2N for faces of side N).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Orientation of named face files (conventions, cube2, irrlicht; default from the
-    /// names: cube2 for ft/rt/bk/lf/up/dn, conventions otherwise). See docs/cube.md.
-    #[arg(long)]
-    pub naming: Option<String>,
-    /// Projection of the input panorama for `--to cube` (auto = 2:1 equirect).
-    #[arg(long, default_value = "auto")]
-    pub projection: String,
+    /// The input panorama's projection (`--to cube`).
+    #[command(flatten)]
+    pub projection: ProjectionOpt,
     /// Resampling filter.
-    #[arg(long, default_value = "bilinear", value_parser = |s: &str| s.parse::<Sampler>())]
+    #[arg(long, default_value = "bilinear", value_parser = named::<Sampler>())]
     pub sampler: Sampler,
     /// The pixel limit for the input panorama (`--to cube`).
     #[command(flatten)]
-    pub limit: crate::max_pixels::MaxPixelsArg,
+    pub limit: MaxPixelsArg,
 }
 
 /// Run `viewer convert`.
@@ -71,15 +86,10 @@ fn to_cube(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()> {
     if a.size.is_some() {
         bail!("--size is for --to equirect; use --face-size for cube faces");
     }
-    let layout = match &a.layout {
-        Some(s) => s.parse::<Layout>().map_err(anyhow::Error::msg)?,
-        None => Layout::Files,
-    };
-    let projection: Option<Projection> =
-        parse_projection(&a.projection).map_err(anyhow::Error::msg)?;
+    let layout = a.cube.layout.unwrap_or(Layout::Files);
+    let projection = a.projection.value.map_only("convert --to cube")?;
     let opts = a.limit.options(projection, lut_core::Tone::default());
-    let map =
-        lut_core::load_map(input, &opts, &mut |_| {}).map_err(crate::cli_common::map_error)?;
+    let map = lut_core::load_map(input, &opts, &mut |_| {}).map_err(crate::panorama::map_error)?;
     let face_size = a.face_size.unwrap_or((map.width() / 4).max(1));
     let cube = CubeMap::from_envmap(&map, face_size, a.sampler)?;
     write_cube(&cube, layout, output)
@@ -116,7 +126,7 @@ fn to_equirect(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()>
     if a.face_size.is_some() {
         bail!("--face-size is for --to cube; use --size WxH for the equirect");
     }
-    let cube = crate::cube_cmd::load_cube(inputs, a.layout.as_deref(), a.naming.as_deref())?;
+    let cube = load_cube(inputs, a.cube)?;
     let n = cube.face_size();
     let (w, h) = a.size.unwrap_or((4 * n, 2 * n));
     let px = cube.to_equirect(w, h, a.sampler)?;
@@ -136,10 +146,7 @@ fn write_any(out: &Path, px: &[u32], w: u32, h: u32) -> Result<()> {
     match out.extension().and_then(image_format) {
         Some(image::ImageFormat::Png) => write_png_atomic(out, px, w, h),
         Some(_) => {
-            let mut rgb = Vec::with_capacity(px.len() * 3);
-            for p in px {
-                rgb.extend_from_slice(&[(p >> 16) as u8, (p >> 8) as u8, *p as u8]);
-            }
+            let rgb = rgb24(px);
             write_image_atomic(out, |f| {
                 image::codecs::jpeg::JpegEncoder::new_with_quality(f, 95)
                     .encode(&rgb, w, h, image::ExtendedColorType::Rgb8)
@@ -173,7 +180,7 @@ mod tests {
         let cube = sample_cube();
         let dir = tmp.path().join("faces");
         write_cube(&cube, Layout::Files, &dir).unwrap();
-        let back = crate::cube_cmd::load_cube(std::slice::from_ref(&dir), None, None).unwrap();
+        let back = load_cube(std::slice::from_ref(&dir), CubeArgs::default()).unwrap();
         assert!(back == cube, "files");
         for (layout, name) in [
             (Layout::Cross, "c.png"),
@@ -182,7 +189,7 @@ mod tests {
         ] {
             let path = tmp.path().join(name);
             write_cube(&cube, layout, &path).unwrap();
-            let back = crate::cube_cmd::load_cube(std::slice::from_ref(&path), None, None).unwrap();
+            let back = load_cube(std::slice::from_ref(&path), CubeArgs::default()).unwrap();
             assert!(back == cube, "{name}");
         }
     }

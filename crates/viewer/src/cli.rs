@@ -1,0 +1,59 @@
+//! The command line: `viewer [PANORAMA]` opens the window; the subcommands render,
+//! convert, summarize IES files and measure.
+
+use crate::commands::{bench, bench_load, convert, ies, render};
+use clap::{Parser, Subcommand};
+
+/// CPU panorama viewer: scanline-coherent LUT rendering (US 5,748,194).
+#[derive(Parser, Debug)]
+#[command(
+    name = "viewer",
+    version,
+    about,
+    args_conflicts_with_subcommands = true
+)]
+pub struct Cli {
+    /// The subcommand; none opens the window.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// Open the window (the default when no subcommand is given).
+    #[command(flatten)]
+    pub open: crate::window::OpenArgs,
+}
+
+/// The subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render one view of a panorama to a PNG file.
+    Render(Box<render::RenderArgs>),
+    /// Convert equirect <-> cube maps.
+    Convert(convert::ConvertArgs),
+    /// Summarize an IES LM-63 file and sample its candela distribution.
+    Ies(ies::IesArgs),
+    /// Measure speed against error for every renderer configuration.
+    Bench(bench::BenchArgs),
+    /// Huge panoramas: load time, table build, frame time and peak memory for generated
+    /// 8k, 16k and 32k equirectangular JPEGs (each in a fresh process).
+    BenchLoad(bench_load::BenchLoadArgs),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_command_line_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn no_subcommand_opens_the_window() {
+        let cli = Cli::try_parse_from(["viewer", "a.jpg", "--size", "800x500"]).unwrap();
+        assert!(cli.command.is_none());
+        assert_eq!(cli.open.size, (800, 500));
+        assert_eq!(cli.open.panorama, [std::path::PathBuf::from("a.jpg")]);
+        let cli = Cli::try_parse_from(["viewer", "ies", "x.ies", "--sample", "1,2"]).unwrap();
+        assert!(matches!(cli.command, Some(Command::Ies(_))));
+    }
+}

@@ -1,0 +1,275 @@
+//! `viewer bench`: speed against error for every renderer configuration, in one run.
+//!
+//! Two phases over the same fixed view sets (see [`configs::view_sets`]):
+//! 1. **error**: per view, the exact map positions and the exact images (nearest and
+//!    bilinear) are computed once; every LUT configuration's sampling positions
+//!    (`Renderer::positions`, the same kernel as `render`) are compared with them
+//!    (`accuracy::position_error`, the angular metric), and every renderer's image is
+//!    compared with the exact image of the same sampler (PSNR over R, G, B, pooled over
+//!    the set's frames).
+//! 2. **speed**: every configuration renders every frame of the set (one warm-up pass,
+//!    then `--passes` timed passes); the median milliseconds per frame is reported.
+//!
+//! Tables are built before timing (their build time is reported separately), so a frame's
+//! time is all the per-view work: per-scanline setup plus the kernels. A third set, the
+//! minification set, compares samplers zoomed out with a supersampled truth.
+//!
+//! * [`mod@configs`]: the view sets and the renderer configurations;
+//! * [`measure`]: the thread pool, errors, PSNR, timing;
+//! * [`report`]: the rows (`--json`) and the text table;
+//! * [`plot`]: `--plot`; [`export`]: `--export-maps`.
+
+pub mod configs;
+pub mod export;
+pub mod measure;
+pub mod plot;
+pub mod report;
+
+use crate::args::{named, parse_map_size, parse_size, MaxPixelsArg, ProjectionOpt};
+use anyhow::{anyhow, bail, Context, Result};
+use clap::Args;
+use configs::{configs, view_sets, ViewsArg};
+use lut_core::CubeMap;
+use lut_core::TableKind;
+use lut_core::{Projection, Renderer, Sampler, Surface};
+use measure::{gather_source, in_pool, measure_errors, time_config, Ctx};
+use report::{row_line, Row, RunInfo, Tables};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// `viewer bench` arguments.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Panorama to measure; without it a generated 8192x4096 equirectangular grid map
+    /// (`--map-size` changes the size).
+    pub panorama: Option<PathBuf>,
+    /// The map's projection (auto: detected from PANORAMA; equirect for the generated
+    /// map).
+    #[command(flatten)]
+    pub projection: ProjectionOpt,
+    /// Size of the generated map when no PANORAMA is given.
+    #[arg(long, default_value = "8192x4096", value_parser = parse_map_size)]
+    pub map_size: (u32, u32),
+    /// Output size WIDTHxHEIGHT.
+    #[arg(long, default_value = "1920x1080", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Worker threads (a rayon pool of this size runs every renderer); default: all cores.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// The view sets: quick or full.
+    #[arg(long, default_value = "quick", value_parser = named::<ViewsArg>())]
+    pub views: ViewsArg,
+    /// Timed passes over each set (after one warm-up pass).
+    #[arg(long, default_value_t = 3)]
+    pub passes: u32,
+    /// Print one JSON array instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Also write the speed-against-error chart to this PNG.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Also export, for the hfov-90 set, the source map (map.rgb, raw RGB24), the exact
+    /// sampling maps in OpenCV's convention (mapx_NN.f32 / mapy_NN.f32 = u − ½, v − ½),
+    /// the exact renders (exact_{bilinear,nearest}_NN.rgb) and views.json, for
+    /// scripts/peers.py.
+    #[arg(long)]
+    pub export_maps: Option<PathBuf>,
+    /// Skip the cube renderers (they convert the map to a cube first, which takes a while).
+    #[arg(long)]
+    pub no_cube: bool,
+    /// Skip the minification set (zoomed out: bilinear and trilinear against the exact
+    /// render supersampled 8x8, which takes a while).
+    #[arg(long)]
+    pub no_minify: bool,
+    /// The pixel limit for PANORAMA.
+    #[command(flatten)]
+    pub limit: MaxPixelsArg,
+}
+
+/// Run `viewer bench`.
+pub fn run(a: BenchArgs) -> Result<()> {
+    if a.passes == 0 {
+        bail!("--passes must be at least 1");
+    }
+    in_pool(a.threads, |threads| run_in_pool(&a, threads))
+}
+
+/// Progress goes to stderr (with --json, stdout is only the JSON array).
+pub fn progress(msg: &str) {
+    eprintln!("bench: {msg}");
+}
+
+fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
+    let t0 = Instant::now();
+    let projection = a.projection.value.map_only("bench")?;
+    let map = match &a.panorama {
+        Some(p) => crate::panorama::load_panorama(
+            Some(p),
+            &a.limit.options(projection, lut_core::Tone::default()),
+        )?,
+        None => lut_core::grid_map(
+            a.map_size.0,
+            a.map_size.1,
+            projection.unwrap_or(Projection::Equirect),
+        )
+        .map_err(|e| anyhow!("cannot generate the benchmark map: {e}"))?,
+    };
+    progress(&format!(
+        "map {}x{} {:?} ready in {:.1} s; {} threads",
+        map.width(),
+        map.height(),
+        map.projection(),
+        t0.elapsed().as_secs_f64(),
+        threads
+    ));
+    let (w, h) = a.size;
+    let run = RunInfo {
+        width: w,
+        height: h,
+        threads,
+        map_width: map.width(),
+        map_height: map.height(),
+        projection: map.projection().name(),
+    };
+    let sets = view_sets(a.views)?;
+    let mut renderer = Renderer::new(&map);
+
+    // Tables: built once, timed, before any frame.
+    let mut tables = Tables::default();
+    for (i, kind) in [TableKind::Wide, TableKind::High].into_iter().enumerate() {
+        let t = Instant::now();
+        let table = renderer.table(Surface::Cylinder, kind);
+        tables.build_ms[i] = t.elapsed().as_secs_f64() * 1e3;
+        tables.bytes[i] = table.bytes();
+        tables.unfolded[i] = table.unfolded_bytes();
+    }
+
+    let cube_map = if a.no_cube {
+        None
+    } else {
+        let size = (map.width() / 4).clamp(16, 4096);
+        let t = Instant::now();
+        let c = CubeMap::from_envmap(&map, size, Sampler::Bilinear)
+            .map_err(|e| anyhow!("cannot convert the map to a cube: {e}"))?;
+        progress(&format!(
+            "cube {size}² faces converted in {:.1} s",
+            t.elapsed().as_secs_f64()
+        ));
+        Some(c)
+    };
+    let src: Vec<u32> = gather_source(&map);
+
+    let mut rows = Vec::new();
+    for set in &sets {
+        let export = match (&a.export_maps, set.table) {
+            (Some(d), TableKind::Wide) => Some(d.as_path()),
+            _ => None,
+        };
+        let cfgs = configs(cube_map.is_some());
+        let ctx = Ctx {
+            map: &map,
+            cube: cube_map.as_ref(),
+            src: &src,
+            set,
+            w,
+            h,
+        };
+        let errs = measure_errors(&ctx, &mut renderer, &cfgs, export)?;
+        let ti = if set.table == TableKind::Wide { 0 } else { 1 };
+        for (cfg, e) in cfgs.iter().zip(&errs.per_config) {
+            let times = time_config(&ctx, &mut renderer, *cfg, &errs.gather_idx, a.passes)?;
+            let (index_step, lut) = cfg.lut_fields(set.table);
+            let mut row = Row {
+                index_step,
+                lut,
+                ..Row::timed(
+                    &run,
+                    cfg.renderer_name(),
+                    cfg.sampler(),
+                    set.hfov,
+                    set.views.len(),
+                    &times,
+                )
+            };
+            e.fill(&mut row);
+            if let configs::Config::Lut(..) = cfg {
+                row.exact_fraction = Some(e.exact_fraction());
+                row.table_bytes = Some(tables.bytes[ti]);
+                row.table_build_ms = Some(tables.build_ms[ti]);
+            }
+            progress(&row_line(&row));
+            rows.push(row);
+        }
+    }
+
+    let mut minify_note = None;
+    if !a.no_minify {
+        let (mut mrows, note) = measure::minify_set(&run, a.size, a.passes, &map, &mut renderer)?;
+        rows.append(&mut mrows);
+        minify_note = Some(note);
+    }
+
+    if let Some(p) = &a.plot {
+        plot::plot(p, &rows).with_context(|| format!("{}: cannot draw the chart", p.display()))?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        report::write_table(&mut std::io::stdout().lock(), &rows, &tables)?;
+        if let Some(n) = minify_note {
+            println!("{n}");
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::cli::{Cli, Command};
+    use clap::Parser;
+
+    fn bench_args(extra: &[&str]) -> Result<super::BenchArgs, clap::Error> {
+        let mut argv = vec!["viewer", "bench"];
+        argv.extend_from_slice(extra);
+        match Cli::try_parse_from(argv)?.command {
+            Some(Command::Bench(a)) => Ok(a),
+            other => panic!("not bench: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn arguments_parse_with_their_defaults() {
+        let a = bench_args(&[]).unwrap();
+        assert_eq!(
+            (a.map_size, a.size, a.passes),
+            ((8192, 4096), (1920, 1080), 3)
+        );
+        assert_eq!(a.views, super::ViewsArg::Quick);
+        assert_eq!(a.projection.value.map_only("bench").unwrap(), None);
+        let a = bench_args(&[
+            "--views",
+            "full",
+            "--map-size",
+            "512x256",
+            "--projection",
+            "sine",
+            "--threads",
+            "2",
+            "--json",
+            "--no-cube",
+            "--no-minify",
+        ])
+        .unwrap();
+        assert_eq!(a.views, super::ViewsArg::Full);
+        assert_eq!(a.map_size, (512, 256));
+        assert_eq!(
+            a.projection.value.map_only("bench").unwrap(),
+            Some(lut_core::Projection::Sine)
+        );
+        assert!(a.json && a.no_cube && a.no_minify && a.threads == Some(2));
+        for (flag, bad) in [("--views", "all"), ("--map-size", "big"), ("--size", "1x0")] {
+            let e = bench_args(&[flag, bad]).unwrap_err().to_string();
+            assert!(e.contains(bad), "{e}");
+        }
+    }
+}

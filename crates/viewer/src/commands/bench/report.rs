@@ -1,0 +1,362 @@
+//! `viewer bench`'s report: one [`Row`] per configuration and set (the `--json` array's
+//! elements; the field names are an interface scripts read), the text table, and the
+//! minification set's note.
+
+use lut_core::Sampler;
+use serde::Serialize;
+use std::io::Write;
+
+/// What every row of one run shares: output size, threads, the map.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RunInfo {
+    /// Output width.
+    pub width: u32,
+    /// Output height.
+    pub height: u32,
+    /// Worker threads.
+    pub threads: usize,
+    /// Map width.
+    pub map_width: u32,
+    /// Map height.
+    pub map_height: u32,
+    /// The map's projection name.
+    pub projection: &'static str,
+}
+
+/// One line of the report (one element of the `--json` array).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Row {
+    /// "exact", "lut", "cube-basic", "cube-scanline" or "gather".
+    pub renderer: &'static str,
+    /// The sampler's name.
+    pub sampler: &'static str,
+    /// A number, "adaptive", or null (not a LUT renderer).
+    pub index_step: serde_json::Value,
+    /// "wide", "high" or null.
+    pub lut: Option<&'static str>,
+    /// Output size, threads, the map (`width` … `projection` in the JSON).
+    #[serde(flatten)]
+    pub run: RunInfo,
+    /// Horizontal field of view of the set.
+    pub hfov: f64,
+    /// Frames in the set.
+    pub frames: usize,
+    /// Median milliseconds per frame.
+    pub ms_median: f64,
+    /// Fastest frame.
+    pub ms_min: f64,
+    /// Slowest frame.
+    pub ms_max: f64,
+    /// Max sampling-position error over all frames, source pixels (null: not measured,
+    /// e.g. a cube renderer samples cube faces, not the map).
+    pub max_err_px: Option<f64>,
+    /// Mean sampling-position error, source pixels.
+    pub mean_err_px: Option<f64>,
+    /// PSNR against the exact render with the same sampler (null: identical images).
+    pub psnr_db: Option<f64>,
+    /// PSNR against the exact render supersampled 8×8 per pixel (the minification set).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub psnr_ss_db: Option<f64>,
+    /// Fraction of pixels the LUT renderer evaluated exactly (pole zones, beyond a table).
+    pub exact_fraction: Option<f64>,
+    /// Bytes of the table (LUT rows).
+    pub table_bytes: Option<usize>,
+    /// Milliseconds the table took to build (LUT rows).
+    pub table_build_ms: Option<f64>,
+}
+
+impl Row {
+    /// A row of `renderer` with `sampler` over `frames` frames at `hfov` that took `times`
+    /// milliseconds each; nothing measured yet (the caller fills in what it measured).
+    pub fn timed(
+        run: &RunInfo,
+        renderer: &'static str,
+        sampler: Sampler,
+        hfov: f64,
+        frames: usize,
+        times: &[f64],
+    ) -> Row {
+        Row {
+            renderer,
+            sampler: sampler.name(),
+            index_step: serde_json::Value::Null,
+            lut: None,
+            run: *run,
+            hfov,
+            frames,
+            ms_median: super::measure::median(times),
+            ms_min: times.iter().copied().fold(f64::INFINITY, f64::min),
+            ms_max: times.iter().copied().fold(0.0, f64::max),
+            max_err_px: None,
+            mean_err_px: None,
+            psnr_db: None,
+            psnr_ss_db: None,
+            exact_fraction: None,
+            table_bytes: None,
+            table_build_ms: None,
+        }
+    }
+}
+
+/// The two tables (wide, high): build milliseconds, bytes, bytes unfolded.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Tables {
+    /// Build time in milliseconds.
+    pub build_ms: [f64; 2],
+    /// Bytes as stored (folded).
+    pub bytes: [usize; 2],
+    /// Bytes of the same table unfolded.
+    pub unfolded: [usize; 2],
+}
+
+fn fmt_opt(v: Option<f64>, prec: usize) -> String {
+    v.map_or("-".to_string(), |x| format!("{x:.prec$}"))
+}
+
+/// An index step as the table and the chart show it: a number, "adaptive", or "-".
+pub fn step_str(v: &serde_json::Value) -> String {
+    match v {
+        serde_json::Value::Null => "-".into(),
+        serde_json::Value::String(s) => s.clone(),
+        o => o.to_string(),
+    }
+}
+
+/// One row as a line of the text table (also the progress line).
+pub fn row_line(r: &Row) -> String {
+    format!(
+        "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9.2} {:>9.2} {:>10} {:>10} {:>7} {:>7}",
+        r.renderer,
+        r.sampler,
+        step_str(&r.index_step),
+        r.lut.unwrap_or("-"),
+        r.hfov,
+        r.ms_median,
+        r.ms_min,
+        fmt_opt(r.max_err_px, 4),
+        fmt_opt(r.mean_err_px, 5),
+        fmt_opt(r.psnr_db, 1),
+        r.exact_fraction
+            .map_or("-".into(), |f| format!("{:.2}%", f * 100.0)),
+    )
+}
+
+/// The text table: what was measured, the tables, one line per row, the units.
+pub fn write_table(o: &mut impl Write, rows: &[Row], t: &Tables) -> std::io::Result<()> {
+    if let Some(r) = rows.first() {
+        let run = &r.run;
+        writeln!(
+            o,
+            "map {}x{} {}, output {}x{}, {} threads, {} frames per set",
+            run.map_width,
+            run.map_height,
+            run.projection,
+            run.width,
+            run.height,
+            run.threads,
+            r.frames
+        )?;
+    }
+    writeln!(
+        o,
+        "tables: wide {:.1} ms, {} KiB (unfolded {} KiB, 1/{:.2}); high {:.1} ms, {} KiB (unfolded {} KiB, 1/{:.2})",
+        t.build_ms[0],
+        t.bytes[0] / 1024,
+        t.unfolded[0] / 1024,
+        t.unfolded[0] as f64 / t.bytes[0].max(1) as f64,
+        t.build_ms[1],
+        t.bytes[1] / 1024,
+        t.unfolded[1] / 1024,
+        t.unfolded[1] as f64 / t.bytes[1].max(1) as f64
+    )?;
+    writeln!(
+        o,
+        "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9} {:>9} {:>10} {:>10} {:>7} {:>7}",
+        "renderer",
+        "sampler",
+        "step",
+        "lut",
+        "hfov",
+        "ms_med",
+        "ms_min",
+        "max_err",
+        "mean_err",
+        "PSNR",
+        "exact"
+    )?;
+    for r in rows {
+        writeln!(o, "{}", row_line(r))?;
+    }
+    writeln!(
+        o,
+        "errors in source pixels (angular metric); PSNR in dB against the exact render with the same sampler ('-' = identical)"
+    )
+}
+
+/// The minification set in a few lines: what it is, the pyramid, each row's time and
+/// PSNR against the supersampled truth.
+pub fn minify_note(
+    size: (u32, u32),
+    views: usize,
+    pyramid_ms: f64,
+    pyramid_bytes: usize,
+    map_bytes: usize,
+    rows: &[Row],
+) -> String {
+    let (w, h) = size;
+    let mut note = format!(
+        "minification set: {w}x{h} at hfov {}, {views} views; pyramid built in {pyramid_ms:.0} ms, \
+         {:.1} MiB ({:.0} % of the map); PSNR against the exact render supersampled 8x8:",
+        super::configs::MINIFY_HFOV,
+        pyramid_bytes as f64 / 1048576.0,
+        100.0 * pyramid_bytes as f64 / map_bytes as f64
+    );
+    for r in rows {
+        note.push_str(&format!(
+            "\n  {:<6} {:<9} {:>7.2} ms  {:>5.1} dB",
+            r.renderer,
+            r.sampler,
+            r.ms_median,
+            r.psnr_ss_db.unwrap_or(f64::INFINITY)
+        ));
+    }
+    note
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run() -> RunInfo {
+        RunInfo {
+            width: 1920,
+            height: 1080,
+            threads: 2,
+            map_width: 8192,
+            map_height: 4096,
+            projection: "equirect",
+        }
+    }
+
+    fn lut_row() -> Row {
+        Row {
+            index_step: serde_json::json!(4),
+            lut: Some("wide"),
+            max_err_px: Some(0.01234),
+            mean_err_px: Some(0.001),
+            psnr_db: Some(48.25),
+            exact_fraction: Some(0.0125),
+            table_bytes: Some(1 << 20),
+            table_build_ms: Some(12.0),
+            ..Row::timed(&run(), "lut", Sampler::Bilinear, 90.0, 3, &[3.0, 1.0, 2.0])
+        }
+    }
+
+    /// The JSON field names and their order are an interface (scripts/peers.py, docs).
+    #[test]
+    fn json_fields_are_the_interface() {
+        let v = serde_json::to_value(lut_row()).unwrap();
+        let keys: Vec<&str> = v.as_object().unwrap().keys().map(|k| k.as_str()).collect();
+        let mut want = vec![
+            "renderer",
+            "sampler",
+            "index_step",
+            "lut",
+            "width",
+            "height",
+            "threads",
+            "map_width",
+            "map_height",
+            "projection",
+            "hfov",
+            "frames",
+            "ms_median",
+            "ms_min",
+            "ms_max",
+            "max_err_px",
+            "mean_err_px",
+            "psnr_db",
+            "exact_fraction",
+            "table_bytes",
+            "table_build_ms",
+        ];
+        let mut got = keys.clone();
+        got.sort_unstable();
+        want.sort_unstable();
+        assert_eq!(got, want, "psnr_ss_db is left out when not measured");
+        let text = serde_json::to_string(&lut_row()).unwrap();
+        assert!(
+            text.starts_with(
+                r#"{"renderer":"lut","sampler":"bilinear","index_step":4,"lut":"wide","width":1920"#
+            ),
+            "{text}"
+        );
+        assert_eq!(v["ms_median"], 2.0);
+        assert_eq!(
+            (v["ms_min"].as_f64(), v["ms_max"].as_f64()),
+            (Some(1.0), Some(3.0))
+        );
+        let ss = Row {
+            psnr_ss_db: Some(30.0),
+            ..lut_row()
+        };
+        assert_eq!(serde_json::to_value(ss).unwrap()["psnr_ss_db"], 30.0);
+        let exact = serde_json::to_value(Row::timed(
+            &run(),
+            "exact",
+            Sampler::Nearest,
+            50.0,
+            1,
+            &[9.0],
+        ))
+        .unwrap();
+        assert!(exact["index_step"].is_null() && exact["lut"].is_null());
+    }
+
+    #[test]
+    fn table_lines() {
+        assert_eq!(
+            row_line(&lut_row()),
+            "lut           bilinear        4 wide    90      2.00      1.00     0.0123    0.00100    48.2   1.25%"
+        );
+        let gather = Row::timed(&run(), "gather", Sampler::Nearest, 90.0, 13, &[0.5]);
+        assert_eq!(
+            row_line(&gather),
+            "gather        nearest         - -       90      0.50      0.50          -          -       -       -"
+        );
+        assert_eq!(step_str(&serde_json::json!("adaptive")), "adaptive");
+        let mut out = Vec::new();
+        let tables = Tables {
+            build_ms: [10.0, 20.0],
+            bytes: [2048, 4096],
+            unfolded: [16384, 8192],
+        };
+        write_table(&mut out, &[lut_row()], &tables).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 5, "{text}");
+        assert_eq!(
+            lines[0],
+            "map 8192x4096 equirect, output 1920x1080, 2 threads, 3 frames per set"
+        );
+        assert_eq!(
+            lines[1],
+            "tables: wide 10.0 ms, 2 KiB (unfolded 16 KiB, 1/8.00); high 20.0 ms, 4 KiB (unfolded 8 KiB, 1/2.00)"
+        );
+        assert!(lines[2].starts_with("renderer      sampler"));
+        assert_eq!(lines[3], row_line(&lut_row()));
+    }
+
+    #[test]
+    fn minify_note_lines() {
+        let rows = [Row {
+            psnr_ss_db: Some(31.26),
+            ..Row::timed(&run(), "lut", Sampler::Trilinear, 120.0, 5, &[4.0])
+        }];
+        let note = minify_note((640, 360), 5, 80.0, 3 << 20, 12 << 20, &rows);
+        assert_eq!(
+            note,
+            "minification set: 640x360 at hfov 120, 5 views; pyramid built in 80 ms, 3.0 MiB (25 % of the map); PSNR against the exact render supersampled 8x8:\n  lut    trilinear    4.00 ms   31.3 dB"
+        );
+    }
+}

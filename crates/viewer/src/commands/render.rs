@@ -1,0 +1,264 @@
+//! `viewer render`: one view of a panorama to a PNG, headless.
+
+use crate::args::{named, parse_angle, parse_size, parse_stops, InputArgs, MaxPixelsArg};
+use crate::lighting::{apply_lights, LightArgs};
+use crate::output::write_png_atomic;
+use crate::panorama::{coverage_text, heading_text, load_cube, load_panorama_partial};
+use crate::scene::{render_scene, Scene};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use lut_core::{
+    IndexStep, LutChoice, RenderOptions, RenderReport, RendererKind, Sampler, Surface, View,
+};
+use std::path::PathBuf;
+
+/// Arguments of `viewer render`.
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Panorama image (JPEG, PNG, ...), or a cube map: a folder, six face files, or one
+    /// layout image with --projection cube. The bundled sample when omitted.
+    pub panorama: Vec<PathBuf>,
+    /// Output PNG, written atomically.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Yaw in degrees (any value, taken modulo 360; positive turns right).
+    #[arg(long, default_value = "0", value_parser = parse_angle, allow_hyphen_values = true)]
+    pub yaw: f64,
+    /// Pitch in degrees (positive looks up; clamped to [-90, 90]).
+    #[arg(long, default_value = "0", value_parser = parse_angle, allow_hyphen_values = true)]
+    pub pitch: f64,
+    /// Horizontal field of view in degrees, in (0, 180).
+    #[arg(long, default_value = "90", value_parser = parse_angle, allow_hyphen_values = true)]
+    pub hfov: f64,
+    /// Output size WIDTHxHEIGHT (each side 1..=16384).
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// How to read the panorama (shared with the window).
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Renderer.
+    #[arg(long, default_value = "lut", value_parser = named::<RendererKind>())]
+    pub renderer: RendererKind,
+    /// Pixel interpolation.
+    #[arg(long, default_value = "bilinear", value_parser = named::<Sampler>())]
+    pub sampler: Sampler,
+    /// Index interpolation step.
+    #[arg(long, default_value = "adaptive", value_parser = named::<IndexStep>())]
+    pub index_step: IndexStep,
+    /// Which look-up table.
+    #[arg(long, default_value = "auto", value_parser = named::<LutChoice>())]
+    pub lut: LutChoice,
+    /// Surface the look-up table is built on.
+    #[arg(long, default_value = "cylinder", value_parser = named::<Surface>())]
+    pub lut_surface: Surface,
+    /// Exposure in stops for HDR maps (.hdr, .exr): values times 2^EV, then the tone
+    /// curve x/(1+x) and sRGB. 8-bit images are shown as stored.
+    #[arg(long, default_value = "0", value_parser = parse_stops, allow_hyphen_values = true)]
+    pub exposure: f64,
+    /// Keep the view inside the covered area of a partial panorama: reduce hfov if the
+    /// view is larger than the coverage, then clamp pitch and yaw.
+    #[arg(long)]
+    pub view_limit: bool,
+    /// Render on one thread.
+    #[arg(long)]
+    pub single_thread: bool,
+    /// The pixel limit.
+    #[command(flatten)]
+    pub limit: MaxPixelsArg,
+    /// Print which path rendered and the table size.
+    #[arg(long, short)]
+    pub verbose: bool,
+    /// Luminaires lighting the scene.
+    #[command(flatten)]
+    pub lights: LightArgs,
+}
+
+impl RenderArgs {
+    /// The render options these arguments select.
+    pub fn options(&self) -> RenderOptions {
+        RenderOptions {
+            renderer: self.renderer,
+            sampler: self.sampler,
+            index_step: self.index_step,
+            lut: self.lut,
+            surface: self.lut_surface,
+            threads: !self.single_thread,
+            cube: self.input.cube_renderer,
+        }
+    }
+
+    /// The panorama these arguments name: a cube map, or a map placed by `--coverage` or
+    /// its GPano XMP.
+    fn load(&self) -> Result<Scene> {
+        let input = &self.input;
+        if input.projection.value.reads_cube(&self.panorama) {
+            if input.coverage.is_some() {
+                bail!("--coverage applies to equirectangular panoramas, not cube maps");
+            }
+            return Ok(Scene::Cube(load_cube(&self.panorama, input.cube)?));
+        }
+        if self.panorama.len() > 1 {
+            bail!(
+                "{} files given: a single panorama takes one file (use --projection cube for six faces)",
+                self.panorama.len()
+            );
+        }
+        let tone = lut_core::Tone {
+            exposure_ev: self.exposure,
+        };
+        let (map, _) = load_panorama_partial(
+            self.panorama.first().map(|p| p.as_path()),
+            &self.limit.options(input.projection.value.map(), tone),
+            input.coverage,
+            &mut |_| {},
+        )?;
+        Ok(Scene::map(map))
+    }
+}
+
+/// Run `viewer render`.
+pub fn run(a: RenderArgs) -> Result<()> {
+    let mut view = View::new(a.yaw, a.pitch, a.hfov).context("invalid view")?;
+    let (w, h) = a.size;
+    let mut scene = a.load()?;
+    if let (true, Some(map)) = (a.view_limit, scene.env_map()) {
+        view = lut_core::limit_view(view, w, h, &map.coverage());
+    }
+    let mut out = vec![0u32; w as usize * h as usize];
+    let report = render_scene(scene.as_mut(), view, &a.options(), &mut out, w, h)?;
+    if a.verbose {
+        print_report(&a, &scene, &report, view);
+    }
+    apply_lights(&a.lights, view, &mut out, w, h)?;
+    write_png_atomic(&a.output, &out, w, h)?;
+    Ok(())
+}
+
+/// `-v`: what rendered the frame, on stderr.
+fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View) {
+    let (w, h) = a.size;
+    match scene {
+        Scene::Map { map, .. } => {
+            eprintln!(
+                "rendered {}x{} from {}x{} {} map: path {}, table {} bytes, {} of {} pixels exact, index step {}..{}",
+                w,
+                h,
+                map.width(),
+                map.height(),
+                map.projection(),
+                report.path.name(),
+                report.table_bytes,
+                report.exact_pixels,
+                report.pixels,
+                report.min_step,
+                report.max_step
+            );
+            if let Some(c) = coverage_text(map) {
+                eprintln!("partial panorama: {c}");
+            }
+            if a.view_limit {
+                eprintln!(
+                    "view (limited): yaw {:.4} pitch {:.4} hfov {:.4}",
+                    view.yaw_deg(),
+                    view.pitch_deg(),
+                    view.hfov_deg()
+                );
+            }
+            if let Some(hd) = heading_text(map, view.yaw_deg()) {
+                eprintln!("view centre {hd}");
+            }
+        }
+        Scene::Cube(cube) => eprintln!(
+            "rendered {w}x{h} from a cube map of {}px faces",
+            cube.face_size()
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::cli::{Cli, Command};
+    use clap::Parser;
+    use lut_core::{CubeRenderer, IndexStep, LutChoice, Naming, RendererKind, Sampler, Surface};
+
+    fn render_args(extra: &[&str]) -> Result<super::RenderArgs, clap::Error> {
+        let mut argv = vec!["viewer", "render", "-o", "x.png"];
+        argv.extend_from_slice(extra);
+        match Cli::try_parse_from(argv)?.command {
+            Some(Command::Render(a)) => Ok(*a),
+            other => panic!("not render: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn defaults_are_the_documented_ones() {
+        let a = render_args(&[]).unwrap();
+        assert_eq!(a.options(), lut_core::RenderOptions::default());
+        assert_eq!(a.options().cube, CubeRenderer::Accelerated);
+        assert_eq!(a.size, (1280, 720));
+        assert_eq!((a.yaw, a.pitch, a.hfov), (0.0, 0.0, 90.0));
+        assert_eq!(a.input.cube_renderer, CubeRenderer::Accelerated);
+        assert_eq!(a.input.projection.value, crate::args::ProjectionArg::Auto);
+    }
+
+    #[test]
+    fn every_option_value_parses_by_its_name() {
+        let a = render_args(&[
+            "--renderer",
+            "exact",
+            "--sampler",
+            "trilinear",
+            "--index-step",
+            "16",
+            "--lut",
+            "high",
+            "--lut-surface",
+            "plane",
+            "--cube-renderer",
+            "basic",
+            "--naming",
+            "sauerbraten",
+            "--layout",
+            "3x2",
+            "--projection",
+            "sinusoidal",
+            "--yaw",
+            "-30",
+            "--single-thread",
+        ])
+        .unwrap();
+        let o = a.options();
+        assert_eq!(o.renderer, RendererKind::Exact);
+        assert_eq!(o.sampler, Sampler::Trilinear);
+        assert_eq!(o.index_step, IndexStep::Fixed(16));
+        assert_eq!(o.lut, LutChoice::High);
+        assert_eq!(o.surface, Surface::Plane);
+        assert!(!o.threads);
+        assert_eq!(a.input.cube_renderer, CubeRenderer::Basic);
+        assert_eq!(a.input.cube.naming, Some(Naming::Cube2));
+        assert_eq!(a.input.cube.layout, Some(lut_core::Layout::Grid3x2));
+        assert_eq!(
+            a.input.projection.value.map(),
+            Some(lut_core::Projection::Elliptical)
+        );
+        assert_eq!(a.yaw, -30.0);
+    }
+
+    #[test]
+    fn bad_values_are_refused_naming_them() {
+        for (flag, bad) in [
+            ("--index-step", "3"),
+            ("--sampler", "cubic"),
+            ("--lut", "medium"),
+            ("--cube-renderer", "accelerated"),
+            ("--layout", "hex"),
+            ("--naming", "opengl3"),
+            ("--projection", "mercator"),
+            ("--size", "0x10"),
+            ("--yaw", "nan"),
+        ] {
+            let e = render_args(&[flag, bad]).unwrap_err().to_string();
+            assert!(e.contains(bad), "{flag} {bad}: {e}");
+        }
+    }
+}

@@ -1,0 +1,31 @@
+//! `viewer`: the CPU panorama viewer, as a library the `viewer` binary and the tests use.
+//!
+//! * `viewer [PANORAMA]` opens the interactive window ([`window`]).
+//! * `viewer render ...` renders one view to a PNG (headless).
+//! * `viewer convert ...` converts between equirectangular and cube maps.
+//! * `viewer ies ...` summarizes and samples an IES photometric file.
+//! * `viewer bench ...` measures speed against error.
+//! * `viewer bench-load ...` measures loading and panning huge (8k-32k) maps.
+//!
+//! Modules:
+//! * [`cli`]: the command line; [`commands`]: one module per subcommand.
+//! * [`args`]: arguments the commands share and the parsers of their values (one clap
+//!   value parser for every option enum, from `lut_core::Named`).
+//! * [`panorama`]: opening maps (pixel limit, partial panoramas) and cube maps.
+//! * [`scene`]: a map or a cube map, and [`scene::render_scene`], the one place either
+//!   is rendered.
+//! * [`lighting`]: luminaires lighting a rendered room (`--light`, the panel's lights).
+//! * [`output`]: images written atomically.
+//! * [`window`]: winit + softbuffer + egui, all drawn on the CPU.
+
+#![warn(missing_docs)]
+
+pub mod args;
+pub mod assets;
+pub mod cli;
+pub mod commands;
+pub mod lighting;
+pub mod output;
+pub mod panorama;
+pub mod scene;
+pub mod window;

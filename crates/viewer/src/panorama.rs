@@ -1,0 +1,174 @@
+//! Opening panoramas: a map from a file or the bundled sample (with the pixel limit,
+//! partial panoramas placed by `--coverage` or GPano XMP), a cube map from a folder, face
+//! files or a layout image; and the texts the panel and `viewer render -v` show about a
+//! partial map (coverage, compass heading).
+
+use crate::args::CubeArgs;
+use anyhow::{anyhow, Result};
+use lut_core::{compass_heading, compass_point};
+use lut_core::{Coverage, CoverageSource, CubeMap, EnvMap, Layout, LoadOptions, MapError};
+use std::path::{Path, PathBuf};
+
+/// The command-line hint for a library map error: which flag changes the outcome.
+pub fn map_error_hint(e: &MapError) -> Option<&'static str> {
+    match e {
+        MapError::TooManyPixels { .. } => Some("raise the limit with --max-pixels"),
+        MapError::UnknownProjection { .. } => {
+            Some("give --projection cylinder|sine|elliptical|diamond")
+        }
+        _ => None,
+    }
+}
+
+/// A library map error as one line, with its command-line hint (see [`map_error_hint`]).
+pub fn map_error(e: MapError) -> anyhow::Error {
+    match map_error_hint(&e) {
+        Some(hint) => anyhow!("{e}; {hint}"),
+        None => anyhow::Error::new(e),
+    }
+}
+
+/// Load the panorama at `path` (the bundled sample when `None`) with `opts`: projection,
+/// tone and the pixel limit (`--max-pixels`, checked from the header before decoding).
+/// The file is streamed into the map, never held whole by this function. GPano XMP is
+/// not read (see [`load_panorama_partial`]).
+pub fn load_panorama(path: Option<&Path>, opts: &LoadOptions) -> Result<EnvMap> {
+    Ok(match path {
+        Some(p) => lut_core::load_map(p, opts, &mut |_| {}).map_err(map_error)?,
+        None => lut_core::decode_map(
+            crate::assets::SAMPLE_JPEG,
+            crate::assets::SAMPLE_NAME,
+            opts,
+            &mut |_| {},
+        )
+        .map_err(map_error)?,
+    })
+}
+
+/// Turn a placement error into one line that says how to override bad metadata (or, for
+/// an image that cannot be read, the hint of [`map_error`]).
+pub fn coverage_error(e: lut_core::CoverageError, coverage: Option<Coverage>) -> anyhow::Error {
+    if let lut_core::CoverageError::Map(m) = e {
+        return map_error(m);
+    }
+    let hint = match (&e, coverage) {
+        (lut_core::CoverageError::Syntax { .. }, _) | (_, Some(_)) => "",
+        // Bad metadata or a placement that does not fit, and no coverage given.
+        (_, None) => {
+            " (give --coverage HFOVxVFOV±YAW±PITCH to place the image yourself, e.g. \
+             --coverage 360x180 to show it as a full panorama)"
+        }
+    };
+    anyhow::anyhow!("{e}{hint}")
+}
+
+/// Load a panorama (`None`: the bundled sample) with the pixel limit, projection and tone
+/// of `opts`, placed by `coverage` when given, else by the GPano XMP in the file (JPEG),
+/// else as a full panorama; `progress` as in `lut_core::load_map`. Bad metadata is an
+/// error that says how to override it.
+pub fn load_panorama_partial(
+    path: Option<&Path>,
+    opts: &LoadOptions,
+    coverage: Option<Coverage>,
+    progress: &mut dyn FnMut(lut_core::LoadProgress),
+) -> Result<(EnvMap, CoverageSource)> {
+    match path {
+        Some(p) => lut_core::load_partial(p, opts, coverage, progress),
+        None => lut_core::decode_partial(
+            crate::assets::SAMPLE_JPEG,
+            crate::assets::SAMPLE_NAME,
+            opts,
+            coverage,
+            progress,
+        ),
+    }
+    .map_err(|e| coverage_error(e, coverage))
+}
+
+/// "covers 120°×60° around yaw 30°, pitch −10° (stored 2000×1000 of 6000×3000)" for a
+/// partial map, `None` for a full one.
+pub fn coverage_text(map: &EnvMap) -> Option<String> {
+    let crop = map.crop()?;
+    let c = crop.coverage();
+    Some(format!(
+        "covers {:.1}°×{:.1}° around yaw {:.1}°, pitch {:.1}° (stored {}×{} of {}×{})",
+        c.hfov(),
+        c.vfov(),
+        c.yaw(),
+        c.pitch(),
+        crop.width(),
+        crop.height(),
+        crop.full_width(),
+        crop.full_height()
+    ))
+}
+
+/// "heading 213° (SW)" for the view centre, when the map knows its heading.
+pub fn heading_text(map: &EnvMap, yaw: f64) -> Option<String> {
+    let h = compass_heading(map.pose_heading_deg()?, yaw);
+    Some(format!("heading {h:.0}° ({})", compass_point(h)))
+}
+
+/// Load a cube map from `inputs` (a folder, six face files, or one layout image) with
+/// `--layout` (detected when omitted: a folder or six files are `files`, one image is
+/// recognized by its aspect ratio) and `--naming` (omitted: what the file names imply, see
+/// `docs/cube.md`).
+///
+/// # Errors
+/// Every [`lut_core::CubeError`], with the file named.
+pub fn load_cube(inputs: &[PathBuf], cube: CubeArgs) -> Result<CubeMap> {
+    Ok(lut_core::load_cube(inputs, cube.layout, cube.naming)?)
+}
+
+/// True when `inputs` look like a cube map rather than one panorama image: a folder, six
+/// or more files, or one image whose aspect ratio is a cube layout (4:3, 6:1, 3:2). For
+/// the window's drop handler.
+pub fn looks_like_cube(inputs: &[PathBuf]) -> bool {
+    match inputs {
+        [one] if one.is_dir() => true,
+        [one] => image::ImageReader::open(one)
+            .ok()
+            .and_then(|r| r.with_guessed_format().ok())
+            .and_then(|r| r.into_dimensions().ok())
+            .map(|(w, h)| Layout::detect(w, h).is_some())
+            .unwrap_or(false),
+        many => many.len() >= 6,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cube_layouts_are_recognized_by_aspect_ratio() {
+        let tmp = tempfile::tempdir().unwrap();
+        let img = |name: &str, w: u32, h: u32| {
+            let p = tmp.path().join(name);
+            image::RgbImage::new(w, h).save(&p).unwrap();
+            p
+        };
+        assert!(looks_like_cube(&[img("cross.png", 64, 48)]));
+        assert!(looks_like_cube(&[img("strip.png", 96, 16)]));
+        assert!(looks_like_cube(&[img("grid.png", 48, 32)]));
+        assert!(!looks_like_cube(&[img("pano.png", 64, 32)]));
+        assert!(looks_like_cube(&[tmp.path().to_path_buf()]));
+        assert!(!looks_like_cube(&[tmp.path().join("missing.png")]));
+        let six: Vec<PathBuf> = (0..6).map(|i| PathBuf::from(format!("{i}.png"))).collect();
+        assert!(looks_like_cube(&six));
+        assert!(!looks_like_cube(&six[..2]));
+    }
+
+    #[test]
+    fn the_bundled_sample_loads_and_is_full() {
+        let map = load_panorama(None, &LoadOptions::default()).unwrap();
+        assert_eq!(map.width(), 2 * map.height());
+        assert!(coverage_text(&map).is_none());
+        let (partial, _) =
+            load_panorama_partial(None, &LoadOptions::default(), None, &mut |_| {}).unwrap();
+        assert_eq!(
+            (partial.width(), partial.height()),
+            (map.width(), map.height())
+        );
+    }
+}

@@ -1,0 +1,136 @@
+//! What the viewer renders — a map with its LUT renderer (which owns the tables), or a
+//! cube map — and the one function that renders it, [`render_scene`], through lut-core's
+//! one render entry. `viewer render`, the window (frames and "Save view…") and `viewer
+//! bench` all render through it.
+
+use lut_core::{CubeMap, EnvMap, Frame, RenderOptions, RenderReport, Renderer, View, ViewError};
+
+/// A panorama ready to render, owning its data (and, for a map, its tables).
+pub enum Scene {
+    /// A map on a surface of revolution, with its LUT renderer.
+    Map {
+        /// The map.
+        map: EnvMap,
+        /// Its renderer (tables built on first use).
+        renderer: Renderer,
+    },
+    /// A cube map.
+    Cube(CubeMap),
+}
+
+impl Scene {
+    /// A map with a new renderer.
+    pub fn map(map: EnvMap) -> Scene {
+        let renderer = Renderer::new(&map);
+        Scene::Map { map, renderer }
+    }
+
+    /// The scene to pass to [`render_scene`].
+    pub fn as_mut(&mut self) -> SceneRef<'_> {
+        match self {
+            Scene::Map { map, renderer } => SceneRef::Map { map, renderer },
+            Scene::Cube(cube) => SceneRef::Cube(cube),
+        }
+    }
+
+    /// The map, if the scene is one.
+    pub fn env_map(&self) -> Option<&EnvMap> {
+        match self {
+            Scene::Map { map, .. } => Some(map),
+            Scene::Cube(_) => None,
+        }
+    }
+}
+
+/// A scene borrowed for one render.
+pub enum SceneRef<'a> {
+    /// A map and its renderer.
+    Map {
+        /// The map.
+        map: &'a EnvMap,
+        /// Its renderer.
+        renderer: &'a mut Renderer,
+    },
+    /// A cube map.
+    Cube(&'a CubeMap),
+}
+
+/// Render `view` of `scene` into `out` (`width × height` 0RGB pixels) through lut-core's
+/// one render entry: a map with its renderer (and tables), a cube map with
+/// `opts.cube`.
+///
+/// # Errors
+/// As `Frame::new` and `Renderer::render`: a bad size or buffer, a bad option.
+pub fn render_scene(
+    scene: SceneRef<'_>,
+    view: View,
+    opts: &RenderOptions,
+    out: &mut [u32],
+    width: u32,
+    height: u32,
+) -> Result<RenderReport, ViewError> {
+    let mut frame = Frame::new(out, width, height)?;
+    match scene {
+        SceneRef::Map { map, renderer } => {
+            renderer.render(lut_core::Scene::Map(map), view, opts, &mut frame)
+        }
+        SceneRef::Cube(cube) => {
+            Renderer::default().render(lut_core::Scene::Cube(cube), view, opts, &mut frame)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lut_core::{CubeRenderer, Projection, RenderPath, Sampler};
+
+    /// The map path is the map's renderer, the cube path lut-core's cube renderer, with
+    /// the options given: same pixels as calling lut-core directly.
+    #[test]
+    fn renders_maps_and_cubes_as_lut_core_does() {
+        let map = lut_core::grid_map(128, 64, Projection::Equirect).unwrap();
+        let view = View::new(30.0, 10.0, 90.0).unwrap();
+        let (w, h) = (40, 24);
+        let opts = RenderOptions {
+            sampler: Sampler::Nearest,
+            ..RenderOptions::default()
+        };
+        let mut want = vec![0u32; (w * h) as usize];
+        let direct = Renderer::new(&map)
+            .render(
+                lut_core::Scene::Map(&map),
+                view,
+                &opts,
+                &mut Frame::new(&mut want, w, h).unwrap(),
+            )
+            .unwrap();
+        let cube = CubeMap::from_envmap(&map, 16, Sampler::Bilinear).unwrap();
+        let mut scene = Scene::map(map);
+        let mut got = vec![1u32; want.len()];
+        let report = render_scene(scene.as_mut(), view, &opts, &mut got, w, h).unwrap();
+        assert_eq!(report, direct);
+        assert_eq!(direct.path, RenderPath::LutWide);
+        assert_eq!(got, want);
+
+        for kind in [CubeRenderer::Basic, CubeRenderer::Accelerated] {
+            let opts = RenderOptions { cube: kind, ..opts };
+            Renderer::default()
+                .render(
+                    lut_core::Scene::Cube(&cube),
+                    view,
+                    &opts,
+                    &mut Frame::new(&mut want, w, h).unwrap(),
+                )
+                .unwrap();
+            let mut scene = Scene::Cube(cube.clone());
+            let report = render_scene(scene.as_mut(), view, &opts, &mut got, w, h).unwrap();
+            assert_eq!(report.path, RenderPath::Cube(kind));
+            assert_eq!(got, want);
+            assert!(scene.env_map().is_none());
+        }
+        // A bad size is an error, not a panic.
+        let mut scene = Scene::Cube(cube);
+        assert!(render_scene(scene.as_mut(), view, &opts, &mut got, 0, h).is_err());
+    }
+}

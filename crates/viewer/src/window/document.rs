@@ -1,0 +1,349 @@
+//! The window's document: what is shown, what is loading, the last error, the files
+//! dropped. A pure state machine — no window, no thread, no clock: its methods take what
+//! happened (a load's progress or result, a drop, a panel action) and return the
+//! [`Effect`]s the event loop carries out (start a load, set the title, print a line,
+//! show the panel), so every transition is unit-tested like `input.rs`.
+//!
+//! Rules:
+//! * A load runs in the background; the current panorama stays until it is done, and
+//!   stays if it fails. A newer load supersedes an older one: the older one's reports
+//!   are ignored.
+//! * A failed load shows its error (and the panel); with nothing to show yet the bundled
+//!   sample opens under the message (its success keeps the message). Any other successful
+//!   load clears the error.
+//! * The panel's projection choice reopens the file it applies to: the current one, or
+//!   the one that failed.
+//! * Paths dropped in one event batch open together: `.ies` files add lights, the rest is
+//!   one panorama or cube map.
+
+use super::loader::{LoadRequest, Loaded, Source};
+use super::ui::{LoadStatus, LoadStep, Readouts};
+use lut_core::{Coverage, EnvMap, LoadOptions, Naming, Projection, Tone};
+use std::path::PathBuf;
+
+/// A report from the loading thread.
+pub enum LoadEvent {
+    /// A step's progress.
+    Progress {
+        /// Which load.
+        id: u64,
+        /// The step it is in.
+        step: LoadStep,
+        /// Done fraction of the step, when known.
+        fraction: Option<f32>,
+    },
+    /// The load finished.
+    Done {
+        /// Which load.
+        id: u64,
+        /// The panorama, or the error (one line).
+        result: Result<Box<Loaded>, String>,
+    },
+}
+
+/// What the event loop does for the document.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Effect {
+    /// Run this load on a loading thread and report back through
+    /// [`Document::on_event`] (or [`Document::load_not_started`]).
+    Load(LoadRequest),
+    /// Add a light for each of these (dropped) IES files.
+    AddLights(Vec<PathBuf>),
+    /// The window title.
+    Title(String),
+    /// A line for stdout with `--print-view`.
+    PrintView(String),
+    /// A message for stderr.
+    Stderr(String),
+    /// Show the panel: there is something to read in it.
+    ShowPanel,
+}
+
+/// A load in progress.
+struct Loading {
+    id: u64,
+    source: Source,
+    status: LoadStatus,
+}
+
+/// The document state (see the module docs for its rules).
+pub struct Document {
+    current: Option<Box<Loaded>>,
+    /// Bumped for every panorama shown (cached frames of the old one are stale).
+    generation: u64,
+    /// Projection chosen in the panel for the current (or failed) file.
+    projection: Option<Projection>,
+    /// The source the projection choice applies to: the current one, or a failed one.
+    projection_source: Option<Source>,
+    loading: Option<Loading>,
+    next_id: u64,
+    error: Option<String>,
+    /// The running load is the fallback after a failed one: its success keeps the error.
+    keep_error: bool,
+    /// Paths dropped since the last event batch: one drop of several items arrives as one
+    /// event per item, and they open together (six face files are one cube map).
+    pending_drops: Vec<PathBuf>,
+    /// `--coverage`, for the source given on the command line only.
+    coverage: Option<(Source, Coverage)>,
+    /// `--max-pixels`: the pixel limit for every panorama opened.
+    max_pixels: u64,
+    /// Cube face naming from the command line (for every cube opened).
+    naming: Option<Naming>,
+    /// What the panel shows about the document and its last frame.
+    pub readouts: Readouts,
+}
+
+/// What the panel shows and edits of the document.
+pub struct PanelParts<'a> {
+    /// The projection choice (`None` = auto); the panel edits it.
+    pub projection: &'a mut Option<Projection>,
+    /// The readouts.
+    pub readouts: &'a Readouts,
+    /// The load in progress.
+    pub loading: Option<&'a LoadStatus>,
+    /// The last error.
+    pub error: Option<&'a str>,
+}
+
+impl Document {
+    /// An empty document: nothing shown, nothing loading. `projection` is the command
+    /// line's, `max_pixels` and `naming` apply to everything opened.
+    pub fn new(projection: Option<Projection>, max_pixels: u64, naming: Option<Naming>) -> Self {
+        Document {
+            current: None,
+            generation: 0,
+            projection,
+            projection_source: None,
+            loading: None,
+            next_id: 0,
+            error: None,
+            keep_error: false,
+            pending_drops: Vec::new(),
+            coverage: None,
+            max_pixels,
+            naming,
+            readouts: Readouts::default(),
+        }
+    }
+
+    /// Open what the command line names, placed by `coverage` when given.
+    pub fn open(&mut self, source: Source, coverage: Option<Coverage>, exposure_ev: f64) -> Effect {
+        self.coverage = coverage.map(|c| (source.clone(), c));
+        self.start_load(source, self.projection, exposure_ev)
+    }
+
+    /// Start loading `source`; the current panorama stays until it is done.
+    fn start_load(
+        &mut self,
+        source: Source,
+        projection: Option<Projection>,
+        exposure_ev: f64,
+    ) -> Effect {
+        self.next_id += 1;
+        let id = self.next_id;
+        self.loading = Some(Loading {
+            id,
+            source: source.clone(),
+            status: LoadStatus::new(source.name()),
+        });
+        self.keep_error = false;
+        let coverage = self
+            .coverage
+            .as_ref()
+            .filter(|(s, _)| *s == source)
+            .map(|(_, c)| *c);
+        Effect::Load(LoadRequest {
+            id,
+            source,
+            opts: LoadOptions {
+                projection,
+                tone: Tone { exposure_ev },
+                max_pixels: self.max_pixels,
+            },
+            naming: self.naming,
+            coverage,
+        })
+    }
+
+    /// The load `id` could not be started (no thread): it is not running.
+    pub fn load_not_started(&mut self, id: u64, why: &str) {
+        if self.loading.as_ref().is_some_and(|l| l.id == id) {
+            self.loading = None;
+            self.error = Some(format!("cannot start loading: {why}"));
+        }
+    }
+
+    /// A report from the loading thread. Reports of a superseded load are ignored.
+    /// `exposure_ev` is the panel's, for the fallback load after a failure.
+    pub fn on_event(&mut self, ev: LoadEvent, exposure_ev: f64) -> Vec<Effect> {
+        let current_id = self.loading.as_ref().map(|l| l.id);
+        match ev {
+            LoadEvent::Progress { id, step, fraction } if Some(id) == current_id => {
+                if let Some(l) = &mut self.loading {
+                    l.status.advance(step, fraction);
+                }
+                Vec::new()
+            }
+            LoadEvent::Done { id, result } if Some(id) == current_id => {
+                let source = self.loading.take().map(|l| l.source);
+                match result {
+                    Ok(loaded) => self.show(loaded),
+                    Err(e) => self.failed(e, source, exposure_ev),
+                }
+            }
+            _ => Vec::new(), // from a superseded load
+        }
+    }
+
+    /// A load succeeded: show it.
+    fn show(&mut self, loaded: Box<Loaded>) -> Vec<Effect> {
+        let mut fx = Vec::new();
+        let (mw, mh, proj) = loaded.describe();
+        fx.push(Effect::PrintView(format!(
+            "loaded {} {mw}x{mh} {proj}",
+            loaded.source.name()
+        )));
+        self.readouts.map = loaded.label();
+        fx.push(Effect::Title(format!(
+            "viewer: {}",
+            loaded.source.short_name()
+        )));
+        if !std::mem::take(&mut self.keep_error) {
+            self.error = None;
+            self.projection = loaded.projection;
+            self.projection_source = Some(loaded.source.clone());
+        }
+        self.readouts.hdr = loaded.hdr;
+        let map = loaded.map();
+        self.readouts.partial = map.and_then(crate::panorama::coverage_text);
+        self.readouts.pose_heading = map.and_then(EnvMap::pose_heading_deg);
+        if let Some(p) = &self.readouts.partial {
+            fx.push(Effect::PrintView(format!("partial {p}")));
+        }
+        self.current = Some(loaded);
+        self.generation += 1;
+        fx
+    }
+
+    /// A load failed: keep what is shown, say why; with nothing shown, open the sample.
+    fn failed(&mut self, e: String, source: Option<Source>, exposure_ev: f64) -> Vec<Effect> {
+        let mut fx = vec![Effect::Stderr(format!("viewer: {e}")), Effect::ShowPanel];
+        self.error = Some(e);
+        // A projection chosen next retries this file.
+        self.projection_source = source;
+        if self.current.is_none() {
+            // Nothing to keep showing: fall back to the bundled sample.
+            fx.push(self.start_load(Source::Sample, None, exposure_ev));
+            self.keep_error = true;
+        }
+        fx
+    }
+
+    /// A path was dropped on the window (opened with the rest of its batch by
+    /// [`Document::open_drops`]).
+    pub fn drop_path(&mut self, path: PathBuf) {
+        self.pending_drops.push(path);
+    }
+
+    /// True when dropped paths wait to be opened.
+    pub fn has_drops(&self) -> bool {
+        !self.pending_drops.is_empty()
+    }
+
+    /// Open what was dropped: `.ies` files add lights, the rest is one panorama or cube.
+    pub fn open_drops(&mut self, exposure_ev: f64) -> Vec<Effect> {
+        let (ies, rest): (Vec<PathBuf>, Vec<PathBuf>) = std::mem::take(&mut self.pending_drops)
+            .into_iter()
+            .partition(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("ies")));
+        let mut fx = Vec::new();
+        if !ies.is_empty() {
+            fx.push(Effect::AddLights(ies));
+            fx.push(Effect::ShowPanel);
+        }
+        if let Some(source) = Source::of_paths(rest, false, None) {
+            fx.push(self.start_load(source, None, exposure_ev));
+        }
+        fx
+    }
+
+    /// The panel's "Dismiss": the error goes, the projection choice is the current one's.
+    pub fn dismiss_error(&mut self) {
+        self.error = None;
+        self.projection_source = self.current.as_ref().map(|c| c.source.clone());
+        self.projection = self.current.as_ref().and_then(|c| c.projection);
+    }
+
+    /// The panel's projection choice changed: reopen the file it applies to with it.
+    pub fn projection_changed(&mut self, exposure_ev: f64) -> Option<Effect> {
+        let source = self
+            .projection_source
+            .clone()
+            .or_else(|| self.current.as_ref().map(|c| c.source.clone()))?;
+        Some(self.start_load(source.as_map(), self.projection, exposure_ev))
+    }
+
+    /// The exposure changed: decode the current HDR file again with it (the current
+    /// picture stays until it is ready). Nothing for 8-bit images or an unchanged value.
+    pub fn reload_exposure(&mut self, exposure_ev: f64) -> Option<Effect> {
+        let cur = self.current.as_ref().filter(|c| c.hdr)?;
+        if cur.exposure_ev == exposure_ev && self.loading.is_none() {
+            return None;
+        }
+        let (source, projection) = (cur.source.clone(), cur.projection);
+        Some(self.start_load(source, projection, exposure_ev))
+    }
+
+    /// The panorama shown, if any.
+    pub fn current(&self) -> Option<&Loaded> {
+        self.current.as_deref()
+    }
+
+    /// The panorama shown, to render it.
+    pub fn current_mut(&mut self) -> Option<&mut Loaded> {
+        self.current.as_deref_mut()
+    }
+
+    /// Bumped each time another panorama is shown.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// The load in progress.
+    pub fn loading(&self) -> Option<&LoadStatus> {
+        self.loading.as_ref().map(|l| &l.status)
+    }
+
+    /// The error shown.
+    pub fn error(&self) -> Option<&str> {
+        self.error.as_deref()
+    }
+
+    /// Show an error (a frame that failed to render).
+    pub fn set_error(&mut self, e: String) {
+        self.error = Some(e);
+    }
+
+    /// The projection chosen in the panel (`None` = auto).
+    pub fn projection(&self) -> Option<Projection> {
+        self.projection
+    }
+
+    /// The panel's view of the document.
+    pub fn panel_parts(&mut self) -> PanelParts<'_> {
+        PanelParts {
+            projection: &mut self.projection,
+            readouts: &self.readouts,
+            loading: self.loading.as_ref().map(|l| &l.status),
+            error: self.error.as_deref(),
+        }
+    }
+
+    /// A partial map's coverage (the view limit keeps the view inside it).
+    pub fn partial_coverage(&self) -> Option<Coverage> {
+        let map = self.current.as_ref()?.map()?;
+        map.crop().is_some().then(|| map.coverage())
+    }
+}
+
+#[cfg(test)]
+mod tests;

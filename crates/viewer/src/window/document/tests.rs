@@ -1,0 +1,346 @@
+//! The document's transitions, without a window: loads started, reported and finished
+//! (or failed, or superseded), drops, errors kept and cleared, what the readouts show.
+
+use super::*;
+use crate::scene::Scene;
+use lut_core::Projection;
+use std::path::Path;
+
+fn file(name: &str) -> Source {
+    Source::File(PathBuf::from(name))
+}
+
+/// A loaded equirectangular map of `w × w/2` from `source`.
+fn loaded(source: Source, w: u32, hdr: bool, exposure_ev: f64) -> Box<Loaded> {
+    let map = lut_core::grid_map(w, w / 2, Projection::Equirect).unwrap();
+    Box::new(Loaded {
+        scene: Scene::map(map),
+        source,
+        projection: None,
+        hdr,
+        exposure_ev,
+    })
+}
+
+/// The load requests among `fx`.
+fn loads(fx: &[Effect]) -> Vec<&LoadRequest> {
+    fx.iter()
+        .filter_map(|e| match e {
+            Effect::Load(r) => Some(r),
+            _ => None,
+        })
+        .collect()
+}
+
+fn request(e: Effect) -> LoadRequest {
+    match e {
+        Effect::Load(r) => r,
+        other => panic!("not a load: {other:?}"),
+    }
+}
+
+fn done(id: u64, result: Result<Box<Loaded>, String>) -> LoadEvent {
+    LoadEvent::Done { id, result }
+}
+
+fn doc() -> Document {
+    Document::new(None, 1000, None)
+}
+
+#[test]
+fn a_load_starts_reports_progress_and_shows_its_panorama() {
+    let mut d = doc();
+    let r = request(d.open(file("a.png"), None, 0.5));
+    assert_eq!(r.id, 1);
+    assert_eq!(r.source, file("a.png"));
+    assert_eq!(r.opts.max_pixels, 1000);
+    assert_eq!(r.opts.tone.exposure_ev, 0.5);
+    assert_eq!(
+        (r.opts.projection, r.coverage, r.naming),
+        (None, None, None)
+    );
+    let st = d.loading().unwrap();
+    assert_eq!(
+        (st.name.as_str(), st.step, st.fraction),
+        ("a.png", LoadStep::Reading, None)
+    );
+
+    let fx = d.on_event(
+        LoadEvent::Progress {
+            id: 1,
+            step: LoadStep::Decoding,
+            fraction: Some(0.5),
+        },
+        0.0,
+    );
+    assert!(fx.is_empty());
+    let st = d.loading().unwrap();
+    assert_eq!((st.step, st.fraction), (LoadStep::Decoding, Some(0.5)));
+    assert!(d.current().is_none(), "nothing shown while loading");
+
+    let fx = d.on_event(done(1, Ok(loaded(file("a.png"), 64, false, 0.5))), 0.0);
+    assert_eq!(
+        fx,
+        [
+            Effect::PrintView("loaded a.png 64x32 equirect".into()),
+            Effect::Title("viewer: a.png".into()),
+        ]
+    );
+    assert!(d.loading().is_none());
+    assert_eq!(d.current().unwrap().source, file("a.png"));
+    assert_eq!(d.generation(), 1);
+    assert_eq!(d.error(), None);
+    // The readouts after the load.
+    assert_eq!(d.readouts.map, "a.png (64×32, equirect, 0.0 MiB in memory)");
+    assert!(!d.readouts.hdr);
+    assert_eq!(d.readouts.partial, None);
+    assert_eq!(d.readouts.pose_heading, None);
+    assert_eq!(d.partial_coverage(), None);
+}
+
+#[test]
+fn a_drop_while_loading_supersedes_the_load() {
+    let mut d = doc();
+    d.open(file("a.png"), None, 0.0);
+    d.drop_path(PathBuf::from("b.png"));
+    assert!(d.has_drops());
+    let fx = d.open_drops(0.0);
+    assert!(!d.has_drops());
+    assert_eq!(loads(&fx).len(), 1);
+    assert_eq!(
+        (loads(&fx)[0].id, &loads(&fx)[0].source),
+        (2, &file("b.png"))
+    );
+    assert_eq!(d.loading().unwrap().name, "b.png");
+    // The first load's reports are stale now.
+    let p = LoadEvent::Progress {
+        id: 1,
+        step: LoadStep::Tables,
+        fraction: Some(0.9),
+    };
+    assert!(d.on_event(p, 0.0).is_empty());
+    assert_eq!(d.loading().unwrap().step, LoadStep::Reading);
+    assert!(d
+        .on_event(done(1, Ok(loaded(file("a.png"), 64, false, 0.0))), 0.0)
+        .is_empty());
+    assert!(d.current().is_none());
+    assert!(d.on_event(done(1, Err("late".into())), 0.0).is_empty());
+    assert_eq!(d.error(), None);
+    d.on_event(done(2, Ok(loaded(file("b.png"), 32, false, 0.0))), 0.0);
+    assert_eq!(d.current().unwrap().source, file("b.png"));
+    assert_eq!(d.generation(), 1);
+}
+
+#[test]
+fn a_second_drop_keeps_the_picture_until_ready_and_after_it_fails() {
+    let mut d = doc();
+    d.open(file("a.png"), None, 0.0);
+    d.on_event(done(1, Ok(loaded(file("a.png"), 64, false, 0.0))), 0.0);
+    d.drop_path(PathBuf::from("c.jpg"));
+    let r = request(d.open_drops(0.0).remove(0));
+    assert_eq!(
+        d.current().unwrap().source,
+        file("a.png"),
+        "shown while c loads"
+    );
+    let fx = d.on_event(done(r.id, Err("c.jpg: not 2:1".into())), 0.0);
+    assert_eq!(
+        fx,
+        [
+            Effect::Stderr("viewer: c.jpg: not 2:1".into()),
+            Effect::ShowPanel
+        ],
+        "no fallback: a is still shown"
+    );
+    assert_eq!(d.current().unwrap().source, file("a.png"));
+    assert_eq!(d.error(), Some("c.jpg: not 2:1"));
+    assert_eq!(d.generation(), 1);
+    // Choosing a projection retries the file that failed, with it.
+    *d.panel_parts().projection = Some(Projection::Cylinder);
+    let r = request(d.projection_changed(0.0).unwrap());
+    assert_eq!(r.source, file("c.jpg"));
+    assert_eq!(r.opts.projection, Some(Projection::Cylinder));
+    // Its success clears the error and takes the projection it was opened with.
+    let mut c = loaded(file("c.jpg"), 32, false, 0.0);
+    c.projection = Some(Projection::Cylinder);
+    d.on_event(done(r.id, Ok(c)), 0.0);
+    assert_eq!(d.error(), None);
+    assert_eq!(d.projection(), Some(Projection::Cylinder));
+    assert_eq!(d.generation(), 2);
+}
+
+#[test]
+fn a_failed_first_load_opens_the_sample_and_keeps_the_error() {
+    let mut d = Document::new(Some(Projection::Sine), 1000, None);
+    let r = request(d.open(file("bad.png"), None, 0.0));
+    assert_eq!(r.opts.projection, Some(Projection::Sine));
+    let fx = d.on_event(done(r.id, Err("bad.png: truncated".into())), 2.0);
+    assert_eq!(fx.len(), 3);
+    assert_eq!(
+        fx[..2],
+        [
+            Effect::Stderr("viewer: bad.png: truncated".into()),
+            Effect::ShowPanel
+        ]
+    );
+    let sample = loads(&fx)[0].clone();
+    assert_eq!((sample.id, &sample.source), (2, &Source::Sample));
+    assert_eq!(sample.opts.projection, None, "the sample in auto");
+    assert_eq!(sample.opts.tone.exposure_ev, 2.0);
+    // The sample's success keeps the message, and the projection still applies to the
+    // failed file.
+    d.on_event(done(2, Ok(loaded(Source::Sample, 64, false, 0.0))), 0.0);
+    assert_eq!(d.error(), Some("bad.png: truncated"));
+    assert_eq!(d.projection(), Some(Projection::Sine));
+    let r = request(d.projection_changed(0.0).unwrap());
+    assert_eq!(r.source, file("bad.png"));
+    // Dismissed: the error goes and the choice is the sample's again.
+    d.dismiss_error();
+    assert_eq!((d.error(), d.projection()), (None, None));
+    let r = request(d.projection_changed(0.0).unwrap());
+    assert_eq!(r.source, Source::Sample);
+}
+
+#[test]
+fn the_next_success_clears_a_kept_error() {
+    let mut d = doc();
+    let r = request(d.open(file("bad.png"), None, 0.0));
+    d.on_event(done(r.id, Err("bad".into())), 0.0);
+    d.on_event(done(2, Ok(loaded(Source::Sample, 64, false, 0.0))), 0.0);
+    assert!(d.error().is_some());
+    d.drop_path(PathBuf::from("good.png"));
+    let r = request(d.open_drops(0.0).remove(0));
+    d.on_event(
+        done(r.id, Ok(loaded(file("good.png"), 64, false, 0.0))),
+        0.0,
+    );
+    assert_eq!(d.error(), None);
+    assert_eq!(
+        d.readouts.map,
+        "good.png (64×32, equirect, 0.0 MiB in memory)"
+    );
+}
+
+#[test]
+fn dropped_ies_files_add_lights_and_six_files_are_a_cube() {
+    let mut d = doc();
+    for p in ["lamp.IES", "b.ies"] {
+        d.drop_path(PathBuf::from(p));
+    }
+    assert_eq!(
+        d.open_drops(0.0),
+        [
+            Effect::AddLights(vec![PathBuf::from("lamp.IES"), PathBuf::from("b.ies")]),
+            Effect::ShowPanel
+        ]
+    );
+    assert!(d.loading().is_none());
+    let faces: Vec<PathBuf> = ["ft", "rt", "bk", "lf", "up", "dn"]
+        .iter()
+        .map(|f| PathBuf::from(format!("sky/{f}.jpg")))
+        .collect();
+    for f in &faces {
+        d.drop_path(f.clone());
+    }
+    d.drop_path(PathBuf::from("lamp.ies"));
+    let fx = d.open_drops(0.0);
+    assert_eq!(fx.len(), 3);
+    assert_eq!(
+        loads(&fx)[0].source,
+        Source::Cube {
+            paths: faces,
+            layout: None
+        }
+    );
+    assert!(d.open_drops(0.0).is_empty(), "nothing left");
+}
+
+#[test]
+fn exposure_reloads_hdr_files_only_when_it_changed() {
+    let mut d = doc();
+    d.open(file("a.png"), None, 0.0);
+    d.on_event(done(1, Ok(loaded(file("a.png"), 64, false, 0.0))), 0.0);
+    assert_eq!(d.reload_exposure(1.0), None, "8-bit images ignore it");
+    d.drop_path(PathBuf::from("sky.hdr"));
+    let r = request(d.open_drops(0.0).remove(0));
+    let mut hdr = loaded(file("sky.hdr"), 64, true, 0.0);
+    hdr.projection = Some(Projection::Equirect);
+    d.on_event(done(r.id, Ok(hdr)), 0.0);
+    assert!(d.readouts.hdr);
+    assert_eq!(d.reload_exposure(0.0), None, "unchanged");
+    let r = request(d.reload_exposure(1.5).unwrap());
+    assert_eq!(r.source, file("sky.hdr"));
+    assert_eq!(r.opts.tone.exposure_ev, 1.5);
+    assert_eq!(r.opts.projection, Some(Projection::Equirect));
+    // While that load runs, going back to the shown exposure loads again (the running
+    // load would show 1.5).
+    assert!(d.reload_exposure(0.0).is_some());
+}
+
+#[test]
+fn coverage_applies_to_the_command_line_source_only() {
+    let mut d = doc();
+    let cov: Coverage = "180x90".parse().unwrap();
+    let r = request(d.open(file("strip.jpg"), Some(cov), 0.0));
+    assert_eq!(r.coverage, Some(cov));
+    d.on_event(done(r.id, Err("x".into())), 0.0);
+    d.drop_path(PathBuf::from("other.jpg"));
+    let r = request(d.open_drops(0.0).remove(0));
+    assert_eq!(r.coverage, None);
+    d.on_event(done(r.id, Err("y".into())), 0.0);
+    d.drop_path(PathBuf::from("strip.jpg"));
+    let r = request(d.open_drops(0.0).remove(0));
+    assert_eq!(r.coverage, Some(cov), "the same file again");
+}
+
+#[test]
+fn readouts_of_a_partial_panorama() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path().join("half.png");
+    image::RgbImage::from_pixel(64, 64, image::Rgb([200, 100, 50]))
+        .save(&p)
+        .unwrap();
+    // The document's pixel limit goes to the loader: 1000 pixels refuse this image.
+    let cov: Coverage = "180x90+90+0".parse().unwrap();
+    let r = request(doc().open(Source::File(p.clone()), Some(cov), 0.0));
+    let e = super::super::loader::load(r, &mut |_, _| {}).err().unwrap();
+    assert!(e.contains("above the limit of 1000 pixels"), "{e}");
+    let mut d = Document::new(None, lut_core::DEFAULT_MAX_PIXELS, None);
+    let r = request(d.open(Source::File(p.clone()), Some(cov), 0.0));
+    let loaded = super::super::loader::load(r.clone(), &mut |_, _| {}).unwrap();
+    let fx = d.on_event(done(r.id, Ok(loaded)), 0.0);
+    let partial = d.readouts.partial.clone().expect("a partial map");
+    assert!(
+        partial.starts_with("covers 180.0°×90.0° around yaw 90.0°"),
+        "{partial}"
+    );
+    assert!(fx.contains(&Effect::PrintView(format!("partial {partial}"))));
+    assert_eq!(d.partial_coverage().map(|c| c.hfov()), Some(180.0));
+    assert!(
+        // The map's size is the full panorama's (the stored crop is 64×64).
+        d.readouts.map.starts_with("half.png (128×128, equirect"),
+        "{}",
+        d.readouts.map
+    );
+    assert_eq!(
+        fx[0],
+        Effect::PrintView(format!(
+            "loaded {} 128x128 equirect",
+            Path::new(&p).display()
+        ))
+    );
+}
+
+#[test]
+fn a_load_that_cannot_start_is_an_error() {
+    let mut d = doc();
+    let r = request(d.open(file("a.png"), None, 0.0));
+    d.load_not_started(r.id + 1, "stale");
+    assert!(d.loading().is_some());
+    d.load_not_started(r.id, "no threads");
+    assert!(d.loading().is_none());
+    assert_eq!(d.error(), Some("cannot start loading: no threads"));
+    let parts = d.panel_parts();
+    assert_eq!(parts.error, Some("cannot start loading: no threads"));
+    assert!(parts.loading.is_none());
+}
