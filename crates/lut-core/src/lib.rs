@@ -144,7 +144,7 @@ pub use light::{
     detect_format, lux_at, shade_frame, IesError, IesFile, IesFormat, Interpolation, LampSet,
     LdtError, LdtFile, LdtSymmetry, LdtType, LightError, LightFileFormat, LightScene, LightTable,
     Luminaire, PhotometricType, Photometry, PhotometrySource, Room, ShadeOptions, Symmetry,
-    TableOptions, Tilt, TiltData,
+    TableOptions, Tilt, TiltData, MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES,
 };
 
 /// The module layout's rules, checked from the source: dependencies between the stages

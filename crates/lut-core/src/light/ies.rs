@@ -191,7 +191,7 @@ impl IesFile {
     ///
     /// # Errors
     /// [`IesError::Io`] when it cannot be read (or is larger than
-    /// [`MAX_FILE_BYTES`](super::MAX_FILE_BYTES)), otherwise as [`IesFile::parse`].
+    /// [`MAX_LIGHT_FILE_BYTES`](crate::MAX_LIGHT_FILE_BYTES)), otherwise as [`IesFile::parse`].
     pub fn load(path: &Path) -> Result<IesFile, IesError> {
         let name = path.display().to_string();
         // UTF-8, or Latin-1 as old files often are; refused past MAX_FILE_BYTES.

@@ -203,7 +203,7 @@ impl LdtFile {
     ///
     /// # Errors
     /// [`LdtError::Io`] when it cannot be read (or is larger than
-    /// [`MAX_FILE_BYTES`](super::MAX_FILE_BYTES)), otherwise as [`LdtFile::parse`].
+    /// [`MAX_LIGHT_FILE_BYTES`](crate::MAX_LIGHT_FILE_BYTES)), otherwise as [`LdtFile::parse`].
     pub fn load(path: &Path) -> Result<LdtFile, LdtError> {
         let name = path.display().to_string();
         let text = super::read_text(path).map_err(|reason| LdtError::Io {
