@@ -78,6 +78,7 @@
 
 mod cube;
 mod error;
+mod file;
 mod geom;
 mod io;
 mod light;
@@ -125,8 +126,12 @@ pub use render::{
 };
 
 // Input.
-pub use io::cube::{load_cube, load_face_files, load_layout_image};
+pub use file::open_regular;
+pub use io::cube::{
+    cube_face_files, decode_layout_image, load_cube, load_face_files, load_layout_image,
+};
 pub use io::gpano::{insert_xmp, jpeg_xmp, read_gpano, xmp_packet, GPano, GPANO_NS, XMP_SIGNATURE};
+pub use io::jpeg::jpeg_max_pixels;
 pub use io::load::{
     check_pixel_limit, decode_map, load_map, map_from_image, resolve_projection, LoadOptions,
     LoadPhase, LoadProgress, DEFAULT_MAX_PIXELS,
@@ -164,8 +169,12 @@ mod layout {
         ("lut", &["geom", "error", "named"]),
         ("cube", &["geom", "map", "error", "named"]),
         ("render", &["geom", "map", "lut", "cube", "error", "named"]),
-        ("light", &["geom", "render", "error"]),
-        ("io", &["geom", "map", "lut", "cube", "render", "error"]),
+        ("file", &[]),
+        ("light", &["geom", "render", "error", "file"]),
+        (
+            "io",
+            &["geom", "map", "lut", "cube", "render", "error", "file"],
+        ),
     ];
 
     /// The stage a source file belongs to: its first folder, or its stem at the root.
