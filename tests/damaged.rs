@@ -268,28 +268,11 @@ fn a_damaged_dwab_exr_is_refused_within_bounded_memory() {
     assert!(e.to_string().contains("cut.exr"), "{e}");
 }
 
-fn y_only_exr(w: usize, h: usize) -> (Vec<u8>, Vec<f32>) {
-    use exr::prelude::*;
-    let v: Vec<f32> = (0..w * h)
-        .map(|p| (p % w) as f32 / (w - 1) as f32 * 4.0 - 0.5)
-        .collect();
-    let layer = Layer::new(
-        (w, h),
-        LayerAttributes::default(),
-        Encoding::SMALL_LOSSLESS,
-        AnyChannels::sort(vec![AnyChannel::new("Y", FlatSamples::F32(v.clone()))].into()),
-    );
-    let mut out = std::io::Cursor::new(Vec::new());
-    Image::from_layer(layer)
-        .write()
-        .to_buffered(&mut out)
-        .unwrap();
-    (out.into_inner(), v)
-}
-
 #[test]
 fn a_luminance_only_exr_loads_as_gray() {
-    let (bytes, values) = y_only_exr(64, 32);
+    use exr::prelude::{Blocks, Compression};
+    use test_support::exr_files::{exr_file, exr_value};
+    let bytes = exr_file(64, 32, &["Y"], Compression::ZIP16, Blocks::ScanLines, false);
     let map = lut_core::decode_map(
         &bytes,
         "luminance.exr",
@@ -304,11 +287,19 @@ fn a_luminance_only_exr_loads_as_gray() {
         (map.width(), map.height(), map.projection()),
         (64, 32, Projection::Equirect)
     );
-    for (i, v) in values.iter().enumerate() {
-        let want = u32::from(lut_core::tone_map(*v)) * 0x0001_0101;
-        let (x, y) = ((i % 64) as u32, (i / 64) as u32);
-        assert_eq!(map.pixel(x, y), want, "({x},{y}) Y {v}");
+    let mut negative = 0;
+    for y in 0..32 {
+        for x in 0..64 {
+            let v = exr_value(0, x, y, 64);
+            negative += usize::from(v < 0.0);
+            let want = u32::from(lut_core::tone_map(v)) * 0x0001_0101;
+            assert_eq!(map.pixel(x as u32, y as u32), want, "({x},{y}) Y {v}");
+        }
     }
+    assert!(
+        negative > 0,
+        "the ramp starts below zero (clamped to black)"
+    );
 }
 
 #[test]

@@ -364,40 +364,11 @@ pub(crate) fn check_dwa_counts(header: &Header, chunk: &Chunk) -> Result<(), Str
 mod tests {
     use super::*;
 
-    /// A small EXR written by `exr` with `compression` and the given channels.
-    pub(crate) fn write_exr(
-        w: usize,
-        h: usize,
-        names: &[&str],
-        compression: Compression,
-    ) -> Vec<u8> {
-        use exr::prelude::*;
-        let chans: Vec<AnyChannel<FlatSamples>> = names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| {
-                let v: Vec<f32> = (0..w * h)
-                    .map(|p| ((p % w) as f32 / w as f32) * (i as f32 + 1.0) + (p / w) as f32 * 0.01)
-                    .collect();
-                AnyChannel::new(*n, FlatSamples::F32(v))
-            })
-            .collect();
-        let layer = Layer::new(
-            (w, h),
-            LayerAttributes::default(),
-            Encoding {
-                compression,
-                blocks: Blocks::ScanLines,
-                line_order: LineOrder::Increasing,
-            },
-            AnyChannels::sort(chans.into()),
-        );
-        let mut out = std::io::Cursor::new(Vec::new());
-        Image::from_layer(layer)
-            .write()
-            .to_buffered(&mut out)
-            .unwrap();
-        out.into_inner()
+    use exr::prelude::Blocks;
+    use test_support::exr_files::exr_file;
+
+    fn write_exr(w: usize, h: usize, names: &[&str], compression: Compression) -> Vec<u8> {
+        exr_file(w, h, names, compression, Blocks::ScanLines, false)
     }
 
     #[test]
