@@ -2,10 +2,11 @@
 
 use crate::args::{named, parse_angle, parse_size, parse_stops, InputArgs, MaxPixelsArg};
 use crate::lighting::{apply_lights, LightArgs};
-use crate::output::write_png_atomic;
+use crate::output::{check_not_input, output_kind, write_image};
 use crate::panorama::{coverage_text, heading_text, load_cube, load_panorama_partial};
 use crate::scene::{render_scene, Scene};
-use anyhow::{bail, Context, Result};
+use crate::usage;
+use anyhow::Result;
 use clap::Args;
 use lut_core::{
     IndexStep, LutChoice, RenderOptions, RenderReport, RendererKind, Sampler, Surface, View,
@@ -18,7 +19,8 @@ pub struct RenderArgs {
     /// Panorama image (JPEG, PNG, ...), or a cube map: a folder, six face files, or one
     /// layout image with --projection cube. The bundled sample when omitted.
     pub panorama: Vec<PathBuf>,
-    /// Output PNG, written atomically.
+    /// Output image: .png or .jpg/.jpeg (by the name), written atomically; a device or
+    /// FIFO (e.g. /dev/stdout) is written into as PNG.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Yaw in degrees (any value, taken modulo 360; positive turns right).
@@ -93,15 +95,17 @@ impl RenderArgs {
         let input = &self.input;
         if input.projection.value.reads_cube(&self.panorama) {
             if input.coverage.is_some() {
-                bail!("--coverage applies to equirectangular panoramas, not cube maps");
+                return Err(usage!(
+                    "--coverage applies to equirectangular panoramas, not cube maps"
+                ));
             }
             return Ok(Scene::Cube(load_cube(&self.panorama, input.cube)?));
         }
         if self.panorama.len() > 1 {
-            bail!(
+            return Err(usage!(
                 "{} files given: a single panorama takes one file (use --projection cube for six faces)",
                 self.panorama.len()
-            );
+            ));
         }
         let tone = lut_core::Tone {
             exposure_ev: self.exposure,
@@ -118,8 +122,14 @@ impl RenderArgs {
 
 /// Run `viewer render`.
 pub fn run(a: RenderArgs) -> Result<()> {
-    let mut view = View::new(a.yaw, a.pitch, a.hfov).context("invalid view")?;
+    let mut view = View::new(a.yaw, a.pitch, a.hfov).map_err(|e| usage!("invalid view: {e}"))?;
     let (w, h) = a.size;
+    // The output is checked before anything is loaded: its format, and that it is not
+    // one of the files read.
+    output_kind(&a.output)?;
+    let mut inputs = a.panorama.clone();
+    inputs.extend(a.lights.lights.iter().map(|l| l.file.clone()));
+    check_not_input(std::slice::from_ref(&a.output), &inputs)?;
     let mut scene = a.load()?;
     if let (true, Some(map)) = (a.view_limit, scene.env_map()) {
         view = lut_core::limit_view(view, w, h, &map.coverage());
@@ -130,7 +140,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         print_report(&a, &scene, &report, view);
     }
     apply_lights(&a.lights, view, &mut out, w, h)?;
-    write_png_atomic(&a.output, &out, w, h)?;
+    write_image(&a.output, &out, w, h)?;
     Ok(())
 }
 
@@ -139,7 +149,7 @@ fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View
     let (w, h) = a.size;
     match scene {
         Scene::Map { map, .. } => {
-            eprintln!(
+            crate::errln!(
                 "rendered {}x{} from {}x{} {} map: path {}, table {} bytes, {} of {} pixels exact, index step {}..{}",
                 w,
                 h,
@@ -154,10 +164,10 @@ fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View
                 report.max_step
             );
             if let Some(c) = coverage_text(map) {
-                eprintln!("partial panorama: {c}");
+                crate::errln!("partial panorama: {c}");
             }
             if a.view_limit {
-                eprintln!(
+                crate::errln!(
                     "view (limited): yaw {:.4} pitch {:.4} hfov {:.4}",
                     view.yaw_deg(),
                     view.pitch_deg(),
@@ -165,10 +175,10 @@ fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View
                 );
             }
             if let Some(hd) = heading_text(map, view.yaw_deg()) {
-                eprintln!("view centre {hd}");
+                crate::errln!("view centre {hd}");
             }
         }
-        Scene::Cube(cube) => eprintln!(
+        Scene::Cube(cube) => crate::errln!(
             "rendered {w}x{h} from a cube map of {}px faces",
             cube.face_size()
         ),

@@ -10,7 +10,7 @@ pub use state::{
 };
 
 use crate::args::values::finite;
-use anyhow::{anyhow, Context, Result};
+use anyhow::Result;
 use clap::Args;
 use lut_core::View;
 use lut_core::{LightTable, Room, ShadeOptions};
@@ -65,7 +65,11 @@ pub struct LightSpec {
     pub aim: (f64, f64),
 }
 
-fn parse_light(s: &str) -> Result<LightSpec, String> {
+/// Parse one `--light FILE@X,Y,Z[:YAW,PITCH]` (the file is not opened).
+///
+/// # Errors
+/// A message quoting `s` and saying which part is wrong.
+pub fn parse_light(s: &str) -> Result<LightSpec, String> {
     let (file, rest) = s
         .rsplit_once('@')
         .ok_or_else(|| format!("light '{s}' must look like FILE.ies@X,Y,Z[:YAW,PITCH]"))?;
@@ -124,7 +128,7 @@ impl LightArgs {
     pub fn state(&self) -> Result<LightsState> {
         let lux = self.exposure_lux.unwrap_or(DEFAULT_EXPOSURE_LUX);
         if !(lux.is_finite() && lux > 0.0) {
-            return Err(anyhow!(
+            return Err(crate::usage!(
                 "--exposure-lux must be a positive number of lux, got {lux}"
             ));
         }
@@ -143,7 +147,8 @@ impl LightArgs {
             return Ok(st);
         }
         let (w, d, h) = st.room;
-        Room::new(w, d, h, st.camera_height).context("--room/--camera-height")?;
+        Room::new(w, d, h, st.camera_height)
+            .map_err(|e| crate::usage!("--room/--camera-height: {e}"))?;
         let mut tables: HashMap<&Path, Arc<LightTable>> = HashMap::new();
         for spec in &self.lights {
             let table = match tables.get(spec.file.as_path()) {
@@ -162,7 +167,8 @@ impl LightArgs {
                 pitch: spec.aim.1,
             });
         }
-        st.scene().map_err(anyhow::Error::msg)?;
+        // What is left to go wrong is where the lights are: command-line values.
+        st.scene().map_err(|e| crate::usage!("{e}"))?;
         Ok(st)
     }
 }

@@ -187,10 +187,10 @@ impl App {
                 }
                 Effect::PrintView(line) => {
                     if self.print_view {
-                        println!("{line}");
+                        let _ = crate::outln!("{line}");
                     }
                 }
-                Effect::Stderr(line) => eprintln!("{line}"),
+                Effect::Stderr(line) => crate::errln!("{line}"),
                 Effect::ShowPanel => self.show_panel = true,
             }
         }
@@ -408,7 +408,7 @@ impl App {
             Err(e) => format!("save failed: {e}"),
         };
         if self.print_view {
-            println!("{status}");
+            let _ = crate::outln!("{status}");
         }
         self.doc.readouts.export_status = Some(status);
         self.show_panel = true;
@@ -493,7 +493,7 @@ impl App {
                 readouts.scene = (rect.w, rect.h);
                 self.scene_key = Some(key);
                 if self.print_view {
-                    println!(
+                    let _ = crate::outln!(
                         "view yaw={:.4} pitch={:.4} hfov={:.4} path={path} sampler={} fast={} size={}x{} lights={}",
                         look.yaw,
                         look.pitch,

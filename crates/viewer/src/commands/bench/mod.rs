@@ -26,7 +26,7 @@ pub mod plot;
 pub mod report;
 
 use crate::args::{named, parse_map_size, parse_size, MaxPixelsArg, ProjectionOpt};
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use configs::{configs, view_sets, ViewsArg};
 use lut_core::CubeMap;
@@ -89,14 +89,14 @@ pub struct BenchArgs {
 /// Run `viewer bench`.
 pub fn run(a: BenchArgs) -> Result<()> {
     if a.passes == 0 {
-        bail!("--passes must be at least 1");
+        return Err(crate::usage!("--passes must be at least 1"));
     }
     in_pool(a.threads, |threads| run_in_pool(&a, threads))
 }
 
 /// Progress goes to stderr (with --json, stdout is only the JSON array).
 pub fn progress(msg: &str) {
-    eprintln!("bench: {msg}");
+    crate::errln!("bench: {msg}");
 }
 
 fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
@@ -213,11 +213,11 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         plot::plot(p, &rows).with_context(|| format!("{}: cannot draw the chart", p.display()))?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        crate::outln!("{}", serde_json::to_string_pretty(&rows)?)?;
     } else {
         report::write_table(&mut std::io::stdout().lock(), &rows, &tables)?;
         if let Some(n) = minify_note {
-            println!("{n}");
+            crate::outln!("{n}")?;
         }
     }
     Ok(())
