@@ -1,0 +1,319 @@
+#!/usr/bin/env bash
+# Window soak: drives the real viewer window under Xvfb for a given time with random
+# (seeded) user actions — drags, flicks, wheel, keys, resize storms, minimizing (unmapped,
+# and shrunk to 1x1) and back, fullscreen, dropping good and bad files (a truncated JPEG,
+# header-only files claiming huge sizes, a text file, a FIFO, a symbolic-link loop, a
+# damaged EXR, a cube folder, a cube layout image, an IES light), and clicks all over
+# the panel (every menu, checkbox, slider and button it has) — while sampling the
+# process's resident memory (VmRSS from /proc) to a CSV once a second.
+#
+# Passes when: the viewer never exits or panics, every drop is taken (the XDND exchange
+# completes, so the window never stopped answering), the window still answers at the end
+# (R resets the view, Ctrl+Q exits 0), and — for runs of 5 minutes or more — the resident
+# memory after the warm-up (the first fifth of the run, at least 60 s) stays flat: the
+# median of every later tenth of the run within 5 % of the first tenth's. Shorter runs
+# (CI's minute) report the memory curve without judging it: their warm-up is not over.
+#
+# Output in target/window-soak/: rss.csv (seconds, VmRSS kB, frames so far), rss-table.md
+# (the memory curve: one row per tenth of the run), summary.txt, the viewer's logs.
+#
+# Usage: scripts/window-soak.sh [--duration SECONDS] [--seed N] [--install] [--no-build]
+#   --duration S  how long to drive the window (default 600)
+#   --seed N      the random seed (default 1): the same seed repeats the same actions
+#   --install     apt-get the X tools first (as scripts/window-smoke.sh --install, plus
+#                 python3-xlib for the drops)
+#   --no-build    use the existing release binary
+# Honours CARGO_TARGET_DIR; VIEWER_BIN=path tests another binary (implies --no-build).
+set -euo pipefail
+
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+OUT=$ROOT/target/window-soak
+DURATION=600
+SEED=1
+INSTALL=0
+BUILD=1
+while [ $# -gt 0 ]; do
+  case $1 in
+    --duration) DURATION=$2; shift ;;
+    --seed) SEED=$2; shift ;;
+    --install) INSTALL=1 ;;
+    --no-build) BUILD=0 ;;
+    -h|--help) sed -n '2,27p' "$0"; exit 0 ;;
+    *) echo "window-soak: unknown argument '$1'" >&2; exit 2 ;;
+  esac
+  shift
+done
+
+fail() { echo "window-soak: FAIL: $*" >&2; exit 1; }
+log() { echo "window-soak: $*"; }
+
+if [ "$INSTALL" = 1 ]; then
+  SUDO=""
+  [ "$(id -u)" = 0 ] || SUDO=sudo
+  $SUDO apt-get update
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y xvfb xdotool x11-utils x11-apps \
+    imagemagick python3-xlib libx11-6 libx11-xcb1 libxcursor1 libxi6 libxkbcommon-x11-0 \
+    libxkbcommon0 libxcb1 libxcb-xkb1
+fi
+PY=/usr/bin/python3
+for tool in Xvfb xdotool xdpyinfo mkfifo; do
+  command -v "$tool" >/dev/null || fail "$tool not found (run with --install)"
+done
+"$PY" -c 'import Xlib' 2>/dev/null || fail "python3-xlib not found (run with --install)"
+
+TARGET=${CARGO_TARGET_DIR:-$ROOT/target}
+[ -z "${VIEWER_BIN:-}" ] || BUILD=0
+if [ "$BUILD" = 1 ]; then
+  log "building the release binary"
+  cargo build --release -p viewer --bin viewer
+fi
+BIN=${VIEWER_BIN:-$TARGET/release/viewer}
+case $BIN in /*) ;; *) BIN=$ROOT/$BIN ;; esac
+[ -x "$BIN" ] || fail "$BIN not found"
+
+rm -rf "$OUT"
+mkdir -p "$OUT/files" "$OUT/work"
+VIEWLOG=$OUT/viewer.stdout
+ERRLOG=$OUT/viewer.stderr
+CSV=$OUT/rss.csv
+
+# --- the files to drop ------------------------------------------------------------------
+F=$OUT/files
+cp assets/courtyard.jpg "$F/pano.jpg"
+cp tests/data/hdr/interior.exr "$F/interior.exr"
+cp -r tests/data/cube/skyfantasy "$F/skyfantasy"
+cp tests/data/ies/type_b_full.ies "$F/lamp.ies"
+"$BIN" render "$F/pano.jpg" -o "$F/view.png" --size 512x256 --yaw 40
+"$BIN" convert "$F/pano.jpg" "$F/cross.png" --to cube --layout cross --face-size 64
+head -c 20000 assets/courtyard.jpg >"$F/truncated.jpg"
+head -c "$(($(stat -c %s tests/data/hdr/interior.exr) * 6 / 10))" tests/data/hdr/interior.exr >"$F/cut.exr"
+echo "not an image" >"$F/text.jpg"
+mkfifo "$F/pipe.jpg"
+ln -s loop-b.jpg "$F/loop-a.jpg"
+ln -s loop-a.jpg "$F/loop-b.jpg"
+"$PY" - "$F" <<'EOF'
+import struct, sys, zlib
+d = sys.argv[1]
+# A PNG whose IHDR claims 100000 x 100000 and no pixels.
+ihdr = b"IHDR" + struct.pack(">IIBBBBB", 100000, 100000, 8, 2, 0, 0, 0)
+png = b"\x89PNG\r\n\x1a\n" + struct.pack(">I", 13) + ihdr + struct.pack(">I", zlib.crc32(ihdr))
+open(f"{d}/huge-header.png", "wb").write(png)
+# A 2.3 KB JPEG whose SOF0 claims 32768 x 16384 (inside the default pixel limit).
+sof = b"\xff\xc0\x00\x11\x08" + struct.pack(">HH", 16384, 32768) + b"\x03\x01\x22\x00\x02\x11\x01\x03\x11\x01"
+com = b"\xff\xfe" + struct.pack(">H", 2280) + b"x" * 2278
+open(f"{d}/claims-32k.jpg", "wb").write(b"\xff\xd8" + sof + com + b"\xff\xd9")
+EOF
+GOOD=("$F/pano.jpg" "$F/interior.exr" "$F/skyfantasy" "$F/view.png" "$F/cross.png" "$F/lamp.ies")
+BAD=("$F/truncated.jpg" "$F/cut.exr" "$F/text.jpg" "$F/pipe.jpg" "$F/loop-a.jpg" "$F/huge-header.png" "$F/claims-32k.jpg")
+
+# --- X and the viewer -------------------------------------------------------------------
+DISP=""
+for n in $(seq 121 160); do
+  if [ ! -e /tmp/.X11-unix/X$n ] && [ ! -e /tmp/.X$n-lock ]; then DISP=:$n; break; fi
+done
+[ -n "$DISP" ] || fail "no free X display number"
+XVFB_PID=""
+VIEWER_PID=""
+SAMPLER_PID=""
+cleanup() {
+  [ -z "$SAMPLER_PID" ] || kill "$SAMPLER_PID" 2>/dev/null || true
+  if [ -n "$VIEWER_PID" ] && kill -0 "$VIEWER_PID" 2>/dev/null; then kill "$VIEWER_PID" || true; fi
+  if [ -n "$XVFB_PID" ] && kill -0 "$XVFB_PID" 2>/dev/null; then kill "$XVFB_PID" || true; fi
+}
+trap cleanup EXIT
+log "starting Xvfb on $DISP"
+Xvfb "$DISP" -screen 0 1280x800x24 -nolisten tcp >"$OUT/xvfb.log" 2>&1 &
+XVFB_PID=$!
+export DISPLAY=$DISP
+for _ in $(seq 1 100); do
+  xdpyinfo >/dev/null 2>&1 && break
+  sleep 0.1
+done
+xdpyinfo >/dev/null 2>&1 || fail "Xvfb did not start (see $OUT/xvfb.log)"
+
+alive() { kill -0 "$VIEWER_PID" 2>/dev/null || fail "the viewer exited (see $ERRLOG)"; }
+wait_for() { # pattern, from line, timeout
+  local end=$((SECONDS + $3))
+  while [ $SECONDS -lt "$end" ]; do
+    tail -n +"$(($2 + 1))" "$VIEWLOG" | grep -q -- "$1" && return 0
+    alive
+    sleep 0.1
+  done
+  fail "timed out waiting for '$1' (see $VIEWLOG)"
+}
+lines() { wc -l <"$VIEWLOG"; }
+
+log "starting the viewer"
+for attempt in 1 2; do
+  (cd "$OUT/work" && exec "$BIN" --size 800x500 --print-view) >"$VIEWLOG" 2>"$ERRLOG" &
+  VIEWER_PID=$!
+  sleep 1
+  if kill -0 "$VIEWER_PID" 2>/dev/null || ! grep -q 'cannot open a window' "$ERRLOG"; then break; fi
+  log "the viewer could not connect (attempt $attempt): $(cat "$ERRLOG")"
+  sleep 1
+done
+wait_for '^loaded ' 0 60
+wait_for '^view ' 0 60
+WID=$(xdotool search --sync --onlyvisible --name '^viewer' | head -n 1)
+[ -n "$WID" ] || fail "no viewer window found"
+
+# Resident memory once a second: seconds since start, VmRSS in kB, frames so far.
+echo "seconds,rss_kb,frames" >"$CSV"
+(
+  t0=$(date +%s.%N)
+  while kill -0 "$VIEWER_PID" 2>/dev/null; do
+    rss=$(awk '/^VmRSS:/ {print $2}' "/proc/$VIEWER_PID/status" 2>/dev/null || true)
+    frames=$(grep -c '^view ' "$VIEWLOG" || true)
+    [ -n "$rss" ] && echo "$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN {printf "%.1f", b - a}'),$rss,$frames" >>"$CSV"
+    sleep 1
+  done
+) &
+SAMPLER_PID=$!
+
+# --- the actions ------------------------------------------------------------------------
+RANDOM=$SEED
+rnd() { echo $((RANDOM % $1)); } # 0..n-1
+geom() { eval "$(xdotool getwindowgeometry --shell "$WID")"; }
+focus() { xdotool windowfocus "$WID" 2>/dev/null || true; }
+key() { focus; xdotool keydown "$1"; sleep 0.05; xdotool keyup "$1"; }
+declare -A COUNT
+DROPS_OK=0
+act_drag() {
+  geom; local sw=$((WIDTH > 300 ? WIDTH - 230 : WIDTH)) x y i
+  x=$((X + 20 + $(rnd $((sw > 40 ? sw - 40 : 1))))); y=$((Y + 20 + $(rnd $((HEIGHT > 40 ? HEIGHT - 40 : 1)))))
+  xdotool mousemove "$x" "$y" mousedown 1
+  for i in $(seq 1 10); do xdotool mousemove "$((x + (RANDOM % 41 - 20) * i / 2))" "$((y + (RANDOM % 21 - 10) * i / 2))"; sleep 0.02; done
+  sleep 0.2; xdotool mouseup 1
+}
+act_flick() {
+  geom; local x=$((X + 100 + $(rnd 200))) y=$((Y + 100 + $(rnd 200))) dx=$(( (RANDOM % 2) * 2 - 1 ))
+  xdotool mousemove "$x" "$y" mousedown 1
+  for i in 1 2 3 4 5; do xdotool mousemove "$((x + dx * 25 * i))" "$((y + 3 * i))"; sleep 0.01; done
+  xdotool mouseup 1
+}
+act_wheel() {
+  geom; xdotool mousemove "$((X + WIDTH / 3))" "$((Y + HEIGHT / 2))"
+  local b=$((4 + $(rnd 2))) n=$((1 + $(rnd 5))) i
+  for i in $(seq 1 "$n"); do xdotool click "$b"; sleep 0.03; done
+}
+KEYS=(Left Right Up Down a d w s plus minus r bracketleft bracketright h Tab)
+act_key() { key "${KEYS[$(rnd ${#KEYS[@]})]}"; }
+act_resize_storm() {
+  local i
+  for i in $(seq 1 12); do
+    xdotool windowsize "$WID" "$((200 + $(rnd 1080)))" "$((150 + $(rnd 650)))" 2>/dev/null || true
+    sleep 0.03
+  done
+}
+act_minimize() {
+  xdotool windowunmap "$WID"; sleep 0.3; xdotool windowmap "$WID"; sleep 0.2
+  xdotool windowsize "$WID" 1 1; sleep 0.3; xdotool windowsize "$WID" 800 500; sleep 0.2
+}
+act_fullscreen() { key f; sleep 0.4; key Escape; }
+act_drop() {
+  local f
+  if [ "$(rnd 2)" = 0 ]; then f=${GOOD[$(rnd ${#GOOD[@]})]}; else f=${BAD[$(rnd ${#BAD[@]})]}; fi
+  timeout 20 "$PY" scripts/xdnd-drop.py "$WID" "$f" 2>>"$OUT/drops.log" ||
+    fail "dropping $(basename "$f") was not taken: the window stopped answering (see $OUT/drops.log)"
+  DROPS_OK=$((DROPS_OK + 1))
+  echo "$(basename "$f")" >>"$OUT/dropped.txt"
+}
+act_panel() {
+  geom
+  [ "$WIDTH" -gt 300 ] || return 0
+  local i
+  for i in 1 2 3 4 5; do
+    xdotool mousemove "$((X + WIDTH - 228 + $(rnd 226)))" "$((Y + 2 + $(rnd $((HEIGHT - 4)))))" click 1
+    sleep 0.1
+  done
+  key Escape # close a menu left open
+}
+act_save() { key p; }
+ACTIONS=(drag drag flick wheel key key resize_storm minimize fullscreen drop drop panel panel panel save)
+
+log "driving the window for $DURATION s (seed $SEED)"
+START=$SECONDS
+while [ $((SECONDS - START)) -lt "$DURATION" ]; do
+  a=${ACTIONS[$(rnd ${#ACTIONS[@]})]}
+  "act_$a"
+  COUNT[$a]=$((${COUNT[$a]:-0} + 1))
+  alive
+  sleep 0.$((1 + $(rnd 4)))
+done
+
+# --- the end: still answering? ----------------------------------------------------------
+log "actions: $(for k in "${!COUNT[@]}"; do printf '%s=%s ' "$k" "${COUNT[$k]}"; done)"
+xdotool windowmap "$WID" 2>/dev/null || true
+xdotool windowsize "$WID" 800 500
+sleep 1
+N=$(lines)
+ok=0
+for _ in 1 2 3; do
+  key Escape
+  key r
+  if timeout 20 bash -c "until tail -n +$((N + 1)) '$VIEWLOG' | grep -q 'yaw=0.0000 pitch=0.0000 hfov=90.0000'; do sleep 0.1; done"; then ok=1; break; fi
+done
+[ "$ok" = 1 ] || fail "the window did not answer R (reset) at the end"
+alive
+focus
+xdotool keydown ctrl; sleep 0.1; xdotool key q; sleep 0.1; xdotool keyup ctrl
+RC=""
+for _ in $(seq 1 100); do
+  if ! kill -0 "$VIEWER_PID" 2>/dev/null; then set +e; wait "$VIEWER_PID"; RC=$?; set -e; break; fi
+  sleep 0.1
+done
+[ -n "$RC" ] || fail "the viewer did not close on Ctrl+Q"
+VIEWER_PID=""
+[ "$RC" = 0 ] || fail "the viewer exited with $RC (see $ERRLOG)"
+! grep -q 'panicked' "$ERRLOG" || fail "the viewer panicked (see $ERRLOG)"
+kill "$SAMPLER_PID" 2>/dev/null || true
+wait "$SAMPLER_PID" 2>/dev/null || true
+SAMPLER_PID=""
+
+# --- the memory curve -------------------------------------------------------------------
+FRAMES=$(grep -c '^view ' "$VIEWLOG" || true)
+VARIETY=$(grep '^view ' "$VIEWLOG" | tr ' ' '\n' | grep -E '^(path|sampler|lights)=' | sort -u | tr '\n' ' ')
+ERRORS=$(sort -u "$ERRLOG" | grep -c '^viewer: ' || true)
+"$PY" - "$CSV" "$OUT/rss-table.md" <<'EOF' >"$OUT/memory.txt"
+import csv, statistics, sys
+rows = [(float(r["seconds"]), int(r["rss_kb"])) for r in csv.DictReader(open(sys.argv[1]))]
+if len(rows) < 10:
+    print("FLAT no: too few samples"); sys.exit()
+end = rows[-1][0]
+warm = min(max(60.0, end / 5), end / 2)
+after = [r for r in rows if r[0] >= warm]
+n = 10
+span = (end - warm) / n
+parts = [[kb for t, kb in after if warm + i * span <= t < warm + (i + 1) * span or (i == n - 1 and t >= end)] for i in range(n)]
+parts = [p for p in parts if p]
+meds = [statistics.median(p) for p in parts]
+ref = meds[0]
+worst = max(abs(m - ref) / ref for m in meds)
+with open(sys.argv[2], "w") as f:
+    f.write("| from s | to s | RSS MiB min | median | max |\n|---:|---:|---:|---:|---:|\n")
+    wu = [kb for t, kb in rows if t < warm]
+    if wu:
+        f.write(f"| 0 | {warm:.0f} (warm-up) | {min(wu)/1024:.1f} | {statistics.median(wu)/1024:.1f} | {max(wu)/1024:.1f} |\n")
+    for i, p in enumerate(parts):
+        f.write(f"| {warm + i*span:.0f} | {warm + (i+1)*span:.0f} | {min(p)/1024:.1f} | {statistics.median(p)/1024:.1f} | {max(p)/1024:.1f} |\n")
+print(f"warm-up {warm:.0f} s; after it: min {min(kb for _, kb in after)/1024:.1f} MiB, "
+      f"max {max(kb for _, kb in after)/1024:.1f} MiB; medians of the tenths within "
+      f"{100*worst:.1f} % of the first")
+print("FLAT yes" if worst <= 0.05 else "FLAT no")
+EOF
+{
+  echo "duration ${DURATION} s, seed $SEED, $(date -u +%Y-%m-%dT%H:%MZ)"
+  echo "actions: $(for k in "${!COUNT[@]}"; do printf '%s=%s ' "$k" "${COUNT[$k]}"; done)"
+  echo "drops taken: $DROPS_OK ($(sort "$OUT/dropped.txt" 2>/dev/null | uniq -c | awk '{printf "%s %s, ", $2, $1}'))"
+  echo "frames rendered: $FRAMES; seen: $VARIETY"
+  echo "distinct error messages shown: $ERRORS"
+  head -n 1 "$OUT/memory.txt"
+} | tee "$OUT/summary.txt"
+cat "$OUT/rss-table.md"
+if [ "$DURATION" -ge 300 ]; then
+  grep -q '^FLAT yes' "$OUT/memory.txt" || fail "resident memory grew after the warm-up (see $OUT/rss-table.md)"
+else
+  log "memory not judged: a run shorter than 300 s has not finished warming up"
+fi
+log "PASS (logs and the memory curve in $OUT)"
