@@ -126,11 +126,12 @@ log "starting Xvfb on $DISP"
 Xvfb "$DISP" -screen 0 1280x800x24 -nolisten tcp >"$OUT/xvfb.log" 2>&1 &
 XVFB_PID=$!
 export DISPLAY=$DISP
-for _ in $(seq 1 100); do
+for _ in $(seq 1 300); do
   xdpyinfo >/dev/null 2>&1 && break
+  kill -0 "$XVFB_PID" 2>/dev/null || fail "Xvfb exited: $(cat "$OUT/xvfb.log")"
   sleep 0.1
 done
-xdpyinfo >/dev/null 2>&1 || fail "Xvfb did not start (see $OUT/xvfb.log)"
+xdpyinfo >/dev/null 2>&1 || fail "Xvfb did not answer in 30 s (see $OUT/xvfb.log)"
 
 alive() { kill -0 "$VIEWER_PID" 2>/dev/null || fail "the viewer exited (see $ERRLOG)"; }
 wait_for() { # pattern, from line, timeout
@@ -177,23 +178,30 @@ rnd() { echo $((RANDOM % $1)); } # 0..n-1
 geom() { eval "$(xdotool getwindowgeometry --shell "$WID")"; }
 focus() { xdotool windowfocus "$WID" 2>/dev/null || true; }
 key() { focus; xdotool keydown "$1"; sleep 0.05; xdotool keyup "$1"; }
+# Move the pointer, kept on the 1280x800 screen.
+move() {
+  local x=$1 y=$2
+  [ "$x" -ge 0 ] || x=0; [ "$x" -le 1279 ] || x=1279
+  [ "$y" -ge 0 ] || y=0; [ "$y" -le 799 ] || y=799
+  xdotool mousemove "$x" "$y"
+}
 declare -A COUNT
 DROPS_OK=0
 act_drag() {
   geom; local sw=$((WIDTH > 300 ? WIDTH - 230 : WIDTH)) x y i
   x=$((X + 20 + $(rnd $((sw > 40 ? sw - 40 : 1))))); y=$((Y + 20 + $(rnd $((HEIGHT > 40 ? HEIGHT - 40 : 1)))))
-  xdotool mousemove "$x" "$y" mousedown 1
-  for i in $(seq 1 10); do xdotool mousemove "$((x + (RANDOM % 41 - 20) * i / 2))" "$((y + (RANDOM % 21 - 10) * i / 2))"; sleep 0.02; done
+  move "$x" "$y"; xdotool mousedown 1
+  for i in $(seq 1 10); do move "$((x + (RANDOM % 41 - 20) * i / 2))" "$((y + (RANDOM % 21 - 10) * i / 2))"; sleep 0.02; done
   sleep 0.2; xdotool mouseup 1
 }
 act_flick() {
   geom; local x=$((X + 100 + $(rnd 200))) y=$((Y + 100 + $(rnd 200))) dx=$(( (RANDOM % 2) * 2 - 1 ))
-  xdotool mousemove "$x" "$y" mousedown 1
-  for i in 1 2 3 4 5; do xdotool mousemove "$((x + dx * 25 * i))" "$((y + 3 * i))"; sleep 0.01; done
+  move "$x" "$y"; xdotool mousedown 1
+  for i in 1 2 3 4 5; do move "$((x + dx * 25 * i))" "$((y + 3 * i))"; sleep 0.01; done
   xdotool mouseup 1
 }
 act_wheel() {
-  geom; xdotool mousemove "$((X + WIDTH / 3))" "$((Y + HEIGHT / 2))"
+  geom; move "$((X + WIDTH / 3))" "$((Y + HEIGHT / 2))"
   local b=$((4 + $(rnd 2))) n=$((1 + $(rnd 5))) i
   for i in $(seq 1 "$n"); do xdotool click "$b"; sleep 0.03; done
 }
@@ -224,7 +232,8 @@ act_panel() {
   [ "$WIDTH" -gt 300 ] || return 0
   local i
   for i in 1 2 3 4 5; do
-    xdotool mousemove "$((X + WIDTH - 228 + $(rnd 226)))" "$((Y + 2 + $(rnd $((HEIGHT - 4)))))" click 1
+    move "$((X + WIDTH - 228 + $(rnd 226)))" "$((Y + 2 + $(rnd $((HEIGHT - 4)))))"
+    xdotool click 1
     sleep 0.1
   done
   key Escape # close a menu left open
