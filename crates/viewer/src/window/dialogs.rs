@@ -45,7 +45,7 @@ impl Dialogs {
             .add_save_extension("PNG", "png")
             .add_save_extension("JPEG", "jpg")
             .default_save_extension("PNG")
-            .default_size([720.0, 440.0]);
+            .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO);
         Dialogs {
             dialog,
             purpose: None,
@@ -57,8 +57,25 @@ impl Dialogs {
         self.purpose.is_some()
     }
 
+    /// Fit the dialog in a `screen`-sized window (points) and take the keyboard from
+    /// whatever egui widget had it (the dialog's own keys ignore input while another
+    /// widget is focused).
+    fn prepare(&mut self, ctx: &egui::Context) {
+        let screen = ctx.content_rect().size();
+        let c = self.dialog.config_mut();
+        c.default_size = egui::vec2(720.0, 440.0).min(screen - egui::vec2(24.0, 24.0));
+        c.max_size = Some(screen - egui::vec2(8.0, 8.0));
+        c.min_size = egui::vec2(200.0, 160.0).min(screen);
+        ctx.memory_mut(|m| {
+            if let Some(id) = m.focused() {
+                m.surrender_focus(id);
+            }
+        });
+    }
+
     /// Show the Open dialog in `dir`.
-    pub fn open_panorama(&mut self, dir: &Path) {
+    pub fn open_panorama(&mut self, ctx: &egui::Context, dir: &Path) {
+        self.prepare(ctx);
         let c = self.dialog.config_mut();
         c.initial_directory = dir.to_path_buf();
         c.title = Some("Open a panorama".into());
@@ -67,7 +84,8 @@ impl Dialogs {
     }
 
     /// Show the Save dialog in `dir` with the file name `name`.
-    pub fn save_view(&mut self, dir: &Path, name: &str) {
+    pub fn save_view(&mut self, ctx: &egui::Context, dir: &Path, name: &str) {
+        self.prepare(ctx);
         let c = self.dialog.config_mut();
         c.initial_directory = dir.to_path_buf();
         c.default_file_name = name.to_string();

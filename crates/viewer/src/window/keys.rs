@@ -228,20 +228,14 @@ pub const BINDINGS: &[Binding] = &[
 
 /// Mouse actions and drops, for the help overlay: (input, what it does).
 pub const MOUSE_HELP: &[(&str, &str)] = &[
-    (
-        "drag",
-        "turn the view (grab: the point under the cursor follows it; QTVR in the panel)",
-    ),
-    ("quick drag and release", "keeps turning briefly (inertia)"),
+    ("drag", "turn the view (grab or QTVR: panel)"),
+    ("quick drag, release", "keeps turning briefly (inertia)"),
     ("wheel", "zoom toward the cursor"),
     ("double-click", "zoom in toward the point"),
     ("drop an image", "open it"),
-    ("drop a folder or six faces", "open them as a cube map"),
-    ("drop an .ies or .ldt file", "add a light"),
-    (
-        "Tab",
-        "move the keyboard focus between buttons (Enter presses)",
-    ),
+    ("drop a folder", "open it as a cube map (or six faces)"),
+    ("drop .ies / .ldt", "add a light"),
+    ("Tab, Enter", "focus and press the buttons"),
 ];
 
 /// The action of `key` pressed with `modifiers`, from [`BINDINGS`].

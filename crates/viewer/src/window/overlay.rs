@@ -265,15 +265,16 @@ pub fn help(ctx: &egui::Context, scene: egui::Rect) -> bool {
                 egui::ScrollArea::vertical()
                     .max_height((scene.height() - 60.0).max(100.0))
                     .show(ui, |ui| {
-                        if scene.width() > 900.0 {
+                        if scene.width() > 860.0 {
                             ui.horizontal_top(|ui| {
                                 grid(ui, "help_keys", keys);
                                 ui.separator();
                                 grid(ui, "help_mouse", mouse);
                             });
                         } else {
+                            // (No separator: it would take the whole width.)
                             grid(ui, "help_keys", keys);
-                            ui.separator();
+                            ui.add_space(10.0);
                             grid(ui, "help_mouse", mouse);
                         }
                     });

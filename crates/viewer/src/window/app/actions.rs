@@ -24,8 +24,11 @@ impl App {
                 Effect::Load(req) => self.spawn_load(req),
                 Effect::AddLights(paths) => {
                     for p in &paths {
-                        // The error (if any) is shown in the Lights section.
-                        let _ = self.lights.load_and_add(p);
+                        // The error is also kept in the Lights section.
+                        if let Err(e) = self.lights.load_and_add(p) {
+                            let t = self.now();
+                            self.notices.error(e, t);
+                        }
                     }
                 }
                 Effect::Title(t) => {
@@ -226,7 +229,7 @@ impl App {
             .and_then(Path::parent)
             .filter(|d| d.is_dir())
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
-        self.dialogs.open_panorama(&dir);
+        self.dialogs.open_panorama(&self.egui_ctx, &dir);
         if self.print_view {
             println!("dialog open {}", dir.display());
         }
@@ -250,7 +253,7 @@ impl App {
         let name = name
             .file_name()
             .map_or_else(|| "view.png".into(), |n| n.to_string_lossy().into_owned());
-        self.dialogs.save_view(&dir, &name);
+        self.dialogs.save_view(&self.egui_ctx, &dir, &name);
         if self.print_view {
             println!("dialog save {}", dir.display());
         }

@@ -139,8 +139,13 @@ impl App {
         req
     }
 
-    /// The viewing UI over the scene: toolbar, compass, notices, help.
+    /// The viewing UI over the scene: toolbar, compass, notices, help (only the notices
+    /// while a dialog is open: it is modal, and drawn below egui's foreground).
     fn overlays(&mut self, ctx: &egui::Context, scene: egui::Rect, req: &mut FrameRequests) {
+        req.notices = overlay::notices(ctx, scene, self.doc.error(), &self.notices);
+        if self.dialogs.is_open() {
+            return;
+        }
         let bar = overlay::toolbar(
             ctx,
             ToolbarModel {
@@ -168,7 +173,6 @@ impl App {
         req.open_recent = bar.open_recent;
         let pose = self.doc.readouts.pose_heading;
         overlay::compass(ctx, scene, &self.ctl.look(), pose);
-        req.notices = overlay::notices(ctx, scene, self.doc.error(), &self.notices);
         if self.show_help && overlay::help(ctx, scene) {
             req.keys.push(KeyAction::Help);
         }
