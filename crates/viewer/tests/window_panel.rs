@@ -247,10 +247,15 @@ fn button_labels_have_glyphs_in_the_default_fonts() {
         ui.label("x");
     });
     let font = egui::FontId::proportional(14.0);
-    for label in BUTTON_LABELS.iter().chain(&TOOLBAR_LABELS) {
-        assert!(
-            ctx.fonts_mut(|f| f.has_glyphs(&font, label)),
-            "no glyph for button label {label:?}"
-        );
+    let mono = egui::FontId::monospace(14.0);
+    let help: Vec<String> = overlay::help_rows().into_iter().map(|r| r.0).collect();
+    let help: Vec<&str> = help.iter().map(String::as_str).collect();
+    for label in BUTTON_LABELS.iter().chain(&TOOLBAR_LABELS).chain(&help) {
+        for font in [&font, &mono] {
+            assert!(
+                ctx.fonts_mut(|f| f.has_glyphs(font, label)),
+                "no glyph for label {label:?} in {font:?}"
+            );
+        }
     }
 }

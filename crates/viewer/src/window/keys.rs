@@ -89,11 +89,15 @@ const fn ctrl(key: Key) -> Chord {
 }
 
 impl Chord {
-    /// The chord as the help shows it: "Ctrl+O", "⏴", "PageDown".
+    /// The chord as the help (and the README) shows it: "Ctrl+O", "⬅", "PageDown".
     pub fn label(self) -> String {
         let key = match self.key {
             Key::Escape => "Esc",
             Key::Minus => "−",
+            Key::ArrowLeft => "⬅",
+            Key::ArrowRight => "➡",
+            Key::ArrowUp => "⬆",
+            Key::ArrowDown => "⬇",
             k => k.symbol_or_name(),
         };
         if self.command {
@@ -120,7 +124,7 @@ pub struct Binding {
 }
 
 impl Binding {
-    /// The chords as the help shows them: "⏴ or A".
+    /// The chords as the help shows them: "⬅ or A".
     pub fn keys_label(&self) -> String {
         let labels: Vec<String> = self.chords.iter().map(|c| c.label()).collect();
         labels.join(" or ")
