@@ -817,6 +817,14 @@ mod tests {
         t
     }
 
+    /// Hold `held` from `t0` for `frames` frames at 60 Hz.
+    fn hold(c: &mut Controller, held: Held, t0: f64, frames: u32) {
+        c.set_held(held, t0);
+        for i in 1..=frames {
+            c.frame(t0 + f64::from(i) / 60.0);
+        }
+    }
+
     #[test]
     fn grab_keeps_the_grabbed_point_under_the_cursor() {
         for &(yaw, pitch, hfov) in &[(0.0, 0.0, 90.0), (170.0, 40.0, 60.0), (-30.0, -70.0, 120.0)] {
@@ -1348,16 +1356,11 @@ mod tests {
         assert!(c.take_zoomed_past_widest(), "the hook for wide projections");
         assert!(!c.take_zoomed_past_widest(), "reported once");
         c.frame(0.0);
-        c.set_held(
-            Held {
-                zoom_in: true,
-                ..Held::default()
-            },
-            0.0,
-        );
-        for i in 1..=120 {
-            c.frame(f64::from(i) / 60.0);
-        }
+        let zoom_in = Held {
+            zoom_in: true,
+            ..Held::default()
+        };
+        hold(&mut c, zoom_in, 0.0, 120);
         assert_eq!(c.look().hfov, 80.0);
         // Off for inspection: the global range.
         c.set_zoom_range(HFOV_MIN, HFOV_MAX);
