@@ -190,10 +190,13 @@ impl Document {
     ) -> Effect {
         self.next_id += 1;
         let id = self.next_id;
-        if opening {
-            if let Some(p) = source.single_path().filter(|p| !p.is_dir()) {
-                self.last_file = Some(p.to_path_buf());
-            }
+        if opening && source != Source::Sample {
+            // A folder or six faces: nothing to step from (the sample shown after a
+            // failed load keeps the failed file).
+            self.last_file = source
+                .single_path()
+                .filter(|p| !p.is_dir())
+                .map(|p| p.to_path_buf());
         }
         self.loading = Some(Loading {
             id,

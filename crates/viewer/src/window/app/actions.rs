@@ -124,6 +124,10 @@ impl App {
             Some(Chosen::Save(p)) => self.save_view_to(&p, t),
             None => {}
         }
+        if !req.keys.is_empty() {
+            // Keys and buttons count as input (auto-rotation waits again).
+            self.ctl.interacted(t);
+        }
         for a in req.keys {
             self.do_action(a, t, el);
         }

@@ -217,9 +217,6 @@ impl App {
             Route::Shortcuts
         };
         let keys = self.shortcuts.route(&mut raw.events, route);
-        if !keys.is_empty() {
-            self.ctl.interacted(t);
-        }
         let look_before = self.ctl.look();
         let mut req = FrameRequests::default();
         let full = ctx.run_ui(raw, |ui| req = self.build_ui(ui, t, (w, h)));

@@ -195,6 +195,11 @@ fn a_failed_first_load_opens_the_sample_and_keeps_the_error() {
     assert_eq!((sample.id, &sample.source), (2, &Source::Sample));
     assert_eq!(sample.opts.projection, None, "the sample in auto");
     assert_eq!(sample.opts.tone.exposure_ev, 2.0);
+    assert_eq!(
+        d.last_file(),
+        Some(Path::new("bad.png")),
+        "PageDown steps from the failed file, not the sample"
+    );
     // The sample's success keeps the message, and the projection still applies to the
     // failed file.
     d.on_event(done(2, Ok(loaded(Source::Sample, 64, false, 0.0))), 0.0);
@@ -331,6 +336,11 @@ fn opened_files_start_at_their_own_view_reloads_keep_it() {
     assert!(fx.contains(&Effect::StartView(DEFAULT_START)));
     assert!(fx.contains(&Effect::Opened(PathBuf::from("b.jpg"))));
     assert_eq!(d.last_file(), Some(Path::new("b.jpg")));
+    // A folder (a cube map) is opened: there is no file to step from.
+    let dir = tempfile::tempdir().unwrap();
+    let r = request(d.open_path(dir.path().to_path_buf(), 0.0).unwrap());
+    assert!(matches!(r.source, Source::Cube { .. }));
+    assert_eq!(d.last_file(), None);
     // The sample is not a recent file.
     let r = request(d.open(Source::Sample, None, StartArgs::default(), 0.0));
     let fx = d.on_event(done(r.id, Ok(loaded(Source::Sample, 64, false, 0.0))), 0.0);
