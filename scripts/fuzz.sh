@@ -5,9 +5,10 @@
 # executions, executions per second, coverage (libFuzzer's cov = edges, ft = features),
 # corpus size and what was found.
 #
-# Usage: scripts/fuzz.sh [--time SECONDS] [--jobs N] [--sanitizer none|address] [--ci]
-#                        [--install] [TARGET...]
+# Usage: scripts/fuzz.sh [--time SECONDS] [--runs N] [--jobs N] [--sanitizer none|address]
+#                        [--ci] [--install] [TARGET...]
 #   --time S       seconds per target (default 60)
+#   --runs N       stop a target after N executions (or at --time, whichever comes first)
 #   --jobs N       targets run at once (default 2)
 #   --sanitizer X  none (default: Rust's own checks plus overflow checks, 2-3x faster) or
 #                  address (AddressSanitizer, for the decoders' unsafe code)
@@ -28,6 +29,7 @@ cd "$(dirname "$0")/.."
 ROOT=$PWD
 
 TIME=60
+RUNS=-1
 JOBS=2
 SAN=none
 CI=0
@@ -36,11 +38,12 @@ TARGETS=()
 while [ $# -gt 0 ]; do
   case $1 in
     --time) TIME=$2; shift ;;
+    --runs) RUNS=$2; shift ;;
     --jobs) JOBS=$2; shift ;;
     --sanitizer) SAN=$2; shift ;;
     --ci) CI=1; INSTALL=1 ;;
     --install) INSTALL=1 ;;
-    -h|--help) sed -n '2,28p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,29p' "$0"; exit 0 ;;
     -*) echo "fuzz.sh: unknown option '$1'" >&2; exit 2 ;;
     *) TARGETS+=("$1") ;;
   esac
@@ -104,8 +107,8 @@ run_one() {
   local dirs=("$corpus")
   [ -d "fuzz/seeds/$t" ] && dirs+=("fuzz/seeds/$t")
   for d in $(extra_seeds "$t"); do dirs+=("$d"); done
-  local log=$LOG/$t.log rc=0
-  nice -n "$NICE" "$BIN/$t" "${dirs[@]}" -max_total_time="$TIME" -timeout=10 \
+  local log=$LOG/$t.log rc=0 t0=$SECONDS
+  nice -n "$NICE" "$BIN/$t" "${dirs[@]}" -max_total_time="$TIME" -runs="$RUNS" -timeout=10 \
     -rss_limit_mb=2048 -malloc_limit_mb=512 -print_final_stats=1 \
     -artifact_prefix="$art" >"$log" 2>&1 || rc=$?
   local done_line execs eps found
@@ -118,8 +121,9 @@ run_one() {
   corp=$(echo "$done_line" | sed -n 's/.* corp: \([^ ]*\).*/\1/p')
   found=$(ls -A "$art" | tr '\n' ' ')
   [ "$rc" = 0 ] || found="exit $rc: ${found:-see $log}"
-  printf '%-12s %12s execs %8s/s  cov %6s  ft %6s  corpus %-12s %s\n' \
-    "$t" "${execs:-?}" "${eps:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}" "${found:-nothing found}" \
+  printf '%-12s %12s execs in %5s s %8s/s  cov %6s  ft %6s  corpus %-12s %s\n' \
+    "$t" "${execs:-?}" "$((SECONDS - t0))" "${eps:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}" \
+    "${found:-nothing found}" \
     | tee "$LOG/$t.summary"
   [ "$rc" = 0 ] && [ -z "$(ls -A "$art")" ]
 }
