@@ -21,7 +21,11 @@ fuzz_target!(|data: &[u8]| {
                 let (yaw, pitch, hfov) = views[s.len() % views.len()];
                 let v = View::new(yaw, pitch, hfov).unwrap();
                 let l = limit_view(v, 640, 480, &c);
-                assert!(l.hfov_deg().is_finite() && l.yaw_deg().is_finite() && l.pitch_deg().is_finite());
+                assert!(
+                    l.hfov_deg().is_finite()
+                        && l.yaw_deg().is_finite()
+                        && l.pitch_deg().is_finite()
+                );
             }
         }
     }

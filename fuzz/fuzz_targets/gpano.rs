@@ -6,7 +6,10 @@ use lut_core::{read_gpano, GPano};
 
 fn place(g: &GPano) {
     let mut sizes = vec![(512, 256), (1, 1), (300, 200), (4096, 3)];
-    if let (Some(w), Some(h)) = (g.cropped_area_image_width_pixels, g.cropped_area_image_height_pixels) {
+    if let (Some(w), Some(h)) = (
+        g.cropped_area_image_width_pixels,
+        g.cropped_area_image_height_pixels,
+    ) {
         if (1.0..=65536.0).contains(&w) && (1.0..=65536.0).contains(&h) {
             sizes.push((w as u32, h as u32));
         }

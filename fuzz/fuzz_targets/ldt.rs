@@ -4,23 +4,13 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 use lut_core::{detect_format, LdtFile, Photometry};
-
-fn text(data: &[u8]) -> String {
-    match std::str::from_utf8(data) {
-        Ok(s) => s.to_string(),
-        Err(_) => data.iter().map(|&b| char::from(b)).collect(),
-    }
-}
-
-fn safe(msg: &str) {
-    assert!(!msg.chars().any(char::is_control), "raw control character in {msg:?}");
-}
+use lutpano_fuzz::{assert_safe, text};
 
 fuzz_target!(|data: &[u8]| {
     let t = text(data);
     let _ = detect_format(&t);
     match LdtFile::parse(&t, "fuzz.ldt") {
-        Err(e) => safe(&e.to_string()),
+        Err(e) => assert_safe(&e.to_string()),
         Ok(ldt) => {
             let p = Photometry::from_ldt(&ldt);
             let _ = p.max_candela();

@@ -4,13 +4,7 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 use lut_core::{LightTable, Photometry, TableOptions};
-
-fn text(data: &[u8]) -> String {
-    match std::str::from_utf8(data) {
-        Ok(s) => s.to_string(),
-        Err(_) => data.iter().map(|&b| char::from(b)).collect(),
-    }
-}
+use lutpano_fuzz::text;
 
 fuzz_target!(|data: &[u8]| {
     let Ok(p) = Photometry::parse(&text(data), "fuzz") else {
@@ -19,7 +13,13 @@ fuzz_target!(|data: &[u8]| {
     let Ok(table) = LightTable::from_photometry(&p, &TableOptions::default()) else {
         return;
     };
-    for (v, h) in [(0.0, 0.0), (45.0, 90.0), (90.0, 180.0), (180.0, 359.0), (-10.0, 725.0)] {
+    for (v, h) in [
+        (0.0, 0.0),
+        (45.0, 90.0),
+        (90.0, 180.0),
+        (180.0, 359.0),
+        (-10.0, 725.0),
+    ] {
         let c = table.candela(v, h);
         assert!(c.is_finite() && c >= 0.0, "candela {c} at {v},{h}");
     }
