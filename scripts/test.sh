@@ -43,7 +43,11 @@ if [ -f scripts/window-smoke.sh ]; then
   VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-smoke.sh
 fi
 echo "== window soak under Xvfb (one minute of random input, drops and the memory curve)"
+t0=$SECONDS
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-soak.sh --duration 60
+echo "== window soak took $((SECONDS - t0)) s"
 echo "== fuzz targets, ${FUZZ_SECONDS:-20} s each on the committed seeds (installs nightly and cargo-fuzz if missing)"
+t0=$SECONDS
 bash scripts/fuzz.sh --ci --time "${FUZZ_SECONDS:-20}"
+echo "== fuzzing (install, build, runs) took $((SECONDS - t0)) s"
 echo "== all tests passed"
