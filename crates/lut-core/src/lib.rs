@@ -102,6 +102,7 @@ pub use geom::fixed::{from_fx, to_fx, Fx, FX_BITS, FX_HALF, FX_ONE};
 pub use geom::limits::{MAX_MAP_HEIGHT, MAX_MAP_PIXELS, MAX_MAP_WIDTH, MAX_OUTPUT_SIDE};
 pub use geom::mapping::{exact_uv, exact_uv_at};
 pub use geom::projection::{wrap_pi, Projection};
+pub use geom::view_projection::{ViewProjection, PANNINI_D_DEFAULT, PANNINI_D_MAX};
 pub use geom::viewlimit::{frame_extent, limit_view, view_inside, FrameExtent};
 
 // Maps.

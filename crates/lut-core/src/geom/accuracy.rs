@@ -24,13 +24,20 @@ pub fn position_error(
 ) -> f64 {
     let s = p.row_scale(phi);
     let du = wrap_du(p, w, s, got.0 - exact.0);
-    let scale = if s > 1e-9 {
+    let dv = got.1 - exact.1;
+    ((du * u_scale(p, phi)).powi(2) + dv * dv).sqrt()
+}
+
+/// The factor the metric scales a u difference by at latitude `phi`: `cos φ / s(φ)`
+/// (at most 2; 1 where the row scale vanishes).
+#[inline]
+pub(crate) fn u_scale(p: Projection, phi: f64) -> f64 {
+    let s = p.row_scale(phi);
+    if s > 1e-9 {
         (phi.cos() / s).min(2.0)
     } else {
         1.0
-    };
-    let dv = got.1 - exact.1;
-    ((du * scale).powi(2) + dv * dv).sqrt()
+    }
 }
 
 /// A u difference reduced around the row's wrap: W for 360° maps, s(φ)·W for elliptical
@@ -113,7 +120,7 @@ pub fn compare_positions(
             let ex = exact_uv(&cam, p, w, h, x, y);
             match (ex, got) {
                 (Some(e), Some(g)) => {
-                    let (_, phi) = cam.pixel_lat_long(x, y);
+                    let (_, phi) = cam.pixel_lat_long(x, y).expect("a pixel with a position");
                     let err = position_error(p, w, h, phi, e, g);
                     let raw = raw_error(p, w, phi, e, g);
                     st.count += 1;

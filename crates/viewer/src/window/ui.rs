@@ -248,8 +248,10 @@ pub fn path_label(p: Option<RenderPath>) -> &'static str {
     match p {
         Some(RenderPath::LutWide) => "wide-FOV LUT",
         Some(RenderPath::LutHigh) => "high-resolution LUT",
+        Some(RenderPath::Grid) => "per-view grid",
         Some(RenderPath::Exact) => "exact (no LUT)",
         Some(RenderPath::Cube(_)) => "cube map",
+        Some(RenderPath::CubeProjected) => "cube map (per pixel)",
         None => "none yet",
     }
 }

@@ -186,7 +186,8 @@ pub fn measure_errors(
             .for_each(|(y, row)| {
                 for (x, e) in row.iter_mut().enumerate() {
                     let uv = exact_uv(&cam, proj, mw as f64, mh as f64, x as u32, y as u32);
-                    *e = (uv, cam.pixel_lat_long(x as u32, y as u32).1);
+                    let phi = cam.pixel_lat_long(x as u32, y as u32).map_or(0.0, |d| d.1);
+                    *e = (uv, phi);
                 }
             });
         for (si, s) in SAMPLERS.iter().enumerate() {
