@@ -154,6 +154,13 @@ pub(crate) fn prepare(
                 scan.col_per_x = 1.0 / rho;
                 Some(a)
             }
+            Surface::Diamond => {
+                // The scanline's plane meets the face y + z = 1 (folded a ∈ [0, π/2]) at
+                // r = sin a/(sin a + cos a); its pixels at x = t/(sin a + cos a).
+                let (s, c) = a.sin_cos();
+                scan.col_per_x = 1.0 / (rho * (s + c));
+                Some(s / (s + c))
+            }
             Surface::Plane => {
                 if back || a >= table.row_max() {
                     None
