@@ -667,3 +667,104 @@ fn grid_trilinear_close_to_exact_trilinear() {
         assert!(p >= 35.0, "{vp}: {p:.1} dB");
     }
 }
+
+// ---------------------------------------------------------------------------------------
+// The error heat map.
+
+/// The heat map's summary is the measurement: its max is the max of `compare_positions`
+/// (bit for bit), the largest of its per-pixel errors, and the worst pixel's colour is
+/// the scale's colour of that max; the exact renderer's map is all zeros; a cube map's
+/// too (both cube renderers compute every pixel's face coordinates exactly).
+#[test]
+fn heat_map_max_is_the_measured_max() {
+    let map = grid_map(4096, 2048, Projection::Equirect).unwrap();
+    let mut r = Renderer::new(&map);
+    let (w, h) = (200u32, 120u32);
+    for (view, renderer) in [
+        (View::new(30.0, 80.0, 100.0).unwrap(), RendererKind::Lut),
+        (View::new(180.0, -20.0, 60.0).unwrap(), RendererKind::Grid),
+        (
+            View::with_projection(0.0, -90.0, 300.0, ViewProjection::Stereographic).unwrap(),
+            RendererKind::Lut,
+        ),
+        (
+            View::with_projection(10.0, 20.0, 200.0, ViewProjection::Fisheye).unwrap(),
+            RendererKind::Grid,
+        ),
+    ] {
+        let opts = grid_opts(renderer);
+        let em = lut_core::ErrorMap::measure(&mut r, Scene::Map(&map), view, &opts, w, h).unwrap();
+        let (pos, _) = r
+            .positions(4096, 2048, Projection::Equirect, view, &opts, w, h)
+            .unwrap();
+        let st = compare_positions(&pos, view, w, h, Projection::Equirect, 4096, 2048);
+        assert_eq!(em.stats, st, "{view:?}");
+        let finite_max = em
+            .errors
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|e| e.is_finite())
+            .fold(0.0f64, f64::max);
+        assert_eq!(finite_max, em.stats.max);
+        assert!(
+            em.stats.max > 0.0 && em.stats.max <= BOUND,
+            "{view:?}: {}",
+            em.stats.max
+        );
+        let (x, y) = em.stats.worst_pixel;
+        let i = (y * w + x) as usize;
+        assert_eq!(em.errors[i], Some(em.stats.max));
+        assert_eq!(em.colors()[i], lut_core::heat_color(em.stats.max));
+        // The exact renderer measures nothing.
+        let ex = lut_core::ErrorMap::measure(
+            &mut r,
+            Scene::Map(&map),
+            view,
+            &grid_opts(RendererKind::Exact),
+            w,
+            h,
+        )
+        .unwrap();
+        assert_eq!((ex.stats.max, ex.stats.mean), (0.0, 0.0));
+    }
+    let cube = CubeMap::from_envmap(&map, 64, Sampler::Bilinear).unwrap();
+    let view = View::with_projection(0.0, 0.0, 360.0, ViewProjection::Fisheye).unwrap();
+    let em = lut_core::ErrorMap::measure(
+        &mut r,
+        Scene::Cube(&cube),
+        view,
+        &RenderOptions::default(),
+        64,
+        32,
+    )
+    .unwrap();
+    assert_eq!(em.stats.max, 0.0);
+    // Outside the 360° fisheye's disc there is no direction: background.
+    assert_eq!(em.errors[0], None);
+    assert_eq!(em.colors()[0], lut_core::HEAT_BACKGROUND);
+    assert_eq!(em.errors[16 * 64 + 32], Some(0.0));
+}
+
+#[test]
+fn heat_scale_is_logarithmic_from_a_thousandth_to_one_pixel() {
+    use lut_core::{heat_color, heat_scale};
+    assert_eq!(heat_scale(0.0), 0.0);
+    assert_eq!(heat_scale(0.001), 0.0);
+    assert!((heat_scale(0.01) - 1.0 / 3.0).abs() < 1e-12);
+    assert!((heat_scale(0.1) - 2.0 / 3.0).abs() < 1e-12);
+    assert_eq!(heat_scale(1.0), 1.0);
+    assert_eq!(heat_scale(7.0), 1.0);
+    assert_eq!(heat_scale(f64::NAN), 0.0);
+    assert_eq!(heat_color(0.0), heat_color(0.0005));
+    assert_eq!(heat_color(1.0), heat_color(50.0));
+    assert_ne!(heat_color(0.001), heat_color(1.0));
+    // Distinct colours along the scale, none the background's or the mismatch's.
+    let mut seen = std::collections::HashSet::new();
+    for k in 0..=30 {
+        let c = heat_color(10f64.powf(-3.0 + k as f64 * 0.1));
+        assert!(c != lut_core::HEAT_BACKGROUND && c != lut_core::HEAT_MISMATCH);
+        seen.insert(c);
+    }
+    assert!(seen.len() >= 25, "{}", seen.len());
+}

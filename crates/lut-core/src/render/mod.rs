@@ -13,6 +13,7 @@
 //! * `sink.rs`: where a scanline writes (pixels per sampler, or positions).
 //!
 //! `exact.rs` is the per-pixel reference renderer, `cube.rs` the cube renderers,
+//! `heat.rs` the error heat map (per-pixel sampling-position error of a renderer),
 //! `grid.rs` the per-view adaptive grid (every output projection, with the same span
 //! kernels), `projected.rs` cube maps in the other output projections.
 //!
@@ -24,6 +25,7 @@ pub(crate) mod cube;
 pub(crate) mod exact;
 pub(crate) mod frame;
 pub(crate) mod grid;
+pub(crate) mod heat;
 pub(crate) mod kernel;
 pub(crate) mod projected;
 pub(crate) mod rows;
