@@ -29,7 +29,7 @@ const STOPS: [u32; 8] = [
 /// Position in [0, 1] of an error on the logarithmic scale (0 at [`HEAT_MIN`] and below,
 /// 1 at [`HEAT_MAX`] and above).
 pub fn heat_scale(error_px: f64) -> f64 {
-    if !(error_px > HEAT_MIN) {
+    if error_px.is_nan() || error_px <= HEAT_MIN {
         return 0.0;
     }
     ((error_px.log10() - HEAT_MIN.log10()) / (HEAT_MAX.log10() - HEAT_MIN.log10())).min(1.0)
