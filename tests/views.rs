@@ -514,6 +514,35 @@ fn renderer_choice_for_each_projection() {
     assert_eq!((rep.path, st.max), (RenderPath::Exact, 0.0));
 }
 
+/// Building the grid alone (what the bench times) finds the same cells as a frame.
+#[test]
+fn building_the_grid_alone_finds_the_frames_cells() {
+    let mut r = Renderer::default();
+    for (vp, pitch) in [
+        (ViewProjection::Rectilinear, 80.0),
+        (ViewProjection::Fisheye, -90.0),
+    ] {
+        let view = View::with_projection(40.0, pitch, hfov_at(vp, 0.8), vp).unwrap();
+        let (_, frame) = measure(
+            &mut r,
+            (4096, 2048, Projection::Equirect),
+            view,
+            RendererKind::Grid,
+            (320, 200),
+        );
+        for threads in [false, true] {
+            let built = r
+                .build_grid(4096, 2048, Projection::Equirect, view, 320, 200, threads)
+                .unwrap();
+            assert_eq!(built, frame, "{vp} threads {threads}");
+        }
+        assert!(
+            frame.exact_pixels > 0 && frame.min_step >= 2 && frame.max_step <= 32,
+            "{frame:?}"
+        );
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // Images.
 

@@ -206,6 +206,33 @@ impl GridStats {
         }
     }
 
+    /// Count one leaf of side `g` at (x0, y0) of a `w × h` frame.
+    fn add(&mut self, leaf: &Leaf, x0: u32, y0: u32, g: u32, w: u32, h: u32) {
+        match leaf {
+            Leaf::Interp(_) => {
+                self.min_cell = self.min_cell.min(g);
+                self.max_cell = self.max_cell.max(g);
+            }
+            Leaf::Exact => {
+                let (xs, ys) = ((x0 + g).min(w) - x0, (y0 + g).min(h) - y0);
+                self.exact_pixels += xs as u64 * ys as u64;
+            }
+            Leaf::Background => {}
+        }
+    }
+
+    /// 0 for the smallest cell when no cell was interpolated.
+    fn finish(self) -> GridStats {
+        if self.min_cell == u32::MAX {
+            GridStats {
+                min_cell: 0,
+                ..self
+            }
+        } else {
+            self
+        }
+    }
+
     fn merge(self, o: GridStats) -> GridStats {
         GridStats {
             exact_pixels: self.exact_pixels + o.exact_pixels,
@@ -440,6 +467,47 @@ impl<'a> Grid<'a> {
         footprint: bool,
     ) -> GridStats {
         let w = self.w as usize;
+        let mut stats = GridStats::empty();
+        self.visit_band(y0, &mut |x0, cy0, cg, leaf| {
+            stats.add(&leaf, x0, cy0, cg, self.w, self.h);
+            let ys = (cy0 - y0) as usize..((cy0 + cg).min(self.h) - y0) as usize;
+            let xs = x0 as usize..((x0 + cg).min(self.w)) as usize;
+            match leaf {
+                Leaf::Interp(k) => {
+                    self.draw_interp(rows, w, y0, (x0, cy0, cg), k, sinks, footprint);
+                }
+                Leaf::Exact => {
+                    for r in ys {
+                        let y = y0 as usize + r;
+                        let mut s = sinks.sink(&mut rows[r * w..(r + 1) * w], y);
+                        for x in xs.clone() {
+                            let uv = exact_uv_at(
+                                &self.cam,
+                                self.fr.proj,
+                                self.fr.mw,
+                                self.fr.mh,
+                                x as f64 + 0.5,
+                                y as f64 + 0.5,
+                            );
+                            s.exact(x, uv);
+                        }
+                    }
+                }
+                Leaf::Background => {
+                    for r in ys {
+                        let mut s = sinks.sink(&mut rows[r * w..(r + 1) * w], y0 as usize + r);
+                        for x in xs.clone() {
+                            s.background(x);
+                        }
+                    }
+                }
+            }
+        });
+        stats
+    }
+
+    /// Measure the cells of the band whose top row is `y0`, calling `leaf` for each.
+    fn visit_band(&self, y0: u32, leaf: &mut impl FnMut(u32, u32, u32, Leaf)) {
         let g = GRID_CELL;
         let cells = self.w.div_ceil(g);
         let node_row = |y: u32| -> Vec<Option<Node>> {
@@ -448,48 +516,34 @@ impl<'a> Grid<'a> {
                 .collect()
         };
         let (top, bottom) = (node_row(y0), node_row(y0 + g));
-        let mut stats = GridStats::empty();
         for i in 0..cells as usize {
             let corners = [top[i], top[i + 1], bottom[i], bottom[i + 1]];
-            self.cell(i as u32 * g, y0, g, corners, &mut |x0, cy0, cg, leaf| {
-                let ys = (cy0 - y0) as usize..((cy0 + cg).min(self.h) - y0) as usize;
-                let xs = x0 as usize..((x0 + cg).min(self.w)) as usize;
-                match leaf {
-                    Leaf::Interp(k) => {
-                        stats.min_cell = stats.min_cell.min(cg);
-                        stats.max_cell = stats.max_cell.max(cg);
-                        self.draw_interp(rows, w, y0, (x0, cy0, cg), k, sinks, footprint);
-                    }
-                    Leaf::Exact => {
-                        stats.exact_pixels += (ys.len() * xs.len()) as u64;
-                        for r in ys {
-                            let y = y0 as usize + r;
-                            let mut s = sinks.sink(&mut rows[r * w..(r + 1) * w], y);
-                            for x in xs.clone() {
-                                let uv = exact_uv_at(
-                                    &self.cam,
-                                    self.fr.proj,
-                                    self.fr.mw,
-                                    self.fr.mh,
-                                    x as f64 + 0.5,
-                                    y as f64 + 0.5,
-                                );
-                                s.exact(x, uv);
-                            }
-                        }
-                    }
-                    Leaf::Background => {
-                        for r in ys {
-                            let mut s = sinks.sink(&mut rows[r * w..(r + 1) * w], y0 as usize + r);
-                            for x in xs.clone() {
-                                s.background(x);
-                            }
-                        }
-                    }
-                }
-            });
+            self.cell(i as u32 * g, y0, g, corners, leaf);
         }
-        stats
+    }
+
+    /// Measure every cell of the frame without drawing: the grid's per-view build alone
+    /// (what `viewer bench` times), in parallel bands when `threads`.
+    pub(crate) fn build(&self, threads: bool) -> GridStats {
+        let run = |b: u32| {
+            let mut stats = GridStats::empty();
+            self.visit_band(b * GRID_CELL, &mut |x0, y0, g, leaf| {
+                stats.add(&leaf, x0, y0, g, self.w, self.h);
+            });
+            stats
+        };
+        let bands = self.h.div_ceil(GRID_CELL);
+        let stats = if threads {
+            (0..bands)
+                .into_par_iter()
+                .map(run)
+                .reduce(GridStats::empty, GridStats::merge)
+        } else {
+            (0..bands)
+                .map(run)
+                .fold(GridStats::empty(), GridStats::merge)
+        };
+        stats.finish()
     }
 
     /// Draw an interpolated cell: each of its rows one span from the left edge's
@@ -571,13 +625,6 @@ impl<'a> Grid<'a> {
                 .map(run)
                 .fold(GridStats::empty(), GridStats::merge)
         };
-        if stats.min_cell == u32::MAX {
-            GridStats {
-                min_cell: 0,
-                ..stats
-            }
-        } else {
-            stats
-        }
+        stats.finish()
     }
 }

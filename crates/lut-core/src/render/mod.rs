@@ -506,6 +506,31 @@ impl Renderer {
         grid_report(stats, width, height)
     }
 
+    /// Build the grid renderer's cells for `view` of a `map_w × map_h` map in
+    /// `projection` on a `width × height` output without drawing them: the per-view part
+    /// of a grid frame alone (its cost is inside every grid frame; `viewer bench` times
+    /// it). The report counts the exact pixels and the cell sizes as a grid frame's does.
+    ///
+    /// # Errors
+    /// [`ViewError::BadSize`] for a bad output size.
+    #[allow(clippy::too_many_arguments)]
+    pub fn build_grid(
+        &mut self,
+        map_w: u32,
+        map_h: u32,
+        projection: Projection,
+        view: View,
+        width: u32,
+        height: u32,
+        threads: bool,
+    ) -> Result<RenderReport, ViewError> {
+        check_size(width, height)?;
+        self.set_geometry(map_w, map_h, projection);
+        let setup = Setup::new(width, (map_w, map_h, projection), 0.0);
+        let grid = Grid::new(view, width, height, &setup, &self.row_scale);
+        Ok(grid_report(grid.build(threads), width, height))
+    }
+
     /// The map positions the renderer `opts` selects samples for `view` (row-major,
     /// `None` = background): the same kernels as [`Renderer::render`] (the LUT's or the
     /// grid's), writing positions instead of pixels; the exact positions for the exact
