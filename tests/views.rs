@@ -525,14 +525,14 @@ fn building_the_grid_alone_finds_the_frames_cells() {
         let view = View::with_projection(40.0, pitch, hfov_at(vp, 0.8), vp).unwrap();
         let (_, frame) = measure(
             &mut r,
-            (4096, 2048, Projection::Equirect),
+            (2048, 1024, Projection::Equirect),
             view,
             RendererKind::Grid,
-            (320, 200),
+            (640, 400),
         );
         for threads in [false, true] {
             let built = r
-                .build_grid(4096, 2048, Projection::Equirect, view, 320, 200, threads)
+                .build_grid(2048, 1024, Projection::Equirect, view, 640, 400, threads)
                 .unwrap();
             assert_eq!(built, frame, "{vp} threads {threads}");
         }
@@ -706,9 +706,9 @@ fn grid_trilinear_close_to_exact_trilinear() {
 /// too (both cube renderers compute every pixel's face coordinates exactly).
 #[test]
 fn heat_map_max_is_the_measured_max() {
-    let map = grid_map(4096, 2048, Projection::Equirect).unwrap();
+    let map = grid_map(2048, 1024, Projection::Equirect).unwrap();
     let mut r = Renderer::new(&map);
-    let (w, h) = (200u32, 120u32);
+    let (w, h) = (400u32, 240u32);
     for (view, renderer) in [
         (View::new(30.0, 80.0, 100.0).unwrap(), RendererKind::Lut),
         (View::new(180.0, -20.0, 60.0).unwrap(), RendererKind::Grid),
@@ -724,9 +724,9 @@ fn heat_map_max_is_the_measured_max() {
         let opts = grid_opts(renderer);
         let em = lut_core::ErrorMap::measure(&mut r, Scene::Map(&map), view, &opts, w, h).unwrap();
         let (pos, _) = r
-            .positions(4096, 2048, Projection::Equirect, view, &opts, w, h)
+            .positions(2048, 1024, Projection::Equirect, view, &opts, w, h)
             .unwrap();
-        let st = compare_positions(&pos, view, w, h, Projection::Equirect, 4096, 2048);
+        let st = compare_positions(&pos, view, w, h, Projection::Equirect, 2048, 1024);
         assert_eq!(em.stats, st, "{view:?}");
         let finite_max = em
             .errors

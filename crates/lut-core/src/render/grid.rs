@@ -69,31 +69,54 @@ use super::scanline::emit;
 use super::setup::Setup;
 use super::sink::{RowSinks, Sink};
 use crate::geom::accuracy::u_scale;
-use crate::geom::camera::{dir_to_lat_long, Camera, View};
+use crate::geom::camera::{Camera, View};
 use crate::geom::fixed::to_fx;
-use crate::geom::mapping::exact_uv_at;
 use rayon::prelude::*;
 use std::f64::consts::TAU;
 
 /// Side of the largest grid cell, in output pixels.
 pub const GRID_CELL: u32 = 32;
 
-/// Side of the smallest grid cell; one that still fails its budget is evaluated exactly.
+/// Side of the smallest grid cell, evaluated exactly: its four pixels are its corner and
+/// the three points a measurement would take, so measuring it would cost more than
+/// evaluating it.
 pub const GRID_MIN_CELL: u32 = 2;
+const _: () = assert!(GRID_MIN_CELL == 2, "Leaf::Exact holds a 2x2 cell's pixels");
 
 /// The largest estimated sampling-position error (source pixels, angular metric) a grid
 /// cell may have; above it the cell splits (see the module docs).
 pub const GRID_CELL_BUDGET: f64 = 0.03;
 
+/// A cell whose estimate is above [`GRID_CELL_BUDGET`] but at most this (and whose
+/// estimate can be trusted) becomes its four half-size children without measuring them:
+/// halving the side quarters the interpolation error (second derivatives unchanged), so
+/// each child's estimate would be at most half the budget. This saves the measurement of
+/// most leaves (their five points cost more than the rest of the build).
+pub const GRID_HALVES_LIMIT: f64 = 2.0 * GRID_CELL_BUDGET;
+
+/// What to do with a measured cell.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Verdict {
+    /// One leaf.
+    Accept(Leaf),
+    /// Its four children, interpolated without measuring.
+    Halves,
+    /// Split and measure the children.
+    Split,
+}
+
 /// Largest |V| a node keeps (cylindrical maps far beyond their coverage).
 const V_CLAMP: f64 = 1e7;
 
-/// An exact node: Λ and V in map pixels, and the latitude (for the error metric).
-#[derive(Debug, Clone, Copy)]
+/// An exact node: Λ and V in map pixels, and the direction (λ, φ) (for the error metric
+/// and for exact pixels).
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct Node {
     l: f64,
     v: f64,
+    lambda: f64,
     phi: f64,
+    cos_phi: f64,
 }
 
 /// Where the view's projection has directions, in pixel coordinates.
@@ -176,13 +199,14 @@ impl Valid {
 }
 
 /// What a cell becomes.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 enum Leaf {
     /// Bilinear between the four corner nodes (Λ unwrapped, V): top-left, top-right,
     /// bottom-left, bottom-right.
     Interp([(f64, f64); 4]),
-    /// Every pixel evaluated exactly.
-    Exact,
+    /// A cell of the smallest size: its pixels (x0, y0), (x0 + 1, y0), (x0, y0 + 1),
+    /// (x0 + 1, y0 + 1) evaluated exactly (`None`: no direction, the background).
+    Exact([Option<Node>; 4]),
     /// Every pixel shows the background.
     Background,
 }
@@ -213,7 +237,7 @@ impl GridStats {
                 self.min_cell = self.min_cell.min(g);
                 self.max_cell = self.max_cell.max(g);
             }
-            Leaf::Exact => {
+            Leaf::Exact(_) => {
                 let (xs, ys) = ((x0 + g).min(w) - x0, (y0 + g).min(h) - y0);
                 self.exact_pixels += xs as u64 * ys as u64;
             }
@@ -279,7 +303,23 @@ impl<'a> Grid<'a> {
     /// The exact node at pixel-centre coordinates (x, y), or `None` without a direction.
     #[inline]
     fn node(&self, x: f64, y: f64) -> Option<Node> {
-        let (lambda, phi) = dir_to_lat_long(self.cam.ray(x, y)?);
+        let d = self.cam.ray(x, y)?;
+        // λ = atan2(X, Z), φ = atan2(Y, √(X² + Z²)) as `dir_to_lat_long`, with atan where
+        // the second argument is positive (the same angle to an ulp, at about half the
+        // instructions: the build is mostly these calls) and cos φ from the vector (the
+        // error metric's weight).
+        let horiz = (d.x * d.x + d.z * d.z).sqrt();
+        let lambda = if d.z > 0.0 {
+            (d.x / d.z).atan()
+        } else {
+            d.x.atan2(d.z)
+        };
+        let phi = if horiz > 0.0 {
+            (d.y / horiz).atan()
+        } else {
+            d.y.atan2(horiz)
+        };
+        let len = (horiz * horiz + d.y * d.y).sqrt();
         let v = self
             .fr
             .proj
@@ -288,7 +328,9 @@ impl<'a> Grid<'a> {
         Some(Node {
             l: lambda * self.lam_px,
             v,
+            lambda,
             phi,
+            cos_phi: if len > 0.0 { horiz / len } else { 0.0 },
         })
     }
 
@@ -313,7 +355,7 @@ impl<'a> Grid<'a> {
             let l = self.unwrap(n.l, r);
             lo = lo.min(l);
             hi = hi.max(l);
-            cos_min = cos_min.min(n.phi.cos());
+            cos_min = cos_min.min(n.cos_phi);
         }
         let margin = 1.0 + 2.0 * GRID_CELL_BUDGET / cos_min.max(1e-9);
         let half = self.fr.mw * 0.5;
@@ -354,10 +396,18 @@ impl<'a> Grid<'a> {
         if class == Class::Outside {
             return leaf(x0, y0, g, Leaf::Background);
         }
-        if g <= GRID_MIN_CELL && class == Class::Straddle {
-            return leaf(x0, y0, g, Leaf::Exact);
-        }
         let hf = gf * 0.5;
+        if g <= GRID_MIN_CELL {
+            // The smallest cell's four pixels are its corner and the three points a
+            // measurement would take: evaluate them and show them exactly.
+            let px = [
+                c[0],
+                self.node(xa + hf, ya),
+                self.node(xa, ya + hf),
+                self.node(xa + hf, ya + hf),
+            ];
+            return leaf(x0, y0, g, Leaf::Exact(px));
+        }
         // Top, left, centre, right, bottom: the children's new corners.
         let m = [
             self.node(xa + hf, ya),
@@ -366,30 +416,52 @@ impl<'a> Grid<'a> {
             self.node(xa + gf, ya + hf),
             self.node(xa + hf, ya + gf),
         ];
-        if class == Class::Inside {
-            if let Some(l) = self.interpolate(&c, &m) {
-                return leaf(x0, y0, g, l);
-            }
-        }
-        if g <= GRID_MIN_CELL {
-            return leaf(x0, y0, g, Leaf::Exact);
+        let verdict = if class == Class::Inside {
+            self.interpolate(&c, &m)
+        } else {
+            Verdict::Split
+        };
+        if let Verdict::Accept(l) = verdict {
+            return leaf(x0, y0, g, l);
         }
         let hg = g / 2;
         let [top, left, centre, right, bottom] = m;
-        self.cell(x0, y0, hg, [c[0], top, left, centre], leaf);
-        self.cell(x0 + hg, y0, hg, [top, c[1], centre, right], leaf);
-        self.cell(x0, y0 + hg, hg, [left, centre, c[2], bottom], leaf);
-        self.cell(x0 + hg, y0 + hg, hg, [centre, right, bottom, c[3]], leaf);
+        let children = [
+            (x0, y0, [c[0], top, left, centre]),
+            (x0 + hg, y0, [top, c[1], centre, right]),
+            (x0, y0 + hg, [left, centre, c[2], bottom]),
+            (x0 + hg, y0 + hg, [centre, right, bottom, c[3]]),
+        ];
+        for (cx, cy, k) in children {
+            if verdict == Verdict::Halves {
+                // The parent's estimate predicts a quarter of it for each half-size child
+                // (within half the budget): interpolated without measuring it.
+                if cx < self.w && cy < self.h {
+                    leaf(cx, cy, hg, self.leaf_of(&k));
+                }
+            } else {
+                self.cell(cx, cy, hg, k, leaf);
+            }
+        }
     }
 
-    /// The cell as one interpolated (or background) leaf, if its estimate is within
-    /// budget and the estimate can be trusted (see the module docs); `None`: split it.
-    fn interpolate(&self, c: &[Option<Node>; 4], m: &[Option<Node>; 5]) -> Option<Leaf> {
+    /// The interpolated leaf of corner nodes `k` (all with a direction), Λ unwrapped next
+    /// to the first.
+    fn leaf_of(&self, k: &[Option<Node>; 4]) -> Leaf {
+        let r = k[0].map_or(0.0, |n| n.l);
+        let at = |n: &Option<Node>| n.map_or((r, 0.0), |n| (self.unwrap(n.l, r), n.v));
+        Leaf::Interp([at(&k[0]), at(&k[1]), at(&k[2]), at(&k[3])])
+    }
+
+    /// What to do with a cell (see the module docs): one interpolated (or background)
+    /// leaf if its estimate is within budget and can be trusted; its four children as
+    /// leaves if the estimate is within [`GRID_HALVES_LIMIT`]; else split and measure.
+    fn interpolate(&self, c: &[Option<Node>; 4], m: &[Option<Node>; 5]) -> Verdict {
         let [Some(c0), Some(c1), Some(c2), Some(c3)] = *c else {
-            return None;
+            return Verdict::Split;
         };
         let [Some(top), Some(left), Some(centre), Some(right), Some(bottom)] = *m else {
-            return None;
+            return Verdict::Split;
         };
         let pts = [&c0, &c1, &c2, &c3, &top, &left, &centre, &right, &bottom];
         let p = self.fr.proj;
@@ -397,7 +469,12 @@ impl<'a> Grid<'a> {
         // cell's points: the errors below are weighted by it, not by each point's own.
         let (mut w_max, mut w_min) = (0.0f64, f64::INFINITY);
         for n in pts {
-            let w = u_scale(p, n.phi);
+            // cos φ / s(φ): cos φ on rectangular maps (s = 1).
+            let w = if self.fr.scaled {
+                u_scale(p, n.phi)
+            } else {
+                n.cos_phi
+            };
             w_max = w_max.max(w);
             w_min = w_min.min(w);
         }
@@ -425,7 +502,8 @@ impl<'a> Grid<'a> {
             } else {
                 dl
             };
-            (du * w_max).hypot(dv)
+            let du = du * w_max;
+            (du * du + dv * dv).sqrt()
         };
         let [k0, k1, k2, k3] = [k(&c0), k(&c1), k(&c2), k(&c3)];
         // Second differences along the rows (top edge, middle row, bottom edge) and the
@@ -442,19 +520,28 @@ impl<'a> Grid<'a> {
         // of the map the metric's weight changes fast (cos φ → 0), and near a singular
         // point of the view (the centre of a 360° little planet holds a hemisphere) the
         // scale does: split such cells rather than trust five points.
-        let len = |a: (f64, f64), b: (f64, f64)| ((b.0 - a.0) * w_max).hypot(b.1 - a.1);
+        let len = |a: (f64, f64), b: (f64, f64)| {
+            let (du, dv) = ((b.0 - a.0) * w_max, b.1 - a.1);
+            (du * du + dv * dv).sqrt()
+        };
         let even = |a: f64, b: f64| a.max(b) <= 2.0 * a.min(b) + 0.01;
         let smooth = w_max <= 2.0 * w_min
             && even(len(k0, k1), len(k2, k3))
             && even(len(k0, k2), len(k1, k3));
         if !smooth || (self.fr.scaled && self.crosses_seam(&pts, r)) {
-            return None;
+            return Verdict::Split;
         }
         if self.all_uncovered(&pts) {
-            return Some(Leaf::Background);
+            return Verdict::Accept(Leaf::Background);
         }
-        // NaN fails too.
-        (estimate <= GRID_CELL_BUDGET).then_some(Leaf::Interp([k0, k1, k2, k3]))
+        // NaN fails both.
+        if estimate <= GRID_CELL_BUDGET {
+            Verdict::Accept(Leaf::Interp([k0, k1, k2, k3]))
+        } else if estimate <= GRID_HALVES_LIMIT {
+            Verdict::Halves
+        } else {
+            Verdict::Split
+        }
     }
 
     /// Measure and draw the band of cells whose top row is `y0` into `rows` (its output
@@ -476,19 +563,15 @@ impl<'a> Grid<'a> {
                 Leaf::Interp(k) => {
                     self.draw_interp(rows, w, y0, (x0, cy0, cg), k, sinks, footprint);
                 }
-                Leaf::Exact => {
+                Leaf::Exact(px) => {
                     for r in ys {
                         let y = y0 as usize + r;
                         let mut s = sinks.sink(&mut rows[r * w..(r + 1) * w], y);
                         for x in xs.clone() {
-                            let uv = exact_uv_at(
-                                &self.cam,
-                                self.fr.proj,
-                                self.fr.mw,
-                                self.fr.mh,
-                                x as f64 + 0.5,
-                                y as f64 + 0.5,
-                            );
+                            let i = (x - x0 as usize) + 2 * (y - cy0 as usize);
+                            let uv = px[i].and_then(|n| {
+                                self.fr.proj.uv(n.lambda, n.phi, self.fr.mw, self.fr.mh)
+                            });
                             s.exact(x, uv);
                         }
                     }
