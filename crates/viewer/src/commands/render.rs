@@ -7,12 +7,12 @@ use crate::heatmap::{summary, write_error_map};
 use crate::lighting::{apply_lights, LightArgs};
 use crate::output::write_png_atomic;
 use crate::panorama::{coverage_text, heading_text, load_cube, load_panorama_partial};
-use crate::scene::{render_scene, Scene};
+use crate::scene::{measure_errors, render_scene, Scene};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use lut_core::{
-    ErrorMap, IndexStep, LutChoice, RenderOptions, RenderReport, RendererKind, Sampler, Surface,
-    View, ViewProjection, PANNINI_D_DEFAULT,
+    IndexStep, LutChoice, RenderOptions, RenderReport, RendererKind, Sampler, Surface, View,
+    ViewProjection, PANNINI_D_DEFAULT,
 };
 use std::path::PathBuf;
 
@@ -191,7 +191,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let mut out = vec![0u32; w as usize * h as usize];
     let report = render_scene(scene.as_mut(), view, &a.options(), &mut out, w, h)?;
     let error_map = if a.verbose || a.error_map.is_some() {
-        Some(measure_errors(&mut scene, view, &a.options(), w, h)?)
+        Some(
+            measure_errors(scene.as_mut(), view, &a.options(), w, h)
+                .context("cannot measure the sampling-position error")?,
+        )
     } else {
         None
     };
@@ -207,30 +210,6 @@ pub fn run(a: RenderArgs) -> Result<()> {
     apply_lights(&a.lights, view, &mut out, w, h)?;
     write_png_atomic(&a.output, &out, w, h)?;
     Ok(())
-}
-
-/// The error map of the renderer `opts` selects for `view` of `scene`.
-fn measure_errors(
-    scene: &mut Scene,
-    view: View,
-    opts: &RenderOptions,
-    w: u32,
-    h: u32,
-) -> Result<ErrorMap> {
-    let em = match scene {
-        Scene::Map { map, renderer } => {
-            ErrorMap::measure(renderer, lut_core::Scene::Map(map), view, opts, w, h)
-        }
-        Scene::Cube(cube) => ErrorMap::measure(
-            &mut lut_core::Renderer::default(),
-            lut_core::Scene::Cube(cube),
-            view,
-            opts,
-            w,
-            h,
-        ),
-    };
-    em.context("cannot measure the sampling-position error")
 }
 
 /// `-v`: what rendered the frame, on stderr.
