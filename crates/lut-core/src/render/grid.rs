@@ -33,7 +33,11 @@
 //! * it lies within twice its size of the edge of the valid area (below),
 //! * on elliptical and diamond maps, the seam may cross it (below).
 //!
-//! A cell of [`GRID_MIN_CELL`] pixels that still fails is evaluated exactly per pixel.
+//! A cell whose estimate is above the budget but within [`GRID_HALVES_LIMIT`] (twice it,
+//! and trusted) becomes its four half-size children without measuring them: halving the
+//! side quarters the interpolation error, so each child is within half the budget. A cell
+//! of [`GRID_MIN_CELL`] (2) pixels is never measured: its four pixels are its corner and
+//! the three points a measurement would take, so they are evaluated and drawn exactly.
 //! The bound is not proven: it is measured, over random views of every output
 //! projection on every map projection and over the hard views (`tests/views.rs`).
 //!
