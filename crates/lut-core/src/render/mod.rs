@@ -269,6 +269,20 @@ pub struct RenderReport {
     pub min_step: u32,
 }
 
+impl RenderReport {
+    /// The report of the exact renderer: every one of `pixels` evaluated exactly.
+    fn exact(pixels: u64) -> RenderReport {
+        RenderReport {
+            path: RenderPath::Exact,
+            exact_pixels: pixels,
+            pixels,
+            table_bytes: 0,
+            max_step: 1,
+            min_step: 1,
+        }
+    }
+}
+
 /// Sampling positions of a frame, row-major; `None` where the background shows.
 pub type Positions = Vec<Option<(f64, f64)>>;
 
@@ -413,14 +427,7 @@ impl Renderer {
         };
         if opts.renderer == RendererKind::Exact {
             render_exact(map, view, opts.sampler, frame, opts.threads);
-            return Ok(RenderReport {
-                path: RenderPath::Exact,
-                exact_pixels: pixels,
-                pixels,
-                table_bytes: 0,
-                max_step: 1,
-                min_step: 1,
-            });
+            return Ok(RenderReport::exact(pixels));
         }
         self.set_geometry(map.width(), map.height(), map.projection());
         if uses_grid(view, opts) {
@@ -562,15 +569,7 @@ impl Renderer {
                     *p = exact_uv(&cam, projection, mw, mh, x as u32, y as u32);
                 }
             });
-            let report = RenderReport {
-                path: RenderPath::Exact,
-                exact_pixels: pixels,
-                pixels,
-                table_bytes: 0,
-                max_step: 1,
-                min_step: 1,
-            };
-            return Ok((out, report));
+            return Ok((out, RenderReport::exact(pixels)));
         }
         if uses_grid(view, opts) {
             let setup = Setup::new(width, (map_w, map_h, projection), 0.0);
