@@ -5,9 +5,10 @@
 //!   pitch and clamp hfov to the new projection's [`widest_hfov`].
 //! * [`Controller::toggle_planet`]: into the little planet (stereographic, pitch −90°,
 //!   hfov [`PLANET_HFOV`]) and back to the look it left, each way over [`PLANET_S`]
-//!   seconds (eased; yaw, pitch and hfov move together in the stereographic projection,
-//!   which at the ends equals the view it leaves or reaches but for a rectilinear start,
-//!   whose projection comes back at the end). Any input finishes a transition at once.
+//!   seconds (eased; yaw, pitch and hfov move together in the stereographic projection).
+//!   The glide starts (and ends) at the stereographic hfov with the same centre scale as
+//!   the look it leaves (returns to), so the centre of the picture does not jump where the
+//!   projection changes; only the periphery does. Any input finishes a transition at once.
 
 use super::{Controller, Look, HFOV_MAX, HFOV_MIN};
 use lut_core::{wrap_deg, Named, ViewProjection};
@@ -34,6 +35,14 @@ pub fn widest_hfov(p: ViewProjection) -> f64 {
         _ => WIDE_HFOV_MAX,
     };
     max.min(cap).max(HFOV_MIN)
+}
+
+/// The stereographic hfov whose centre scale (the focal length: every projection maps
+/// small angles θ to radius f·θ) equals `l`'s.
+fn stereo_hfov_like(l: Look) -> f64 {
+    let f = l.projection.focal(1000, l.hfov.to_radians());
+    let h = (4.0 * (250.0 / f).atan()).to_degrees();
+    h.clamp(HFOV_MIN, widest_hfov(ViewProjection::Stereographic))
 }
 
 /// The little planet: the look to return to and the transition in progress.
@@ -86,7 +95,7 @@ impl Controller {
         self.finish_planet_transition();
         let stereo = ViewProjection::Stereographic;
         let l = self.look;
-        let from = Look::in_projection(l.yaw, l.pitch, l.hfov, stereo);
+        let from = Look::in_projection(l.yaw, l.pitch, stereo_hfov_like(l), stereo);
         let (back, to, leaving) = match self.planet {
             None => (
                 l,
@@ -95,7 +104,8 @@ impl Controller {
             ),
             Some(p) => {
                 let b = p.back;
-                (b, Look::in_projection(b.yaw, b.pitch, b.hfov, stereo), true)
+                let to = Look::in_projection(b.yaw, b.pitch, stereo_hfov_like(b), stereo);
+                (b, to, true)
             }
         };
         let moving = Some(Transition {
@@ -249,7 +259,10 @@ mod tests {
         let mid = c.look();
         assert_eq!(mid.projection, ViewProjection::Stereographic);
         close(mid.pitch, (10.0 - 90.0) / 2.0, 1e-9, "pitch half way");
-        close(mid.hfov, (80.0 + PLANET_HFOV) / 2.0, 1e-9, "hfov half way");
+        // From the stereographic hfov with rectilinear 80°'s centre scale (91.0°).
+        let h0 = 4.0 * (40f64.to_radians().tan() / 2.0).atan().to_degrees();
+        close(h0, 91.0, 0.05, "matched hfov");
+        close(mid.hfov, (h0 + PLANET_HFOV) / 2.0, 1e-9, "hfov half way");
         assert!(
             c.frame(1.0 + PLANET_S / 2.0 + 0.05).fast,
             "the transition is motion"
@@ -273,6 +286,9 @@ mod tests {
         assert!(!c.in_planet());
         c.frame(4.0 + PLANET_S / 3.0);
         assert_eq!(c.look().projection, ViewProjection::Stereographic);
+        // Just before the end: the stereographic hfov of the same centre scale.
+        c.frame(4.0 + PLANET_S * 0.999);
+        close(c.look().hfov, h0, 1e-3, "glides to the matched hfov");
         c.frame(4.0 + PLANET_S + 0.01);
         assert_eq!(c.look(), start);
         assert!(!c.animating());
