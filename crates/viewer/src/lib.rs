@@ -15,6 +15,7 @@
 //! * [`scene`]: a map or a cube map, and [`scene::render_scene`], the one place either
 //!   is rendered.
 //! * [`lighting`]: luminaires lighting a rendered room (`--light`, the panel's lights).
+//! * [`heatmap`]: the error heat map as an image with its legend (`render --error-map`).
 //! * [`output`]: images written atomically (format by extension, special files written
 //!   into, inputs never overwritten).
 //! * [`exit`]: exit statuses (0, 1 for files, 2 for usage), usage errors, standard
@@ -28,6 +29,7 @@ pub mod assets;
 pub mod cli;
 pub mod commands;
 pub mod exit;
+pub mod heatmap;
 pub mod lighting;
 pub mod output;
 pub mod panorama;

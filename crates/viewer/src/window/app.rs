@@ -48,6 +48,7 @@ struct SceneKey {
     index_step: IndexStep,
     lut: LutChoice,
     cube_renderer: CubeRenderer,
+    heat_map: bool,
     map_generation: u64,
     lights: LightsKey,
 }
