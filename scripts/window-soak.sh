@@ -15,7 +15,7 @@
 # (a turn, then R back to the start view; Ctrl+Q exits 0), and — for runs of 5 minutes
 # or more — the resident memory stays flat after the warm-up (the first fifth of the run,
 # at least 60 s): every twelfth of the run the soak returns to one checkpoint state (the
-# sample panorama loaded, MAX_LIGHTS lights, 800x500, idle) and reads VmRSS; every
+# sample panorama loaded, MAX_LIGHTS lights, rectilinear, 800x500, idle) and reads VmRSS; every
 # checkpoint after the warm-up must be within 5 % of the first one after it. (The
 # once-a-second curve is reported too, not judged: it follows what is on show — a cube,
 # an EXR, how many lights.) Shorter runs (CI's minute) report without judging: their
@@ -215,7 +215,7 @@ act_wheel() {
   local b=$((4 + $(rnd 2))) n=$((1 + $(rnd 5))) i
   for i in $(seq 1 "$n"); do xdotool click "$b"; sleep 0.03; done
 }
-KEYS=(Left Right Up Down a d w s plus minus r bracketleft bracketright Tab space question F1)
+KEYS=(Left Right Up Down a d w s plus minus r bracketleft bracketright Tab space question F1 v l)
 act_key() { key "${KEYS[$(rnd ${#KEYS[@]})]}"; }
 # Hide the panel and show it again (H), so the panel clicks find it.
 act_panel_toggle() { key h; sleep 0.3; key h; }
@@ -242,8 +242,10 @@ drop_file() {
   DROPS_OK=$((DROPS_OK + 1))
   echo "$(basename "$1")" >>"$OUT/dropped.txt"
 }
-# The lights of the last frame (each dropped IES file adds one; the panel removes them).
+# The lights of the last frame (each dropped IES file adds one; the panel removes them),
+# and its output projection (V cycles them; the panel sets them).
 lights_now() { grep '^view ' "$VIEWLOG" | tail -n 1 | sed -n 's/.* lights=\([0-9]*\).*/\1/p'; }
+proj_now() { grep '^view ' "$VIEWLOG" | tail -n 1 | sed -n 's/.* proj=\([a-z]*\).*/\1/p'; }
 MAX_LIGHTS=3
 act_drop() {
   local f
@@ -279,10 +281,11 @@ idle() {
   return 1
 }
 # A checkpoint: the same state every time — dialogs, help and fullscreen closed, the
-# window at 800x500, the sample panorama loaded, MAX_LIGHTS lights, idle — and its
+# window at 800x500, the sample panorama loaded, MAX_LIGHTS lights, the rectilinear
+# projection, idle — and its
 # resident memory. The memory of the checkpoints after the warm-up is what is judged.
 CHECKS=$OUT/checkpoints.csv
-echo "seconds,rss_kb,lights" >"$CHECKS"
+echo "seconds,rss_kb,lights,projection" >"$CHECKS"
 checkpoint() {
   local n l
   for _ in 1 2 3; do key Escape; sleep 0.2; done
@@ -300,8 +303,14 @@ checkpoint() {
     drop_file "$F/lamp.ies"
     wait_new "^view .*lights=$((l + 1))\$" "$n" 30 || true
   done
+  for _ in 1 2 3 4 5 6; do
+    [ "$(proj_now)" != rectilinear ] || break
+    n=$(lines)
+    key v
+    wait_new '^view ' "$n" 30 || true
+  done
   idle || log "checkpoint: the window did not become idle in 40 s"
-  echo "$((SECONDS - START)),$(awk '/^VmRSS:/ {print $2}' "/proc/$VIEWER_PID/status"),$(lights_now)" >>"$CHECKS"
+  echo "$((SECONDS - START)),$(awk '/^VmRSS:/ {print $2}' "/proc/$VIEWER_PID/status"),$(lights_now),$(proj_now)" >>"$CHECKS"
 }
 act_save() {
   local n
@@ -379,7 +388,7 @@ ERRORS=$(sort -u "$ERRLOG" | grep -c '^viewer: ' || true)
 "$PY" - "$CSV" "$CHECKS" "$OUT/rss-table.md" <<'EOF' >"$OUT/memory.txt"
 import csv, statistics, sys
 rows = [(float(r["seconds"]), int(r["rss_kb"])) for r in csv.DictReader(open(sys.argv[1]))]
-checks = [(float(r["seconds"]), int(r["rss_kb"]), r["lights"]) for r in csv.DictReader(open(sys.argv[2]))]
+checks = [(float(r["seconds"]), int(r["rss_kb"]), r["lights"], r["projection"]) for r in csv.DictReader(open(sys.argv[2]))]
 if len(rows) < 10:
     print("FLAT no: too few samples"); sys.exit()
 end = rows[-1][0]
@@ -398,13 +407,13 @@ with open(sys.argv[3], "w") as f:
     for i, p in enumerate(parts):
         if p:
             f.write(f"| {warm + i*span:.0f} | {warm + (i+1)*span:.0f} | {min(p)/1024:.1f} | {statistics.median(p)/1024:.1f} | {max(p)/1024:.1f} |\n")
-    f.write("\nCheckpoints (the same state each time: the sample loaded, the same lights, 800x500, idle):\n\n")
-    f.write("| s | RSS MiB | lights |\n|---:|---:|---:|\n")
-    for t, kb, lights in checks:
-        f.write(f"| {t:.0f}{' (warm-up)' if t < warm else ''} | {kb/1024:.1f} | {lights} |\n")
+    f.write("\nCheckpoints (the same state each time: the sample loaded, the same lights and projection, 800x500):\n\n")
+    f.write("| s | RSS MiB | lights | projection |\n|---:|---:|---:|---|\n")
+    for t, kb, lights, proj in checks:
+        f.write(f"| {t:.0f}{' (warm-up)' if t < warm else ''} | {kb/1024:.1f} | {lights} | {proj} |\n")
 print(f"warm-up {warm:.0f} s; every second after it: {min(kb for _, kb in after)/1024:.1f} to "
       f"{max(kb for _, kb in after)/1024:.1f} MiB (what is on show varies)")
-judged = [(t, kb) for t, kb, _ in checks if t >= warm]
+judged = [(t, kb) for t, kb, _, _ in checks if t >= warm]
 if len(judged) < 3:
     print(f"FLAT no: {len(judged)} checkpoints after the warm-up, 3 needed"); sys.exit()
 ref = judged[0][1]
