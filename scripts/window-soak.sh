@@ -31,12 +31,13 @@
 #   --install     apt-get the X tools first (as scripts/window-smoke.sh --install, plus
 #                 python3-xlib for the drops)
 #   --no-build    use the existing release binary
-# Honours CARGO_TARGET_DIR; VIEWER_BIN=path tests another binary (implies --no-build).
+# Honours CARGO_TARGET_DIR; VIEWER_BIN=path tests another binary (implies --no-build);
+# SOAK_OUT=folder puts the output elsewhere.
 set -euo pipefail
 
 cd "$(dirname "$0")/.."
 ROOT=$PWD
-OUT=$ROOT/target/window-soak
+OUT=${SOAK_OUT:-$ROOT/target/window-soak}
 DURATION=600
 SEED=1
 INSTALL=0
@@ -47,7 +48,7 @@ while [ $# -gt 0 ]; do
     --seed) SEED=$2; shift ;;
     --install) INSTALL=1 ;;
     --no-build) BUILD=0 ;;
-    -h|--help) sed -n '2,35p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,36p' "$0"; exit 0 ;;
     *) echo "window-soak: unknown argument '$1'" >&2; exit 2 ;;
   esac
   shift
@@ -217,6 +218,14 @@ act_wheel() {
 }
 KEYS=(Left Right Up Down a d w s plus minus r bracketleft bracketright Tab space question F1 v l)
 act_key() { key "${KEYS[$(rnd ${#KEYS[@]})]}"; }
+# A click in the scene, away from the panel: a panel text field or number being edited
+# (a click on a number edits it) gives the keyboard back to the shortcuts.
+unfocus() {
+  geom
+  move "$((X + (WIDTH > 300 ? WIDTH - 230 : WIDTH) / 2))" "$((Y + HEIGHT / 2))"
+  xdotool click 1
+  sleep 0.2
+}
 # Hide the panel and show it again (H), so the panel clicks find it.
 act_panel_toggle() { key h; sleep 0.3; key h; }
 # The next or previous file of the current one's folder (the drop folder: bad files too).
@@ -289,6 +298,7 @@ echo "seconds,rss_kb,lights,projection" >"$CHECKS"
 checkpoint() {
   local n l
   for _ in 1 2 3; do key Escape; sleep 0.2; done
+  unfocus
   xdotool windowmap "$WID" 2>/dev/null || true
   xdotool windowsize "$WID" 800 500
   sleep 0.5
@@ -352,6 +362,7 @@ sleep 1
 # for its load, turn (a new frame), then R: the start view of the sample is rendered.
 # (R on a view already at its start renders nothing: hence the turn first.)
 for _ in 1 2 3; do key Escape; sleep 0.3; done
+unfocus
 N=$(lines)
 drop_file "$F/pano.jpg"
 wait_for "^loaded $F/pano.jpg" "$N" 60
