@@ -268,6 +268,29 @@ fn a_damaged_dwab_exr_is_refused_within_bounded_memory() {
     assert!(e.to_string().contains("cut.exr"), "{e}");
 }
 
+/// Found by the `map_exr` fuzz target: a damaged B44A block whose differences underflow.
+/// exr's B44 decoder computes them in unsigned arithmetic that wraps, as OpenEXR's C
+/// reference does; with overflow checks on (this profile, the fuzz build) it panicked.
+/// exr is now built without overflow checks in every profile (Cargo.toml): the file
+/// decodes to whatever its blocks say (B44 has no checksum) or is refused, never a panic.
+#[test]
+fn a_damaged_b44a_exr_does_not_panic() {
+    let bytes = std::fs::read(test_support::test_data("fuzz/map_exr-b44a-underflow.exr")).unwrap();
+    let opts = LoadOptions {
+        projection: Some(Projection::Elliptical),
+        max_pixels: 1 << 18,
+        ..LoadOptions::default()
+    };
+    let r = std::panic::catch_unwind(|| {
+        lut_core::decode_map(&bytes, "b44a.exr", &opts, &mut |_| {})
+            .map(|m| (m.width(), m.height()))
+    });
+    let r = r.expect("decoding a damaged B44A file panicked");
+    if let Ok((w, h)) = r {
+        assert!(w >= 1 && h >= 1 && u64::from(w) * u64::from(h) <= 1 << 18);
+    }
+}
+
 #[test]
 fn a_luminance_only_exr_loads_as_gray() {
     use exr::prelude::{Blocks, Compression};
