@@ -523,6 +523,44 @@ impl EnvMap {
         }
     }
 
+    /// A run of [`EnvMap::nearest_cropped`] (`BILINEAR` false) or
+    /// [`EnvMap::bilinear_cropped`] samples at full-panorama positions (u + i·du,
+    /// v + i·dv), u wrapped per pixel. Spans inside the stored pixels or wholly in the
+    /// background take the span kernels ([`crate::Kernel::cropped_span`]); spans over the
+    /// crop's edge are sampled per pixel.
+    pub fn sample_span_cropped<const BILINEAR: bool>(
+        &self,
+        out: &mut [u32],
+        u: Fx,
+        v: Fx,
+        du: Fx,
+        dv: Fx,
+    ) {
+        let Some(c) = self.crop else {
+            return self.sample_span::<BILINEAR>(out, u, v, du, dv);
+        };
+        let w = crate::simd::Window {
+            full_width: c.full_width,
+            full_height: c.full_height,
+            left: c.left,
+            top: c.top,
+            background: self.background,
+        };
+        if crate::simd::cropped_span(BILINEAR, &self.texels(), &w, out, u, v, du, dv) {
+            return;
+        }
+        let (mut u, mut v) = (u, v);
+        for o in out.iter_mut() {
+            *o = if BILINEAR {
+                self.bilinear_cropped(u, v)
+            } else {
+                self.nearest_cropped(u, v)
+            };
+            u += du;
+            v += dv;
+        }
+    }
+
     /// [`EnvMap::sample`] for a partial map.
     #[inline]
     pub(crate) fn sample_cropped(&self, sampler: Sampler, u: Fx, v: Fx) -> u32 {

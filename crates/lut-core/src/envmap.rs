@@ -7,7 +7,7 @@
 //! `H − 1` (vertical clamp).
 
 use crate::error::MapError;
-use crate::fixed::{Fx, FX_BITS, FX_HALF, FX_ONE};
+use crate::fixed::{Fx, FX_BITS, FX_HALF};
 use crate::projection::Projection;
 use std::path::Path;
 
@@ -316,69 +316,31 @@ impl EnvMap {
     /// / [`EnvMap::nearest`] per pixel with u wrapped into [0, W) for 360° maps.
     ///
     /// This is the LUT renderer's inner loop. When the whole run stays inside the map
-    /// (after one wrap of its start), the loop has no clamps and no wrap tests: the
-    /// padding column and row make x + 1 and y + 1 readable at the last column and row.
-    /// Otherwise it falls back to the per-pixel functions.
+    /// (after one wrap of its start), it runs the span kernel ([`crate::Kernel`]: no clamps,
+    /// no wrap tests, SIMD where the CPU has it). Otherwise it falls back to the per-pixel
+    /// functions.
     #[inline]
     pub fn sample_span<const BILINEAR: bool>(&self, out: &mut [u32], u: Fx, v: Fx, du: Fx, dv: Fx) {
-        let m = out.len() as i64;
-        if m == 0 {
-            return;
-        }
-        let wfx = (self.width as i64) << FX_BITS;
-        let hfx = (self.height as i64) << FX_BITS;
-        // Bilinear reads the pixel centres around (u − ½, v − ½).
-        let bias = if BILINEAR { FX_HALF } else { 0 };
-        let wraps = self.projection.wraps();
-        let mut uu = u - bias;
-        if wraps && !(0..wfx).contains(&uu) {
-            // One period off at most on the renderer's path; a division otherwise.
-            uu += if uu < 0 { wfx } else { -wfx };
-            if !(0..wfx).contains(&uu) {
-                uu = uu.rem_euclid(wfx);
-            }
-        }
-        let mut vv = v - bias;
-        let (u_end, v_end) = (uu + du * (m - 1), vv + dv * (m - 1));
-        // Nearest may read column W and row H (padding equal to the clamped pixel);
-        // bilinear needs x0, y0 ≤ W − 1, H − 1 so that x0 + 1, y0 + 1 are the padding.
-        let (u_lim, v_lim) = if BILINEAR {
-            (wfx, hfx)
+        let t = self.texels();
+        let done = if BILINEAR {
+            crate::simd::bilinear_span(&t, out, u, v, du, dv)
         } else {
-            (wfx + FX_ONE, hfx + FX_ONE)
+            crate::simd::nearest_span(&t, out, u, v, du, dv)
         };
-        let inside = |a: Fx, lim: Fx| a >= 0 && a < lim;
-        if !(inside(uu, u_lim) && inside(u_end, u_lim) && inside(vv, v_lim) && inside(v_end, v_lim))
-        {
+        if !done {
             self.sample_span_slow::<BILINEAR>(out, u, v, du, dv);
-            return;
         }
-        let stride = self.width as usize + 1;
-        let data = &self.data[..];
-        if BILINEAR {
-            for o in out.iter_mut() {
-                let x0 = (uu >> FX_BITS) as usize;
-                let y0 = (vv >> FX_BITS) as usize;
-                let fx = ((uu >> (FX_BITS - 8)) & 0xFF) as u32;
-                let fy = ((vv >> (FX_BITS - 8)) & 0xFF) as u32;
-                let i = y0 * stride + x0;
-                // One bounds check for the 2×2 block.
-                let q = &data[i..i + stride + 2];
-                *o = lerp_px(
-                    lerp_px(q[0], q[1], fx),
-                    lerp_px(q[stride], q[stride + 1], fx),
-                    fy,
-                );
-                uu += du;
-                vv += dv;
-            }
-        } else {
-            for o in out.iter_mut() {
-                *o = data[(vv >> FX_BITS) as usize * stride + (uu >> FX_BITS) as usize];
-                uu += du;
-                vv += dv;
-            }
-        }
+    }
+
+    /// The stored pixels as the span kernels read them.
+    #[inline]
+    pub(crate) fn texels(&self) -> crate::simd::Texels<'_> {
+        // A partial map's stored pixels wrap only when the crop spans 360°.
+        let wraps = self
+            .crop
+            .map_or(self.projection.wraps(), |c| c.width() == c.full_width());
+        crate::simd::Texels::new(&self.data, self.width, self.height, wraps)
+            .expect("a map holds (width + 1) x (height + 1) pixels, fewer than 2^31")
     }
 
     #[inline(never)]

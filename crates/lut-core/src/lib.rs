@@ -65,6 +65,7 @@ pub mod projection;
 pub mod pyramid;
 pub mod raster;
 mod rows;
+mod simd;
 pub mod synth;
 pub mod viewlimit;
 
@@ -77,5 +78,9 @@ pub use load::{LoadOptions, LoadPhase, LoadProgress, DEFAULT_MAX_PIXELS};
 pub use projection::Projection;
 pub use raster::{
     IndexStep, LutChoice, RenderOptions, RenderPath, RenderReport, Renderer, RendererKind,
+};
+pub use simd::{
+    active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
+    KernelError, KernelInfo, KernelSource, Lod, Texels, Window, KERNEL_ENV, TRILINEAR_CHUNK,
 };
 pub use viewlimit::limit_view;

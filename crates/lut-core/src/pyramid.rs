@@ -112,6 +112,14 @@ impl EnvMap {
         let frac = (lod & 0xFF) as u32;
         let (a_map, ka) = self.level(k);
         let (b_map, kb) = self.level(k + 1);
+        if frac != 0 && kb != ka {
+            let lv = crate::simd::Lod { ka, kb, frac };
+            let levels = (&a_map.texels(), &b_map.texels());
+            if crate::simd::trilinear_span(levels, lv, out, u, v, du, dv) {
+                return;
+            }
+        }
+        // A level's span leaves its map: per level, with the per-pixel fallbacks.
         a_map.sample_span::<true>(out, u >> ka, v >> ka, du >> ka, dv >> ka);
         if frac == 0 || kb == ka {
             return;

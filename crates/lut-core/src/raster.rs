@@ -251,9 +251,10 @@ impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CR
         };
     }
     #[inline(always)]
-    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, w_fx: Fx) {
+    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
         if CROP {
-            put_run(self, x, m, (u, v), (du, dv), w_fx); // per pixel: the crop test
+            self.map
+                .sample_span_cropped::<BILINEAR>(&mut self.row[x..x + m], u, v, du, dv);
         } else {
             self.map
                 .sample_span::<BILINEAR>(&mut self.row[x..x + m], u, v, du, dv);

@@ -1,0 +1,377 @@
+//! Span kernels: the LUT renderer's inner loops, in portable scalar code and in x86-64
+//! SIMD (SSE4.1, AVX2), chosen once per process.
+//!
+//! A *span* is a run of output pixels whose map positions step linearly in Q.16:
+//! pixel `i` samples (u + i·du, v + i·dv). The renderer reads its table every 8–64
+//! pixels and hands each span to these kernels; a span that stays inside the map (checked
+//! at its two ends: positions are linear, so every pixel between is inside too) is
+//! sampled with no clamps or wraps, the padding column and row of the map making x + 1
+//! and y + 1 readable at the last column and row. A span that leaves the map is refused
+//! (the functions return `false`, nothing is written) and the caller samples it per pixel.
+//!
+//! The kernels take plain data ([`Texels`]: the padded pixel slice and its size) and
+//! Q.16 coordinates, so they do not depend on the rest of the crate.
+//!
+//! # Identical bytes
+//! Every SIMD kernel computes exactly what its scalar twin in `scalar.rs` computes: the
+//! same 8-bit weights, the same rounding (`(a·(256 − w) + b·w + 128) >> 8` per channel, in
+//! 16-bit lanes where it cannot overflow: at most 255·256 + 128), the same positions. The
+//! property tests in `tests.rs` compare the bytes of every available kernel with the
+//! scalar one over random spans (the seam, the last column and row, the poles, partial
+//! maps, lengths 1..=64, odd output offsets, negative and huge steps, 1×1 and 2×1 maps,
+//! 65536-wide maps). The whole test suite also runs with the scalar kernel forced
+//! (`LUTPANO_KERNEL=scalar`, see `scripts/test.sh`).
+//!
+//! # Positions in 32-bit lanes
+//! Q.16 positions of a 65536-wide map reach 2³² and do not fit an `i32` lane. The SIMD
+//! kernels split the span's start into a whole pixel (x₀, y₀), folded into one base
+//! index, and a fraction f < 1; lanes hold the span-local `f + i·du`, exact in `i32` as
+//! long as `|du|·(len − 1) + 1` stays below 2³¹ (32768 map pixels of travel per span).
+//! Spans that travel further (only far zoomed out on a huge map) run the scalar kernel.
+//! Lane indices are also clamped to the slice before each load, so memory safety never
+//! rests on that arithmetic; equality with the scalar twin is what the tests prove.
+//!
+//! # Loads, not gathers
+//! Each bilinear pixel reads its 2×2 block with two 64-bit loads (top pair, bottom pair)
+//! from lane indices stored to the stack; two `shufps` then separate the left and right
+//! texels of 8 pixels. Hardware gathers (`vpgatherdd`/`vpgatherdq`) were measured slower
+//! on this CPU (see `docs/performance.md`).
+//!
+//! # Choosing the kernel once
+//! [`active_kernel`] is decided on first use: the `LUTPANO_KERNEL` environment variable
+//! (`auto`, `scalar`, `sse41`, `avx2`; read once) or else the best kernel the CPU runs
+//! ([`Kernel::best`], from `is_x86_feature_detected!`). [`set_kernel`] changes it (the
+//! benchmarks compare kernels in one run); [`kernel_info`] tells what runs and which CPU
+//! features were detected. The choice is one relaxed atomic load per span, never a test
+//! per pixel.
+//!
+//! Why not a crate: `multiversion` (0.9, MIT/Apache-2.0, maintained) compiles one generic
+//! function for several targets, but these kernels are different code per instruction set
+//! (a 4-lane and an 8-lane layout, scalar index arithmetic), and its dispatcher cannot be
+//! forced to a lower level at run time, which the tests and benchmarks need. `pulp`
+//! (0.22, MIT, maintained) is a portable SIMD abstraction whose API changes between 0.x
+//! releases and does not express the paired 64-bit loads and byte shuffles these kernels
+//! are made of. The standard library's detection (itself cached in an atomic) plus one
+//! atomic byte for the choice is all the dispatch needs.
+//!
+//! aarch64 and x86 CPUs without SSE4.1 run the scalar kernel.
+
+mod scalar;
+mod select;
+#[cfg(test)]
+mod tests;
+#[cfg(target_arch = "x86_64")]
+mod x86;
+
+use select::{active, Selected};
+pub use select::{
+    active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
+    KernelError, KernelInfo, KernelSource, KERNEL_ENV,
+};
+
+use crate::fixed::{Fx, FX_BITS, FX_HALF, FX_ONE};
+
+/// Longest span the trilinear kernel blends in one piece (the second level restarts its
+/// position every this many pixels, as the per-pixel path always has).
+pub const TRILINEAR_CHUNK: usize = 64;
+
+/// A map's pixels as the kernels read them: `(width + 1) × (height + 1)` 0RGB `u32`,
+/// row-major, the last column and row being padding (column `width` repeats column 0
+/// for maps that wrap horizontally, else column `width − 1`; row `height` repeats row
+/// `height − 1`).
+#[derive(Debug, Clone, Copy)]
+pub struct Texels<'a> {
+    px: &'a [u32],
+    width: u32,
+    height: u32,
+    wraps: bool,
+}
+
+impl<'a> Texels<'a> {
+    /// The padded pixels of a `width × height` map; `wraps`: the map is 360° wide (a
+    /// span may start one period off and is wrapped once). `None` when `px` does not
+    /// hold `(width + 1) × (height + 1)` pixels, a side is 0, or it holds 2³¹ or more.
+    pub fn new(px: &'a [u32], width: u32, height: u32, wraps: bool) -> Option<Texels<'a>> {
+        let n = (width as usize + 1).checked_mul(height as usize + 1)?;
+        (width > 0 && height > 0 && px.len() == n && n <= i32::MAX as usize).then_some(Texels {
+            px,
+            width,
+            height,
+            wraps,
+        })
+    }
+
+    /// Pixels per row, padding included.
+    #[inline(always)]
+    pub fn stride(&self) -> usize {
+        self.width as usize + 1
+    }
+}
+
+/// A partial map's place in the full panorama, for [`Kernel::cropped_span`]: the stored
+/// [`Texels`] hold columns `left..left + width` (mod `full_width`) and rows
+/// `top..top + height` of a `full_width × full_height` panorama.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Window {
+    /// Full panorama width in pixels.
+    pub full_width: u32,
+    /// Full panorama height in pixels.
+    pub full_height: u32,
+    /// First stored column, in `0..full_width`.
+    pub left: u32,
+    /// First stored row.
+    pub top: u32,
+    /// The background colour (0RGB) outside the stored pixels.
+    pub background: u32,
+}
+
+/// Level of detail of a trilinear span: level-0 positions are shifted right by `ka` for
+/// the first level and by `kb` for the second, and the two bilinear samples blended
+/// with weight `frac` (0..=255, out of 256) towards the second.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Lod {
+    /// Shift of the first level.
+    pub ka: u32,
+    /// Shift of the second level.
+    pub kb: u32,
+    /// Blend weight towards the second level.
+    pub frac: u32,
+}
+
+/// A span checked to lie inside its map: the start (already biased by −½ for bilinear
+/// and wrapped into the map) and the step, Q.16.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Span {
+    u: Fx,
+    v: Fx,
+    du: Fx,
+    dv: Fx,
+}
+
+/// [`Kernel::nearest_span`] with the [`active_kernel`].
+#[inline]
+pub(crate) fn nearest_span(t: &Texels, out: &mut [u32], u: Fx, v: Fx, du: Fx, dv: Fx) -> bool {
+    span::<false>(active(), t, out, (u, v), (du, dv))
+}
+
+/// [`Kernel::bilinear_span`] with the [`active_kernel`].
+#[inline]
+pub(crate) fn bilinear_span(t: &Texels, out: &mut [u32], u: Fx, v: Fx, du: Fx, dv: Fx) -> bool {
+    span::<true>(active(), t, out, (u, v), (du, dv))
+}
+
+/// [`Kernel::trilinear_span`] with the [`active_kernel`].
+#[inline]
+pub(crate) fn trilinear_span(
+    levels: (&Texels, &Texels),
+    lod: Lod,
+    out: &mut [u32],
+    u: Fx,
+    v: Fx,
+    du: Fx,
+    dv: Fx,
+) -> bool {
+    trilinear(active(), levels, lod, out, (u, v), (du, dv))
+}
+
+/// [`Kernel::cropped_span`] with the [`active_kernel`].
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn cropped_span(
+    bilinear: bool,
+    t: &Texels,
+    w: &Window,
+    out: &mut [u32],
+    u: Fx,
+    v: Fx,
+    du: Fx,
+    dv: Fx,
+) -> bool {
+    cropped(active(), bilinear, t, w, out, (u, v), (du, dv))
+}
+
+/// Check a span and wrap its start (see [`Kernel::nearest_span`]).
+#[inline(always)]
+fn prepare<const BILINEAR: bool>(t: &Texels, m: usize, uv: (Fx, Fx), d: (Fx, Fx)) -> Option<Span> {
+    let wfx = (t.width as i64) << FX_BITS;
+    let hfx = (t.height as i64) << FX_BITS;
+    // Bilinear reads the pixel centres around (u − ½, v − ½).
+    let bias = if BILINEAR { FX_HALF } else { 0 };
+    let mut uu = uv.0.checked_sub(bias)?;
+    if t.wraps && !(0..wfx).contains(&uu) {
+        // One period off at most on the renderer's path; a division otherwise.
+        uu += if uu < 0 { wfx } else { -wfx };
+        if !(0..wfx).contains(&uu) {
+            uu = uu.rem_euclid(wfx);
+        }
+    }
+    let vv = uv.1.checked_sub(bias)?;
+    let n = m as i64 - 1;
+    let u_end = uu.checked_add(d.0.checked_mul(n)?)?;
+    let v_end = vv.checked_add(d.1.checked_mul(n)?)?;
+    // Nearest may read column W and row H (padding equal to the clamped pixel);
+    // bilinear needs x0, y0 ≤ W − 1, H − 1 so that x0 + 1, y0 + 1 are the padding.
+    let (u_lim, v_lim) = if BILINEAR {
+        (wfx, hfx)
+    } else {
+        (wfx + FX_ONE, hfx + FX_ONE)
+    };
+    let inside = |a: Fx, lim: Fx| a >= 0 && a < lim;
+    (inside(uu, u_lim) && inside(u_end, u_lim) && inside(vv, v_lim) && inside(v_end, v_lim))
+        .then_some(Span {
+            u: uu,
+            v: vv,
+            du: d.0,
+            dv: d.1,
+        })
+}
+
+#[inline(always)]
+fn span<const BILINEAR: bool>(
+    k: Selected,
+    t: &Texels,
+    out: &mut [u32],
+    uv: (Fx, Fx),
+    d: (Fx, Fx),
+) -> bool {
+    if out.is_empty() {
+        return true;
+    }
+    let Some(s) = prepare::<BILINEAR>(t, out.len(), uv, d) else {
+        return false;
+    };
+    if BILINEAR {
+        bilinear_core(k, t, out, s);
+    } else {
+        nearest_core(k, t, out, s);
+    }
+    true
+}
+
+#[inline(always)]
+fn nearest_core(k: Selected, t: &Texels, out: &mut [u32], s: Span) {
+    #[cfg(target_arch = "x86_64")]
+    if x86::nearest(k, t, out, s) {
+        return;
+    }
+    let _ = k;
+    scalar::nearest(t, out, s);
+}
+
+#[inline(always)]
+fn bilinear_core(k: Selected, t: &Texels, out: &mut [u32], s: Span) {
+    #[cfg(target_arch = "x86_64")]
+    if x86::bilinear(k, t, out, s, None) {
+        return;
+    }
+    let _ = k;
+    scalar::bilinear(t, out, s);
+}
+
+/// `out[i]` = lerp(out[i], bilinear sample i, frac).
+#[inline(always)]
+fn blend_core(k: Selected, t: &Texels, out: &mut [u32], s: Span, frac: u32) {
+    #[cfg(target_arch = "x86_64")]
+    if x86::bilinear(k, t, out, s, Some(frac)) {
+        return;
+    }
+    let _ = k;
+    scalar::blend_bilinear(t, out, s, frac);
+}
+
+fn trilinear(
+    k: Selected,
+    (a, b): (&Texels, &Texels),
+    lod: Lod,
+    out: &mut [u32],
+    (u, v): (Fx, Fx),
+    (du, dv): (Fx, Fx),
+) -> bool {
+    if out.is_empty() {
+        return true;
+    }
+    let (ka, kb) = (lod.ka.min(62), lod.kb.min(62));
+    let Some(sa) = prepare::<true>(a, out.len(), (u >> ka, v >> ka), (du >> ka, dv >> ka)) else {
+        return false;
+    };
+    bilinear_core(k, a, out, sa);
+    let (mut u, mut v) = (u, v);
+    for chunk in out.chunks_mut(TRILINEAR_CHUNK) {
+        let Some(sb) = prepare::<true>(b, chunk.len(), (u >> kb, v >> kb), (du >> kb, dv >> kb))
+        else {
+            return false;
+        };
+        blend_core(k, b, chunk, sb, lod.frac & 0xFF);
+        // Cannot overflow: the checks above bound every position of the span.
+        u += du * chunk.len() as i64;
+        v += dv * chunk.len() as i64;
+    }
+    true
+}
+
+fn cropped(
+    k: Selected,
+    bilinear: bool,
+    t: &Texels,
+    w: &Window,
+    out: &mut [u32],
+    (u, v): (Fx, Fx),
+    (du, dv): (Fx, Fx),
+) -> bool {
+    let m = out.len();
+    if m == 0 {
+        return true;
+    }
+    let n = m as i64 - 1;
+    let (Some(eu), Some(ev)) = (du.checked_mul(n), dv.checked_mul(n)) else {
+        return false;
+    };
+    let fw = (w.full_width as i64) << FX_BITS;
+    let fh = (w.full_height as i64) << FX_BITS;
+    let top = (w.top as i64) << FX_BITS;
+    let bottom = top + ((t.height as i64) << FX_BITS);
+    let Some(v_end) = v.checked_add(ev) else {
+        return false;
+    };
+    // Wholly above or below the stored rows (v is clamped into the panorama first, so
+    // only a crop not touching the panorama's edge has background there).
+    let (v_lo, v_hi) = (v.min(v_end), v.max(v_end));
+    if (w.top > 0 && v_hi < top) || (bottom < fh && v_lo >= bottom) {
+        out.fill(w.background);
+        return true;
+    }
+    // The stored-pixel column of the start, on the sheet [0, W) of the panorama.
+    let Some(su) = u.checked_sub((w.left as i64) << FX_BITS) else {
+        return false;
+    };
+    let su = su.rem_euclid(fw.max(1));
+    let Some(su_end) = su.checked_add(eu) else {
+        return false;
+    };
+    let sv = v - top;
+    let sv_end = v_end - top;
+    let cw = (t.width as i64) << FX_BITS;
+    let ch = (t.height as i64) << FX_BITS;
+    let narrow = (t.width as i64) < w.full_width as i64;
+    if narrow {
+        let (lo, hi) = (su.min(su_end), su.max(su_end));
+        // Wholly in the uncovered longitudes of this sheet.
+        if lo >= cw && hi < fw {
+            out.fill(w.background);
+            return true;
+        }
+        // Covered needs su < cw (and ≥ 0, which the span kernels check with the bias).
+        if hi >= cw {
+            return false;
+        }
+    }
+    // Covered rows: sv in [0, ch); the span kernels check sv (− ½ for bilinear) ≥ 0.
+    if sv.max(sv_end) >= ch {
+        return false;
+    }
+    if bilinear {
+        span::<true>(k, t, out, (su, sv), (du, dv))
+    } else {
+        span::<false>(k, t, out, (su, sv), (du, dv))
+    }
+}
