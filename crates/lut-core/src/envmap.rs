@@ -9,6 +9,7 @@
 use crate::error::MapError;
 use crate::fixed::{Fx, FX_BITS, FX_HALF};
 use crate::projection::Projection;
+use crate::simd::SpanJob;
 use std::path::Path;
 
 /// Largest accepted map side. 65536 wide is the widest map whose fixed-point path is
@@ -329,6 +330,24 @@ impl EnvMap {
         };
         if !done {
             self.sample_span_slow::<BILINEAR>(out, u, v, du, dv);
+        }
+    }
+
+    /// [`EnvMap::sample_span`] for a batch of spans of one output row (at most
+    /// [`crate::MAX_JOBS`]): one kernel call for them all; spans leaving the map are
+    /// sampled per pixel.
+    pub(crate) fn sample_spans<const BILINEAR: bool>(&self, row: &mut [u32], jobs: &[SpanJob]) {
+        let t = self.texels();
+        let mut refused = if BILINEAR {
+            crate::simd::bilinear_spans(&t, row, jobs)
+        } else {
+            crate::simd::nearest_spans(&t, row, jobs)
+        };
+        while refused != 0 {
+            let j = &jobs[refused.trailing_zeros() as usize];
+            refused &= refused - 1;
+            let (x, n) = (j.x as usize, j.len as usize);
+            self.sample_span_slow::<BILINEAR>(&mut row[x..x + n], j.u, j.v, j.du, j.dv);
         }
     }
 

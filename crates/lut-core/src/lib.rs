@@ -81,6 +81,7 @@ pub use raster::{
 };
 pub use simd::{
     active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
-    KernelError, KernelInfo, KernelSource, Lod, Texels, Window, KERNEL_ENV, TRILINEAR_CHUNK,
+    KernelError, KernelInfo, KernelSource, Lod, SpanJob, Texels, Window, KERNEL_ENV, MAX_JOBS,
+    TRILINEAR_CHUNK,
 };
 pub use viewlimit::limit_view;

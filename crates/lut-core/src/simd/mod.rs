@@ -75,6 +75,27 @@ use crate::fixed::{Fx, FX_BITS, FX_HALF, FX_ONE};
 /// position every this many pixels, as the per-pixel path always has).
 pub const TRILINEAR_CHUNK: usize = 64;
 
+/// Most spans in one batch ([`Kernel::bilinear_spans`]: one bit per span in its answer).
+pub const MAX_JOBS: usize = 32;
+
+/// One span of an output row, for the batch kernels: `len` pixels from column `x` on
+/// sample (u + i·du, v + i·dv), Q.16 map coordinates.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SpanJob {
+    /// First output column.
+    pub x: u32,
+    /// Pixels.
+    pub len: u32,
+    /// Position of the first pixel.
+    pub u: Fx,
+    /// Position of the first pixel.
+    pub v: Fx,
+    /// Step per pixel.
+    pub du: Fx,
+    /// Step per pixel.
+    pub dv: Fx,
+}
+
 /// A map's pixels as the kernels read them: `(width + 1) × (height + 1)` 0RGB `u32`,
 /// row-major, the last column and row being padding (column `width` repeats column 0
 /// for maps that wrap horizontally, else column `width − 1`; row `height` repeats row
@@ -190,14 +211,20 @@ pub(crate) fn cropped_span(
     cropped(active(), bilinear, t, w, out, (u, v), (du, dv))
 }
 
-/// Check a span and wrap its start (see [`Kernel::nearest_span`]).
+/// Check a span and wrap its start (see [`Kernel::nearest_span`]). Positions or steps
+/// of 2⁴⁶ or more (no map comes near) and spans of 2¹⁶ pixels or more are refused, so
+/// the arithmetic below cannot overflow.
 #[inline(always)]
 fn prepare<const BILINEAR: bool>(t: &Texels, m: usize, uv: (Fx, Fx), d: (Fx, Fx)) -> Option<Span> {
+    let big = uv.0.unsigned_abs() | uv.1.unsigned_abs() | d.0.unsigned_abs() | d.1.unsigned_abs();
+    if (big >> 46 | m as u64 >> 16) != 0 {
+        return None;
+    }
     let wfx = (t.width as i64) << FX_BITS;
     let hfx = (t.height as i64) << FX_BITS;
     // Bilinear reads the pixel centres around (u − ½, v − ½).
     let bias = if BILINEAR { FX_HALF } else { 0 };
-    let mut uu = uv.0.checked_sub(bias)?;
+    let mut uu = uv.0 - bias;
     if t.wraps && !(0..wfx).contains(&uu) {
         // One period off at most on the renderer's path; a division otherwise.
         uu += if uu < 0 { wfx } else { -wfx };
@@ -205,10 +232,9 @@ fn prepare<const BILINEAR: bool>(t: &Texels, m: usize, uv: (Fx, Fx), d: (Fx, Fx)
             uu = uu.rem_euclid(wfx);
         }
     }
-    let vv = uv.1.checked_sub(bias)?;
+    let vv = uv.1 - bias;
     let n = m as i64 - 1;
-    let u_end = uu.checked_add(d.0.checked_mul(n)?)?;
-    let v_end = vv.checked_add(d.1.checked_mul(n)?)?;
+    let (u_end, v_end) = (uu + d.0 * n, vv + d.1 * n);
     // Nearest may read column W and row H (padding equal to the clamped pixel);
     // bilinear needs x0, y0 ≤ W − 1, H − 1 so that x0 + 1, y0 + 1 are the padding.
     let (u_lim, v_lim) = if BILINEAR {
@@ -216,7 +242,8 @@ fn prepare<const BILINEAR: bool>(t: &Texels, m: usize, uv: (Fx, Fx), d: (Fx, Fx)
     } else {
         (wfx + FX_ONE, hfx + FX_ONE)
     };
-    let inside = |a: Fx, lim: Fx| a >= 0 && a < lim;
+    // Both ends inside [0, lim): the unsigned comparison also rejects negatives.
+    let inside = |a: Fx, lim: Fx| (a as u64) < lim as u64;
     (inside(uu, u_lim) && inside(u_end, u_lim) && inside(vv, v_lim) && inside(v_end, v_lim))
         .then_some(Span {
             u: uu,
@@ -226,53 +253,91 @@ fn prepare<const BILINEAR: bool>(t: &Texels, m: usize, uv: (Fx, Fx), d: (Fx, Fx)
         })
 }
 
+/// Runs `run` on every span of `jobs` inside the map (the slice of `row` it covers and
+/// the checked span); returns a mask of the spans refused (bit i: `jobs[i]`).
+///
+/// # Panics
+/// When a span does not fit in `row`, or there are more than [`MAX_JOBS`] spans.
+#[inline(always)]
+fn run_jobs<const BILINEAR: bool>(
+    t: &Texels,
+    row: &mut [u32],
+    jobs: &[SpanJob],
+    mut run: impl FnMut(&mut [u32], Span),
+) -> u64 {
+    assert!(jobs.len() <= MAX_JOBS, "{} spans in one batch", jobs.len());
+    let mut refused = 0u64;
+    for (i, j) in jobs.iter().enumerate() {
+        let out = &mut row[j.x as usize..j.x as usize + j.len as usize];
+        if out.is_empty() {
+            continue;
+        }
+        match prepare::<BILINEAR>(t, out.len(), (j.u, j.v), (j.du, j.dv)) {
+            Some(s) => run(out, s),
+            None => refused |= 1 << i,
+        }
+    }
+    refused
+}
+
+/// The batch kernels with kernel `k`.
+#[inline]
+fn jobs<const BILINEAR: bool>(k: Selected, t: &Texels, row: &mut [u32], jobs: &[SpanJob]) -> u64 {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(r) = x86::jobs::<BILINEAR>(k, t, row, jobs) {
+        return r;
+    }
+    let _ = k;
+    run_jobs::<BILINEAR>(t, row, jobs, |out, s| {
+        if BILINEAR {
+            scalar::bilinear(t, out, s)
+        } else {
+            scalar::nearest(t, out, s)
+        }
+    })
+}
+
+/// [`Kernel::nearest_spans`] with the [`active_kernel`].
+#[inline]
+pub(crate) fn nearest_spans(t: &Texels, row: &mut [u32], spans: &[SpanJob]) -> u64 {
+    jobs::<false>(active(), t, row, spans)
+}
+
+/// [`Kernel::bilinear_spans`] with the [`active_kernel`].
+#[inline]
+pub(crate) fn bilinear_spans(t: &Texels, row: &mut [u32], spans: &[SpanJob]) -> u64 {
+    jobs::<true>(active(), t, row, spans)
+}
+
+/// One span: a batch of one (each SIMD loop then has a single caller, the batch loop,
+/// and is compiled into it).
 #[inline(always)]
 fn span<const BILINEAR: bool>(
     k: Selected,
     t: &Texels,
     out: &mut [u32],
-    uv: (Fx, Fx),
-    d: (Fx, Fx),
+    (u, v): (Fx, Fx),
+    (du, dv): (Fx, Fx),
 ) -> bool {
-    if out.is_empty() {
-        return true;
+    if out.len() >> 16 != 0 {
+        return false; // prepare() refuses these too
     }
-    let Some(s) = prepare::<BILINEAR>(t, out.len(), uv, d) else {
-        return false;
+    let job = SpanJob {
+        x: 0,
+        len: out.len() as u32,
+        u,
+        v,
+        du,
+        dv,
     };
-    if BILINEAR {
-        bilinear_core(k, t, out, s);
-    } else {
-        nearest_core(k, t, out, s);
-    }
-    true
-}
-
-#[inline(always)]
-fn nearest_core(k: Selected, t: &Texels, out: &mut [u32], s: Span) {
-    #[cfg(target_arch = "x86_64")]
-    if x86::nearest(k, t, out, s) {
-        return;
-    }
-    let _ = k;
-    scalar::nearest(t, out, s);
-}
-
-#[inline(always)]
-fn bilinear_core(k: Selected, t: &Texels, out: &mut [u32], s: Span) {
-    #[cfg(target_arch = "x86_64")]
-    if x86::bilinear(k, t, out, s, None) {
-        return;
-    }
-    let _ = k;
-    scalar::bilinear(t, out, s);
+    jobs::<BILINEAR>(k, t, out, &[job]) == 0
 }
 
 /// `out[i]` = lerp(out[i], bilinear sample i, frac).
 #[inline(always)]
 fn blend_core(k: Selected, t: &Texels, out: &mut [u32], s: Span, frac: u32) {
     #[cfg(target_arch = "x86_64")]
-    if x86::bilinear(k, t, out, s, Some(frac)) {
+    if x86::blend(k, t, out, s, frac) {
         return;
     }
     let _ = k;
@@ -291,10 +356,9 @@ fn trilinear(
         return true;
     }
     let (ka, kb) = (lod.ka.min(62), lod.kb.min(62));
-    let Some(sa) = prepare::<true>(a, out.len(), (u >> ka, v >> ka), (du >> ka, dv >> ka)) else {
+    if !span::<true>(k, a, out, (u >> ka, v >> ka), (du >> ka, dv >> ka)) {
         return false;
-    };
-    bilinear_core(k, a, out, sa);
+    }
     let (mut u, mut v) = (u, v);
     for chunk in out.chunks_mut(TRILINEAR_CHUNK) {
         let Some(sb) = prepare::<true>(b, chunk.len(), (u >> kb, v >> kb), (du >> kb, dv >> kb))

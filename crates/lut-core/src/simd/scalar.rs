@@ -6,6 +6,7 @@ use crate::envmap::lerp_px;
 use crate::fixed::FX_BITS;
 
 /// `out[i]` = the pixel containing (u + i·du, v + i·dv) of a span checked inside.
+#[inline(always)]
 pub(super) fn nearest(t: &Texels, out: &mut [u32], s: Span) {
     let stride = t.stride();
     let (mut u, mut v) = (s.u, s.v);
@@ -35,6 +36,7 @@ fn bilinear_at(px: &[u32], stride: usize, u: i64, v: i64) -> u32 {
 }
 
 /// Bilinear samples along a span checked inside.
+#[inline(always)]
 pub(super) fn bilinear(t: &Texels, out: &mut [u32], s: Span) {
     let stride = t.stride();
     let (mut u, mut v) = (s.u, s.v);

@@ -1,6 +1,6 @@
 //! Choosing the kernel: CPU detection, `LUTPANO_KERNEL`, the active kernel.
 
-use super::{cropped, span, trilinear, Lod, Texels, Window};
+use super::{cropped, jobs, span, trilinear, Lod, SpanJob, Texels, Window};
 use crate::fixed::Fx;
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::OnceLock;
@@ -93,6 +93,26 @@ impl Kernel {
     /// When the CPU does not run this kernel ([`Kernel::is_supported`]).
     pub fn nearest_span(self, t: &Texels, out: &mut [u32], u: Fx, v: Fx, du: Fx, dv: Fx) -> bool {
         span::<false>(self.selected(), t, out, (u, v), (du, dv))
+    }
+
+    /// [`Kernel::nearest_span`] for a batch of spans of one output row (at most
+    /// [`MAX_JOBS`](super::MAX_JOBS)): one call for many short spans. Returns a mask of
+    /// the spans left unwritten because they leave the map (bit i: `spans[i]`).
+    ///
+    /// # Panics
+    /// When the CPU does not run this kernel, a span does not fit in `row`, or there are
+    /// more than [`MAX_JOBS`](super::MAX_JOBS) spans.
+    pub fn nearest_spans(self, t: &Texels, row: &mut [u32], spans: &[SpanJob]) -> u64 {
+        jobs::<false>(self.selected(), t, row, spans)
+    }
+
+    /// [`Kernel::bilinear_span`] for a batch of spans of one output row (see
+    /// [`Kernel::nearest_spans`]).
+    ///
+    /// # Panics
+    /// As [`Kernel::nearest_spans`].
+    pub fn bilinear_spans(self, t: &Texels, row: &mut [u32], spans: &[SpanJob]) -> u64 {
+        jobs::<true>(self.selected(), t, row, spans)
     }
 
     /// Bilinear samples along a span: the four pixel centres around each position

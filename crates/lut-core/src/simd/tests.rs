@@ -145,6 +145,54 @@ proptest! {
         prop_assert!(accepted > 0 || *w < 2 || *h < 2 || cases.iter().all(|c| c.len > 40));
     }
 
+    /// Batches of spans of one row: every kernel writes what the scalar single-span
+    /// kernel writes for each span, and reports exactly the spans it refuses.
+    #[test]
+    fn batches_equal_single_spans(
+        (mi, wraps, cases) in (0..maps().len(), any::<bool>()).prop_flat_map(|(mi, wraps)| {
+            let (w, h, _) = &maps()[mi];
+            (Just(mi), Just(wraps), prop::collection::vec(span_case(*w, *h), 1..=MAX_JOBS))
+        }),
+        bilinear in any::<bool>(),
+    ) {
+        let (w, h, px) = &maps()[mi];
+        let t = Texels::new(px, *w, *h, wraps).unwrap();
+        // Lay the spans side by side along a row, a gap of `off` pixels before each.
+        let mut x = 0u32;
+        let jobs: Vec<SpanJob> = cases
+            .iter()
+            .map(|c| {
+                x += c.off as u32;
+                let j = SpanJob { x, len: c.len as u32, u: c.u, v: c.v, du: c.du, dv: c.dv };
+                x += c.len as u32;
+                j
+            })
+            .collect();
+        let mut want = vec![SENTINEL; x as usize + 3];
+        let mut want_refused = 0u64;
+        for (i, j) in jobs.iter().enumerate() {
+            let o = &mut want[j.x as usize..(j.x + j.len) as usize];
+            let ok = if bilinear {
+                Kernel::Scalar.bilinear_span(&t, o, j.u, j.v, j.du, j.dv)
+            } else {
+                Kernel::Scalar.nearest_span(&t, o, j.u, j.v, j.du, j.dv)
+            };
+            if !ok {
+                want_refused |= 1 << i;
+            }
+        }
+        for k in Kernel::available() {
+            let mut got = vec![SENTINEL; x as usize + 3];
+            let refused = if bilinear {
+                k.bilinear_spans(&t, &mut got, &jobs)
+            } else {
+                k.nearest_spans(&t, &mut got, &jobs)
+            };
+            prop_assert_eq!(refused, want_refused, "{}", k);
+            prop_assert_eq!(&got, &want, "{} bilinear {}", k, bilinear);
+        }
+    }
+
     /// The scalar span equals the per-pixel samplers (u wrapped per pixel) wherever it
     /// accepts a span; what it refuses the per-pixel path handles.
     #[test]

@@ -13,7 +13,7 @@
 
 #![allow(unsafe_code)]
 
-use super::{Kernel, Selected, Span, Texels};
+use super::{run_jobs, scalar, Kernel, Selected, Span, SpanJob, Texels};
 use crate::fixed::FX_BITS;
 use std::arch::x86_64::*;
 
@@ -33,26 +33,23 @@ struct Local {
 }
 
 impl Local {
-    /// `None` when some lane value `f + i·d` (i < len) would not fit an `i32`.
+    /// `None` when some lane value `f + i·d` (i < len) would not fit an `i32`, or the
+    /// slice holds 2³¹ pixels or more. `s` was checked by `prepare` (steps below 2⁴⁶,
+    /// fewer than 2¹⁶ pixels: the product below cannot overflow).
+    #[inline(always)]
     fn new(t: &Texels, s: Span, len: usize, bilinear: bool) -> Option<Local> {
         const LIM: u64 = i32::MAX as u64 - 0xFFFF;
-        let n = len as u64 - 1;
-        let fits = |d: i64| d.unsigned_abs().checked_mul(n).is_some_and(|r| r <= LIM);
-        if !(fits(s.du) && fits(s.dv)) {
+        let reach = s.du.unsigned_abs().max(s.dv.unsigned_abs()) * (len as u64 - 1);
+        let stride = t.stride();
+        // The last index whose read (one pixel, or the 2×2 block) stays in the slice.
+        let last =
+            t.px.len()
+                .wrapping_sub(if bilinear { stride + 2 } else { 1 });
+        let base = (s.v >> FX_BITS) as usize * stride + (s.u >> FX_BITS) as usize;
+        // (base ≤ last always holds for a checked span.)
+        if reach > LIM || t.px.len() > i32::MAX as usize || base > last {
             return None;
         }
-        let stride = t.stride();
-        let base = (s.v >> FX_BITS) as usize * stride + (s.u >> FX_BITS) as usize;
-        // The last index whose read (one pixel, or the 2×2 block) stays in the slice.
-        let last = if bilinear {
-            t.px.len().checked_sub(stride + 2)?
-        } else {
-            t.px.len() - 1
-        };
-        if base > last {
-            return None; // cannot happen for a checked span
-        }
-        // Texels hold fewer than 2³¹ pixels, so these fit.
         Some(Local {
             base,
             fu: (s.u & 0xFFFF) as i32,
@@ -65,36 +62,28 @@ impl Local {
     }
 }
 
-/// Nearest span with a SIMD kernel; `false` when `k` is scalar or the span's positions do
-/// not fit 32-bit lanes (the caller runs the scalar kernel).
+/// The batch kernels ([`super::jobs`]) with a SIMD kernel; `None` for the scalar one.
 #[inline(always)]
-pub(super) fn nearest(k: Selected, t: &Texels, out: &mut [u32], s: Span) -> bool {
-    if k.0 == Kernel::Scalar || out.len() < 2 {
-        return false;
-    }
-    let Some(l) = Local::new(t, s, out.len(), false) else {
-        return false;
-    };
-    match k.0 {
-        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        Kernel::Avx2 => unsafe { avx2::nearest(t.px, t.stride(), out, l) },
-        // SAFETY: as above.
-        Kernel::Sse41 => unsafe { sse41::nearest(t.px, t.stride(), out, l) },
-        Kernel::Scalar => return false,
-    }
-    true
-}
-
-/// Bilinear span (`blend` = Some(frac): blended into `out`, the second trilinear level)
-/// with a SIMD kernel; `false` as [`nearest`].
-#[inline(always)]
-pub(super) fn bilinear(
+pub(super) fn jobs<const BILINEAR: bool>(
     k: Selected,
     t: &Texels,
-    out: &mut [u32],
-    s: Span,
-    blend: Option<u32>,
-) -> bool {
+    row: &mut [u32],
+    jobs: &[SpanJob],
+) -> Option<u64> {
+    match k.0 {
+        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
+        Kernel::Avx2 => Some(unsafe { avx2::jobs::<BILINEAR>(t, row, jobs) }),
+        // SAFETY: as above.
+        Kernel::Sse41 => Some(unsafe { sse41::jobs::<BILINEAR>(t, row, jobs) }),
+        Kernel::Scalar => None,
+    }
+}
+
+/// `out[i]` = lerp(out[i], bilinear sample i, frac) (the second trilinear level) with a
+/// SIMD kernel; `false` when `k` is scalar or the span's positions do not fit 32-bit
+/// lanes (the caller runs the scalar kernel).
+#[inline(always)]
+pub(super) fn blend(k: Selected, t: &Texels, out: &mut [u32], s: Span, frac: u32) -> bool {
     if k.0 == Kernel::Scalar || out.len() < 2 {
         return false;
     }
@@ -102,16 +91,12 @@ pub(super) fn bilinear(
         return false;
     };
     let (px, stride) = (t.px, t.stride());
-    match (k.0, blend) {
+    match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        (Kernel::Avx2, None) => unsafe { avx2::bilinear::<false>(px, stride, out, l, 0) },
+        Kernel::Avx2 => unsafe { avx2::bilinear::<true>(px, stride, out, l, frac) },
         // SAFETY: as above.
-        (Kernel::Avx2, Some(f)) => unsafe { avx2::bilinear::<true>(px, stride, out, l, f) },
-        // SAFETY: as above.
-        (Kernel::Sse41, None) => unsafe { sse41::bilinear::<false>(px, stride, out, l, 0) },
-        // SAFETY: as above.
-        (Kernel::Sse41, Some(f)) => unsafe { sse41::bilinear::<true>(px, stride, out, l, f) },
-        (Kernel::Scalar, _) => return false,
+        Kernel::Sse41 => unsafe { sse41::bilinear::<true>(px, stride, out, l, frac) },
+        Kernel::Scalar => return false,
     }
     true
 }
@@ -127,6 +112,22 @@ fn padded<const N: usize>(src: &[u32]) -> [u32; N] {
 
 mod avx2 {
     use super::*;
+
+    /// A batch of spans of one row (see [`super::super::jobs`]): the span setup and the
+    /// kernel compiled together, the constants loaded once.
+    #[target_feature(enable = "avx2")]
+    pub(super) fn jobs<const BILINEAR: bool>(t: &Texels, row: &mut [u32], jobs: &[SpanJob]) -> u64 {
+        run_jobs::<BILINEAR>(t, row, jobs, |out, s| {
+            match Local::new(t, s, out.len(), BILINEAR) {
+                Some(l) if out.len() >= 2 && BILINEAR => {
+                    bilinear::<false>(t.px, t.stride(), out, l, 0)
+                }
+                Some(l) if out.len() >= 2 => nearest(t.px, t.stride(), out, l),
+                _ if BILINEAR => scalar::bilinear(t, out, s),
+                _ => scalar::nearest(t, out, s),
+            }
+        })
+    }
 
     /// Per 32-bit lane: the fraction byte (bits 8..16) in both 16-bit halves.
     #[inline]
@@ -172,6 +173,20 @@ mod avx2 {
     fn merge(c: (__m256i, __m256i)) -> __m256i {
         let g = _mm256_and_si256(_mm256_slli_epi32::<8>(c.1), _mm256_set1_epi32(0xFF00));
         _mm256_or_si256(c.0, g)
+    }
+
+    /// `d · [0, 1, …, 7]` per lane without `vpmulld` (10 cycles of latency on the
+    /// span's critical path): each lane adds d, 2d and 4d by the bits of its index.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn times_iota(d: __m256i) -> __m256i {
+        let d2 = _mm256_add_epi32(d, d);
+        let d4 = _mm256_add_epi32(d2, d2);
+        let m1 = _mm256_setr_epi32(0, -1, 0, -1, 0, -1, 0, -1);
+        let m2 = _mm256_setr_epi32(0, 0, -1, -1, 0, 0, -1, -1);
+        let m4 = _mm256_setr_epi32(0, 0, 0, 0, -1, -1, -1, -1);
+        let a = _mm256_add_epi32(_mm256_and_si256(d, m1), _mm256_and_si256(d2, m2));
+        _mm256_add_epi32(a, _mm256_and_si256(d4, m4))
     }
 
     /// Lane indices (relative to the span's base pixel) of positions `ru`, `rv`, clamped.
@@ -242,6 +257,7 @@ mod avx2 {
     }
 
     /// Bilinear (or, `BLEND`, blended into `out` by `frac`) along a checked span.
+    #[inline]
     #[target_feature(enable = "avx2")]
     pub(super) fn bilinear<const BLEND: bool>(
         px: &[u32],
@@ -264,8 +280,8 @@ mod avx2 {
             }
         };
         // Lanes i < m hold f + i·d exactly (Local::new); the wrapping adds stay exact.
-        let mut ru = _mm256_add_epi32(fu, _mm256_mullo_epi32(iota, du));
-        let mut rv = _mm256_add_epi32(fv, _mm256_mullo_epi32(iota, dv));
+        let mut ru = _mm256_add_epi32(fu, times_iota(du));
+        let mut rv = _mm256_add_epi32(fv, times_iota(dv));
         let (su, sv) = (_mm256_slli_epi32::<3>(du), _mm256_slli_epi32::<3>(dv));
         let mut i = 0;
         while i + 8 <= m {
@@ -305,6 +321,7 @@ mod avx2 {
     }
 
     /// Nearest along a checked span.
+    #[inline]
     #[target_feature(enable = "avx2")]
     pub(super) fn nearest(px: &[u32], stride: usize, out: &mut [u32], l: Local) {
         let m = out.len();
@@ -312,8 +329,8 @@ mod avx2 {
         let (fu, fv) = (_mm256_set1_epi32(l.fu), _mm256_set1_epi32(l.fv));
         let (du, dv) = (_mm256_set1_epi32(l.du), _mm256_set1_epi32(l.dv));
         let st = _mm256_set1_epi32(stride as i32);
-        let mut ru = _mm256_add_epi32(fu, _mm256_mullo_epi32(iota, du));
-        let mut rv = _mm256_add_epi32(fv, _mm256_mullo_epi32(iota, dv));
+        let mut ru = _mm256_add_epi32(fu, times_iota(du));
+        let mut rv = _mm256_add_epi32(fv, times_iota(dv));
         let (su, sv) = (_mm256_slli_epi32::<3>(du), _mm256_slli_epi32::<3>(dv));
         let p = px.as_ptr();
         let fetch = |a: &[i32; 8], j: usize| -> u32 {
@@ -348,6 +365,22 @@ mod avx2 {
 
 mod sse41 {
     use super::*;
+
+    /// A batch of spans of one row (see [`super::super::jobs`]): the span setup and the
+    /// kernel compiled together, the constants loaded once.
+    #[target_feature(enable = "sse4.1")]
+    pub(super) fn jobs<const BILINEAR: bool>(t: &Texels, row: &mut [u32], jobs: &[SpanJob]) -> u64 {
+        run_jobs::<BILINEAR>(t, row, jobs, |out, s| {
+            match Local::new(t, s, out.len(), BILINEAR) {
+                Some(l) if out.len() >= 2 && BILINEAR => {
+                    bilinear::<false>(t.px, t.stride(), out, l, 0)
+                }
+                Some(l) if out.len() >= 2 => nearest(t.px, t.stride(), out, l),
+                _ if BILINEAR => scalar::bilinear(t, out, s),
+                _ => scalar::nearest(t, out, s),
+            }
+        })
+    }
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
@@ -442,6 +475,7 @@ mod sse41 {
         lerp(top, bot, weights(rv))
     }
 
+    #[inline]
     #[target_feature(enable = "sse4.1")]
     pub(super) fn bilinear<const BLEND: bool>(
         px: &[u32],
@@ -502,6 +536,7 @@ mod sse41 {
         }
     }
 
+    #[inline]
     #[target_feature(enable = "sse4.1")]
     pub(super) fn nearest(px: &[u32], stride: usize, out: &mut [u32], l: Local) {
         let m = out.len();
