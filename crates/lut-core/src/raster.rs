@@ -19,6 +19,7 @@ use crate::fixed::{to_fx, Fx, FX_BITS, FX_ONE};
 use crate::lut::{LutTable, Surface, TableKind, TableSpec};
 use crate::projection::Projection;
 use crate::rows::for_each_row;
+use crate::simd::{SpanJob, MAX_JOBS};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
@@ -219,6 +220,50 @@ trait Sink {
     /// footprint): the trilinear sink picks its pyramid level from it.
     #[inline(always)]
     fn footprint(&mut self, _dl: Fx, _dv: Fx, _region: usize) {}
+    /// Write what the sink still holds (called at the end of each row).
+    #[inline(always)]
+    fn flush(&mut self) {}
+}
+
+/// Spans of one row waiting for a batch kernel ([`EnvMap::sample_spans`]): one kernel
+/// call per [`MAX_JOBS`] spans instead of one per span.
+struct Batch {
+    jobs: [SpanJob; MAX_JOBS],
+    n: usize,
+}
+
+impl Batch {
+    fn new() -> Batch {
+        Batch {
+            jobs: [SpanJob::default(); MAX_JOBS],
+            n: 0,
+        }
+    }
+
+    /// Queue a span; `true` when the batch is full (flush it).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn push(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx) -> bool {
+        self.jobs[self.n] = SpanJob {
+            x: x as u32,
+            len: m as u32,
+            u,
+            v,
+            du,
+            dv,
+        };
+        self.n += 1;
+        self.n == MAX_JOBS
+    }
+
+    /// Sample the queued spans into `row`.
+    #[inline]
+    fn flush<const BILINEAR: bool>(&mut self, map: &EnvMap, row: &mut [u32]) {
+        if self.n > 0 {
+            map.sample_spans::<BILINEAR>(row, &self.jobs[..self.n]);
+            self.n = 0;
+        }
+    }
 }
 
 /// [`Sink::span`] pixel by pixel through [`Sink::put`].
@@ -238,6 +283,7 @@ fn put_run<S: Sink + ?Sized>(s: &mut S, x: usize, m: usize, uv: (Fx, Fx), d: (Fx
 struct PixelSink<'a, const BILINEAR: bool, const CROP: bool> {
     row: &'a mut [u32],
     map: &'a EnvMap,
+    batch: Batch,
 }
 
 impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CROP> {
@@ -255,10 +301,13 @@ impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CR
         if CROP {
             self.map
                 .sample_span_cropped::<BILINEAR>(&mut self.row[x..x + m], u, v, du, dv);
-        } else {
-            self.map
-                .sample_span::<BILINEAR>(&mut self.row[x..x + m], u, v, du, dv);
+        } else if self.batch.push(x, m, u, v, du, dv) {
+            self.batch.flush::<BILINEAR>(self.map, self.row);
         }
+    }
+    #[inline(always)]
+    fn flush(&mut self) {
+        self.batch.flush::<BILINEAR>(self.map, self.row);
     }
     #[inline(always)]
     fn background(&mut self, x: usize) {
@@ -283,6 +332,8 @@ struct TriSink<'a> {
     /// Vertical footprint per region of this scanline, in level-0 map pixels.
     fy: [f32; STEP_REGIONS],
     lod: i32,
+    /// Spans at level 0 (plain bilinear), batched.
+    batch: Batch,
 }
 
 impl Sink for TriSink<'_> {
@@ -292,8 +343,17 @@ impl Sink for TriSink<'_> {
     }
     #[inline(always)]
     fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
-        self.map
-            .trilinear_span(&mut self.row[x..x + m], u, v, du, dv, self.lod);
+        if self.lod > 0 {
+            self.map
+                .trilinear_span(&mut self.row[x..x + m], u, v, du, dv, self.lod);
+        } else if self.batch.push(x, m, u, v, du, dv) {
+            // Level 0: plain bilinear (see EnvMap::trilinear_span), batched.
+            self.batch.flush::<true>(self.map, self.row);
+        }
+    }
+    #[inline(always)]
+    fn flush(&mut self) {
+        self.batch.flush::<true>(self.map, self.row);
     }
     #[inline(always)]
     fn background(&mut self, x: usize) {
@@ -425,8 +485,10 @@ impl Renderer {
                     map,
                     fy: scan.fy,
                     lod: crate::pyramid::lod_q8(scan.fy[0] as f64),
+                    batch: Batch::new(),
                 };
                 render_row(scan, table, &frame, row_scale, &mut s);
+                s.flush();
             });
             return Ok(report);
         }
@@ -440,8 +502,13 @@ impl Renderer {
         ) {
             let (scans, table, frame, row_scale) = k;
             for_each_row(out, w, threads, |y, row| {
-                let mut s = PixelSink::<BILINEAR, CROP> { row, map };
+                let mut s = PixelSink::<BILINEAR, CROP> {
+                    row,
+                    map,
+                    batch: Batch::new(),
+                };
                 render_row(&scans[y], table, frame, row_scale, &mut s);
+                s.flush();
             });
         }
         let k = (&scans[..], table, &frame, row_scale);
