@@ -55,6 +55,11 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // A bad LUTPANO_KERNEL (the span kernel override) is refused up front.
+    if let Err(e) = lut_core::kernel_from_env() {
+        eprintln!("viewer: {e}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Some(Command::Render(a)) => render_cmd::run(*a),
         Some(Command::Convert(a)) => convert_cmd::run(a),
