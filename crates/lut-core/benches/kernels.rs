@@ -10,7 +10,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use lut_core::synth::grid_map;
-use lut_core::{Kernel, Lod, Projection, SpanJob, Texels, MAX_JOBS};
+use lut_core::{Kernel, Projection, SpanJob, Texels, MAX_JOBS};
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -64,6 +64,7 @@ fn kernels(c: &mut Criterion) {
     let px1 = pad(l1);
     let t0 = Texels::new(&px0, 8192, 4096, true).expect("texels");
     let t1 = Texels::new(&px1, l1.width(), l1.height(), true).expect("texels");
+    let levels = [t0, t1];
     let mut out = vec![0u32; W as usize];
     for sampler in ["nearest", "bilinear", "trilinear"] {
         let mut g = c.benchmark_group(format!("kernels/{sampler}"));
@@ -89,23 +90,11 @@ fn kernels(c: &mut Criterion) {
                                     }
                                 }
                                 _ => {
-                                    // level 0 and 1, half way: both levels read
-                                    let lod = Lod {
-                                        ka: 0,
-                                        kb: 1,
-                                        frac: 128,
-                                    };
-                                    for j in jobs {
-                                        let o = &mut out[j.x as usize..(j.x + j.len) as usize];
-                                        black_box(k.trilinear_span(
-                                            (&t0, &t1),
-                                            lod,
-                                            o,
-                                            j.u,
-                                            j.v,
-                                            j.du,
-                                            j.dv,
-                                        ));
+                                    // levels 0 and 1 blended half way: both levels read
+                                    let lods = [128; MAX_JOBS];
+                                    for batch in jobs.chunks(MAX_JOBS) {
+                                        let l = &lods[..batch.len()];
+                                        black_box(k.trilinear_spans(&levels, &mut out, batch, l));
                                     }
                                 }
                             }

@@ -81,7 +81,7 @@ pub use raster::{
 };
 pub use simd::{
     active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
-    KernelError, KernelInfo, KernelSource, Lod, SpanJob, Texels, Window, KERNEL_ENV, MAX_JOBS,
-    TRILINEAR_CHUNK,
+    KernelError, KernelInfo, KernelSource, SpanJob, Texels, Window, KERNEL_ENV, MAX_JOBS,
+    MAX_LEVELS, TRILINEAR_CHUNK,
 };
 pub use viewlimit::limit_view;

@@ -23,6 +23,7 @@
 
 use crate::envmap::{lerp_px, EnvMap};
 use crate::fixed::Fx;
+use crate::simd::{SpanJob, Texels, MAX_LEVELS};
 use rayon::prelude::*;
 
 /// Smallest level side built.
@@ -112,12 +113,9 @@ impl EnvMap {
         let frac = (lod & 0xFF) as u32;
         let (a_map, ka) = self.level(k);
         let (b_map, kb) = self.level(k + 1);
-        if frac != 0 && kb != ka {
-            let lv = crate::simd::Lod { ka, kb, frac };
-            let levels = (&a_map.texels(), &b_map.texels());
-            if crate::simd::trilinear_span(levels, lv, out, u, v, du, dv) {
-                return;
-            }
+        let (levels, n) = self.level_texels();
+        if crate::simd::trilinear_span(&levels[..n], lod, out, u, v, du, dv) {
+            return;
         }
         // A level's span leaves its map: per level, with the per-pixel fallbacks.
         a_map.sample_span::<true>(out, u >> ka, v >> ka, du >> ka, dv >> ka);
@@ -134,6 +132,41 @@ impl EnvMap {
             }
             u += du * chunk.len() as i64;
             v += dv * chunk.len() as i64;
+        }
+    }
+}
+
+impl EnvMap {
+    /// The texels of level 0 (this map) and of each pyramid level, as the span kernels
+    /// take them, and how many there are.
+    pub(crate) fn level_texels(&self) -> ([Texels<'_>; MAX_LEVELS], usize) {
+        let mut t = [self.texels(); MAX_LEVELS];
+        let levels = self.pyramid();
+        let n = 1 + levels.len().min(MAX_LEVELS - 1);
+        for (d, l) in t[1..n].iter_mut().zip(levels) {
+            *d = l.texels();
+        }
+        (t, n)
+    }
+
+    /// [`EnvMap::trilinear_span`] for a batch of spans of one output row (`lods[i]` the
+    /// level of detail of `jobs[i]`): one kernel call for them all. `levels` is
+    /// [`EnvMap::level_texels`] (taken once per frame). For the renderer's trilinear rows;
+    /// partial maps are sampled bilinearly elsewhere.
+    pub(crate) fn trilinear_spans(
+        &self,
+        levels: &[Texels],
+        row: &mut [u32],
+        jobs: &[SpanJob],
+        lods: &[i32],
+    ) {
+        let mut refused = crate::simd::trilinear_spans(levels, row, jobs, lods);
+        while refused != 0 {
+            let i = refused.trailing_zeros() as usize;
+            refused &= refused - 1;
+            let j = &jobs[i];
+            let o = &mut row[j.x as usize..(j.x + j.len) as usize];
+            self.trilinear_span(o, j.u, j.v, j.du, j.dv, lods[i]);
         }
     }
 }

@@ -146,18 +146,8 @@ pub struct Window {
     pub background: u32,
 }
 
-/// Level of detail of a trilinear span: level-0 positions are shifted right by `ka` for
-/// the first level and by `kb` for the second, and the two bilinear samples blended
-/// with weight `frac` (0..=255, out of 256) towards the second.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Lod {
-    /// Shift of the first level.
-    pub ka: u32,
-    /// Shift of the second level.
-    pub kb: u32,
-    /// Blend weight towards the second level.
-    pub frac: u32,
-}
+/// Most pyramid levels the trilinear kernels take (level 0, the map, included).
+pub const MAX_LEVELS: usize = 32;
 
 /// A span checked to lie inside its map: the start (already biased by −½ for bilinear
 /// and wrapped into the map) and the step, Q.16.
@@ -184,8 +174,8 @@ pub(crate) fn bilinear_span(t: &Texels, out: &mut [u32], u: Fx, v: Fx, du: Fx, d
 /// [`Kernel::trilinear_span`] with the [`active_kernel`].
 #[inline]
 pub(crate) fn trilinear_span(
-    levels: (&Texels, &Texels),
-    lod: Lod,
+    levels: &[Texels],
+    lod: i32,
     out: &mut [u32],
     u: Fx,
     v: Fx,
@@ -193,6 +183,17 @@ pub(crate) fn trilinear_span(
     dv: Fx,
 ) -> bool {
     trilinear(active(), levels, lod, out, (u, v), (du, dv))
+}
+
+/// [`Kernel::trilinear_spans`] with the [`active_kernel`].
+#[inline]
+pub(crate) fn trilinear_spans(
+    levels: &[Texels],
+    row: &mut [u32],
+    spans: &[SpanJob],
+    lods: &[i32],
+) -> u64 {
+    tri_jobs(active(), levels, row, spans, lods)
 }
 
 /// [`Kernel::cropped_span`] with the [`active_kernel`].
@@ -333,44 +334,116 @@ fn span<const BILINEAR: bool>(
     jobs::<BILINEAR>(k, t, out, &[job]) == 0
 }
 
-/// `out[i]` = lerp(out[i], bilinear sample i, frac).
+/// One trilinear span: a batch of one.
 #[inline(always)]
-fn blend_core(k: Selected, t: &Texels, out: &mut [u32], s: Span, frac: u32) {
-    #[cfg(target_arch = "x86_64")]
-    if x86::blend(k, t, out, s, frac) {
-        return;
-    }
-    let _ = k;
-    scalar::blend_bilinear(t, out, s, frac);
-}
-
 fn trilinear(
     k: Selected,
-    (a, b): (&Texels, &Texels),
-    lod: Lod,
+    levels: &[Texels],
+    lod: i32,
     out: &mut [u32],
     (u, v): (Fx, Fx),
     (du, dv): (Fx, Fx),
 ) -> bool {
-    if out.is_empty() {
-        return true;
+    if out.len() >> 16 != 0 {
+        return false; // prepare() refuses these too
     }
-    let (ka, kb) = (lod.ka.min(62), lod.kb.min(62));
-    if !span::<true>(k, a, out, (u >> ka, v >> ka), (du >> ka, dv >> ka)) {
-        return false;
+    let job = SpanJob {
+        x: 0,
+        len: out.len() as u32,
+        u,
+        v,
+        du,
+        dv,
+    };
+    tri_jobs(k, levels, out, &[job], &[lod]) == 0
+}
+
+/// The trilinear batch kernels with kernel `k`.
+#[inline]
+fn tri_jobs(
+    k: Selected,
+    levels: &[Texels],
+    row: &mut [u32],
+    jobs: &[SpanJob],
+    lods: &[i32],
+) -> u64 {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(r) = x86::tri_jobs(k, levels, row, jobs, lods) {
+        return r;
     }
-    let (mut u, mut v) = (u, v);
-    for chunk in out.chunks_mut(TRILINEAR_CHUNK) {
-        let Some(sb) = prepare::<true>(b, chunk.len(), (u >> kb, v >> kb), (du >> kb, dv >> kb))
-        else {
-            return false;
+    let _ = k;
+    run_tri_jobs(
+        levels,
+        row,
+        jobs,
+        lods,
+        scalar::bilinear,
+        scalar::blend_bilinear,
+    )
+}
+
+/// Runs the trilinear spans of `jobs` (level of detail `lods[i]`, Q.8, as
+/// `crate::pyramid::lod_q8`) on `levels` with the kernels `bil` (bilinear) and `blend`
+/// (bilinear blended into the output); returns the mask of spans refused.
+///
+/// The levels are resolved as the map's pyramid resolves them: `lod` ≤ 0 is bilinear on
+/// level 0; otherwise level k = `lod >> 8` and k + 1 (each clamped to the last level)
+/// blended by `lod & 0xFF`, or level k alone when the weight is 0 or both clamp to the
+/// same level. Level k reads the level-0 positions and steps shifted right by k; the
+/// second level restarts its position every [`TRILINEAR_CHUNK`] pixels.
+///
+/// # Panics
+/// When a span does not fit in `row`, `lods` and `jobs` differ in length, there are more
+/// than [`MAX_JOBS`] spans, or `levels` is empty.
+#[inline(always)]
+fn run_tri_jobs(
+    levels: &[Texels],
+    row: &mut [u32],
+    jobs: &[SpanJob],
+    lods: &[i32],
+    mut bil: impl FnMut(&Texels, &mut [u32], Span),
+    mut blend: impl FnMut(&Texels, &mut [u32], Span, u32),
+) -> u64 {
+    assert!(jobs.len() <= MAX_JOBS, "{} spans in one batch", jobs.len());
+    assert_eq!(jobs.len(), lods.len(), "one level of detail per span");
+    let last = levels.len().checked_sub(1).expect("level 0 at least");
+    let mut refused = 0u64;
+    for (i, (j, &lod)) in jobs.iter().zip(lods).enumerate() {
+        let out = &mut row[j.x as usize..j.x as usize + j.len as usize];
+        if out.is_empty() {
+            continue;
+        }
+        let (ka, kb, frac) = if lod <= 0 {
+            (0, 0, 0)
+        } else {
+            let k = (lod >> 8) as usize;
+            (k.min(last), (k + 1).min(last), (lod & 0xFF) as u32)
         };
-        blend_core(k, b, chunk, sb, lod.frac & 0xFF);
-        // Cannot overflow: the checks above bound every position of the span.
-        u += du * chunk.len() as i64;
-        v += dv * chunk.len() as i64;
+        let shifted = |k: usize| ((j.u >> k, j.v >> k), (j.du >> k, j.dv >> k));
+        let (uv, d) = shifted(ka);
+        let Some(sa) = prepare::<true>(&levels[ka], out.len(), uv, d) else {
+            refused |= 1 << i;
+            continue;
+        };
+        bil(&levels[ka], out, sa);
+        if frac == 0 || kb == ka {
+            continue;
+        }
+        // The second level, its start recomputed every TRILINEAR_CHUNK pixels.
+        let (mut u, mut v) = (j.u, j.v);
+        for chunk in out.chunks_mut(TRILINEAR_CHUNK) {
+            let uv = (u >> kb, v >> kb);
+            let Some(sb) = prepare::<true>(&levels[kb], chunk.len(), uv, shifted(kb).1) else {
+                refused |= 1 << i;
+                break;
+            };
+            blend(&levels[kb], chunk, sb, frac);
+            // (Wrapping: only far outside any map, where prepare() then refuses.)
+            u = u.wrapping_add(j.du.wrapping_mul(chunk.len() as i64));
+            v = v.wrapping_add(j.dv.wrapping_mul(chunk.len() as i64));
+        }
     }
-    true
+    refused
 }
 
 fn cropped(

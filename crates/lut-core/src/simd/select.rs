@@ -1,6 +1,6 @@
 //! Choosing the kernel: CPU detection, `LUTPANO_KERNEL`, the active kernel.
 
-use super::{cropped, jobs, span, trilinear, Lod, SpanJob, Texels, Window};
+use super::{cropped, jobs, span, tri_jobs, trilinear, SpanJob, Texels, Window};
 use crate::fixed::Fx;
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::OnceLock;
@@ -125,20 +125,24 @@ impl Kernel {
         span::<true>(self.selected(), t, out, (u, v), (du, dv))
     }
 
-    /// Trilinear samples along a span: bilinear on the first level at the level-0
-    /// positions shifted by `lod.ka` (start and step shifted, as the map's pyramid steps
-    /// them), blended by `lod.frac` with bilinear on the second level (shifted by
-    /// `lod.kb`, its start recomputed every [`TRILINEAR_CHUNK`](super::TRILINEAR_CHUNK) pixels). Returns
-    /// `false` when either level's span leaves its map; `out` may then hold partial
-    /// results and the caller samples it another way.
+    /// Trilinear samples along a span with level of detail `lod` (Q.8, 256 = one
+    /// level, as `lod_q8` in the pyramid module computes it): `levels[0]` is the map,
+    /// `levels[k]` its pyramid level k (half the size of level k − 1). `lod` ≤ 0 is
+    /// bilinear on level 0; otherwise levels k = `lod >> 8` and k + 1 (each clamped to
+    /// the last) are sampled bilinearly at the positions and steps shifted right by their
+    /// index and blended by `lod & 0xFF` (level k alone when that is 0 or both clamp to
+    /// the same level); the second level restarts its position every
+    /// [`TRILINEAR_CHUNK`](super::TRILINEAR_CHUNK) pixels. Returns `false` when a level's
+    /// span leaves its map; `out` may then hold partial results and the caller samples it
+    /// another way.
     ///
     /// # Panics
-    /// When the CPU does not run this kernel ([`Kernel::is_supported`]).
+    /// When the CPU does not run this kernel, or `levels` is empty.
     #[allow(clippy::too_many_arguments)]
     pub fn trilinear_span(
         self,
-        levels: (&Texels, &Texels),
-        lod: Lod,
+        levels: &[Texels],
+        lod: i32,
         out: &mut [u32],
         u: Fx,
         v: Fx,
@@ -146,6 +150,23 @@ impl Kernel {
         dv: Fx,
     ) -> bool {
         trilinear(self.selected(), levels, lod, out, (u, v), (du, dv))
+    }
+
+    /// [`Kernel::trilinear_span`] for a batch of spans of one output row, `lods[i]` the
+    /// level of detail of `spans[i]` (see [`Kernel::nearest_spans`] for the batch and
+    /// the answer).
+    ///
+    /// # Panics
+    /// As [`Kernel::nearest_spans`], and when `lods` and `spans` differ in length or
+    /// `levels` is empty.
+    pub fn trilinear_spans(
+        self,
+        levels: &[Texels],
+        row: &mut [u32],
+        spans: &[SpanJob],
+        lods: &[i32],
+    ) -> u64 {
+        tri_jobs(self.selected(), levels, row, spans, lods)
     }
 
     /// Nearest (`bilinear` false) or bilinear samples of a partial map along a span of

@@ -229,36 +229,30 @@ proptest! {
     }
 
     /// Trilinear: every kernel equals the scalar one; the scalar one equals the two
-    /// levels sampled separately and blended (the level-b position restarting every 64
-    /// pixels).
+    /// levels sampled separately and blended (the second level's position restarting
+    /// every 64 pixels), levels resolved as the pyramid resolves them (clamped to the
+    /// last level, level 0 for lod ≤ 0, one level when the weight is 0).
     #[test]
     fn trilinear_equals_scalar_and_levels(
-        k in 0u32..4,
-        frac in 1u32..256,
+        lod in prop_oneof![1 => -300i32..=0, 6 => 1i32..(7 << 8), 1 => (0i32..7).prop_map(|k| k << 8)],
         cases in prop::collection::vec(span_case(128, 64), 16),
         long in 65usize..200,
     ) {
-        static MAP: OnceLock<EnvMap> = OnceLock::new();
-        let m = MAP.get_or_init(|| {
-            let px: Vec<u32> = (0..128 * 64).map(|i: u32| i.wrapping_mul(2_246_822_519) & 0xFF_FFFF).collect();
-            EnvMap::from_pixels(128, 64, &px, Projection::Equirect).unwrap()
-        });
-        let levels = m.pyramid();
-        let level = |j: u32| if j == 0 { m } else { &levels[j as usize - 1] };
-        let (a, b) = (level(k), level(k + 1));
-        let lod = Lod { ka: k, kb: k + 1, frac };
-        let (ta, tb) = (a.texels(), b.texels());
+        let m = tri_map();
+        let levels = level_texels(m);
+        let levels = &levels[..];
+        let last = levels.len() - 1;
         let mut cases = cases;
         cases[0].len = long; // beyond one 64-pixel piece
         cases[0].du = (cases[0].du / 4).clamp(-FX_ONE, FX_ONE);
         cases[0].dv = (cases[0].dv / 4).clamp(-FX_ONE / 8, FX_ONE / 8);
         for c in &cases {
-            let f = |kk: Kernel| move |o: &mut [u32]| kk.trilinear_span((&ta, &tb), lod, o, c.u, c.v, c.du, c.dv);
+            let f = |kk: Kernel| move |o: &mut [u32]| kk.trilinear_span(levels, lod, o, c.u, c.v, c.du, c.dv);
             let want = run(c, f(Kernel::Scalar));
             for kk in others() {
                 let got = run(c, f(kk));
                 if want.0 {
-                    prop_assert_eq!(&got, &want, "{} {:?} {:?}", kk, lod, c);
+                    prop_assert_eq!(&got, &want, "{} lod {} {:?}", kk, lod, c);
                 } else {
                     prop_assert!(!got.0, "{} accepted what scalar refused: {:?}", kk, c);
                 }
@@ -266,19 +260,67 @@ proptest! {
             if !want.0 {
                 continue;
             }
+            let (ka, kb, frac) = if lod <= 0 {
+                (0, 0, 0)
+            } else {
+                let k = (lod >> 8) as usize;
+                (k.min(last), (k + 1).min(last), (lod & 0xFF) as u32)
+            };
+            let level = |k: usize| if k == 0 { m } else { &m.pyramid()[k - 1] };
             let mut sep = vec![0u32; c.len];
-            a.sample_span::<true>(&mut sep, c.u >> k, c.v >> k, c.du >> k, c.dv >> k);
-            let (mut u, mut v) = (c.u, c.v);
-            for chunk in sep.chunks_mut(TRILINEAR_CHUNK) {
-                let mut s = vec![0u32; chunk.len()];
-                b.sample_span::<true>(&mut s, u >> (k + 1), v >> (k + 1), c.du >> (k + 1), c.dv >> (k + 1));
-                for (o, q) in chunk.iter_mut().zip(&s) {
-                    *o = crate::envmap::lerp_px(*o, *q, frac);
+            level(ka).sample_span::<true>(&mut sep, c.u >> ka, c.v >> ka, c.du >> ka, c.dv >> ka);
+            if frac != 0 && ka != kb {
+                let (mut u, mut v) = (c.u, c.v);
+                for chunk in sep.chunks_mut(TRILINEAR_CHUNK) {
+                    let mut s = vec![0u32; chunk.len()];
+                    level(kb).sample_span::<true>(&mut s, u >> kb, v >> kb, c.du >> kb, c.dv >> kb);
+                    for (o, q) in chunk.iter_mut().zip(&s) {
+                        *o = crate::envmap::lerp_px(*o, *q, frac);
+                    }
+                    u += c.du * chunk.len() as i64;
+                    v += c.dv * chunk.len() as i64;
                 }
-                u += c.du * chunk.len() as i64;
-                v += c.dv * chunk.len() as i64;
             }
-            prop_assert_eq!(&want.1[c.off..c.off + c.len], &sep[..], "{:?}", c);
+            prop_assert_eq!(&want.1[c.off..c.off + c.len], &sep[..], "lod {} {:?}", lod, c);
+        }
+    }
+
+    /// Trilinear batches: every kernel writes what the scalar single-span kernel writes
+    /// for each span (each with its own level of detail) and refuses the same spans.
+    #[test]
+    fn trilinear_batches_equal_single_spans(
+        cases in prop::collection::vec((span_case(128, 64), -100i32..(7 << 8)), 1..=MAX_JOBS),
+    ) {
+        let levels = level_texels(tri_map());
+        let mut x = 0u32;
+        let (jobs, lods): (Vec<SpanJob>, Vec<i32>) = cases
+            .iter()
+            .map(|(c, lod)| {
+                x += c.off as u32;
+                let j = SpanJob { x, len: c.len as u32, u: c.u, v: c.v, du: c.du, dv: c.dv };
+                x += c.len as u32;
+                (j, *lod)
+            })
+            .unzip();
+        for k in Kernel::available() {
+            let mut want = vec![SENTINEL; x as usize + 3];
+            let mut want_refused = 0u64;
+            for (i, (j, &lod)) in jobs.iter().zip(&lods).enumerate() {
+                let o = &mut want[j.x as usize..(j.x + j.len) as usize];
+                if !k.trilinear_span(&levels, lod, o, j.u, j.v, j.du, j.dv) {
+                    want_refused |= 1 << i;
+                    o.fill(SENTINEL); // refused spans may hold partial results
+                }
+            }
+            let mut got = vec![SENTINEL; x as usize + 3];
+            let refused = k.trilinear_spans(&levels, &mut got, &jobs, &lods);
+            prop_assert_eq!(refused, want_refused, "{}", k);
+            for (i, j) in jobs.iter().enumerate() {
+                if refused & (1 << i) != 0 {
+                    got[j.x as usize..(j.x + j.len) as usize].fill(SENTINEL);
+                }
+            }
+            prop_assert_eq!(&got, &want, "{}", k);
         }
     }
 
@@ -333,6 +375,24 @@ proptest! {
             }
         }
     }
+}
+
+/// A 128×64 map with its pyramid (levels down to 4×2), built once.
+fn tri_map() -> &'static EnvMap {
+    static MAP: OnceLock<EnvMap> = OnceLock::new();
+    MAP.get_or_init(|| {
+        let px: Vec<u32> = (0..128 * 64)
+            .map(|i: u32| i.wrapping_mul(2_246_822_519) & 0xFF_FFFF)
+            .collect();
+        EnvMap::from_pixels(128, 64, &px, Projection::Equirect).unwrap()
+    })
+}
+
+/// The texels of a map and of its pyramid levels.
+fn level_texels(m: &EnvMap) -> Vec<Texels<'_>> {
+    std::iter::once(m.texels())
+        .chain(m.pyramid().iter().map(|l| l.texels()))
+        .collect()
 }
 
 /// The widest map: Q.16 positions past 2³¹ (32-bit lanes hold span-local offsets), and

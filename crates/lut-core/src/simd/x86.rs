@@ -13,7 +13,7 @@
 
 #![allow(unsafe_code)]
 
-use super::{run_jobs, scalar, Kernel, Selected, Span, SpanJob, Texels};
+use super::{run_jobs, run_tri_jobs, scalar, Kernel, Selected, Span, SpanJob, Texels};
 use crate::fixed::FX_BITS;
 use std::arch::x86_64::*;
 
@@ -79,26 +79,23 @@ pub(super) fn jobs<const BILINEAR: bool>(
     }
 }
 
-/// `out[i]` = lerp(out[i], bilinear sample i, frac) (the second trilinear level) with a
-/// SIMD kernel; `false` when `k` is scalar or the span's positions do not fit 32-bit
-/// lanes (the caller runs the scalar kernel).
+/// The trilinear batch kernels ([`super::tri_jobs`]) with a SIMD kernel; `None` for the
+/// scalar one.
 #[inline(always)]
-pub(super) fn blend(k: Selected, t: &Texels, out: &mut [u32], s: Span, frac: u32) -> bool {
-    if k.0 == Kernel::Scalar || out.len() < 2 {
-        return false;
-    }
-    let Some(l) = Local::new(t, s, out.len(), true) else {
-        return false;
-    };
-    let (px, stride) = (t.px, t.stride());
+pub(super) fn tri_jobs(
+    k: Selected,
+    levels: &[Texels],
+    row: &mut [u32],
+    jobs: &[SpanJob],
+    lods: &[i32],
+) -> Option<u64> {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        Kernel::Avx2 => unsafe { avx2::bilinear::<true>(px, stride, out, l, frac) },
+        Kernel::Avx2 => Some(unsafe { avx2::tri_jobs(levels, row, jobs, lods) }),
         // SAFETY: as above.
-        Kernel::Sse41 => unsafe { sse41::bilinear::<true>(px, stride, out, l, frac) },
-        Kernel::Scalar => return false,
+        Kernel::Sse41 => Some(unsafe { sse41::tri_jobs(levels, row, jobs, lods) }),
+        Kernel::Scalar => None,
     }
-    true
 }
 
 /// Copies `src[..n]` into a zeroed `[u32; N]` (tails shorter than a vector).
@@ -113,6 +110,30 @@ fn padded<const N: usize>(src: &[u32]) -> [u32; N] {
 mod avx2 {
     use super::*;
 
+    /// A batch of trilinear spans (see [`super::super::tri_jobs`]).
+    #[target_feature(enable = "avx2")]
+    pub(super) fn tri_jobs(
+        levels: &[Texels],
+        row: &mut [u32],
+        jobs: &[SpanJob],
+        lods: &[i32],
+    ) -> u64 {
+        run_tri_jobs(
+            levels,
+            row,
+            jobs,
+            lods,
+            |t, out, s| match Local::new(t, s, out.len(), true) {
+                Some(l) if out.len() >= 2 => bilinear::<false, 1>(t.px, t.stride(), out, l, 0),
+                _ => scalar::bilinear(t, out, s),
+            },
+            |t, out, s, frac| match Local::new(t, s, out.len(), true) {
+                Some(l) if out.len() >= 2 => bilinear::<true, 2>(t.px, t.stride(), out, l, frac),
+                _ => scalar::blend_bilinear(t, out, s, frac),
+            },
+        )
+    }
+
     /// A batch of spans of one row (see [`super::super::jobs`]): the span setup and the
     /// kernel compiled together, the constants loaded once.
     #[target_feature(enable = "avx2")]
@@ -120,7 +141,7 @@ mod avx2 {
         run_jobs::<BILINEAR>(t, row, jobs, |out, s| {
             match Local::new(t, s, out.len(), BILINEAR) {
                 Some(l) if out.len() >= 2 && BILINEAR => {
-                    bilinear::<false>(t.px, t.stride(), out, l, 0)
+                    bilinear::<false, 0>(t.px, t.stride(), out, l, 0)
                 }
                 Some(l) if out.len() >= 2 => nearest(t.px, t.stride(), out, l),
                 _ if BILINEAR => scalar::bilinear(t, out, s),
@@ -257,9 +278,12 @@ mod avx2 {
     }
 
     /// Bilinear (or, `BLEND`, blended into `out` by `frac`) along a checked span.
+    ///
+    /// `SITE` only tells call sites apart: each instantiation has one caller, so it is
+    /// compiled into that caller (no call, no span setup passed through memory).
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn bilinear<const BLEND: bool>(
+    pub(super) fn bilinear<const BLEND: bool, const SITE: u8>(
         px: &[u32],
         stride: usize,
         out: &mut [u32],
@@ -366,6 +390,30 @@ mod avx2 {
 mod sse41 {
     use super::*;
 
+    /// A batch of trilinear spans (see [`super::super::tri_jobs`]).
+    #[target_feature(enable = "sse4.1")]
+    pub(super) fn tri_jobs(
+        levels: &[Texels],
+        row: &mut [u32],
+        jobs: &[SpanJob],
+        lods: &[i32],
+    ) -> u64 {
+        run_tri_jobs(
+            levels,
+            row,
+            jobs,
+            lods,
+            |t, out, s| match Local::new(t, s, out.len(), true) {
+                Some(l) if out.len() >= 2 => bilinear::<false, 1>(t.px, t.stride(), out, l, 0),
+                _ => scalar::bilinear(t, out, s),
+            },
+            |t, out, s, frac| match Local::new(t, s, out.len(), true) {
+                Some(l) if out.len() >= 2 => bilinear::<true, 2>(t.px, t.stride(), out, l, frac),
+                _ => scalar::blend_bilinear(t, out, s, frac),
+            },
+        )
+    }
+
     /// A batch of spans of one row (see [`super::super::jobs`]): the span setup and the
     /// kernel compiled together, the constants loaded once.
     #[target_feature(enable = "sse4.1")]
@@ -373,7 +421,7 @@ mod sse41 {
         run_jobs::<BILINEAR>(t, row, jobs, |out, s| {
             match Local::new(t, s, out.len(), BILINEAR) {
                 Some(l) if out.len() >= 2 && BILINEAR => {
-                    bilinear::<false>(t.px, t.stride(), out, l, 0)
+                    bilinear::<false, 0>(t.px, t.stride(), out, l, 0)
                 }
                 Some(l) if out.len() >= 2 => nearest(t.px, t.stride(), out, l),
                 _ if BILINEAR => scalar::bilinear(t, out, s),
@@ -475,9 +523,12 @@ mod sse41 {
         lerp(top, bot, weights(rv))
     }
 
+    ///
+    /// `SITE` only tells call sites apart: each instantiation has one caller, so it is
+    /// compiled into that caller (no call, no span setup passed through memory).
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn bilinear<const BLEND: bool>(
+    pub(super) fn bilinear<const BLEND: bool, const SITE: u8>(
         px: &[u32],
         stride: usize,
         out: &mut [u32],
