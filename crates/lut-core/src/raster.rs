@@ -19,7 +19,7 @@ use crate::fixed::{to_fx, Fx, FX_BITS, FX_ONE};
 use crate::lut::{LutTable, Surface, TableKind, TableSpec};
 use crate::projection::Projection;
 use crate::rows::for_each_row;
-use crate::simd::{SpanJob, MAX_JOBS};
+use crate::simd::{SpanJob, Texels, MAX_JOBS};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
@@ -229,6 +229,8 @@ trait Sink {
 /// call per [`MAX_JOBS`] spans instead of one per span.
 struct Batch {
     jobs: [SpanJob; MAX_JOBS],
+    /// Level of detail per span (trilinear only).
+    lods: [i32; MAX_JOBS],
     n: usize,
 }
 
@@ -236,6 +238,7 @@ impl Batch {
     fn new() -> Batch {
         Batch {
             jobs: [SpanJob::default(); MAX_JOBS],
+            lods: [0; MAX_JOBS],
             n: 0,
         }
     }
@@ -243,7 +246,7 @@ impl Batch {
     /// Queue a span; `true` when the batch is full (flush it).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn push(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx) -> bool {
+    fn push(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, lod: i32) -> bool {
         self.jobs[self.n] = SpanJob {
             x: x as u32,
             len: m as u32,
@@ -252,15 +255,26 @@ impl Batch {
             du,
             dv,
         };
+        self.lods[self.n] = lod;
         self.n += 1;
         self.n == MAX_JOBS
     }
 
-    /// Sample the queued spans into `row`.
+    /// Sample the queued spans into `row` (nearest or bilinear).
     #[inline]
     fn flush<const BILINEAR: bool>(&mut self, map: &EnvMap, row: &mut [u32]) {
         if self.n > 0 {
             map.sample_spans::<BILINEAR>(row, &self.jobs[..self.n]);
+            self.n = 0;
+        }
+    }
+
+    /// Sample the queued spans into `row`, trilinear with their levels of detail
+    /// (`levels`: [`EnvMap::level_texels`]).
+    #[inline]
+    fn flush_trilinear(&mut self, map: &EnvMap, levels: &[Texels], row: &mut [u32]) {
+        if self.n > 0 {
+            map.trilinear_spans(levels, row, &self.jobs[..self.n], &self.lods[..self.n]);
             self.n = 0;
         }
     }
@@ -301,7 +315,7 @@ impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CR
         if CROP {
             self.map
                 .sample_span_cropped::<BILINEAR>(&mut self.row[x..x + m], u, v, du, dv);
-        } else if self.batch.push(x, m, u, v, du, dv) {
+        } else if self.batch.push(x, m, u, v, du, dv, 0) {
             self.batch.flush::<BILINEAR>(self.map, self.row);
         }
     }
@@ -329,10 +343,12 @@ impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CR
 struct TriSink<'a> {
     row: &'a mut [u32],
     map: &'a EnvMap,
+    /// The map's levels as the span kernels read them.
+    levels: &'a [Texels<'a>],
     /// Vertical footprint per region of this scanline, in level-0 map pixels.
     fy: [f32; STEP_REGIONS],
     lod: i32,
-    /// Spans at level 0 (plain bilinear), batched.
+    /// Spans waiting for the batch kernel, with their levels of detail.
     batch: Batch,
 }
 
@@ -343,17 +359,13 @@ impl Sink for TriSink<'_> {
     }
     #[inline(always)]
     fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
-        if self.lod > 0 {
-            self.map
-                .trilinear_span(&mut self.row[x..x + m], u, v, du, dv, self.lod);
-        } else if self.batch.push(x, m, u, v, du, dv) {
-            // Level 0: plain bilinear (see EnvMap::trilinear_span), batched.
-            self.batch.flush::<true>(self.map, self.row);
+        if self.batch.push(x, m, u, v, du, dv, self.lod) {
+            self.batch.flush_trilinear(self.map, self.levels, self.row);
         }
     }
     #[inline(always)]
     fn flush(&mut self) {
-        self.batch.flush::<true>(self.map, self.row);
+        self.batch.flush_trilinear(self.map, self.levels, self.row);
     }
     #[inline(always)]
     fn background(&mut self, x: usize) {
@@ -477,12 +489,15 @@ impl Renderer {
         let w = width as usize;
         let bilinear = opts.sampler != Sampler::Nearest;
         if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
-            map.pyramid(); // built once, before the rows run in parallel
+            // The pyramid is built here once, before the rows run in parallel.
+            let (levels, n) = map.level_texels();
+            let levels = &levels[..n];
             for_each_row(out, w, opts.threads, |y, row| {
                 let scan = &scans[y];
                 let mut s = TriSink {
                     row,
                     map,
+                    levels,
                     fy: scan.fy,
                     lod: crate::pyramid::lod_q8(scan.fy[0] as f64),
                     batch: Batch::new(),
