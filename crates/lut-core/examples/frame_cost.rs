@@ -15,7 +15,8 @@
 //! (8192x4096), `size` WxH (1920x1080), `hfov` (90), `pitch` (10), `yaw` (start, 30; each
 //! frame turns 7.3°), `step` adaptive|1|2|4|8|16 (adaptive), `mode` lut|gather (lut:
 //! gather = a plain gather along the frame's precomputed nearest indices, the floor the
-//! nearest kernel is compared with).
+//! nearest kernel is compared with), `cache` PATH (keep the generated map's pixels there
+//! and read them on later runs: much faster under valgrind).
 
 use lut_core::synth::grid_map;
 use lut_core::{IndexStep, Projection, RenderOptions, Renderer, Sampler, View};
@@ -63,6 +64,35 @@ fn gather_frame(src: &[u32], idx: &[u32], out: &mut [u32], w: usize) {
         })
 }
 
+/// The generated grid map, or its pixels from `cache` (raw little-endian 0RGB, written
+/// there on first use): generating an 8k map costs ~20 G instructions, which under
+/// valgrind takes minutes.
+fn load_map(
+    (w, h): (u32, u32),
+    cache: Option<&std::path::Path>,
+) -> Result<lut_core::EnvMap, String> {
+    let n = w as usize * h as usize;
+    if let Some(bytes) = cache.and_then(|p| std::fs::read(p).ok()) {
+        if bytes.len() == n * 4 {
+            let px: Vec<u32> = bytes
+                .chunks_exact(4)
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect();
+            return lut_core::EnvMap::from_pixels(w, h, &px, Projection::Equirect)
+                .map_err(|e| e.to_string());
+        }
+    }
+    let map = grid_map(w, h, Projection::Equirect).map_err(|e| e.to_string())?;
+    if let Some(p) = cache {
+        let bytes: Vec<u8> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .flat_map(|(x, y)| map.pixel(x, y).to_le_bytes())
+            .collect();
+        std::fs::write(p, bytes).map_err(|e| format!("{}: {e}", p.display()))?;
+    }
+    Ok(map)
+}
+
 fn run() -> Result<(), String> {
     let mut sampler = Sampler::Bilinear;
     let mut kernel = None;
@@ -71,6 +101,7 @@ fn run() -> Result<(), String> {
     let (mut hfov, mut pitch, mut yaw) = (90.0, 10.0, 30.0);
     let mut step = IndexStep::Adaptive;
     let mut gather = false;
+    let mut cache = None;
     for a in std::env::args().skip(1) {
         let (k, v) = a
             .split_once('=')
@@ -96,11 +127,12 @@ fn run() -> Result<(), String> {
                 }
             }
             "mode" => gather = v == "gather",
+            "cache" => cache = Some(std::path::PathBuf::from(v)),
             _ => return Err(format!("unknown argument '{k}'")),
         }
     }
     lut_core::set_kernel(kernel).map_err(|e| e.to_string())?;
-    let map = grid_map(map_wh.0, map_wh.1, Projection::Equirect).map_err(|e| e.to_string())?;
+    let map = load_map(map_wh, cache.as_deref())?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.max(1))
         .build()

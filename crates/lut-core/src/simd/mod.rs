@@ -3,24 +3,37 @@
 //!
 //! A *span* is a run of output pixels whose map positions step linearly in Q.16:
 //! pixel `i` samples (u + i·du, v + i·dv). The renderer reads its table every 8–64
-//! pixels and hands each span to these kernels; a span that stays inside the map (checked
-//! at its two ends: positions are linear, so every pixel between is inside too) is
-//! sampled with no clamps or wraps, the padding column and row of the map making x + 1
-//! and y + 1 readable at the last column and row. A span that leaves the map is refused
-//! (the functions return `false`, nothing is written) and the caller samples it per pixel.
+//! pixels; a span that stays inside the map (checked at its two ends: positions are
+//! linear, so every pixel between is inside too) is sampled with no clamps or wraps, the
+//! padding column and row of the map making x + 1 and y + 1 readable at the last column
+//! and row. A span that leaves the map is refused (nothing is written) and the caller
+//! samples it per pixel.
 //!
-//! The kernels take plain data ([`Texels`]: the padded pixel slice and its size) and
-//! Q.16 coordinates, so they do not depend on the rest of the crate.
+//! The kernels take plain data ([`Texels`]: the padded pixel slice and its size;
+//! [`SpanJob`]: a span's place in the output row and its Q.16 start and step), so they do
+//! not depend on the rest of the crate.
+//!
+//! # Batches
+//! Spans are short (8–16 pixels at hfov 90), so what a span costs besides its pixels
+//! (the range check, the lane setup, a call) matters as much as the blend. The renderer
+//! queues a row's spans and hands up to [`MAX_JOBS`] of them to one call
+//! ([`Kernel::bilinear_spans`], [`Kernel::nearest_spans`], [`Kernel::trilinear_spans`]):
+//! the kernel is chosen once per batch, and the span checks and the SIMD loop are
+//! compiled into one `#[target_feature]` function (each SIMD loop has a single caller, so
+//! it is inlined there; a non-inlined kernel taking its span setup through memory cost a
+//! failed store-to-load forward per span, and made AVX2 nearest slower than scalar).
+//! Single spans are batches of one.
 //!
 //! # Identical bytes
 //! Every SIMD kernel computes exactly what its scalar twin in `scalar.rs` computes: the
 //! same 8-bit weights, the same rounding (`(a·(256 − w) + b·w + 128) >> 8` per channel, in
 //! 16-bit lanes where it cannot overflow: at most 255·256 + 128), the same positions. The
 //! property tests in `tests.rs` compare the bytes of every available kernel with the
-//! scalar one over random spans (the seam, the last column and row, the poles, partial
-//! maps, lengths 1..=64, odd output offsets, negative and huge steps, 1×1 and 2×1 maps,
-//! 65536-wide maps). The whole test suite also runs with the scalar kernel forced
-//! (`LUTPANO_KERNEL=scalar`, see `scripts/test.sh`).
+//! scalar one over random spans and batches (the seam, the last column and row, the
+//! poles, partial maps, lengths 1..=64, odd output offsets, negative and huge steps, 1×1
+//! and 2×1 maps, 65536-wide maps), and the scalar one with the per-pixel samplers. The
+//! whole test suite also runs with the scalar kernel forced (`LUTPANO_KERNEL=scalar`, see
+//! `scripts/test.sh`).
 //!
 //! # Positions in 32-bit lanes
 //! Q.16 positions of a 65536-wide map reach 2³² and do not fit an `i32` lane. The SIMD
@@ -31,19 +44,27 @@
 //! Lane indices are also clamped to the slice before each load, so memory safety never
 //! rests on that arithmetic; equality with the scalar twin is what the tests prove.
 //!
-//! # Loads, not gathers
-//! Each bilinear pixel reads its 2×2 block with two 64-bit loads (top pair, bottom pair)
-//! from lane indices stored to the stack; two `shufps` then separate the left and right
-//! texels of 8 pixels. Hardware gathers (`vpgatherdd`/`vpgatherdq`) were measured slower
-//! on this CPU (see `docs/performance.md`).
+//! # Measured and chosen (see `docs/performance.md`, "Span kernels")
+//! - Loads, not gathers: each bilinear pixel reads its 2×2 block with two 64-bit loads
+//!   (top pair, bottom pair); two `shufps` separate the left and right texels of 8
+//!   pixels. On the development machine (which reports no Gather Data Sampling
+//!   mitigation) `vpgatherdq` of the pairs was 5–10 % faster, `vpgatherdd` for nearest no
+//!   faster; gathers are several times slower on CPUs with that microcode fix and on AMD
+//!   Zen 2/3, so the loads stay.
+//! - One pass, not two: writing a batch's per-pixel indices and weights first, then
+//!   gathering and blending all its pixels in one loop, took more instructions per pixel
+//!   (bilinear 67.6 against 62.8 per frame pixel, nearest 62.2 against 49.5): the fixed
+//!   cost of a span (checks, lane setup) stays, and the results must be copied back.
+//! - No AVX-512 kernel yet: at 8–16 pixels per span the per-span cost, not the blend,
+//!   dominates the kernel, and a 16-lane vector would be half empty on 8-pixel spans.
 //!
 //! # Choosing the kernel once
 //! [`active_kernel`] is decided on first use: the `LUTPANO_KERNEL` environment variable
 //! (`auto`, `scalar`, `sse41`, `avx2`; read once) or else the best kernel the CPU runs
 //! ([`Kernel::best`], from `is_x86_feature_detected!`). [`set_kernel`] changes it (the
 //! benchmarks compare kernels in one run); [`kernel_info`] tells what runs and which CPU
-//! features were detected. The choice is one relaxed atomic load per span, never a test
-//! per pixel.
+//! features were detected. The choice costs one relaxed atomic load per batch, never a
+//! test per pixel.
 //!
 //! Why not a crate: `multiversion` (0.9, MIT/Apache-2.0, maintained) compiles one generic
 //! function for several targets, but these kernels are different code per instruction set
