@@ -118,6 +118,11 @@ pub use lut::{LutTable, Surface, TableKind, TableSpec, TABLE_ERROR_BUDGET};
 pub use render::cube::{scanline_runs, CubeRenderer};
 pub use render::exact::{render_exact, render_exact_supersampled, sample_at, sample_at_lod};
 pub use render::frame::Frame;
+pub use render::kernel::{
+    active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
+    KernelError, KernelInfo, KernelSource, SpanJob, Texels, Window, KERNEL_ENV, MAX_JOBS,
+    MAX_LEVELS, TRILINEAR_CHUNK,
+};
 pub use render::steps::{ADAPTIVE_MAX_STEP, SPAN_ERROR_BUDGET};
 pub use render::{
     IndexStep, LutChoice, Positions, RenderOptions, RenderPath, RenderReport, Renderer,

@@ -36,10 +36,11 @@ use crate::named::Named;
 use cube::{render_cube, CubeRenderer};
 use exact::render_exact;
 use frame::Frame;
+use kernel::level_texels;
 use rows::for_each_row;
 use scanline::{render_row, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
-use sink::{PixelSink, PosSink, TriSink};
+use sink::{Batch, PixelSink, PosSink, Sink, TriSink};
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
 pub const LUT_SWITCH_HFOV: f64 = 60.0;
@@ -393,16 +394,21 @@ impl Renderer {
         let out = frame.pixels_mut();
         let bilinear = opts.sampler != Sampler::Nearest;
         if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
-            map.pyramid(); // built once, before the rows run in parallel
+            // The pyramid is built here once, before the rows run in parallel.
+            let (levels, n) = level_texels(map);
+            let levels = &levels[..n];
             for_each_row(out, w, opts.threads, |y, row| {
                 let scan = &scans[y];
                 let mut s = TriSink {
                     row,
                     map,
+                    levels,
                     fy: scan.fy,
                     lod: lod_q8(scan.fy[0] as f64),
+                    batch: Batch::new(),
                 };
                 render_row(scan, table, &setup, row_scale, &mut s);
+                s.flush();
             });
             return Ok(report);
         }
@@ -416,8 +422,13 @@ impl Renderer {
         ) {
             let (scans, table, setup, row_scale) = k;
             for_each_row(out, w, threads, |y, row| {
-                let mut s = PixelSink::<BILINEAR, CROP> { row, map };
+                let mut s = PixelSink::<BILINEAR, CROP> {
+                    row,
+                    map,
+                    batch: Batch::new(),
+                };
                 render_row(&scans[y], table, setup, row_scale, &mut s);
+                s.flush();
             });
         }
         let k = (&scans[..], table, &setup, row_scale);
