@@ -161,6 +161,8 @@ fn gib(b: u64) -> f64 {
 }
 
 fn print_table(rows: &[Sample], a: &BenchLoadArgs) {
+    // The children inherit LUTPANO_KERNEL, so they run the kernel named here.
+    println!("{}", lut_core::kernel_info());
     println!(
         "{} threads; pan {}x{}, {} frames, LUT renderer (pitch 10°, hfov 90°)",
         rayon::current_num_threads(),

@@ -191,6 +191,7 @@ mod tests {
             map_width: 256,
             map_height: 128,
             projection: "equirect",
+            kernel: "scalar",
         };
         let lut = |ms: f64, err: f64| Row {
             index_step: serde_json::json!(4),

@@ -21,6 +21,8 @@ pub struct RunInfo {
     pub map_height: u32,
     /// The map's projection name.
     pub projection: &'static str,
+    /// The span kernel that ran (`lut_core::Kernel` name: scalar, sse41, avx2).
+    pub kernel: &'static str,
 }
 
 /// One line of the report (one element of the `--json` array).
@@ -47,6 +49,8 @@ pub struct Row {
     pub ms_min: f64,
     /// Slowest frame.
     pub ms_max: f64,
+    /// Output megapixels per second at the median frame time.
+    pub mpix_s: f64,
     /// Max sampling-position error over all frames, source pixels (null: not measured,
     /// e.g. a cube renderer samples cube faces, not the map).
     pub max_err_px: Option<f64>,
@@ -76,6 +80,7 @@ impl Row {
         frames: usize,
         times: &[f64],
     ) -> Row {
+        let ms_median = super::measure::median(times);
         Row {
             renderer,
             sampler: sampler.name(),
@@ -84,9 +89,11 @@ impl Row {
             run: *run,
             hfov,
             frames,
-            ms_median: super::measure::median(times),
+            ms_median,
             ms_min: times.iter().copied().fold(f64::INFINITY, f64::min),
             ms_max: times.iter().copied().fold(0.0, f64::max),
+            mpix_s: (run.width as f64 * run.height as f64)
+                / (ms_median * 1e3).max(f64::MIN_POSITIVE),
             max_err_px: None,
             mean_err_px: None,
             psnr_db: None,
@@ -125,7 +132,7 @@ pub fn step_str(v: &serde_json::Value) -> String {
 /// One row as a line of the text table (also the progress line).
 pub fn row_line(r: &Row) -> String {
     format!(
-        "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9.2} {:>9.2} {:>10} {:>10} {:>7} {:>7}",
+        "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9.2} {:>9.2} {:>7.0} {:>10} {:>10} {:>7} {:>7}",
         r.renderer,
         r.sampler,
         step_str(&r.index_step),
@@ -133,6 +140,7 @@ pub fn row_line(r: &Row) -> String {
         r.hfov,
         r.ms_median,
         r.ms_min,
+        r.mpix_s,
         fmt_opt(r.max_err_px, 4),
         fmt_opt(r.mean_err_px, 5),
         fmt_opt(r.psnr_db, 1),
@@ -142,7 +150,10 @@ pub fn row_line(r: &Row) -> String {
 }
 
 /// The text table: what was measured, the tables, one line per row, the units.
-pub fn write_table(o: &mut impl Write, rows: &[Row], t: &Tables) -> std::io::Result<()> {
+///
+/// `cpu`: the kernel line (`lut_core::kernel_info()`: the kernel, how it was chosen, the
+/// CPU features detected).
+pub fn write_table(o: &mut impl Write, rows: &[Row], t: &Tables, cpu: &str) -> std::io::Result<()> {
     if let Some(r) = rows.first() {
         let run = &r.run;
         writeln!(
@@ -157,6 +168,7 @@ pub fn write_table(o: &mut impl Write, rows: &[Row], t: &Tables) -> std::io::Res
             r.frames
         )?;
     }
+    writeln!(o, "{cpu}")?;
     writeln!(
         o,
         "tables: wide {:.1} ms, {} KiB (unfolded {} KiB, 1/{:.2}); high {:.1} ms, {} KiB (unfolded {} KiB, 1/{:.2})",
@@ -171,7 +183,7 @@ pub fn write_table(o: &mut impl Write, rows: &[Row], t: &Tables) -> std::io::Res
     )?;
     writeln!(
         o,
-        "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9} {:>9} {:>10} {:>10} {:>7} {:>7}",
+        "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9} {:>9} {:>7} {:>10} {:>10} {:>7} {:>7}",
         "renderer",
         "sampler",
         "step",
@@ -179,6 +191,7 @@ pub fn write_table(o: &mut impl Write, rows: &[Row], t: &Tables) -> std::io::Res
         "hfov",
         "ms_med",
         "ms_min",
+        "Mpx/s",
         "max_err",
         "mean_err",
         "PSNR",
@@ -189,7 +202,7 @@ pub fn write_table(o: &mut impl Write, rows: &[Row], t: &Tables) -> std::io::Res
     }
     writeln!(
         o,
-        "errors in source pixels (angular metric); PSNR in dB against the exact render with the same sampler ('-' = identical)"
+        "Mpx/s: output megapixels per second at the median; errors in source pixels (angular metric); PSNR in dB against the exact render with the same sampler ('-' = identical)"
     )
 }
 
@@ -235,6 +248,7 @@ mod tests {
             map_width: 8192,
             map_height: 4096,
             projection: "equirect",
+            kernel: "avx2",
         }
     }
 
@@ -268,11 +282,13 @@ mod tests {
             "map_width",
             "map_height",
             "projection",
+            "kernel",
             "hfov",
             "frames",
             "ms_median",
             "ms_min",
             "ms_max",
+            "mpix_s",
             "max_err_px",
             "mean_err_px",
             "psnr_db",
@@ -292,6 +308,9 @@ mod tests {
             "{text}"
         );
         assert_eq!(v["ms_median"], 2.0);
+        // 1920×1080 pixels in 2 ms.
+        assert_eq!(v["mpix_s"], 1920.0 * 1080.0 / 2000.0);
+        assert_eq!(v["kernel"], "avx2");
         assert_eq!(
             (v["ms_min"].as_f64(), v["ms_max"].as_f64()),
             (Some(1.0), Some(3.0))
@@ -317,12 +336,12 @@ mod tests {
     fn table_lines() {
         assert_eq!(
             row_line(&lut_row()),
-            "lut           bilinear        4 wide    90      2.00      1.00     0.0123    0.00100    48.2   1.25%"
+            "lut           bilinear        4 wide    90      2.00      1.00    1037     0.0123    0.00100    48.2   1.25%"
         );
         let gather = Row::timed(&run(), "gather", Sampler::Nearest, 90.0, 13, &[0.5]);
         assert_eq!(
             row_line(&gather),
-            "gather        nearest         - -       90      0.50      0.50          -          -       -       -"
+            "gather        nearest         - -       90      0.50      0.50    4147          -          -       -       -"
         );
         assert_eq!(step_str(&serde_json::json!("adaptive")), "adaptive");
         let mut out = Vec::new();
@@ -331,14 +350,21 @@ mod tests {
             bytes: [2048, 4096],
             unfolded: [16384, 8192],
         };
-        write_table(&mut out, &[lut_row()], &tables).unwrap();
+        write_table(
+            &mut out,
+            &[lut_row()],
+            &tables,
+            "kernel avx2 (auto; CPU: avx2)",
+        )
+        .unwrap();
         let text = String::from_utf8(out).unwrap();
-        let lines: Vec<&str> = text.lines().collect();
-        assert_eq!(lines.len(), 5, "{text}");
+        let mut lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 6, "{text}");
         assert_eq!(
             lines[0],
             "map 8192x4096 equirect, output 1920x1080, 2 threads, 3 frames per set"
         );
+        assert_eq!(lines.remove(1), "kernel avx2 (auto; CPU: avx2)");
         assert_eq!(
             lines[1],
             "tables: wide 10.0 ms, 2 KiB (unfolded 16 KiB, 1/8.00); high 20.0 ms, 4 KiB (unfolded 8 KiB, 1/2.00)"
