@@ -99,3 +99,59 @@ fn trilinear_is_bilinear_when_magnifying() {
         lut(&map, view, Sampler::Bilinear, w, h)
     );
 }
+
+/// `Renderer::set_bilinear_level`: bilinear reads one pyramid level, the one whose
+/// texel matches the footprint. Magnified it is plain bilinear byte for byte; zoomed out
+/// it is closer to the supersampled truth than bilinear on the map, and it reads the
+/// level (the same frame as rendering that level as a map of its own, up to the LUT's
+/// sub-pixel position rounding).
+#[test]
+fn bilinear_level_reads_the_matching_level() {
+    let map = fine_map(2048, 1024);
+    let opts = RenderOptions {
+        sampler: Sampler::Bilinear,
+        ..RenderOptions::default()
+    };
+    let level_frame = |map: &EnvMap, view: View, w: u32, h: u32| {
+        let mut r = Renderer::new(map);
+        r.set_bilinear_level(true);
+        assert!(r.bilinear_level());
+        render_frame(&mut r, Scene::Map(map), view, &opts, w, h).0
+    };
+    // Magnified: level 0, identical bytes.
+    let view = View::new(33.0, 12.0, 20.0).unwrap();
+    assert_eq!(
+        level_frame(&map, view, 160, 120),
+        lut(&map, view, Sampler::Bilinear, 160, 120)
+    );
+    // Zoomed out: hfov 90 over 64 columns of a 2048-wide map is 8 map pixels per screen
+    // pixel at the centre (a little less towards the edges): levels 2 and 3.
+    let (w, h) = (64, 48);
+    let view = View::new(10.0, 0.0, 90.0).unwrap();
+    let got = level_frame(&map, view, w, h);
+    let bi = lut(&map, view, Sampler::Bilinear, w, h);
+    let mut truth = vec![0u32; (w * h) as usize];
+    render_exact_supersampled(
+        &map,
+        view,
+        Sampler::Bilinear,
+        8,
+        &mut Frame::new(&mut truth, w, h).unwrap(),
+        true,
+    );
+    let (pl, pb) = (psnr(&got, &truth), psnr(&bi, &truth));
+    assert!(pl >= pb + 3.0, "level {pl:.1} dB vs bilinear {pb:.1} dB");
+    // The middle of the centre column reads level 3 (footprints 9 to 10 map pixels;
+    // towards the top and bottom they fall below 8): the same as bilinear on that level.
+    let level3 = &map.pyramid()[2];
+    let on_level = lut(level3, view, Sampler::Bilinear, w, h);
+    let x = (w / 2) as usize;
+    let mut diff = 0u32;
+    for y in h as usize / 4..3 * h as usize / 4 {
+        let (a, b) = (got[y * w as usize + x], on_level[y * w as usize + x]);
+        for s in [0, 8, 16] {
+            diff = diff.max(((a >> s) & 0xFF).abs_diff((b >> s) & 0xFF));
+        }
+    }
+    assert!(diff <= 8, "centre column differs from level 3 by {diff}");
+}

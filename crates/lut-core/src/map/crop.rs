@@ -262,7 +262,11 @@ mod tests {
             .unwrap();
         for x in 0..16 {
             let u = to_fx(x as f64 + 0.5);
-            assert_eq!(p.nearest_cropped(u, to_fx(3.5)), m.pixel(x, 2), "column {x}");
+            assert_eq!(
+                p.nearest_cropped(u, to_fx(3.5)),
+                m.pixel(x, 2),
+                "column {x}"
+            );
         }
     }
 

@@ -255,6 +255,9 @@ pub struct Renderer {
     /// Row scale per map row (Q.30: multiplied by Λ up to W/2, so Q.16 would lose up to
     /// 0.06 px), for elliptical and diamond maps.
     row_scale: Vec<i64>,
+    /// Bilinear reads the pyramid level matching the footprint
+    /// ([`Renderer::set_bilinear_level`]).
+    bilinear_level: bool,
 }
 
 /// The table of `surface` and `kind` among `tables` (built by [`Renderer::table`]).
@@ -272,6 +275,27 @@ impl Renderer {
         let mut r = Renderer::default();
         r.set_geometry(map.width(), map.height(), map.projection());
         r
+    }
+
+    /// Bilinear frames of the LUT renderer read the pyramid level whose texel matches
+    /// the pixel footprint (`on`), or the map itself (`false`, the default).
+    ///
+    /// Zoomed out on a big map, a bilinear frame reads texels far apart: each sample a
+    /// cache miss, so the frame costs more the bigger the map. With this on, the frame
+    /// reads level k of the pyramid (one level, no blend: bilinear's cost), where 2^k
+    /// map pixels ≤ the footprint < 2^(k+1), the same footprint the trilinear sampler
+    /// uses: a 32768-wide map then pans at the cost of the level that matches the screen
+    /// (about an 8k map at 1080p, hfov 90), with less aliasing than the map itself. At
+    /// footprints below 2 map pixels it is plain bilinear, byte for byte. Meant for a
+    /// window while the view moves; partial maps (no pyramid) are unaffected. The pyramid
+    /// is built on the first such frame if it was not (`EnvMap::pyramid`).
+    pub fn set_bilinear_level(&mut self, on: bool) {
+        self.bilinear_level = on;
+    }
+
+    /// Whether bilinear reads the pyramid level ([`Renderer::set_bilinear_level`]).
+    pub fn bilinear_level(&self) -> bool {
+        self.bilinear_level
     }
 
     fn set_geometry(&mut self, w: u32, h: u32, p: Projection) {
@@ -393,7 +417,8 @@ impl Renderer {
         let w = width as usize;
         let out = frame.pixels_mut();
         let bilinear = opts.sampler != Sampler::Nearest;
-        if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
+        let level_bilinear = opts.sampler == Sampler::Bilinear && self.bilinear_level;
+        if (opts.sampler == Sampler::Trilinear || level_bilinear) && map.crop().is_none() {
             // The pyramid is built here once, before the rows run in parallel.
             let (levels, n) = level_texels(map);
             let levels = &levels[..n];
@@ -404,9 +429,11 @@ impl Renderer {
                     map,
                     levels,
                     fy: scan.fy,
-                    lod: lod_q8(scan.fy[0] as f64),
+                    lod: 0,
+                    whole_levels: level_bilinear,
                     batch: Batch::new(),
                 };
+                s.set_lod(lod_q8(scan.fy[0] as f64));
                 render_row(scan, table, &setup, row_scale, &mut s);
                 s.flush();
             });

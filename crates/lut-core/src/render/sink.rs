@@ -173,8 +173,24 @@ pub(crate) struct TriSink<'a> {
     /// Vertical footprint per region of this scanline, in level-0 map pixels.
     pub(crate) fy: [f32; STEP_REGIONS],
     pub(crate) lod: i32,
+    /// Whole levels only (bilinear on the level matching the footprint, see
+    /// `Renderer::set_bilinear_level`): the level of detail is rounded down to a level.
+    pub(crate) whole_levels: bool,
     /// Spans waiting for the batch kernel, with their levels of detail.
     pub(crate) batch: Batch,
+}
+
+impl TriSink<'_> {
+    /// Set the level of detail (Q.8); with `whole_levels`, level k for footprints in
+    /// [2^k, 2^(k+1)) map pixels (the −½ bias of `lod_q8` undone, the blend weight 0).
+    #[inline(always)]
+    pub(crate) fn set_lod(&mut self, lod: i32) {
+        self.lod = if self.whole_levels {
+            (lod + 128) & !0xFF
+        } else {
+            lod
+        };
+    }
 }
 
 impl Sink for TriSink<'_> {
@@ -205,7 +221,7 @@ impl Sink for TriSink<'_> {
     #[inline(always)]
     fn footprint(&mut self, dl: Fx, dv: Fx, region: usize) {
         let fx = dl.unsigned_abs().max(dv.unsigned_abs()) as f64 / FX_ONE as f64;
-        self.lod = lod_q8(fx.max(self.fy[region] as f64));
+        self.set_lod(lod_q8(fx.max(self.fy[region] as f64)));
     }
 }
 
