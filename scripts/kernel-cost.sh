@@ -7,6 +7,7 @@
 #   bash scripts/kernel-cost.sh                 # nearest, bilinear, trilinear x every kernel
 #   FRAMES=4 bash scripts/kernel-cost.sh        # more frames per count (default 2)
 #   VIEWS="pitch=0;pitch=80;pitch=10 hfov=150" bash scripts/kernel-cost.sh  # views, bilinear
+#   KERNELS="scalar avx2" bash scripts/kernel-cost.sh  # only these kernels
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v valgrind >/dev/null || { echo "kernel-cost.sh: valgrind is not installed" >&2; exit 1; }
@@ -30,9 +31,11 @@ cost() {
   awk -v ir="$ir" -v n="$((frames * pixels))" 'BEGIN { printf "%.1f", ir / n }'
 }
 
-# The kernels this machine runs under valgrind (valgrind emulates up to AVX2).
-kernels=(scalar)
-for k in sse41 avx2; do
+# The kernels this machine runs under valgrind (valgrind emulates up to AVX2), or those
+# of KERNELS="scalar avx2" that it runs.
+kernels=()
+for k in ${KERNELS:-scalar sse41 avx2}; do
+  [ "$k" = scalar ] && { kernels+=(scalar); continue; }
   if valgrind -q "$bin" frames=0 map=64x32 size=64x32 kernel="$k" >/dev/null 2>&1; then
     kernels+=("$k")
   fi
