@@ -48,6 +48,8 @@ struct SceneKey {
     index_step: IndexStep,
     lut: LutChoice,
     cube_renderer: CubeRenderer,
+    /// Bilinear read from the pyramid level matching the footprint (while moving).
+    bilinear_level: bool,
     map_generation: u64,
     lights: LightsKey,
 }

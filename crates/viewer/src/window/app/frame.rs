@@ -3,7 +3,7 @@
 //! with egui, and decide when the next frame is due.
 
 use super::{App, SceneKey};
-use crate::scene::render_scene;
+use crate::scene::{render_scene, SceneRef};
 use crate::window::dialogs::Chosen;
 use crate::window::input::{resolution_hfov, wheel_notches, Held, Look, HFOV_MAX};
 use crate::window::keys::{KeyAction, Route};
@@ -12,7 +12,7 @@ use crate::window::paint::SceneRect;
 use crate::window::quality::{frame_level, FRAME_BUDGET_MS};
 use crate::window::ui::{self, PanelModel, PanelOutput};
 use anyhow::{anyhow, Result};
-use lut_core::{CubeRenderer, RenderPath};
+use lut_core::{CubeRenderer, RenderPath, Sampler};
 use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -364,6 +364,10 @@ impl App {
             return;
         };
         let opts = s.render_options(level);
+        // While the view moves, bilinear frames read the pyramid level that matches the
+        // screen (`Renderer::set_bilinear_level`): a huge map then pans at the cost of the
+        // level it shows. The still frame reads the map itself.
+        let bilinear_level = fast && opts.sampler == Sampler::Bilinear;
         let key = SceneKey {
             look,
             size: (rect.w, rect.h),
@@ -373,11 +377,15 @@ impl App {
             index_step: opts.index_step,
             lut: opts.lut,
             cube_renderer: opts.cube,
+            bilinear_level,
             map_generation: generation,
             lights: self.lights.key(),
         };
         if self.scene_key.as_ref() == Some(&key) {
             return;
+        }
+        if let SceneRef::Map { renderer, .. } = cur.scene.as_mut() {
+            renderer.set_bilinear_level(bilinear_level);
         }
         self.scene.resize(rect.w as usize * rect.h as usize, 0);
         let t0 = Instant::now();
@@ -417,7 +425,8 @@ impl App {
         self.light_scene(view, rect);
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         self.times.record(level, ms, pixels);
-        self.ctl.rendered(degraded);
+        // A frame read from a pyramid level is not the still frame: one is due.
+        self.ctl.rendered(degraded || bilinear_level);
         self.renders.push_back(Instant::now());
         let r = &mut self.doc.readouts;
         r.table_bytes = report.table_bytes;
