@@ -10,6 +10,9 @@
 #   SKIP="callgrind load" bash scripts/perf-report.sh   # leave steps out: bench peers
 #                                             # extra callgrind load frame4k docs
 #   THREADS=2 SIZE=1920x1080 bash scripts/perf-report.sh
+#   QUICK=1 OUT=/tmp/pr bash scripts/perf-report.sh      # a smoke test of the script
+#             (small maps and frames, one pass, no callgrind; its numbers mean nothing,
+#             and with docs in SKIP nothing is written into the repository)
 #
 # Steps (each writes into $OUT; a skipped step leaves its doc tables as they were):
 #   bench     scripts/peers.py: `viewer bench` (8192x4096 map, $THREADS threads; all
@@ -32,8 +35,17 @@ OUT=${OUT:-target/perf-report}
 THREADS=${THREADS:-2}
 SIZE=${SIZE:-1920x1080}
 SKIP=${SKIP:-}
+# The sizes (QUICK: a smoke test of this script, not a measurement).
+map8k=8192x4096 map4k=4096x2048 passes=3 reps=3 frames=36 cfr=30 size4k=3840x2160
+widths=8k,16k,32k widths120=8k,32k plot=$PWD/docs/img/speed_error.png
+if [ -n "${QUICK:-}" ]; then
+  SIZE=320x180 map8k=1024x512 map4k=512x256 passes=1 reps=1 frames=4 cfr=2
+  size4k=640x360 widths=1k,2k widths120=1k plot=$OUT/speed_error.png
+  SKIP="$SKIP callgrind"
+fi
 mkdir -p "$OUT"
 OUT=$(cd "$OUT" && pwd)
+[ -n "${QUICK:-}" ] && plot=$OUT/speed_error.png
 skip() { [[ " $SKIP " == *" $1 "* ]]; }
 say() { echo "perf-report: $(date -u +%T) $*" >&2; }
 start=$(date +%s)
@@ -47,31 +59,32 @@ viewer=$PWD/target/release/viewer
 if ! skip bench; then
   say "viewer bench + all peers (map 8192x4096, $THREADS threads)"
   mkdir -p "$OUT/main"
-  python3 scripts/peers.py --size "$SIZE" --threads "$THREADS" --out "$OUT/main" \
-    --bench-args "--passes 3 --plot $PWD/docs/img/speed_error.png" >"$OUT/main/peers.txt"
+  python3 scripts/peers.py --size "$SIZE" --threads "$THREADS" --out "$OUT/main" --reps "$reps" \
+    --bench-args "--passes $passes --map-size $map8k --plot $plot" >"$OUT/main/peers.txt"
 fi
 
 if ! skip extra; then
-  quick="--passes 3 --no-cube --no-minify"
-  for run in "t1 8192x4096 1" "map4k 4096x2048 $THREADS" "map4k-t1 4096x2048 1"; do
+  quick="--passes $passes --no-cube --no-minify"
+  for run in "t1 $map8k 1" "map4k $map4k $THREADS" "map4k-t1 $map4k 1"; do
     read -r name map threads <<<"$run"
     say "OpenCV remap peers: map $map, $threads thread(s)"
     python3 scripts/peers.py --size "$SIZE" --threads "$threads" --out "$OUT/$name" \
-      --no-ffmpeg --no-py360 --no-nona --bench-args "$quick --map-size $map" \
-      >"$OUT/$name.txt"
+      --reps "$reps" --no-ffmpeg --no-py360 --no-nona \
+      --bench-args "$quick --map-size $map" >"$OUT/$name.txt"
   done
 fi
 
 if ! skip frame4k; then
   say "3840x2160 frames from the 8k map"
-  target/release/examples/frame_cost size=3840x2160 sampler=bilinear threads="$THREADS" \
-    frames=30 >"$OUT/frame4k.txt"
+  target/release/examples/frame_cost size="$size4k" map="$map8k" sampler=bilinear \
+    threads="$THREADS" frames="$cfr" >"$OUT/frame4k.txt"
 fi
 
 if ! skip load; then
   say "viewer bench-load"
-  "$viewer" bench-load --json >"$OUT/load.json"
-  "$viewer" bench-load --json --widths 8k,32k --hfov 120 >"$OUT/load120.json"
+  "$viewer" bench-load --json --widths "$widths" --frames "$frames" >"$OUT/load.json"
+  "$viewer" bench-load --json --widths "$widths120" --frames "$frames" --hfov 120 \
+    >"$OUT/load120.json"
 fi
 
 if ! skip callgrind; then

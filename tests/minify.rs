@@ -36,6 +36,20 @@ fn lut(map: &EnvMap, view: View, sampler: Sampler, w: u32, h: u32) -> Vec<u32> {
     render_frame(&mut Renderer::new(map), Scene::Map(map), view, &opts, w, h).0
 }
 
+/// The exact render supersampled 8×8 per pixel (bilinear sub-samples, box filter).
+fn truth(map: &EnvMap, view: View, w: u32, h: u32) -> Vec<u32> {
+    let mut truth = vec![0u32; (w * h) as usize];
+    render_exact_supersampled(
+        map,
+        view,
+        Sampler::Bilinear,
+        8,
+        &mut Frame::new(&mut truth, w, h).unwrap(),
+        true,
+    );
+    truth
+}
+
 #[test]
 fn trilinear_is_closer_to_the_supersampled_truth_when_zoomed_out() {
     let map = fine_map(2048, 1024);
@@ -47,15 +61,7 @@ fn trilinear_is_closer_to_the_supersampled_truth_when_zoomed_out() {
         (90.0, 89.0, 100.0),
     ] {
         let view = View::new(yaw, pitch, hfov).unwrap();
-        let mut truth = vec![0u32; (w * h) as usize];
-        render_exact_supersampled(
-            &map,
-            view,
-            Sampler::Bilinear,
-            8,
-            &mut Frame::new(&mut truth, w, h).unwrap(),
-            true,
-        );
+        let truth = truth(&map, view, w, h);
         let bi = lut(&map, view, Sampler::Bilinear, w, h);
         let tri = lut(&map, view, Sampler::Trilinear, w, h);
         let mut tri_exact = vec![0u32; (w * h) as usize];
@@ -130,15 +136,7 @@ fn bilinear_level_reads_the_matching_level() {
     let view = View::new(10.0, 0.0, 90.0).unwrap();
     let got = level_frame(&map, view, w, h);
     let bi = lut(&map, view, Sampler::Bilinear, w, h);
-    let mut truth = vec![0u32; (w * h) as usize];
-    render_exact_supersampled(
-        &map,
-        view,
-        Sampler::Bilinear,
-        8,
-        &mut Frame::new(&mut truth, w, h).unwrap(),
-        true,
-    );
+    let truth = truth(&map, view, w, h);
     let (pl, pb) = (psnr(&got, &truth), psnr(&bi, &truth));
     assert!(pl >= pb + 3.0, "level {pl:.1} dB vs bilinear {pb:.1} dB");
     // The middle of the centre column reads level 3 (footprints 9 to 10 map pixels;
@@ -172,15 +170,7 @@ fn odd_sided_maps_minify_too() {
     for (yaw, pitch) in [(0.0, 0.0), (179.0, 20.0)] {
         // hfov 100 over 48 columns: about 12 map pixels per screen pixel at the centre.
         let view = View::new(yaw, pitch, 100.0).unwrap();
-        let mut truth = vec![0u32; (w * h) as usize];
-        render_exact_supersampled(
-            &map,
-            view,
-            Sampler::Bilinear,
-            8,
-            &mut Frame::new(&mut truth, w, h).unwrap(),
-            true,
-        );
+        let truth = truth(&map, view, w, h);
         let pb = psnr(&lut(&map, view, Sampler::Bilinear, w, h), &truth);
         let pt = psnr(&lut(&map, view, Sampler::Trilinear, w, h), &truth);
         assert!(

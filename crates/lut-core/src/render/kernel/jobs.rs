@@ -181,6 +181,20 @@ pub(crate) fn bilinear_spans(t: &Texels, row: &mut [u32], spans: &[SpanJob]) -> 
     jobs::<true>(active(), t, row, spans)
 }
 
+/// The job of a whole slice `out` starting at (u, v) with steps (du, dv); `None` for
+/// 2¹⁶ pixels or more (which `prepare` refuses too).
+#[inline(always)]
+fn whole(out: &[u32], (u, v): (Fx, Fx), (du, dv): (Fx, Fx)) -> Option<SpanJob> {
+    (out.len() >> 16 == 0).then_some(SpanJob {
+        x: 0,
+        len: out.len() as u32,
+        u,
+        v,
+        du,
+        dv,
+    })
+}
+
 /// One span: a batch of one (each SIMD loop then has a single caller, the batch loop,
 /// and is compiled into it).
 #[inline(always)]
@@ -188,21 +202,10 @@ pub(super) fn span<const BILINEAR: bool>(
     k: Selected,
     t: &Texels,
     out: &mut [u32],
-    (u, v): (Fx, Fx),
-    (du, dv): (Fx, Fx),
+    uv: (Fx, Fx),
+    d: (Fx, Fx),
 ) -> bool {
-    if out.len() >> 16 != 0 {
-        return false; // prepare() refuses these too
-    }
-    let job = SpanJob {
-        x: 0,
-        len: out.len() as u32,
-        u,
-        v,
-        du,
-        dv,
-    };
-    jobs::<BILINEAR>(k, t, out, &[job]) == 0
+    whole(out, uv, d).is_some_and(|job| jobs::<BILINEAR>(k, t, out, &[job]) == 0)
 }
 
 /// One trilinear span: a batch of one.
@@ -212,21 +215,10 @@ pub(super) fn trilinear(
     levels: &[Texels],
     lod: i32,
     out: &mut [u32],
-    (u, v): (Fx, Fx),
-    (du, dv): (Fx, Fx),
+    uv: (Fx, Fx),
+    d: (Fx, Fx),
 ) -> bool {
-    if out.len() >> 16 != 0 {
-        return false; // prepare() refuses these too
-    }
-    let job = SpanJob {
-        x: 0,
-        len: out.len() as u32,
-        u,
-        v,
-        du,
-        dv,
-    };
-    tri_jobs(k, levels, out, &[job], &[lod]) == 0
+    whole(out, uv, d).is_some_and(|job| tri_jobs(k, levels, out, &[job], &[lod]) == 0)
 }
 
 /// The trilinear batch kernels with kernel `k`.
