@@ -10,9 +10,10 @@
 #   SKIP="callgrind load" bash scripts/perf-report.sh   # leave steps out: bench peers
 #                                             # extra callgrind load frame4k docs
 #   THREADS=2 SIZE=1920x1080 bash scripts/perf-report.sh
-#   QUICK=1 OUT=/tmp/pr bash scripts/perf-report.sh      # a smoke test of the script
-#             (small maps and frames, one pass, no callgrind; its numbers mean nothing,
-#             and with docs in SKIP nothing is written into the repository)
+#   QUICK=1 SKIP=docs OUT=/tmp/pr bash scripts/perf-report.sh  # a smoke test of the
+#             script (small maps and frames, one pass, no callgrind, no ffmpeg or nona;
+#             its numbers mean nothing; with docs in SKIP nothing is written into the
+#             repository, then `python3 scripts/perf_tables.py /tmp/pr` shows the tables)
 #
 # Steps (each writes into $OUT; a skipped step leaves its doc tables as they were):
 #   bench     scripts/peers.py: `viewer bench` (8192x4096 map, $THREADS threads; all
@@ -36,12 +37,12 @@ THREADS=${THREADS:-2}
 SIZE=${SIZE:-1920x1080}
 SKIP=${SKIP:-}
 # The sizes (QUICK: a smoke test of this script, not a measurement).
-map8k=8192x4096 map4k=4096x2048 passes=3 reps=3 frames=36 cfr=30 size4k=3840x2160
+map8k=8192x4096 map4k=4096x2048 passes=3 reps=3 frames=36 cfr=30 size4k=3840x2160 main_peers=
 widths=8k,16k,32k widths120=8k,32k plot=$PWD/docs/img/speed_error.png
 if [ -n "${QUICK:-}" ]; then
   SIZE=320x180 map8k=1024x512 map4k=512x256 passes=1 reps=1 frames=4 cfr=2
   size4k=640x360 widths=1k,2k widths120=1k plot=$OUT/speed_error.png
-  SKIP="$SKIP callgrind"
+  SKIP="$SKIP callgrind" main_peers="--no-ffmpeg --no-nona"
 fi
 mkdir -p "$OUT"
 OUT=$(cd "$OUT" && pwd)
@@ -59,7 +60,8 @@ viewer=$PWD/target/release/viewer
 if ! skip bench; then
   say "viewer bench + all peers (map 8192x4096, $THREADS threads)"
   mkdir -p "$OUT/main"
-  python3 scripts/peers.py --size "$SIZE" --threads "$THREADS" --out "$OUT/main" --reps "$reps" \
+  # shellcheck disable=SC2086 # main_peers is a list of flags
+  python3 scripts/peers.py --size "$SIZE" --threads "$THREADS" --out "$OUT/main" --reps "$reps" $main_peers \
     --bench-args "--passes $passes --map-size $map8k --plot $plot" >"$OUT/main/peers.txt"
 fi
 

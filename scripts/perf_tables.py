@@ -179,7 +179,8 @@ def targets_table(ours, peers, runs, load, load120, frame4k):
                 q = r["ratio_ours_over_theirs"]
                 rows.append(
                     f"| LUT bilinear <= 0.5x OpenCV remap, {what} maps ({p['map_width']}x"
-                    f"{p['map_height']}, {p['threads']} threads) | {r['ours_ms']:.2f} / "
+                    f"{p['map_height']}, {p['threads']} thread{'s' if p['threads'] > 1 else ''}) | "
+                    f"{r['ours_ms']:.2f} / "
                     f"{r['ms_median']:.2f} ms = {q:.2f}x | {verdict(q, 0.5)} |")
     lut_nn, gather = ms("lut", "nearest"), ms("gather", "nearest")
     if lut_nn and gather:
