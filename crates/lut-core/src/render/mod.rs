@@ -41,6 +41,7 @@ use rows::for_each_row;
 use scanline::{render_row, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
 use sink::{Batch, PixelSink, PosSink, Sink, TriSink};
+use std::f64::consts::TAU;
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
 pub const LUT_SWITCH_HFOV: f64 = 60.0;
@@ -286,9 +287,11 @@ impl Renderer {
     /// map pixels ≤ the footprint < 2^(k+1), the same footprint the trilinear sampler
     /// uses: a 32768-wide map then pans at the cost of the level that matches the screen
     /// (about an 8k map at 1080p, hfov 90), with less aliasing than the map itself. At
-    /// footprints below 2 map pixels it is plain bilinear, byte for byte. Meant for a
-    /// window while the view moves; partial maps (no pyramid) are unaffected. The pyramid
-    /// is built on the first such frame if it was not (`EnvMap::pyramid`).
+    /// footprints below 2 map pixels it is plain bilinear, byte for byte, and a frame
+    /// whose view centre shows fewer than 2 map pixels per screen pixel is rendered as
+    /// plain bilinear outright (at plain bilinear's cost). Meant for a window while the
+    /// view moves; partial maps (no pyramid) are unaffected. The pyramid is built on the
+    /// first such frame if it was not (`EnvMap::pyramid`).
     pub fn set_bilinear_level(&mut self, on: bool) {
         self.bilinear_level = on;
     }
@@ -417,7 +420,13 @@ impl Renderer {
         let w = width as usize;
         let out = frame.pixels_mut();
         let bilinear = opts.sampler != Sampler::Nearest;
-        let level_bilinear = opts.sampler == Sampler::Bilinear && self.bilinear_level;
+        // Bilinear on the pyramid level only where the view is minified: at the view's
+        // centre 2 map pixels or more per screen pixel (below that the frame would read
+        // level 0 nearly everywhere, at the level sink's cost).
+        let centre_footprint =
+            2.0 * (view.hfov() * 0.5).tan() / width as f64 * map.width() as f64 / TAU;
+        let level_bilinear =
+            opts.sampler == Sampler::Bilinear && self.bilinear_level && centre_footprint >= 2.0;
         if (opts.sampler == Sampler::Trilinear || level_bilinear) && map.crop().is_none() {
             // The pyramid is built here once, before the rows run in parallel.
             let (levels, n) = level_texels(map);
