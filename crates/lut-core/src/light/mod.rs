@@ -165,6 +165,43 @@ pub enum LightError {
         /// The room's high corner.
         high: [f64; 3],
     },
+    /// A point (for a lux reading) lies outside the room box.
+    #[error(
+        "point ({}, {}, {}) m is outside the room (x in {}..{}, y in {}..{}, z in {}..{})",
+        point[0], point[1], point[2], low[0], high[0], low[1], high[1], low[2], high[2]
+    )]
+    PointOutsideRoom {
+        /// The point, room coordinates.
+        point: [f64; 3],
+        /// The room's low corner.
+        low: [f64; 3],
+        /// The room's high corner.
+        high: [f64; 3],
+    },
+    /// A point lies on no face of the room, so the surface normal is not known.
+    #[error(
+        "point ({}, {}, {}) m is not on a wall, the floor or the ceiling (none within {} m): \
+         the surface's normal is needed",
+        point[0], point[1], point[2], tol
+    )]
+    PointOffSurface {
+        /// The point, room coordinates.
+        point: [f64; 3],
+        /// How close to a face it had to be, in metres.
+        tol: f64,
+    },
+    /// A point lies on an edge or corner of the room, where faces with different normals
+    /// meet.
+    #[error(
+        "point ({}, {}, {}) m lies where the {} and the {} meet: the surface's normal is needed",
+        point[0], point[1], point[2], faces.0, faces.1
+    )]
+    PointOnEdge {
+        /// The point, room coordinates.
+        point: [f64; 3],
+        /// Two of the faces meeting there.
+        faces: (&'static str, &'static str),
+    },
     /// The frame buffer does not hold width × height pixels.
     #[error("frame holds {len} pixels but {width}x{height} needs {needed}")]
     BufferSize {

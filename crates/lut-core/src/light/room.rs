@@ -299,6 +299,33 @@ impl Room {
         out
     }
 
+    /// The inward unit normal of the face point `p` (room coordinates) lies on, within
+    /// `tol` metres: what a lux reading at a surface point means by default.
+    ///
+    /// # Errors
+    /// [`LightError::PointOutsideRoom`] outside the box (beyond `tol`),
+    /// [`LightError::PointOffSurface`] when no face is within `tol`,
+    /// [`LightError::PointOnEdge`] when two or three are (an edge or a corner).
+    pub fn surface_normal(&self, p: DVec3, tol: f64) -> Result<DVec3, LightError> {
+        let (lo, hi) = self.bounds();
+        let point = p.to_array();
+        if !(0..3).all(|a| p[a] >= lo[a] - tol && p[a] <= hi[a] + tol) {
+            return Err(LightError::PointOutsideRoom {
+                point,
+                low: lo.to_array(),
+                high: hi.to_array(),
+            });
+        }
+        match self.faces_at(p, tol).as_slice() {
+            [face] => Ok(face.inward_normal()),
+            [] => Err(LightError::PointOffSurface { point, tol }),
+            [a, b, ..] => Err(LightError::PointOnEdge {
+                point,
+                faces: (a.name(), b.name()),
+            }),
+        }
+    }
+
     /// The coordinate of `face`'s plane along its axis.
     pub fn plane(&self, face: RoomFace) -> f64 {
         let (lo, hi) = self.bounds();
@@ -463,6 +490,30 @@ mod tests {
             assert_eq!(RoomFace::on_axis(f.axis(), f.is_high()), f);
             assert_eq!(RoomFace::ALL[f.index()], f);
         }
+    }
+
+    #[test]
+    fn surface_normals_of_points() {
+        let r = Room::new(4.0, 6.0, 3.0, 1.5).unwrap();
+        let n = |x, y, z| r.surface_normal(DVec3::new(x, y, z), 1e-3);
+        assert_eq!(n(0.3, 0.0, 1.0).unwrap(), DVec3::Y);
+        assert_eq!(n(0.3, 3.0004, 1.0).unwrap(), DVec3::NEG_Y);
+        assert_eq!(n(-2.0, 1.0, 1.0).unwrap(), DVec3::X);
+        assert_eq!(n(0.0, 1.0, 2.9995).unwrap(), DVec3::NEG_Z);
+        assert!(matches!(
+            n(0.0, 1.0, 0.0),
+            Err(LightError::PointOffSurface { .. })
+        ));
+        assert!(matches!(
+            n(2.0, 0.0, 0.0),
+            Err(LightError::PointOnEdge {
+                faces: ("floor", "right wall"),
+                ..
+            })
+        ));
+        let e = n(0.0, -0.5, 0.0).unwrap_err();
+        assert!(matches!(e, LightError::PointOutsideRoom { .. }));
+        assert!(e.to_string().contains("outside the room"), "{e}");
     }
 
     #[test]

@@ -101,6 +101,15 @@ pub struct TableOptions {
     /// Leave constant ranges out of the stored tables (claim 8). Default true; the
     /// lookups are the same either way, only the memory differs.
     pub cut_constant_ranges: bool,
+    /// Keep a table of the distance series only while it reproduces the measured table
+    /// within this fraction: at every measured angle (and between them),
+    /// |I_k − I_0| ≤ tolerance · max(I_0, 5 % of the peak). The series stops at the first
+    /// table that does not (a smooth distribution measured finely keeps several tables;
+    /// a peaked one, or one measured coarsely, keeps its measured table at every
+    /// distance, so lux readings are never blurred by the pre-filter). Default
+    /// `Some(0.004)`; `None` builds the plain series (every table halves, whatever it
+    /// costs in accuracy; see docs/lights.md for what that costs a narrow beam).
+    pub series_tolerance: Option<f64>,
 }
 
 impl Default for TableOptions {
@@ -110,6 +119,7 @@ impl Default for TableOptions {
             max_levels: 4,
             interpolation: Interpolation::Linear,
             cut_constant_ranges: true,
+            series_tolerance: Some(0.004),
         }
     }
 }
@@ -170,6 +180,15 @@ impl LightTable {
                 value: 0.0,
             });
         }
+        if let Some(t) = opts.series_tolerance {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(LightError::BadOption {
+                    name: "series tolerance",
+                    expected: "a finite number ≥ 0",
+                    value: t,
+                });
+            }
+        }
         p.check()?;
         let is_c = p.photometric_type == PhotometricType::C;
         let symmetry = p.symmetry;
@@ -221,14 +240,33 @@ impl LightTable {
             h_bounded: !is_c,
         };
         let mut levels = vec![grid.to_level(&spec)];
+        // Where the series is checked: every measured angle and the midpoints between
+        // (folded horizontal angles of the stored subset, as lookups pass them).
+        let probes = |a: &[f64]| -> Vec<f64> {
+            let mut out = a.to_vec();
+            out.extend(a.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+            out
+        };
+        let (hs, vs) = (probes(&grid.h), probes(&grid.v));
+        let peak = grid.vals.iter().cloned().fold(0.0, f64::max) * spec.scale;
         while levels.len() < opts.max_levels {
-            match grid.halve(h_edges) {
-                Some(g) => {
-                    levels.push(g.to_level(&spec));
-                    grid = g;
+            let Some(g) = grid.halve(h_edges) else {
+                break;
+            };
+            let level = g.to_level(&spec);
+            if let Some(tol) = opts.series_tolerance {
+                let faithful = hs.iter().all(|&h| {
+                    vs.iter().all(|&v| {
+                        let want = levels[0].sample(h, v);
+                        (level.sample(h, v) - want).abs() <= tol * want.max(0.05 * peak)
+                    })
+                });
+                if !faithful {
+                    break;
                 }
-                None => break,
             }
+            levels.push(level);
+            grid = g;
         }
         let steps = |a: &[f64]| {
             a.windows(2)
