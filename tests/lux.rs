@@ -56,6 +56,9 @@ fn closed_form(i: &dyn Fn(f64) -> f64, l: DVec3, aim: DVec3, p: DVec3, n: DVec3)
     i(gamma) * cos_t / (d * d)
 }
 
+/// A distribution, a position, an aim (yaw, pitch).
+type Source<'a> = (&'a dyn Fn(f64) -> f64, DVec3, f64, f64);
+
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(1e-12)
 }
@@ -128,7 +131,7 @@ fn aimed_smooth_sources_near_and_beyond_the_reference_distance() {
     let i_a = |g: f64| 1200.0 + 800.0 * g.to_radians().cos();
     let i_b = |g: f64| 900.0 * (1.0 + g.to_radians().cos()) / 2.0 + 100.0;
     let i_c = |g: f64| 500.0 + 300.0 * (2.0 * g.to_radians()).cos();
-    let sources: [(&dyn Fn(f64) -> f64, DVec3, f64, f64); 3] = [
+    let sources: [Source; 3] = [
         (&i_a, DVec3::new(0.0, 8.0, 0.0), 0.0, -90.0),
         (&i_b, DVec3::new(-10.0, 4.0, 6.0), 45.0, -30.0),
         (&i_c, DVec3::new(12.0, 10.0, -15.0), -120.0, 10.0),
