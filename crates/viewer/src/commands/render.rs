@@ -1,7 +1,7 @@
 //! `viewer render`: one view of a panorama to a PNG, headless.
 
 use crate::args::{named, parse_angle, parse_size, parse_stops, InputArgs, MaxPixelsArg};
-use crate::lighting::{apply_lights, LightArgs};
+use crate::lighting::LightArgs;
 use crate::output::write_png_atomic;
 use crate::panorama::{coverage_text, heading_text, load_cube, load_panorama_partial};
 use crate::scene::{render_scene, Scene};
@@ -16,20 +16,24 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// Panorama image (JPEG, PNG, ...), or a cube map: a folder, six face files, or one
-    /// layout image with --projection cube. The bundled sample when omitted.
+    /// layout image with --projection cube. When omitted, the --scene file's panorama,
+    /// else the bundled sample.
     pub panorama: Vec<PathBuf>,
     /// Output PNG, written atomically.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Yaw in degrees (any value, taken modulo 360; positive turns right).
-    #[arg(long, default_value = "0", value_parser = parse_angle, allow_hyphen_values = true)]
-    pub yaw: f64,
-    /// Pitch in degrees (positive looks up; clamped to [-90, 90]).
-    #[arg(long, default_value = "0", value_parser = parse_angle, allow_hyphen_values = true)]
-    pub pitch: f64,
-    /// Horizontal field of view in degrees, in (0, 180).
-    #[arg(long, default_value = "90", value_parser = parse_angle, allow_hyphen_values = true)]
-    pub hfov: f64,
+    /// Yaw in degrees (any value, taken modulo 360; positive turns right). Default 0, or
+    /// the --scene file's view.
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub yaw: Option<f64>,
+    /// Pitch in degrees (positive looks up; clamped to [-90, 90]). Default 0, or the
+    /// --scene file's view.
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub pitch: Option<f64>,
+    /// Horizontal field of view in degrees, in (0, 180). Default 90, or the --scene
+    /// file's view.
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub hfov: Option<f64>,
     /// Output size WIDTHxHEIGHT (each side 1..=16384).
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -74,6 +78,15 @@ pub struct RenderArgs {
 }
 
 impl RenderArgs {
+    /// Yaw, pitch and hfov: the options given, else the scene file's view, else 0, 0, 90.
+    pub fn angles(&self, scene: Option<crate::lighting::SceneView>) -> (f64, f64, f64) {
+        (
+            self.yaw.or(scene.map(|v| v.yaw)).unwrap_or(0.0),
+            self.pitch.or(scene.map(|v| v.pitch)).unwrap_or(0.0),
+            self.hfov.or(scene.map(|v| v.hfov)).unwrap_or(90.0),
+        )
+    }
+
     /// The render options these arguments select.
     pub fn options(&self) -> RenderOptions {
         RenderOptions {
@@ -89,25 +102,31 @@ impl RenderArgs {
 
     /// The panorama these arguments name: a cube map, or a map placed by `--coverage` or
     /// its GPano XMP.
-    fn load(&self) -> Result<Scene> {
+    fn load(&self, from_scene: Option<PathBuf>) -> Result<Scene> {
         let input = &self.input;
-        if input.projection.value.reads_cube(&self.panorama) {
+        let scene_pano: Vec<PathBuf> = from_scene.into_iter().collect();
+        let panorama = if self.panorama.is_empty() {
+            &scene_pano
+        } else {
+            &self.panorama
+        };
+        if input.projection.value.reads_cube(panorama) {
             if input.coverage.is_some() {
                 bail!("--coverage applies to equirectangular panoramas, not cube maps");
             }
-            return Ok(Scene::Cube(load_cube(&self.panorama, input.cube)?));
+            return Ok(Scene::Cube(load_cube(panorama, input.cube)?));
         }
-        if self.panorama.len() > 1 {
+        if panorama.len() > 1 {
             bail!(
                 "{} files given: a single panorama takes one file (use --projection cube for six faces)",
-                self.panorama.len()
+                panorama.len()
             );
         }
         let tone = lut_core::Tone {
             exposure_ev: self.exposure,
         };
         let (map, _) = load_panorama_partial(
-            self.panorama.first().map(|p| p.as_path()),
+            panorama.first().map(|p| p.as_path()),
             &self.limit.options(input.projection.value.map(), tone),
             input.coverage,
             &mut |_| {},
@@ -118,9 +137,13 @@ impl RenderArgs {
 
 /// Run `viewer render`.
 pub fn run(a: RenderArgs) -> Result<()> {
-    let mut view = View::new(a.yaw, a.pitch, a.hfov).context("invalid view")?;
+    let (scene_pano, scene_view) = a.lights.room.scene_panorama()?;
+    let (yaw, pitch, hfov) = a.angles(scene_view);
+    let mut view = View::new(yaw, pitch, hfov).context("invalid view")?;
     let (w, h) = a.size;
-    let mut scene = a.load()?;
+    // The lights first: a bad luminaire or room is reported before the panorama loads.
+    let lights = a.lights.state()?;
+    let mut scene = a.load(scene_pano)?;
     if let (true, Some(map)) = (a.view_limit, scene.env_map()) {
         view = lut_core::limit_view(view, w, h, &map.coverage());
     }
@@ -129,7 +152,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if a.verbose {
         print_report(&a, &scene, &report, view);
     }
-    apply_lights(&a.lights, view, &mut out, w, h)?;
+    lights
+        .light_frame(view, &mut out, w, h)
+        .map_err(anyhow::Error::msg)?;
     write_png_atomic(&a.output, &out, w, h)?;
     Ok(())
 }
@@ -196,7 +221,13 @@ mod tests {
         assert_eq!(a.options(), lut_core::RenderOptions::default());
         assert_eq!(a.options().cube, CubeRenderer::Accelerated);
         assert_eq!(a.size, (1280, 720));
-        assert_eq!((a.yaw, a.pitch, a.hfov), (0.0, 0.0, 90.0));
+        assert_eq!(a.angles(None), (0.0, 0.0, 90.0));
+        let saved = crate::lighting::SceneView {
+            yaw: 10.0,
+            pitch: -20.0,
+            hfov: 70.0,
+        };
+        assert_eq!(a.angles(Some(saved)), (10.0, -20.0, 70.0));
         assert_eq!(a.input.cube_renderer, CubeRenderer::Accelerated);
         assert_eq!(a.input.projection.value, crate::args::ProjectionArg::Auto);
     }
@@ -241,7 +272,7 @@ mod tests {
             a.input.projection.value.map(),
             Some(lut_core::Projection::Elliptical)
         );
-        assert_eq!(a.yaw, -30.0);
+        assert_eq!(a.yaw, Some(-30.0));
     }
 
     #[test]
