@@ -14,7 +14,8 @@
 
 use super::illum::IlluminanceMap;
 use super::shade::{
-    blend, check_frame, decode_lut, encode_lut, false_color, scale_pos, shade_pixel, ShadeOptions,
+    blend, check_frame, decode_lut, encode_lut, false_color, false_color_position, shade_pixel,
+    ShadeOptions,
 };
 use super::shade_table::shade_row;
 use super::LightError;
@@ -267,7 +268,7 @@ impl IlluminanceMap {
                     let max = opts.false_color_max_lux;
                     for (px, &e) in pixels.iter_mut().zip(es.iter()) {
                         let shaded = shade_pixel(*px, ambient + exposure * e, dec, enc);
-                        let c = false_color(scale_pos(e as f64, max));
+                        let c = false_color(false_color_position(e as f64, max));
                         *px = blend(c, shaded, 0.65);
                     }
                 } else {

@@ -40,7 +40,9 @@ pub use ldt::{LampSet, LdtError, LdtFile, LdtSymmetry, LdtType};
 pub use map_shade::BLOCK as MAP_SHADE_BLOCK;
 pub use photometry::{detect_format, LightFileFormat, Photometry, PhotometrySource};
 pub use room::{Room, RoomFace};
-pub use shade::{lux_at, shade_frame, LightScene, Luminaire, ShadeOptions};
+pub use shade::{
+    false_color, false_color_position, lux_at, shade_frame, LightScene, Luminaire, ShadeOptions,
+};
 pub use table::{Interpolation, LightTable, Symmetry, TableOptions};
 
 /// Largest photometric file read, in bytes. Real IES and EULUMDAT files are well under

@@ -324,8 +324,10 @@ pub fn false_color(t: f64) -> u32 {
     (ch(0) << 16) | (ch(1) << 8) | ch(2)
 }
 
-/// Position on the false-colour scale of `lux` for a scale topping at `max_lux`.
-pub(crate) fn scale_pos(lux: f64, max_lux: f64) -> f64 {
+/// Position in [0, 1] on the false-colour scale (the argument of [`false_color`]) of
+/// `lux` for a scale topping at `max_lux`: logarithmic over three decades, 0 at
+/// `max_lux / 1000` and below, 1 at `max_lux` and above.
+pub fn false_color_position(lux: f64, max_lux: f64) -> f64 {
     if lux.is_nan() || lux <= 0.0 {
         return 0.0;
     }
@@ -378,7 +380,7 @@ pub fn shade_frame(
                 let shaded = shade_pixel(*px, k, dec, enc);
                 *px = if opts.false_color {
                     blend(
-                        false_color(scale_pos(e, opts.false_color_max_lux)),
+                        false_color(false_color_position(e, opts.false_color_max_lux)),
                         shaded,
                         0.65,
                     )
@@ -441,7 +443,7 @@ mod tests {
     fn false_color_ends() {
         assert_eq!(false_color(0.0), 0x000060);
         assert_eq!(false_color(1.0), 0xff2000);
-        assert_eq!(scale_pos(1000.0, 1000.0), 1.0);
-        assert_eq!(scale_pos(1.0, 1000.0), 0.0);
+        assert_eq!(false_color_position(1000.0, 1000.0), 1.0);
+        assert_eq!(false_color_position(1.0, 1000.0), 0.0);
     }
 }

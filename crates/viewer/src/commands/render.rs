@@ -69,6 +69,14 @@ pub struct RenderArgs {
     /// The pixel limit.
     #[command(flatten)]
     pub limit: MaxPixelsArg,
+    /// Draw the room box as a wireframe and the luminaires as markers over the view (to
+    /// fit the room to the photograph's walls, floor and ceiling).
+    #[arg(long)]
+    pub show_room: bool,
+    /// Draw the false colours' legend (a bar with its lux scale) at the right edge; needs
+    /// --false-color (or a scene file with false colours on).
+    #[arg(long)]
+    pub legend: bool,
     /// Print which path rendered and the table size.
     #[arg(long, short)]
     pub verbose: bool,
@@ -143,6 +151,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let (w, h) = a.size;
     // The lights first: a bad luminaire or room is reported before the panorama loads.
     let lights = a.lights.state()?;
+    if a.legend && !lights.false_color {
+        bail!("--legend draws the false colours' scale: give --false-color too");
+    }
     let mut scene = a.load(scene_pano)?;
     if let (true, Some(map)) = (a.view_limit, scene.env_map()) {
         view = lut_core::limit_view(view, w, h, &map.coverage());
@@ -155,6 +166,14 @@ pub fn run(a: RenderArgs) -> Result<()> {
     lights
         .light_frame(view, &mut out, w, h)
         .map_err(anyhow::Error::msg)?;
+    if a.show_room {
+        crate::lighting::overlay::draw_room_and_lights(&lights, view, &mut out, w, h)
+            .map_err(anyhow::Error::msg)?;
+    }
+    if a.legend {
+        crate::lighting::legend::draw_legend(&mut out, w, h, lights.false_color_max)
+            .map_err(anyhow::Error::msg)?;
+    }
     write_png_atomic(&a.output, &out, w, h)?;
     Ok(())
 }

@@ -2,6 +2,8 @@
 //! lux` and the window share, the light state ([`LightsState`]) they become, which the
 //! window's panel edits, and scene files ([`SceneFile`]) that save and reopen it.
 
+pub mod legend;
+pub mod overlay;
 mod scene_file;
 mod state;
 

@@ -1,0 +1,267 @@
+//! What the room and its luminaires look like drawn over a view: the room box as a
+//! wireframe (to fit it to the photograph's walls), each light as a marker with its aim,
+//! the false-colour legend. Pure geometry in image coordinates, so the window (egui
+//! shapes) and `viewer render --show-room` (drawn into the frame) draw the same thing.
+
+use glam::DVec3;
+use lut_core::{Camera, Room};
+
+/// How close to the camera plane an edge is clipped, in the camera's focal units (rays
+/// closer to sideways than this are not drawn).
+const NEAR: f64 = 1e-3;
+
+/// A segment in image coordinates (pixels, centres at +0.5).
+pub type Segment = ((f64, f64), (f64, f64));
+
+/// The camera-space depth of a panorama-frame direction: its component along the view
+/// axis.
+fn depth(cam: &Camera, d: DVec3) -> f64 {
+    let f = cam.world_ray(cam.width as f64 / 2.0, cam.height as f64 / 2.0);
+    d.dot(f) / f.length()
+}
+
+/// The part of the 3-D segment `a`–`b` (room coordinates) in front of the camera,
+/// projected into the image; `None` when it is all behind.
+pub fn project_segment(room: &Room, cam: &Camera, a: DVec3, b: DVec3) -> Option<Segment> {
+    let o = room.camera_position();
+    let (mut wa, mut wb) = (room.to_world(a - o), room.to_world(b - o));
+    let (da, db) = (depth(cam, wa), depth(cam, wb));
+    let near = NEAR * wa.length().max(wb.length());
+    if da < near && db < near {
+        return None;
+    }
+    // Clip the part behind the near plane (depth is linear along the segment).
+    if da < near {
+        wa = wa + (wb - wa) * ((near - da) / (db - da));
+    } else if db < near {
+        wb = wb + (wa - wb) * ((near - db) / (da - db));
+    }
+    Some((cam.project(wa)?, cam.project(wb)?))
+}
+
+/// The room box's 12 edges as seen by `cam` (those in front of it).
+pub fn room_edges(room: &Room, cam: &Camera) -> Vec<Segment> {
+    let c = room.corners();
+    Room::EDGES
+        .iter()
+        .filter_map(|&(i, j)| project_segment(room, cam, c[i], c[j]))
+        .collect()
+}
+
+/// Where a light (room coordinates) appears in the image, if in front of the camera.
+pub fn project_point(room: &Room, cam: &Camera, p: DVec3) -> Option<(f64, f64)> {
+    let w = room.to_world(p - room.camera_position());
+    if depth(cam, w) <= NEAR * w.length() {
+        return None;
+    }
+    cam.project(w)
+}
+
+/// A light's marker: its place in the image and a short stroke toward its aim (35 cm
+/// along the aim), when in front of the camera.
+pub fn light_marker(
+    room: &Room,
+    cam: &Camera,
+    position: DVec3,
+    aim: DVec3,
+) -> Option<((f64, f64), Option<Segment>)> {
+    let at = project_point(room, cam, position)?;
+    let stroke = project_segment(room, cam, position, position + aim * 0.35);
+    Some((at, stroke))
+}
+
+/// Blend `color` (0RGB) over the pixel at (x, y) with `alpha` in [0, 1].
+fn blend_px(frame: &mut [u32], w: u32, h: u32, x: i64, y: i64, color: u32, alpha: f64) {
+    if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 || alpha <= 0.0 {
+        return;
+    }
+    let p = &mut frame[(y as u32 * w + x as u32) as usize];
+    let a = alpha.min(1.0);
+    let ch = |s: u32| {
+        let (c, d) = (((color >> s) & 0xff) as f64, ((*p >> s) & 0xff) as f64);
+        ((c * a + d * (1.0 - a)).round() as u32).min(255) << s
+    };
+    *p = ch(16) | ch(8) | ch(0);
+}
+
+/// Distance from (px, py) to the segment `s`.
+fn segment_distance(s: Segment, px: f64, py: f64) -> f64 {
+    let ((x0, y0), (x1, y1)) = s;
+    let (dx, dy) = (x1 - x0, y1 - y0);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 {
+        (((px - x0) * dx + (py - y0) * dy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    ((px - x0 - t * dx).powi(2) + (py - y0 - t * dy).powi(2)).sqrt()
+}
+
+/// Draw an anti-aliased segment `width` pixels wide into a `w × h` 0RGB frame: each pixel
+/// within reach is blended once, by its coverage.
+pub fn draw_segment(frame: &mut [u32], w: u32, h: u32, s: Segment, width: f64, color: u32) {
+    let ((x0, y0), (x1, y1)) = s;
+    if !(x0.is_finite() && y0.is_finite() && x1.is_finite() && y1.is_finite()) {
+        return;
+    }
+    let half = width / 2.0;
+    let r = half.ceil() as i64 + 1;
+    let (dx, dy) = (x1 - x0, y1 - y0);
+    // Walk the major axis inside the frame; cover the pixels across the line.
+    let steep = dy.abs() > dx.abs();
+    let (a0, a1, extent) = if steep { (y0, y1, h) } else { (x0, x1, w) };
+    let lo = (a0.min(a1).floor() as i64 - r).max(0);
+    let hi = (a0.max(a1).ceil() as i64 + r).min(extent as i64 - 1);
+    for m in lo..=hi {
+        let c = m as f64 + 0.5;
+        // Where the line crosses this row (or column).
+        let t = if a1 != a0 {
+            ((c - a0) / (a1 - a0)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let across = if steep { x0 + dx * t } else { y0 + dy * t };
+        for n in across.floor() as i64 - r..=across.floor() as i64 + r {
+            let (xx, yy) = if steep { (n, m) } else { (m, n) };
+            let d = segment_distance(s, xx as f64 + 0.5, yy as f64 + 0.5);
+            blend_px(frame, w, h, xx, yy, color, (half + 0.5 - d).clamp(0.0, 1.0));
+        }
+    }
+}
+
+/// Draw a filled disc of `radius` pixels with a dark outline.
+pub fn draw_marker(frame: &mut [u32], w: u32, h: u32, at: (f64, f64), radius: f64, color: u32) {
+    let r = radius.ceil() as i64 + 2;
+    let (cx, cy) = at;
+    for yy in cy.floor() as i64 - r..=cy.floor() as i64 + r {
+        for xx in cx.floor() as i64 - r..=cx.floor() as i64 + r {
+            let d = ((xx as f64 + 0.5 - cx).powi(2) + (yy as f64 + 0.5 - cy).powi(2)).sqrt();
+            let outline = (radius + 1.5 - d).clamp(0.0, 1.0);
+            blend_px(frame, w, h, xx, yy, 0x101010, outline);
+            blend_px(
+                frame,
+                w,
+                h,
+                xx,
+                yy,
+                color,
+                (radius + 0.5 - d).clamp(0.0, 1.0),
+            );
+        }
+    }
+}
+
+/// Draw the room's wireframe and the lights' markers of `st` over a rendered `w × h`
+/// frame of `view` (what `viewer render --show-room` adds).
+///
+/// # Errors
+/// A room the state cannot build.
+pub fn draw_room_and_lights(
+    st: &super::LightsState,
+    view: lut_core::View,
+    frame: &mut [u32],
+    w: u32,
+    h: u32,
+) -> Result<(), String> {
+    let room = st.room_box()?;
+    let cam = Camera::new(view, w, h);
+    let scale = (w.max(h) as f64 / 800.0).max(1.0);
+    for s in room_edges(&room, &cam) {
+        draw_segment(frame, w, h, s, 2.0 * scale, ROOM_COLOR);
+    }
+    for l in &st.lights {
+        let mut lum = lut_core::Luminaire::new(l.table.clone(), DVec3::from(l.position));
+        lum.yaw_deg = l.yaw;
+        lum.pitch_deg = l.pitch;
+        if let Some((at, stroke)) = light_marker(&room, &cam, lum.position, lum.frame().2) {
+            if let Some(s) = stroke {
+                draw_segment(frame, w, h, s, 2.0 * scale, LIGHT_COLOR);
+            }
+            let color = if l.enabled { LIGHT_COLOR } else { 0x808080 };
+            draw_marker(frame, w, h, at, 5.0 * scale, color);
+        }
+    }
+    Ok(())
+}
+
+/// The wireframe colour of the room box (a light cyan that reads on most photographs).
+pub const ROOM_COLOR: u32 = 0x40e0ff;
+/// The lights' marker colour.
+pub const LIGHT_COLOR: u32 = 0xffd040;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lut_core::View;
+
+    #[test]
+    fn edges_project_where_the_box_is() {
+        // Looking straight down from 1.5 m in a 4 × 4 m room: the floor's four edges form
+        // a square around the image centre, the same on both axes.
+        let room = Room::new(4.0, 4.0, 3.0, 1.5).unwrap();
+        let cam = Camera::new(View::new(0.0, -90.0, 120.0).unwrap(), 200, 200);
+        let edges = room_edges(&room, &cam);
+        // The four floor edges and the four vertical ones are in front; the ceiling's
+        // are behind.
+        assert_eq!(edges.len(), 8);
+        let f = cam.focal;
+        let half = 2.0 / 1.5 * f;
+        let floor_corner = (100.0 + half, 100.0 + half);
+        assert!(edges.iter().any(|s| {
+            let near = |p: (f64, f64)| {
+                (p.0 - floor_corner.0).abs() < 1e-6 && (p.1 - floor_corner.1).abs() < 1e-6
+            };
+            near(s.0) || near(s.1)
+        }));
+    }
+
+    #[test]
+    fn edges_behind_are_clipped_not_dropped() {
+        // Looking at a wall corner: edges running past the camera are cut at the near
+        // plane and still drawn.
+        let room = Room::new(4.0, 4.0, 3.0, 1.5).unwrap();
+        let cam = Camera::new(View::new(45.0, 0.0, 90.0).unwrap(), 100, 60);
+        let edges = room_edges(&room, &cam);
+        assert!(edges.len() >= 3, "{edges:?}");
+        for ((a, b), (c, d)) in &edges {
+            assert!(a.is_finite() && b.is_finite() && c.is_finite() && d.is_finite());
+        }
+    }
+
+    #[test]
+    fn turning_the_room_turns_its_wireframe() {
+        // The corner at the room's front-right, with the room turned by 30°, appears where
+        // the unturned room's corner appears when the view turns by −30°.
+        let room = Room::new(4.0, 6.0, 3.0, 1.5).unwrap();
+        let turned = room.with_yaw(30.0).unwrap();
+        let p = DVec3::new(2.0, 0.0, 3.0);
+        let a = project_point(
+            &turned,
+            &Camera::new(View::new(40.0, -20.0, 90.0).unwrap(), 80, 60),
+            p,
+        );
+        let b = project_point(
+            &room,
+            &Camera::new(View::new(10.0, -20.0, 90.0).unwrap(), 80, 60),
+            p,
+        );
+        let (a, b) = (a.unwrap(), b.unwrap());
+        assert!((a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9);
+    }
+
+    #[test]
+    fn drawing_stays_inside_the_frame() {
+        let mut f = vec![0u32; 50 * 40];
+        draw_segment(
+            &mut f,
+            50,
+            40,
+            ((-100.0, -100.0), (300.0, 200.0)),
+            2.0,
+            0xffffff,
+        );
+        draw_segment(&mut f, 50, 40, ((10.0, 10.0), (10.0, 10.0)), 2.0, 0xffffff);
+        draw_marker(&mut f, 50, 40, (49.0, 39.0), 5.0, 0xff0000);
+        assert!(f.iter().any(|&p| p != 0));
+    }
+}
