@@ -1,13 +1,22 @@
 #!/usr/bin/env bash
-# Smoke test of the real viewer window under Xvfb.
+# The real viewer window under Xvfb, driven as a user would with xdotool; every check
+# reads what the viewer prints with --print-view (the view of each rendered frame with
+# the sampler that rendered it, the panel's readouts as drawn, loads, dialogs, saves).
 #
-# Starts the release binary on the bundled sample in a virtual X display, takes a
-# screenshot, drags with the mouse, scrolls the wheel, takes another, checks that the
-# view changed in the expected direction (from the view the viewer prints with
-# --print-view), checks that an idle window renders nothing, resets with R, closes the
-# window with Ctrl+Q and requires exit code 0.
+# Run 1 (settings: panel shown, zoom limit off), on a folder of three panoramas:
+#   readouts true right after the load, before any input; the window title and icon;
+#   an idle window renders nothing; a drag in the default (adaptive) mode renders moving
+#   frames with the full-quality sampler (trilinear) and turns the right way; the wheel
+#   zooms past the LUT switch; a double-click zooms in; R returns to the start view;
+#   after Tab x3 the arrow keys still turn; ? shows the help; Ctrl+O opens the dialog and
+#   a path typed into it loads; PageDown opens the next file in natural order; Ctrl+Q
+#   exits 0 and the recent files are in the settings file.
+# Run 2 (the settings written by run 1, panel hidden, default zoom limit): the panel
+#   stays hidden, the zoom stops where a map pixel covers two screen pixels, Ctrl+S
+#   saves the view where the settings say; docs/screenshot.png is taken here.
 #
-# Screenshots and logs: target/window-smoke/. Also writes docs/screenshot.png.
+# Screenshots and logs: target/window-smoke/ (kept as CI artifacts). The settings live
+# in a temporary config folder (LUTPANO_CONFIG_DIR), never the real home.
 #
 # Usage: scripts/window-smoke.sh [--install] [--no-build]
 #   --install   apt-get the X tools first (xvfb xdotool x11-utils x11-apps imagemagick and
@@ -26,7 +35,7 @@ for a in "$@"; do
   case $a in
     --install) INSTALL=1 ;;
     --no-build) BUILD=0 ;;
-    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
     *) echo "window-smoke: unknown argument '$a'" >&2; exit 2 ;;
   esac
 done
@@ -46,7 +55,8 @@ fi
 # /usr/local/bin/convert on some machines is a stand-in: use ImageMagick's own paths.
 IMPORT=/usr/bin/import
 COMPARE=/usr/bin/compare
-for tool in Xvfb xdotool xdpyinfo; do
+IDENTIFY=/usr/bin/identify
+for tool in Xvfb xdotool xdpyinfo xprop; do
   command -v "$tool" >/dev/null || fail "$tool not found (run with --install)"
 done
 [ -x "$IMPORT" ] || fail "$IMPORT not found (ImageMagick; run with --install)"
@@ -105,55 +115,116 @@ wait_for() {
 lines() { wc -l <"$VIEWLOG"; }
 # Field `name` of the last "view" line, e.g. field yaw.
 field() { grep '^view ' "$VIEWLOG" | tail -n 1 | tr ' ' '\n' | sed -n "s/^$1=//p"; }
-# Wait for the view to settle: a full-quality frame and then no new frame for 0.5 s.
+# Wait for the view to settle: no new line for 0.5 s, the last frame at full quality
+# (a moving frame that was already full quality needs no frame after it).
 settle() {
   local n
   for _ in $(seq 1 100); do
     n=$(lines)
     sleep 0.5
-    if [ "$(lines)" = "$n" ] && [ "$(field fast)" = false ]; then return 0; fi
+    if [ "$(lines)" = "$n" ] && [ "$(field level)" = full ]; then return 0; fi
   done
   fail "the view never settled"
 }
 
-log "starting the viewer on the bundled sample"
-for attempt in 1 2; do
-  "$BIN" --size 800x500 --print-view >"$VIEWLOG" 2>"$ERRLOG" &
-  VIEWER_PID=$!
-  sleep 1
-  # A display that answered xdpyinfo once refused the viewer in one run out of many:
-  # retry once, then give up (the message is in $ERRLOG).
-  if kill -0 "$VIEWER_PID" 2>/dev/null || ! grep -q 'cannot open a window' "$ERRLOG"; then break; fi
-  log "the viewer could not connect (attempt $attempt): $(cat "$ERRLOG")"
-  kill -0 "$XVFB_PID" 2>/dev/null || fail "Xvfb died (see $OUT/xvfb.log)"
-  sleep 1
-done
+CFG=$OUT/config
+PANOS=$OUT/panos
+SAVES=$OUT/saves
+mkdir -p "$CFG" "$PANOS" "$SAVES"
+# Three panoramas whose natural order (a1, a2, a10) differs from the plain one.
+for n in a1 a2 a10; do cp "$ROOT/assets/courtyard.jpg" "$PANOS/$n.jpg"; done
+export LUTPANO_CONFIG_DIR=$CFG
+
+# Start the viewer with arguments "$@" (a display that answered xdpyinfo once refused
+# the viewer in one run out of many: retry once).
+start_viewer() {
+  for attempt in 1 2; do
+    "$BIN" --size 800x500 --print-view "$@" >"$VIEWLOG" 2>"$ERRLOG" &
+    VIEWER_PID=$!
+    sleep 1
+    if kill -0 "$VIEWER_PID" 2>/dev/null || ! grep -q 'cannot open a window' "$ERRLOG"; then return 0; fi
+    log "the viewer could not connect (attempt $attempt): $(cat "$ERRLOG")"
+    kill -0 "$XVFB_PID" 2>/dev/null || fail "Xvfb died (see $OUT/xvfb.log)"
+    sleep 1
+  done
+}
+# No window manager gives the window the keyboard: focus it, then type through XTEST as
+# a user would (held keys, so a press is not lost in one burst).
+focus() {
+  xdotool mousemove "$CX" "$CY"
+  xdotool windowfocus "$WID" 2>/dev/null || true
+  sleep 0.3
+}
+press() { xdotool keydown "$1"; sleep 0.1; xdotool keyup "$1"; }
+chord() { xdotool keydown "$1"; sleep 0.1; xdotool key "$2"; sleep 0.1; xdotool keyup "$1"; }
+find_window() {
+  WID=$(xdotool search --sync --onlyvisible --name '^viewer' | head -n 1)
+  [ -n "$WID" ] || fail "no viewer window found"
+  eval "$(xdotool getwindowgeometry --shell "$WID")"
+  [ "$WIDTH" -gt 100 ] && [ "$HEIGHT" -gt 100 ] || fail "window too small: ${WIDTH}x${HEIGHT}"
+}
+# Close with Ctrl+Q and require a clean exit.
+quit_viewer() {
+  focus
+  chord ctrl q
+  RC=""
+  for i in $(seq 1 100); do
+    if [ "$i" = 50 ]; then focus; chord ctrl q; fi # one retry
+    if ! kill -0 "$VIEWER_PID" 2>/dev/null; then
+      set +e; wait "$VIEWER_PID"; RC=$?; set -e
+      break
+    fi
+    sleep 0.1
+  done
+  [ -n "$RC" ] || fail "the viewer did not close on Ctrl+Q"
+  VIEWER_PID=""
+  [ "$RC" = 0 ] || fail "the viewer exited with $RC (see $ERRLOG)"
+  if [ -s "$ERRLOG" ]; then log "viewer stderr:"; sed 's/^/  /' "$ERRLOG"; fi
+}
+# Field `name` of the last "readouts" line (the panel as drawn).
+readout() { grep '^readouts ' "$VIEWLOG" | tail -n 1 | tr ';' '\n' | sed -n "s/^ *$1=//p"; }
+
+########## Run 1: panel shown, zoom limit off ##########
+printf '{"panel": true, "zoom_limit": null, "save_dir": "%s"}\n' "$SAVES" >"$CFG/settings.json"
+log "run 1: the viewer on $PANOS/a1.jpg"
+start_viewer "$PANOS/a1.jpg"
 wait_for '^loaded ' 0 60
 wait_for '^view .*fast=false' 0 60
 settle
-WID=$(xdotool search --sync --onlyvisible --name '^viewer' | head -n 1)
-[ -n "$WID" ] || fail "no viewer window found"
-eval "$(xdotool getwindowgeometry --shell "$WID")"
-log "window $WID at ${X},${Y} size ${WIDTH}x${HEIGHT}"
-[ "$WIDTH" -gt 100 ] && [ "$HEIGHT" -gt 100 ] || fail "window too small: ${WIDTH}x${HEIGHT}"
+find_window
+log "window $WID at ${X},${Y} size ${WIDTH}x${HEIGHT}: $(xdotool getwindowname "$WID")"
+xdotool getwindowname "$WID" | grep -q '^viewer: a1.jpg (1024×512)$' ||
+  fail "the title should name the file and its size: $(xdotool getwindowname "$WID")"
+xprop -id "$WID" _NET_WM_ICON | grep -q 'Icon (64 x 64)' || fail "no 64x64 window icon"
 
 YAW0=$(field yaw); PITCH0=$(field pitch); HFOV0=$(field hfov); PATH0=$(field path)
 SCENE=$(field size); SW=${SCENE%x*}; SH=${SCENE#*x}
 log "start: yaw=$YAW0 pitch=$PITCH0 hfov=$HFOV0 $PATH0 scene ${SW}x${SH}"
+CX=$((X + SW / 2)); CY=$((Y + SH / 2))
+# The readouts right after the load, before any input: the table, scene and quality of
+# the frame shown (not "none yet", not 0x0).
+wait_for "^readouts .*in use=wide-FOV LUT.*scene=${SW}×${SH}" 0 10
+log "readouts after the load: $(grep '^readouts ' "$VIEWLOG" | tail -n 1)"
+[ "$(readout quality)" = "trilinear (full)" ] || fail "quality readout: $(readout quality)"
+case $(readout table) in "0.0 KiB"|"") fail "table readout after the load: $(readout table)" ;; esac
 $IMPORT -window root "$OUT/1-start.png"
 
 # Idle: no frame is rendered while nothing changes.
-N=$(lines)
+views() { grep -c '^view ' "$VIEWLOG"; }
+N=$(views)
 sleep 2
-[ "$(lines)" = "$N" ] || fail "the idle window kept rendering ($(($(lines) - N)) frames in 2 s)"
+[ "$(views)" = "$N" ] || fail "the idle window kept rendering ($(($(views) - N)) frames in 2 s)"
 TICKS=$(awk '{print $14 + $15}' "/proc/$VIEWER_PID/stat")
 sleep 2
 TICKS2=$(awk '{print $14 + $15}' "/proc/$VIEWER_PID/stat")
 log "idle CPU: $((TICKS2 - TICKS)) clock ticks in 2 s"
+[ "$(readout fps)" = 0 ] || fail "idle fps readout: $(readout fps)"
 
 # Drag from the scene's center 150 px to the left and 60 px up (grab style): the scene
-# follows the cursor, so the view turns right (yaw grows) and down (pitch falls).
-CX=$((X + SW / 2)); CY=$((Y + SH / 2))
+# follows the cursor, so the view turns right (yaw grows) and down (pitch falls). In the
+# default (adaptive) mode the moving frames keep the full-quality sampler while the last
+# full-quality frames fit the 16 ms budget.
+N=$(lines)
 xdotool mousemove "$CX" "$CY"
 sleep 0.2
 xdotool mousedown 1
@@ -171,6 +242,10 @@ awk -v a="$YAW0" -v b="$YAW1" 'BEGIN { exit !(b > a + 5) }' ||
   fail "dragging left should turn right: yaw $YAW0 -> $YAW1"
 awk -v a="$PITCH0" -v b="$PITCH1" 'BEGIN { exit !(b < a - 1) }' ||
   fail "dragging up should look down: pitch $PITCH0 -> $PITCH1"
+MOVING=$(tail -n +"$((N + 1))" "$VIEWLOG" | grep '^view .*fast=true' || true)
+log "moving frames by sampler and level: $(echo "$MOVING" | grep -o 'sampler=[a-z]* level=[a-z-]*' | sort | uniq -c | tr '\n' ';')"
+echo "$MOVING" | grep -q 'sampler=trilinear level=full fast=true' ||
+  fail "no moving frame was rendered at full quality (see $VIEWLOG)"
 
 # Scroll up (away from the user) five notches at the scene center: zoom in past 60°,
 # which switches from the wide-FOV to the high-resolution LUT.
@@ -187,53 +262,113 @@ awk -v a="$HFOV0" -v b="$HFOV1" 'BEGIN { exit !(b < a && b < 60) }' ||
   fail "scrolling up should zoom in below 60°: hfov $HFOV0 -> $HFOV1"
 [ "$PATH0" = LutWide ] || fail "at hfov $HFOV0 the wide LUT should be in use, got $PATH0"
 [ "$PATH1" = LutHigh ] || fail "at hfov $HFOV1 the high-resolution LUT should be in use, got $PATH1"
-
-# The picture changed between the screenshots.
 DIFF=$($COMPARE -metric AE "$OUT/1-start.png" "$OUT/3-zoomed.png" "$OUT/diff.png" 2>&1 >/dev/null || true)
 DIFF=${DIFF%% *}
 log "pixels changed: $DIFF"
 awk -v d="$DIFF" -v n="$((SW * SH))" 'BEGIN { exit !(d + 0 > n / 4) }' ||
   fail "the screenshots barely differ ($DIFF pixels)"
 
-# No window manager gives the window the keyboard: focus it, then type through XTEST as
-# a user would (held keys, so a press is not lost in one burst).
-focus() {
-  xdotool mousemove "$CX" "$CY"
-  xdotool windowfocus "$WID" 2>/dev/null || true
-  sleep 0.3
-}
+# Double-click: zoom in twice toward the point.
+xdotool mousemove "$((CX + 100))" "$((CY - 50))"
+sleep 0.2
+xdotool click --repeat 2 --delay 80 1
+settle
+HFOV2=$(field hfov)
+log "after double-click: hfov=$HFOV2"
+awk -v a="$HFOV1" -v b="$HFOV2" 'BEGIN { exit !(b < a * 0.55 && b > a * 0.45) }' ||
+  fail "a double-click should halve hfov: $HFOV1 -> $HFOV2"
 
-# R resets the view (the paper's RESIZE). The README screenshot is taken now, with the
-# tables warm, so its render time is a typical one.
+# R returns to the file's start view (no GPano: yaw 0, pitch 0, hfov 90).
 focus
-xdotool keydown r; sleep 0.1; xdotool keyup r
+press r
 settle
 log "after R: yaw=$(field yaw) pitch=$(field pitch) hfov=$(field hfov)"
 [ "$(field yaw)" = 0.0000 ] && [ "$(field pitch)" = 0.0000 ] && [ "$(field hfov)" = 90.0000 ] ||
-  fail "R should reset the view to yaw 0, pitch 0, hfov 90"
-sleep 0.3 # the readouts' follow-up frame
-$IMPORT -window root "$OUT/4-reset.png"
+  fail "R should return to yaw 0, pitch 0, hfov 90"
+
+# The keyboard trap: Tab x3 puts egui's focus on a button; the arrows still turn, at
+# no more frames than the display refreshes.
+for _ in 1 2 3; do press Tab; sleep 0.1; done
+HZ=$(sed -n 's/^refresh \([0-9]*\).*/\1/p' "$VIEWLOG" | head -n 1)
+N=$(views)
+xdotool keydown Right; sleep 1; xdotool keyup Right
+settle
+FRAMES=$(($(views) - N))
+log "after Tab x3 and Right held 1 s: yaw=$(field yaw), $FRAMES frames at ${HZ} Hz"
+awk -v b="$(field yaw)" 'BEGIN { exit !(b > 5) }' || fail "after Tab x3 the arrow keys no longer turn"
+[ "$FRAMES" -le $((HZ * 13 / 10 + 5)) ] || fail "$FRAMES frames for 1 s of turning at ${HZ} Hz"
+
+# ? shows the help overlay (and hides it again).
+N=$(lines)
+xdotool key question
+wait_for '^help shown' "$N" 5
+sleep 0.3
+$IMPORT -window root "$OUT/4-help.png"
+xdotool key question
+wait_for '^help hidden' "$N" 5
+
+# Ctrl+O opens the dialog; / edits its path; the typed file loads.
+N=$(lines)
+chord ctrl o
+wait_for "^dialog open $PANOS" "$N" 5
+sleep 0.5
+press slash
+sleep 0.3
+xdotool type --delay 40 "/a2.jpg"
+sleep 0.3
+$IMPORT -window root "$OUT/5-dialog.png"
+press Return
+wait_for "^dialog picked $PANOS/a2.jpg" "$N" 10
+wait_for "^loaded $PANOS/a2.jpg" "$N" 30
+settle
+wait_for "^readouts .*in use=wide-FOV LUT.*scene=${SW}×${SH}" "$N" 10
+log "opened from the dialog: $(grep '^loaded ' "$VIEWLOG" | tail -n 1)"
+
+# PageDown: the next file in natural order (a2 -> a10).
+N=$(lines)
+focus
+press Next
+wait_for "^loaded $PANOS/a10.jpg" "$N" 30
+settle
+log "after PageDown: $(grep '^loaded ' "$VIEWLOG" | tail -n 1)"
+$IMPORT -window root "$OUT/6-next.png"
+quit_viewer
+for n in a1 a2 a10; do
+  grep -q "\"$PANOS/$n.jpg\"" "$CFG/settings.json" || fail "$n.jpg is not among the recent files"
+done
+
+########## Run 2: the settings of run 1, panel hidden, default zoom limit ##########
+sed -i -e 's/"panel": true/"panel": false/' -e '/"zoom_limit"/d' "$CFG/settings.json"
+log "run 2: the viewer on the bundled sample"
+start_viewer
+wait_for '^loaded ' 0 60
+wait_for '^view .*fast=false' 0 60
+settle
+find_window
+SCENE=$(field size); SW=${SCENE%x*}; SH=${SCENE#*x}
+CX=$((X + SW / 2)); CY=$((Y + SH / 2))
+[ "$SW" = "$WIDTH" ] || fail "the panel should stay hidden: scene ${SW} of ${WIDTH} px"
+! grep -q '^readouts ' "$VIEWLOG" || fail "readouts printed with the panel hidden"
+# One map pixel over two screen pixels at the limit: 1024 px over 360°, f = 2·1024/(2π).
+LIMIT=$(awk -v w="$SW" 'BEGIN { printf "%.4f", 2 * atan2(w / 2, 2 * 1024 / (2 * 3.14159265358979)) * 180 / 3.14159265358979 }')
+log "start: hfov=$(field hfov), the limit for a ${SW}-px scene: $LIMIT"
+xdotool mousemove "$CX" "$CY"
+for _ in 1 2 3 4 5; do xdotool click 4; sleep 0.1; done
+settle
+log "after scroll: hfov=$(field hfov)"
+awk -v a="$(field hfov)" -v l="$LIMIT" 'BEGIN { exit !(a > l - 0.01 && a < l + 0.01) }' ||
+  fail "the zoom should stop at the resolution limit $LIMIT, got $(field hfov)"
+sleep 0.3
 $IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$ROOT/docs/screenshot.png"
 
-# Close with Ctrl+Q and require a clean exit.
-close_keys() {
-  focus
-  xdotool keydown ctrl; sleep 0.1; xdotool key q; sleep 0.1; xdotool keyup ctrl
-}
-close_keys
-RC=""
-for i in $(seq 1 100); do
-  [ "$i" != 50 ] || close_keys # one retry
-  if ! kill -0 "$VIEWER_PID" 2>/dev/null; then
-    set +e; wait "$VIEWER_PID"; RC=$?; set -e
-    break
-  fi
-  sleep 0.1
-done
-[ -n "$RC" ] || fail "the viewer did not close on Ctrl+Q"
-VIEWER_PID=""
-[ "$RC" = 0 ] || fail "the viewer exited with $RC (see $ERRLOG)"
-if [ -s "$ERRLOG" ]; then
-  log "viewer stderr:"; sed 's/^/  /' "$ERRLOG"
-fi
+# Ctrl+S: the Save dialog opens in the folder of the settings, Enter saves view-1.png.
+N=$(lines)
+focus
+chord ctrl s
+wait_for "^dialog save $SAVES" "$N" 5
+sleep 0.5
+press Return
+wait_for "^saved $SAVES/view-1.png (${SW}×${SH})" "$N" 20
+[ "$($IDENTIFY -format '%wx%h' "$SAVES/view-1.png")" = "${SW}x${SH}" ] || fail "view-1.png is not ${SW}x${SH}"
+quit_viewer
 log "PASS (screenshots in $OUT, docs/screenshot.png updated)"

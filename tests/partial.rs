@@ -409,3 +409,48 @@ fn non_square_pixel_geometry_keeps_the_lut_bound() {
         }
     }
 }
+
+/// The file's start view (GPano `InitialView*`) comes with the map, full or partial, and
+/// is relative to the map (the heading minus the pose).
+#[test]
+fn the_start_view_comes_with_the_map() {
+    let mut jpeg = Vec::new();
+    image::RgbImage::from_pixel(64, 32, image::Rgb([1, 2, 3]))
+        .write_to(
+            &mut std::io::Cursor::new(&mut jpeg),
+            image::ImageFormat::Jpeg,
+        )
+        .unwrap();
+    let view = [
+        ("PoseHeadingDegrees", "90"),
+        ("InitialViewHeadingDegrees", "45"),
+        ("InitialViewPitchDegrees", "10"),
+        ("InitialHorizontalFOVDegrees", "60"),
+    ];
+    let full = lut_core::insert_xmp(&jpeg, &lut_core::xmp_packet(&view)).unwrap();
+    let (m, src) = decode(&full, "full.jpg", None).unwrap();
+    assert_eq!(src, CoverageSource::Full);
+    let want = lut_core::StartView {
+        yaw_deg: -45.0,
+        pitch_deg: 10.0,
+        hfov_deg: Some(60.0),
+    };
+    assert_eq!(m.start_view(), Some(want));
+    let mut crop = view.to_vec();
+    crop.extend([
+        ("FullPanoWidthPixels", "128"),
+        ("CroppedAreaLeftPixels", "10"),
+        ("CroppedAreaTopPixels", "5"),
+        ("CroppedAreaImageWidthPixels", "64"),
+        ("CroppedAreaImageHeightPixels", "32"),
+    ]);
+    let part = lut_core::insert_xmp(&jpeg, &lut_core::xmp_packet(&crop)).unwrap();
+    let (m, src) = decode(&part, "part.jpg", None).unwrap();
+    assert_eq!(src, CoverageSource::Xmp);
+    assert_eq!(m.start_view(), Some(want));
+    // No metadata: no start view.
+    assert_eq!(
+        decode(&jpeg, "plain.jpg", None).unwrap().0.start_view(),
+        None
+    );
+}

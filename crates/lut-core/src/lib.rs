@@ -97,7 +97,7 @@ pub use named::{name_list, parse_name, Named};
 // Geometry.
 pub use geom::accuracy::{compare_positions, position_error, raw_error, ErrorStats};
 pub use geom::camera::{check_size, dir_to_lat_long, lat_long_to_dir, wrap_deg, Camera, View};
-pub use geom::coverage::{compass_heading, compass_point, Coverage, Crop};
+pub use geom::coverage::{compass_heading, compass_point, Coverage, Crop, StartView};
 pub use geom::fixed::{from_fx, to_fx, Fx, FX_BITS, FX_HALF, FX_ONE};
 pub use geom::limits::{MAX_MAP_HEIGHT, MAX_MAP_PIXELS, MAX_MAP_WIDTH, MAX_OUTPUT_SIDE};
 pub use geom::mapping::{exact_uv, exact_uv_at};

@@ -58,4 +58,34 @@ mod tests {
         let cli = Cli::try_parse_from(["viewer", "ies", "x.ies", "--sample", "1,2"]).unwrap();
         assert!(matches!(cli.command, Some(Command::Ies(_))));
     }
+
+    #[test]
+    fn the_window_takes_a_start_view() {
+        let cli = Cli::try_parse_from([
+            "viewer", "a.jpg", "--yaw", "-30", "--pitch", "12.5", "--hfov", "60",
+        ])
+        .unwrap();
+        let o = cli.open;
+        assert_eq!(
+            (o.yaw, o.pitch, o.hfov),
+            (Some(-30.0), Some(12.5), Some(60.0))
+        );
+        let o = Cli::try_parse_from(["viewer"]).unwrap().open;
+        assert_eq!(
+            (o.yaw, o.pitch, o.hfov),
+            (None, None, None),
+            "the file's own view"
+        );
+        for (flag, bad, says) in [
+            ("--hfov", "180", "must be in (0, 180)"),
+            ("--hfov", "0", "must be in (0, 180)"),
+            ("--yaw", "nan", "not a finite number"),
+            ("--pitch", "up", "not a number"),
+        ] {
+            let e = Cli::try_parse_from(["viewer", flag, bad])
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(bad) && e.contains(says), "{flag} {bad}: {e}");
+        }
+    }
 }

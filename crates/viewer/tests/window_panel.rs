@@ -1,10 +1,14 @@
-//! The egui panel painted offscreen on the CPU, exactly as the window paints it, with no
-//! display: it shows up on the right, the scene to its left is untouched, and its pixels
-//! are the panel's colours with text and widgets on them.
+//! The egui panel and the viewing overlay painted offscreen on the CPU, exactly as the
+//! window paints them, with no display: the panel shows up on the right, the scene to its
+//! left is untouched, and its pixels are the panel's colours with text and widgets on
+//! them; the toolbar, notices and help draw over the scene.
 
 use viewer::lighting::LightsState;
-use viewer::window::input::{Look, Settings};
+use viewer::window::input::{AutoRotate, Look};
+use viewer::window::notices::Notices;
+use viewer::window::overlay::{self, ToolbarModel, TOOLBAR_LABELS};
 use viewer::window::paint::{Compositor, SceneRect, BACKGROUND};
+use viewer::window::quality::Settings;
 use viewer::window::ui::{self, LoadStatus, PanelModel, Readouts, BUTTON_LABELS, PANEL_WIDTH};
 
 const W: u32 = 800;
@@ -16,12 +20,20 @@ struct Painted {
     scene: Option<SceneRect>,
 }
 
+/// What to draw over the scene besides the panel.
+#[derive(Default)]
+struct Overlays<'a> {
+    error: Option<&'a str>,
+    help: bool,
+    toolbar: bool,
+}
+
 /// Run `passes` UI passes at `ppp` pixels per point and paint the last one.
 fn paint_panel(
     ppp: f32,
     passes: usize,
     loading: Option<&LoadStatus>,
-    error: Option<&str>,
+    over: Overlays<'_>,
 ) -> Painted {
     let ctx = egui::Context::default();
     ctx.set_visuals(egui::Visuals::dark());
@@ -29,6 +41,8 @@ fn paint_panel(
     let mut settings = Settings::default();
     let mut projection = None;
     let mut lights = LightsState::default();
+    let mut zoom_limit = Some(2.0);
+    let mut auto_rotate = AutoRotate::default();
     let readouts = Readouts {
         map: "test map (256×128, equirect)".into(),
         render_ms: 3.5,
@@ -57,11 +71,29 @@ fn paint_panel(
                     look: Look::new(12.5, -3.0, 75.0),
                     readouts: &readouts,
                     loading,
-                    error,
+                    zoom_limit: &mut zoom_limit,
+                    auto_rotate: &mut auto_rotate,
                     lights: &mut lights,
                 },
             );
-            scene = SceneRect::from_points(ui.available_rect_before_wrap(), ppp, W, H);
+            let rect = ui.available_rect_before_wrap();
+            scene = SceneRect::from_points(rect, ppp, W, H);
+            overlay::notices(ui.ctx(), rect, over.error, &Notices::default());
+            if over.help {
+                overlay::help(ui.ctx(), rect);
+            }
+            if over.toolbar {
+                overlay::toolbar(
+                    ui.ctx(),
+                    ToolbarModel {
+                        scene: rect,
+                        title: "test.jpg (256×128)",
+                        recent: &[],
+                        panel: true,
+                        help: over.help,
+                    },
+                );
+            }
         });
         let prims = ctx.tessellate(out.shapes, out.pixels_per_point);
         let r = scene.expect("the scene keeps most of the window");
@@ -83,7 +115,7 @@ fn paint_panel(
 }
 
 fn check(ppp: f32) {
-    let Painted { frame, scene } = paint_panel(ppp, 3, None, None);
+    let Painted { frame, scene } = paint_panel(ppp, 3, None, Overlays::default());
     let scene = scene.expect("scene rect");
     let panel_px = (PANEL_WIDTH * ppp).round() as u32;
     // The scene fills the window left of the panel.
@@ -146,8 +178,8 @@ fn panel_paints_on_the_right_at_hidpi() {
 }
 
 #[test]
-fn load_progress_and_errors_show_in_the_panel() {
-    let plain = paint_panel(1.0, 3, None, None).frame;
+fn load_progress_in_the_panel_and_errors_in_a_notice() {
+    let plain = paint_panel(1.0, 3, None, Overlays::default()).frame;
     let busy = paint_panel(
         1.0,
         3,
@@ -155,17 +187,56 @@ fn load_progress_and_errors_show_in_the_panel() {
             fraction: Some(0.3),
             ..LoadStatus::new("big.jpg".into())
         }),
-        Some("big.jpg: cannot read image: unsupported format"),
+        Overlays {
+            error: Some("big.jpg: cannot read image: unsupported format"),
+            ..Overlays::default()
+        },
     )
     .frame;
-    // The error is drawn in its red-orange colour somewhere in the panel.
+    // The error is drawn in its red-orange colour, in a notice over the scene.
     let reddish = |p: &u32| {
         let (r, g, b) = ((p >> 16) & 255, (p >> 8) & 255, p & 255);
         r > 180 && g < 150 && b < 140
     };
     assert_eq!(plain.iter().filter(|p| reddish(p)).count(), 0);
     assert!(busy.iter().filter(|p| reddish(p)).count() > 30);
+    let scene_w = W - (PANEL_WIDTH as u32);
+    let in_scene = busy
+        .chunks_exact(W as usize)
+        .flat_map(|row| &row[..scene_w as usize])
+        .filter(|p| reddish(p))
+        .count();
+    assert!(in_scene > 30, "the notice is over the scene: {in_scene}");
     assert_ne!(plain, busy);
+}
+
+/// The help overlay and the toolbar draw over the scene (the scene colour is covered
+/// where they are, and only there).
+#[test]
+fn the_help_and_the_toolbar_cover_part_of_the_scene() {
+    let bare = paint_panel(1.0, 3, None, Overlays::default()).frame;
+    let over = paint_panel(
+        1.0,
+        3,
+        None,
+        Overlays {
+            help: true,
+            toolbar: true,
+            ..Overlays::default()
+        },
+    )
+    .frame;
+    let scene_px = |f: &[u32]| f.iter().filter(|&&p| p == SCENE_COLOR).count();
+    let (a, b) = (scene_px(&bare), scene_px(&over));
+    assert!(
+        b < a * 8 / 10,
+        "help and toolbar cover the scene: {b} of {a}"
+    );
+    assert!(b > a / 10, "but not all of it: {b} of {a}");
+    // The toolbar is at the top left: the corner is covered, the bottom left is not.
+    let at = |x: u32, y: u32| over[(y * W + x) as usize];
+    assert_ne!(at(20, 20), SCENE_COLOR);
+    assert_eq!(at(20, H - 5), SCENE_COLOR);
 }
 
 #[test]
@@ -176,10 +247,15 @@ fn button_labels_have_glyphs_in_the_default_fonts() {
         ui.label("x");
     });
     let font = egui::FontId::proportional(14.0);
-    for label in BUTTON_LABELS {
-        assert!(
-            ctx.fonts_mut(|f| f.has_glyphs(&font, label)),
-            "no glyph for button label {label:?}"
-        );
+    let mono = egui::FontId::monospace(14.0);
+    let help: Vec<String> = overlay::help_rows().into_iter().map(|r| r.0).collect();
+    let help: Vec<&str> = help.iter().map(String::as_str).collect();
+    for label in BUTTON_LABELS.iter().chain(&TOOLBAR_LABELS).chain(&help) {
+        for font in [&font, &mono] {
+            assert!(
+                ctx.fonts_mut(|f| f.has_glyphs(font, label)),
+                "no glyph for label {label:?} in {font:?}"
+            );
+        }
     }
 }

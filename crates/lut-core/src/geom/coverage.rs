@@ -367,6 +367,18 @@ impl Crop {
     }
 }
 
+/// The view a panorama asks to be opened at (GPano `InitialView*`, see
+/// [`crate::GPano::start_view`]), relative to the map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StartView {
+    /// Yaw in degrees, (−180, 180].
+    pub yaw_deg: f64,
+    /// Pitch in degrees, [−90, 90].
+    pub pitch_deg: f64,
+    /// Horizontal field of view in degrees, when the file gives one.
+    pub hfov_deg: Option<f64>,
+}
+
 /// Compass heading (degrees clockwise from north, [0, 360)) of the view centre at `yaw`
 /// for a map whose longitude 0 faces `pose_heading` (GPano `PoseHeadingDegrees`, see
 /// [`crate::EnvMap::pose_heading_deg`]): yaw stays relative to the map; positive yaw turns

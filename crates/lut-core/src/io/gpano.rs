@@ -4,7 +4,10 @@
 //! with these fields of the namespace `http://ns.google.com/photos/1.0/panorama/`:
 //! `FullPanoWidthPixels`, `FullPanoHeightPixels`, `CroppedAreaLeftPixels`,
 //! `CroppedAreaTopPixels`, `CroppedAreaImageWidthPixels`, `CroppedAreaImageHeightPixels`,
-//! and `PoseHeadingDegrees` (compass heading of the panorama's centre column).
+//! and `PoseHeadingDegrees` (compass heading of the panorama's centre column); and the
+//! start view viewers open at, `InitialViewHeadingDegrees` (a compass heading, so the yaw
+//! is it minus `PoseHeadingDegrees`), `InitialViewPitchDegrees` and
+//! `InitialHorizontalFOVDegrees` ([`GPano::start_view`]).
 //!
 //! The XMP packet is the JPEG APP1 segment that starts with
 //! `http://ns.adobe.com/xap/1.0/\0`; it is parsed as XML (roxmltree) with namespaces
@@ -21,6 +24,8 @@
 //! * XMP mentioning GPano that does not parse, non-numeric or negative values, a
 //!   `ProjectionType` other than equirectangular, an incomplete set of crop fields, or a
 //!   crop outside the full panorama: an error naming the field;
+//! * the start view is a hint: a value there that does not parse, is not finite, or an
+//!   hfov outside (0, 180) is ignored, never an error;
 //! * `FullPanoHeightPixels` missing: half the full width (a 2:1 panorama);
 //! * `CroppedAreaLeftPixels` at or past the full width: taken modulo the width (longitude
 //!   wraps), and a crop running past the right edge continues at column 0 (it straddles
@@ -31,7 +36,7 @@
 //!   otherwise an error.
 
 use crate::error::{CoverageError, GPanoError};
-use crate::geom::coverage::Crop;
+use crate::geom::coverage::{Crop, StartView};
 use crate::geom::limits::MAX_MAP_WIDTH;
 
 /// The GPano namespace URI.
@@ -59,9 +64,22 @@ pub struct GPano {
     pub pose_heading_degrees: Option<f64>,
     /// `ProjectionType`, when given.
     pub projection_type: Option<String>,
+    /// `InitialViewHeadingDegrees` (compass heading of the start view).
+    pub initial_view_heading_degrees: Option<f64>,
+    /// `InitialViewPitchDegrees`.
+    pub initial_view_pitch_degrees: Option<f64>,
+    /// `InitialHorizontalFOVDegrees`.
+    pub initial_horizontal_fov_degrees: Option<f64>,
 }
 
-const FIELDS: [&str; 8] = [
+/// The start view fields: hints, ignored when they do not parse.
+const VIEW_FIELDS: [&str; 3] = [
+    "InitialViewHeadingDegrees",
+    "InitialViewPitchDegrees",
+    "InitialHorizontalFOVDegrees",
+];
+
+const FIELDS: [&str; 11] = [
     "FullPanoWidthPixels",
     "FullPanoHeightPixels",
     "CroppedAreaLeftPixels",
@@ -70,6 +88,9 @@ const FIELDS: [&str; 8] = [
     "CroppedAreaImageHeightPixels",
     "PoseHeadingDegrees",
     "ProjectionType",
+    "InitialViewHeadingDegrees",
+    "InitialViewPitchDegrees",
+    "InitialHorizontalFOVDegrees",
 ];
 
 impl GPano {
@@ -87,6 +108,27 @@ impl GPano {
         .any(Option::is_some)
     }
 
+    /// The start view the file asks for, relative to the map (yaw = the initial
+    /// heading minus `PoseHeadingDegrees`, which counts as 0 when missing); `None`
+    /// without `InitialViewHeadingDegrees` and `InitialViewPitchDegrees`.
+    pub fn start_view(&self) -> Option<StartView> {
+        if self.initial_view_heading_degrees.is_none() && self.initial_view_pitch_degrees.is_none()
+        {
+            return None;
+        }
+        let heading = self.initial_view_heading_degrees.unwrap_or(0.0);
+        let yaw =
+            (heading - self.pose_heading_degrees.unwrap_or(0.0) + 180.0).rem_euclid(360.0) - 180.0;
+        Some(StartView {
+            yaw_deg: yaw,
+            pitch_deg: self
+                .initial_view_pitch_degrees
+                .unwrap_or(0.0)
+                .clamp(-90.0, 90.0),
+            hfov_deg: self.initial_horizontal_fov_degrees,
+        })
+    }
+
     fn slot(&mut self, field: &str) -> Option<&mut Option<f64>> {
         Some(match field {
             "FullPanoWidthPixels" => &mut self.full_pano_width_pixels,
@@ -96,6 +138,9 @@ impl GPano {
             "CroppedAreaImageWidthPixels" => &mut self.cropped_area_image_width_pixels,
             "CroppedAreaImageHeightPixels" => &mut self.cropped_area_image_height_pixels,
             "PoseHeadingDegrees" => &mut self.pose_heading_degrees,
+            "InitialViewHeadingDegrees" => &mut self.initial_view_heading_degrees,
+            "InitialViewPitchDegrees" => &mut self.initial_view_pitch_degrees,
+            "InitialHorizontalFOVDegrees" => &mut self.initial_horizontal_fov_degrees,
             _ => return None,
         })
     }
@@ -106,6 +151,16 @@ impl GPano {
         if field == "ProjectionType" {
             if self.projection_type.is_none() {
                 self.projection_type = Some(text.to_string());
+            }
+            return Ok(());
+        }
+        if VIEW_FIELDS.contains(&field) {
+            let ok = |v: &f64| {
+                v.is_finite()
+                    && (field != "InitialHorizontalFOVDegrees" || (*v > 0.0 && *v < 180.0))
+            };
+            if let (Some(v), Some(slot)) = (text.parse::<f64>().ok().filter(ok), self.slot(field)) {
+                slot.get_or_insert(v);
             }
             return Ok(());
         }
@@ -430,6 +485,37 @@ mod tests {
                 .pose_heading_degrees,
             Some(10.0)
         );
+    }
+
+    #[test]
+    fn start_view_relative_to_the_pose_and_ignored_when_bad() {
+        let g = GPano::from_xmp(&xmp_packet(&[
+            ("PoseHeadingDegrees", "350"),
+            ("InitialViewHeadingDegrees", "20"),
+            ("InitialViewPitchDegrees", "-12.5"),
+            ("InitialHorizontalFOVDegrees", "75"),
+        ]))
+        .unwrap()
+        .unwrap();
+        assert!(!g.has_crop(), "a start view is not a crop");
+        let v = g.start_view().unwrap();
+        assert!((v.yaw_deg - 30.0).abs() < 1e-9, "{v:?}");
+        assert_eq!((v.pitch_deg, v.hfov_deg), (-12.5, Some(75.0)));
+        // No pose: the heading is the yaw. Bad hints are ignored, not errors.
+        let g = GPano::from_xmp(&xmp_packet(&[
+            ("InitialViewHeadingDegrees", "200"),
+            ("InitialViewPitchDegrees", "level"),
+            ("InitialHorizontalFOVDegrees", "500"),
+        ]))
+        .unwrap()
+        .unwrap();
+        let v = g.start_view().unwrap();
+        assert!((v.yaw_deg + 160.0).abs() < 1e-9, "{v:?}");
+        assert_eq!((v.pitch_deg, v.hfov_deg), (0.0, None));
+        let g = GPano::from_xmp(&xmp_packet(&[("PoseHeadingDegrees", "10")]))
+            .unwrap()
+            .unwrap();
+        assert_eq!(g.start_view(), None);
     }
 
     #[test]

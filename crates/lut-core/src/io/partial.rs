@@ -5,6 +5,7 @@
 use crate::error::{CoverageError, MapError};
 use crate::geom::coverage::Coverage;
 use crate::geom::projection::Projection;
+use crate::io::gpano::GPano;
 use crate::io::load::{decode_map, load_map, LoadOptions, LoadProgress};
 use crate::map::envmap::EnvMap;
 use std::path::Path;
@@ -103,10 +104,12 @@ fn place_partial(
         None
     };
     let heading = meta.as_ref().and_then(|g| g.pose_heading_degrees);
+    let start = meta.as_ref().and_then(GPano::start_view);
     let has_crop = coverage.is_some() || meta.as_ref().is_some_and(|g| g.has_crop());
     if !has_crop {
         let mut m = decode(opts)?;
         m.set_pose_heading_deg(heading);
+        m.set_start_view(start);
         return Ok((m, CoverageSource::Full));
     }
     // Decoded as "elliptical" only so that any aspect ratio is accepted and the padding
@@ -125,6 +128,7 @@ fn place_partial(
     };
     let crop = crop.map_err(|e| in_file(what, e))?;
     m.set_pose_heading_deg(heading);
+    m.set_start_view(start);
     let m = m.into_partial(crop)?;
     let source = if m.crop().is_none() {
         CoverageSource::Full

@@ -3,7 +3,7 @@
 //! texels clamped inside). The rules are in `geom/coverage.rs`.
 
 use crate::error::CoverageError;
-use crate::geom::coverage::{Coverage, Crop};
+use crate::geom::coverage::{Coverage, Crop, StartView};
 use crate::geom::fixed::{Fx, FX_HALF};
 use crate::geom::projection::Projection;
 use crate::map::envmap::EnvMap;
@@ -33,6 +33,16 @@ impl EnvMap {
         self.pose_heading = heading
             .filter(|h| h.is_finite())
             .map(|h| h.rem_euclid(360.0));
+    }
+
+    /// The view the file asks to be opened at (GPano `InitialView*`), when it has one.
+    pub fn start_view(&self) -> Option<StartView> {
+        self.start_view
+    }
+
+    /// Set (or clear) the start view (see [`EnvMap::start_view`]).
+    pub fn set_start_view(&mut self, view: Option<StartView>) {
+        self.start_view = view;
     }
 
     /// Width of the stored pixels (the crop's width for a partial map, else
@@ -81,6 +91,7 @@ impl EnvMap {
             let mut m = EnvMap::from_pixels(w, h, &px, pad_as)?;
             m.background = self.background;
             m.pose_heading = self.pose_heading;
+            m.start_view = self.start_view;
             m
         };
         // Bilinear only wraps for column −1 / W; a non-360° crop never asks for those

@@ -29,6 +29,8 @@ pub struct EnvMap {
     pub(crate) crop: Option<Crop>,
     /// Compass heading of longitude 0 (GPano `PoseHeadingDegrees`).
     pub(crate) pose_heading: Option<f64>,
+    /// The view the file asks to be opened at (GPano `InitialView*`).
+    pub(crate) start_view: Option<crate::geom::coverage::StartView>,
     /// Minification pyramid levels 1.. (see `map/pyramid.rs`), built on first use.
     pub(crate) levels: std::sync::OnceLock<Vec<EnvMap>>,
 }
@@ -130,6 +132,7 @@ impl EnvMap {
             background: 0,
             crop: None,
             pose_heading: None,
+            start_view: None,
             levels: std::sync::OnceLock::new(),
         }
     }

@@ -1,25 +1,33 @@
-//! The event loop: winit window, softbuffer surface, egui input and panel, lut-core
+//! The event loop: winit window, softbuffer surface, egui input and UI, lut-core
 //! renders. Event-driven: a frame is drawn only when input arrives, egui asks for one
-//! (its `repaint_delay`, never the `RedrawRequested` echo), something animates, or the
-//! full-quality frame after fast motion is due. What is shown and loading is the
-//! [`Document`]'s (pure, unit-tested); this module carries out its effects (loading
-//! threads, the title, printing) and draws.
+//! (its `repaint_delay`, never the `RedrawRequested` echo), something animates, a notice
+//! expires, or the full-quality frame after degraded motion is due; frames come at most
+//! once per display refresh. What is shown and loading is the [`Document`]'s (pure,
+//! unit-tested); this module carries out its effects (loading threads, the title,
+//! printing).
+//!
+//! * `frame.rs`: one frame: routing keys, the UI pass, the scene render at the chosen
+//!   quality, composing, and when the next frame is due.
+//! * `actions.rs`: what keys, buttons and dialogs do; settings kept between runs.
 
-use super::document::{Document, Effect, LoadEvent};
-use super::input::{
-    key_action, wheel_notches, Controller, Held, KeyAction, Look, Turn, EXPOSURE_KEY_STEP_EV,
-    TURN_KEYS,
-};
-use super::loader::{self, LoadRequest, Source};
-use super::paint::{Compositor, SceneRect};
-use super::ui::{self, PanelModel};
+mod actions;
+mod frame;
+
+use super::dialogs::Dialogs;
+use super::document::{Document, LoadEvent, StartArgs};
+use super::input::{AutoRotate, Controller, Look};
+use super::keys::Shortcuts;
+use super::loader::Source;
+use super::notices::Notices;
+use super::paint::Compositor;
+use super::prefs::Prefs;
+use super::quality::{FrameTimes, Level};
 use super::OpenArgs;
 use crate::lighting::{LightsKey, LightsState};
-use crate::scene::render_scene;
 use anyhow::{anyhow, Result};
-use lut_core::{CubeRenderer, IndexStep, LutChoice, RenderPath, RendererKind, Sampler};
+use lut_core::{CubeRenderer, IndexStep, LutChoice, RendererKind, Sampler};
 use std::collections::VecDeque;
-use std::num::NonZeroU32;
+use std::path::PathBuf;
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 use winit::application::ApplicationHandler;
@@ -27,13 +35,14 @@ use winit::event::WindowEvent;
 use winit::event_loop::{
     ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy, OwnedDisplayHandle,
 };
-use winit::window::{Fullscreen, Window, WindowId};
+use winit::window::{Icon, Window, WindowId};
 
 /// What a cached scene was rendered from: when it matches, the scene is reused.
 #[derive(Debug, Clone, PartialEq)]
 struct SceneKey {
     look: Look,
     size: (u32, u32),
+    level: Level,
     renderer: RendererKind,
     sampler: Sampler,
     index_step: IndexStep,
@@ -51,17 +60,6 @@ struct Gfx {
     surface_size: (u32, u32),
 }
 
-/// Things the UI pass asks the app to do after it.
-#[derive(Default)]
-struct FrameRequests {
-    keys: Vec<KeyAction>,
-    held: Held,
-    panel: ui::PanelOutput,
-    scene_rect: Option<SceneRect>,
-    /// The pointer over the scene, in scene pixels.
-    cursor: Option<(f64, f64)>,
-}
-
 struct App {
     print_view: bool,
     initial_size: (u32, u32),
@@ -74,11 +72,41 @@ struct App {
     ctl: Controller,
     /// What is shown and loading.
     doc: Document,
-    show_panel: bool,
+    /// Shortcut keys and the turn keys held.
+    shortcuts: Shortcuts,
+    /// Short messages over the scene.
+    notices: Notices,
+    /// The Open and Save dialogs.
+    dialogs: Dialogs,
+    /// Settings kept between runs (the panel shown, the zoom limit and recent files live
+    /// here; the rest is copied from the controller before saving).
+    prefs: Prefs,
+    /// Where they are kept (`None`: nowhere to keep them).
+    prefs_dir: Option<PathBuf>,
+    /// What was last written there.
+    prefs_saved: Prefs,
+    prefs_saved_at: f64,
+    /// The help overlay is shown.
+    show_help: bool,
+    /// The scene at its size; a degraded frame's lower-resolution render.
     scene: Vec<u32>,
+    small: Vec<u32>,
     scene_key: Option<SceneKey>,
+    /// The last render time of each quality level.
+    times: FrameTimes,
+    /// Width of the scene in pixels at the last frame (for the zoom limit).
+    scene_width: u32,
     next_frame_at: Option<Instant>,
-    frame_times: VecDeque<Instant>,
+    /// When scenes were rendered in the last second (the fps readout).
+    renders: VecDeque<Instant>,
+    /// When the last frame was drawn, and the display's refresh interval.
+    last_redraw: Option<Instant>,
+    frame_interval: Duration,
+    /// The readouts as last drawn (for the follow-up frame and `--print-view`).
+    drawn_readouts: Vec<(&'static str, String)>,
+    printed_readouts: String,
+    /// The current panorama for the toolbar: name and size.
+    title: String,
     fatal: Option<anyhow::Error>,
     /// The luminaires (panel state).
     lights: LightsState,
@@ -91,6 +119,19 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
     let softbuffer = softbuffer::Context::new(event_loop.owned_display_handle())
         .map_err(|e| anyhow!("cannot use the display for software drawing: {e}"))?;
     let proxy = event_loop.create_proxy();
+    let prefs_dir = super::prefs::config_dir();
+    let mut notices = Notices::default();
+    let prefs = match &prefs_dir {
+        Some(d) => {
+            let (p, msg) = Prefs::load(d);
+            if let Some(m) = msg {
+                eprintln!("viewer: {m}");
+                notices.error(m, 0.0);
+            }
+            p
+        }
+        None => Prefs::default(),
+    };
     let mut app = App {
         print_view: args.print_view,
         initial_size: args.size,
@@ -106,14 +147,30 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
             args.limit.max_pixels,
             input.cube.naming,
         ),
-        show_panel: true,
+        shortcuts: Shortcuts::default(),
+        notices,
+        dialogs: Dialogs::new(),
+        prefs_saved: prefs.clone(),
+        prefs,
+        prefs_dir,
+        prefs_saved_at: 0.0,
+        show_help: false,
         scene: Vec::new(),
+        small: Vec::new(),
         scene_key: None,
+        times: FrameTimes::default(),
+        scene_width: args.size.0,
         next_frame_at: None,
-        frame_times: VecDeque::new(),
+        renders: VecDeque::new(),
+        last_redraw: None,
+        frame_interval: Duration::from_secs_f64(super::input::DEFAULT_FRAME_S),
+        drawn_readouts: Vec::new(),
+        printed_readouts: String::new(),
+        title: String::new(),
         fatal: None,
         lights,
     };
+    app.take_prefs();
     app.ctl.settings.view_limit = !args.no_view_limit;
     app.ctl.settings.cube_renderer = input.cube_renderer;
     // One image in auto is a map (as `viewer render` takes it); `--projection cube` or
@@ -124,15 +181,22 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
     } else {
         args.panorama.first().cloned().map(Source::File)
     };
+    let start = StartArgs {
+        yaw: args.yaw,
+        pitch: args.pitch,
+        hfov: args.hfov,
+    };
     let open = app.doc.open(
         source.unwrap_or(Source::Sample),
         input.coverage,
+        start,
         app.ctl.settings.exposure_ev,
     );
     app.apply(vec![open]);
     event_loop
         .run_app(&mut app)
         .map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
+    app.save_prefs(true);
     match app.fatal {
         Some(e) => Err(e),
         None => Ok(()),
@@ -169,479 +233,64 @@ impl App {
         }
     }
 
-    /// Carry out what the document asks, then redraw.
-    fn apply(&mut self, effects: Vec<Effect>) {
-        for e in effects {
-            match e {
-                Effect::Load(req) => self.spawn_load(req),
-                Effect::AddLights(paths) => {
-                    for p in &paths {
-                        // The error (if any) is shown in the Lights section.
-                        let _ = self.lights.load_and_add(p);
-                    }
-                }
-                Effect::Title(t) => {
-                    if let Some(g) = &self.gfx {
-                        g.window.set_title(&t);
-                    }
-                }
-                Effect::PrintView(line) => {
-                    if self.print_view {
-                        println!("{line}");
-                    }
-                }
-                Effect::Stderr(line) => eprintln!("{line}"),
-                Effect::ShowPanel => self.show_panel = true,
-            }
-        }
-        self.request_redraw();
+    /// Seconds on the window's clock.
+    fn now(&self) -> f64 {
+        self.start.elapsed().as_secs_f64()
     }
 
-    /// Run `req` on a loading thread that reports to the event loop.
-    fn spawn_load(&mut self, req: LoadRequest) {
-        let (id, proxy) = (req.id, self.proxy.clone());
-        let spawned = std::thread::Builder::new()
-            .name("viewer-load".into())
-            .spawn(move || {
-                let result = loader::load(req, &mut |step, fraction| {
-                    let _ = proxy.send_event(LoadEvent::Progress { id, step, fraction });
-                });
-                let _ = proxy.send_event(LoadEvent::Done { id, result });
-            });
-        if let Err(e) = spawned {
-            self.doc.load_not_started(id, &e.to_string());
+    /// A frame is wanted: now, or at the next display refresh when the last frame was
+    /// drawn less than one refresh ago (input events come faster than the display).
+    fn want_frame(&mut self) {
+        let at = self
+            .last_redraw
+            .map_or_else(Instant::now, |l| l + self.frame_interval);
+        if at <= Instant::now() {
+            self.request_redraw();
+        } else {
+            self.next_frame_at = Some(self.next_frame_at.map_or(at, |n| n.min(at)));
         }
     }
 
-    /// Build this frame's UI and collect what the user did.
-    fn build_ui(&mut self, ui: &mut egui::Ui, t: f64, win: (u32, u32)) -> FrameRequests {
-        let mut req = FrameRequests::default();
-        let ppp = ui.ctx().pixels_per_point();
-        if !ui.ctx().egui_wants_keyboard_input() {
-            ui.input(|i| {
-                for ev in &i.events {
-                    if let egui::Event::Key {
-                        key,
-                        pressed: true,
-                        repeat,
-                        modifiers,
-                        ..
-                    } = ev
-                    {
-                        match key_action(*key, *modifiers) {
-                            Some(KeyAction::Turn(_)) | None => {}
-                            Some(a @ (KeyAction::ZoomIn | KeyAction::ZoomOut)) => req.keys.push(a),
-                            Some(a) if !repeat => req.keys.push(a),
-                            Some(_) => {}
-                        }
-                    }
-                }
-                let plain = !(i.modifiers.ctrl || i.modifiers.command);
-                for k in TURN_KEYS {
-                    if plain && i.key_down(k) {
-                        match key_action(k, egui::Modifiers::NONE) {
-                            Some(KeyAction::Turn(Turn::Left)) => req.held.left = true,
-                            Some(KeyAction::Turn(Turn::Right)) => req.held.right = true,
-                            Some(KeyAction::Turn(Turn::Up)) => req.held.up = true,
-                            Some(KeyAction::Turn(Turn::Down)) => req.held.down = true,
-                            _ => {}
-                        }
-                    }
-                }
-            });
-        }
-        if self.show_panel {
-            let look = self.ctl.look();
-            let doc = self.doc.panel_parts();
-            req.panel = ui::side_panel(
-                ui,
-                PanelModel {
-                    settings: &mut self.ctl.settings,
-                    projection: doc.projection,
-                    look,
-                    readouts: doc.readouts,
-                    loading: doc.loading,
-                    error: doc.error,
-                    lights: &mut self.lights,
-                },
-            );
-        }
-        if let Some(l) = self.doc.loading() {
-            if !self.show_panel || self.doc.current().is_none() {
-                // Nothing else shows the load: a box over the scene.
-                ui::loading_overlay(ui.ctx(), l);
-            }
-        }
-        // The scene: everything the panel leaves. Drags and wheel go through egui so a
-        // click on the panel is never taken for a drag (hit-testing is egui's).
-        let rect = ui.available_rect_before_wrap();
-        let resp = ui.interact(rect, egui::Id::new("scene"), egui::Sense::drag());
-        req.scene_rect = SceneRect::from_points(rect, ppp, win.0, win.1);
-        let Some(sr) = req.scene_rect else {
-            return req;
+    /// The settings kept between runs into the controller.
+    fn take_prefs(&mut self) {
+        let p = &self.prefs;
+        let s = &mut self.ctl.settings;
+        s.aa = p.aa;
+        s.sampler = p.sampler;
+        s.drag = p.drag;
+        s.inertia = p.inertia;
+        s.export_scale = p.export_scale;
+        self.ctl.auto_rotate = AutoRotate {
+            enabled: p.auto_rotate,
+            speed_deg_s: p.auto_rotate_speed,
+            idle_s: p.auto_rotate_idle_s,
         };
-        let size = (sr.w, sr.h);
-        let to_px = |p: egui::Pos2| {
-            (
-                f64::from(p.x * ppp) - f64::from(sr.x),
-                f64::from(p.y * ppp) - f64::from(sr.y),
-            )
-        };
-        req.cursor = resp.hover_pos().map(to_px);
-        let primary = egui::PointerButton::Primary;
-        if resp.drag_started_by(primary) {
-            let origin = ui
-                .input(|i| i.pointer.press_origin())
-                .or(resp.interact_pointer_pos());
-            if let Some(o) = origin {
-                self.ctl.press(to_px(o), size, t);
-            }
-        }
-        if self.ctl.dragging() {
-            match resp.interact_pointer_pos() {
-                Some(p) if resp.dragged_by(primary) => self.ctl.drag_to(to_px(p), size, t),
-                // Released, or the drag ended some other way (pointer gone): never leave
-                // a QTVR turn running.
-                _ => self.ctl.release(t),
-            }
-        }
-        if resp.contains_pointer() {
-            let notches: f64 = ui.input(|i| {
-                i.events
-                    .iter()
-                    .map(|e| match e {
-                        egui::Event::MouseWheel { unit, delta, .. } => {
-                            wheel_notches(*unit, delta.y)
-                        }
-                        _ => 0.0,
-                    })
-                    .sum()
-            });
-            if notches != 0.0 {
-                let cursor = resp.hover_pos().map(to_px);
-                self.ctl.wheel(notches, cursor, size);
-                if let Some(p) = resp.interact_pointer_pos().filter(|_| self.ctl.dragging()) {
-                    // Keep a grab in progress consistent with the new zoom.
-                    self.ctl.press(to_px(p), size, t);
-                }
-            }
-        }
-        req
     }
 
-    fn apply_requests(&mut self, req: &FrameRequests, t: f64, el: &ActiveEventLoop) {
-        self.ctl.set_held(req.held.or(req.panel.held), t);
-        let ev = self.ctl.settings.exposure_ev;
-        if req.panel.reset {
-            self.ctl.key(KeyAction::Reset);
-        }
-        if req.panel.dismiss_error {
-            self.doc.dismiss_error();
-        }
-        if req.panel.projection_changed {
-            let fx = self.doc.projection_changed(ev);
-            self.apply(fx.into_iter().collect());
-        }
-        if req.panel.exposure_commit {
-            let fx = self.doc.reload_exposure(ev);
-            self.apply(fx.into_iter().collect());
-        }
-        if req.panel.save_view {
-            self.save_view();
-        }
-        for &a in &req.keys {
-            match a {
-                KeyAction::ExposureDown | KeyAction::ExposureUp => {
-                    let d = if a == KeyAction::ExposureUp {
-                        EXPOSURE_KEY_STEP_EV
-                    } else {
-                        -EXPOSURE_KEY_STEP_EV
-                    };
-                    let s = &mut self.ctl.settings;
-                    let ev = super::export::step_exposure(s.exposure_ev, d);
-                    if ev != s.exposure_ev && self.doc.readouts.hdr {
-                        s.exposure_ev = ev;
-                        let fx = self.doc.reload_exposure(ev);
-                        self.apply(fx.into_iter().collect());
-                    }
-                }
-                KeyAction::SaveView => self.save_view(),
-                KeyAction::TogglePanel => self.show_panel = !self.show_panel,
-                KeyAction::Quit => el.exit(),
-                KeyAction::ToggleFullscreen => {
-                    if let Some(g) = &self.gfx {
-                        let full = g.window.fullscreen().is_some();
-                        g.window
-                            .set_fullscreen((!full).then_some(Fullscreen::Borderless(None)));
-                    }
-                }
-                KeyAction::LeaveFullscreen => {
-                    if let Some(g) = &self.gfx {
-                        g.window.set_fullscreen(None);
-                    }
-                }
-                other => self.ctl.key(other),
-            }
-        }
-    }
-
-    /// "Save view…" / P: render the current view at the scene's size times the export
-    /// scale, full quality (the chosen sampler, trilinear by default, never the fast
-    /// nearest), lit as shown, and write it to `view-N.png` in the current directory.
-    fn save_view(&mut self) {
-        let scene = match self.doc.readouts.scene {
-            (w, h) if w > 0 && h > 0 => (w, h),
-            _ => self.gfx.as_ref().map_or((1024, 640), |g| {
-                let s = g.window.inner_size();
-                (s.width, s.height)
-            }),
-        };
-        let (w, h) = super::export::export_size(scene, self.ctl.settings.export_scale);
-        let status = match self.render_export(w, h) {
-            Ok(pixels) => {
-                let path = super::export::next_view_path(std::path::Path::new("."), |p| p.exists());
-                match crate::output::write_png_atomic(&path, &pixels, w, h) {
-                    Ok(()) => format!("saved {} ({w}×{h})", path.display()),
-                    Err(e) => format!("save failed: {e:#}"),
-                }
-            }
-            Err(e) => format!("save failed: {e}"),
-        };
-        if self.print_view {
-            println!("{status}");
-        }
-        self.doc.readouts.export_status = Some(status);
-        self.show_panel = true;
-        self.request_redraw();
-    }
-
-    /// The current view rendered into a new `w`×`h` buffer with the window's renderer
-    /// and options at full quality, then lit as the scene is.
-    fn render_export(&mut self, w: u32, h: u32) -> Result<Vec<u32>, String> {
-        let cur = self
-            .doc
-            .current_mut()
-            .ok_or_else(|| "no panorama loaded".to_string())?;
-        let opts = lut_core::RenderOptions {
-            sampler: self.ctl.settings.sampler,
-            ..self.ctl.settings.render_options(false)
-        };
-        let view = self.ctl.look().view();
-        let mut buf = vec![0u32; w as usize * h as usize];
-        render_scene(cur.scene.as_mut(), view, &opts, &mut buf, w, h).map_err(|e| e.to_string())?;
-        self.lights.light_frame(view, &mut buf, w, h)?;
-        Ok(buf)
-    }
-
-    /// Render the scene for `rect` unless the cached one already shows it, then light it
-    /// when there are luminaires.
-    fn render_scene(&mut self, rect: SceneRect, look: Look, fast: bool) {
-        let generation = self.doc.generation();
-        let Some(cur) = self.doc.current_mut() else {
-            return;
-        };
-        let opts = self.ctl.settings.render_options(fast);
-        let key = SceneKey {
-            look,
-            size: (rect.w, rect.h),
-            renderer: opts.renderer,
-            sampler: opts.sampler,
-            index_step: opts.index_step,
-            lut: opts.lut,
-            cube_renderer: opts.cube,
-            map_generation: generation,
-            lights: self.lights.key(),
-        };
-        if self.scene_key.as_ref() == Some(&key) {
+    /// The controller's settings into the kept ones; written when they changed (at most
+    /// once a second unless `now`).
+    fn save_prefs(&mut self, now: bool) {
+        let s = self.ctl.settings;
+        let a = self.ctl.auto_rotate;
+        let p = &mut self.prefs;
+        (p.aa, p.sampler, p.drag, p.inertia, p.export_scale) =
+            (s.aa, s.sampler, s.drag, s.inertia, s.export_scale);
+        (p.auto_rotate, p.auto_rotate_speed, p.auto_rotate_idle_s) =
+            (a.enabled, a.speed_deg_s, a.idle_s);
+        let t = self.now();
+        if self.prefs == self.prefs_saved || (!now && t - self.prefs_saved_at < 1.0) {
             return;
         }
-        self.scene.resize(rect.w as usize * rect.h as usize, 0);
-        let t0 = Instant::now();
-        let view = look.view();
-        let result = render_scene(
-            cur.scene.as_mut(),
-            view,
-            &opts,
-            &mut self.scene,
-            rect.w,
-            rect.h,
-        );
-        match result {
-            Ok(report) => {
-                let readouts = &mut self.doc.readouts;
-                readouts.table_bytes = report.table_bytes;
-                readouts.exact_pixels = report.exact_pixels;
-                readouts.pixels = report.pixels;
-                let path = match report.path {
-                    RenderPath::Cube(kind) => {
-                        readouts.path = None;
-                        readouts.cube = Some(kind);
-                        match kind {
-                            CubeRenderer::Basic => "CubeBasic".to_string(),
-                            CubeRenderer::Accelerated => "CubeScanline".to_string(),
-                        }
-                    }
-                    path => {
-                        readouts.path = Some(path);
-                        readouts.cube = None;
-                        format!("{path:?}")
-                    }
-                };
-                self.light_scene(view, rect);
-                let readouts = &mut self.doc.readouts;
-                readouts.render_ms = t0.elapsed().as_secs_f64() * 1e3;
-                readouts.scene = (rect.w, rect.h);
-                self.scene_key = Some(key);
-                if self.print_view {
-                    println!(
-                        "view yaw={:.4} pitch={:.4} hfov={:.4} path={path} sampler={} fast={} size={}x{} lights={}",
-                        look.yaw,
-                        look.pitch,
-                        look.hfov,
-                        opts.sampler.name(),
-                        fast,
-                        rect.w,
-                        rect.h,
-                        self.lights.lights.len()
-                    );
-                }
-            }
-            Err(e) => {
-                self.doc.set_error(format!("render failed: {e}"));
-                self.scene_key = None;
-            }
-        }
-    }
-
-    /// Light the freshly rendered scene (as `viewer render --light ...` does); a scene
-    /// that cannot be built (a light outside the room) is reported in the panel and the
-    /// frame is left unlit.
-    fn light_scene(&mut self, view: lut_core::View, rect: SceneRect) {
-        let result = self
-            .lights
-            .light_frame(view, &mut self.scene, rect.w, rect.h);
-        self.lights.scene_error = result.err();
-    }
-
-    /// The illuminance at the pointer for the readout; true when it changed.
-    fn update_lux(
-        &mut self,
-        cursor: Option<(f64, f64)>,
-        rect: Option<SceneRect>,
-        look: Look,
-    ) -> bool {
-        let lux = match (cursor, rect, self.lights.scene()) {
-            (Some((x, y)), Some(r), Ok(Some(scene))) if r.w > 0 && r.h > 0 => Some(
-                lut_core::lux_at(&scene, &lut_core::Camera::new(look.view(), r.w, r.h), x, y),
-            ),
-            _ => None,
+        let Some(dir) = &self.prefs_dir else {
+            return;
         };
-        let changed = lux.map(f64::to_bits) != self.lights.lux_at_cursor.map(f64::to_bits);
-        self.lights.lux_at_cursor = lux;
-        changed
-    }
-
-    fn redraw(&mut self, el: &ActiveEventLoop) -> Result<()> {
-        let Some(g) = self.gfx.as_mut() else {
-            return Ok(());
-        };
-        let size = g.window.inner_size();
-        let (w, h) = (size.width, size.height);
-        let (Some(nw), Some(nh)) = (NonZeroU32::new(w), NonZeroU32::new(h)) else {
-            // Minimized (0×0): draw nothing, and run no UI pass whose texture updates
-            // would be lost.
-            return Ok(());
-        };
-        let t = self.start.elapsed().as_secs_f64();
-        let ui_t0 = Instant::now();
-        let raw = g.egui_winit.take_egui_input(&g.window);
-        let ctx = self.egui_ctx.clone();
-        let look_before = self.ctl.look();
-        let mut req = FrameRequests::default();
-        let full = ctx.run_ui(raw, |ui| req = self.build_ui(ui, t, (w, h)));
-        self.apply_requests(&req, t, el);
-        // The view limit: a partial map's coverage at the scene's size, when the panel's
-        // "Keep the view inside" is on.
-        let limit = match (req.scene_rect, self.doc.partial_coverage()) {
-            (Some(r), Some(c)) if self.ctl.settings.view_limit => Some((c, (r.w, r.h))),
-            _ => None,
-        };
-        self.ctl.set_limit(limit);
-        let frame = self.ctl.frame(t);
-        let mut ui_ms = ui_t0.elapsed().as_secs_f64() * 1e3;
-        if let Some(r) = req.scene_rect {
-            self.render_scene(r, frame.look, frame.fast);
+        self.prefs_saved_at = t;
+        self.prefs_saved = self.prefs.clone();
+        if let Err(e) = self.prefs.save(dir) {
+            let m = format!("settings not saved: {e:#}");
+            eprintln!("viewer: {m}");
+            self.notices.error(m, t);
         }
-        let lux_changed = self.update_lux(req.cursor, req.scene_rect, frame.look);
-        let Some(g) = self.gfx.as_mut() else {
-            return Ok(());
-        };
-        g.egui_winit
-            .handle_platform_output(&g.window, full.platform_output);
-        let t1 = Instant::now();
-        let prims = ctx.tessellate(full.shapes, full.pixels_per_point);
-        if g.surface_size != (w, h) {
-            g.surface
-                .resize(nw, nh)
-                .map_err(|e| anyhow!("cannot resize the drawing surface to {w}x{h}: {e}"))?;
-            g.surface_size = (w, h);
-        }
-        let mut buffer = g
-            .surface
-            .buffer_mut()
-            .map_err(|e| anyhow!("cannot get the drawing buffer: {e}"))?;
-        let scene = match (req.scene_rect, &self.scene_key) {
-            (Some(r), Some(k)) if k.size == (r.w, r.h) => Some((self.scene.as_slice(), r)),
-            _ => None,
-        };
-        self.compositor.compose(
-            &mut buffer,
-            w,
-            h,
-            scene,
-            &prims,
-            &full.textures_delta,
-            full.pixels_per_point,
-        );
-        ui_ms += t1.elapsed().as_secs_f64() * 1e3;
-        buffer
-            .present()
-            .map_err(|e| anyhow!("cannot show the frame: {e}"))?;
-        self.doc.readouts.ui_ms = ui_ms;
-
-        let now = Instant::now();
-        self.frame_times.push_back(now);
-        while self
-            .frame_times
-            .front()
-            .is_some_and(|&f| now.duration_since(f) > Duration::from_secs(1))
-        {
-            self.frame_times.pop_front();
-        }
-        self.doc.readouts.fps = match (self.frame_times.front(), self.frame_times.len()) {
-            (Some(&f), n) if n >= 2 => (n - 1) as f64 / now.duration_since(f).as_secs_f64(),
-            _ => 0.0,
-        };
-
-        // When is the next frame due?
-        let mut next: Option<Instant> = None;
-        let mut want = |at: Instant| next = Some(next.map_or(at, |n: Instant| n.min(at)));
-        let delay = full
-            .viewport_output
-            .get(&egui::ViewportId::ROOT)
-            .map_or(Duration::MAX, |v| v.repaint_delay);
-        if delay < Duration::from_secs(3600) {
-            want(now + delay);
-        }
-        if let Some(at) = self.ctl.wake_at() {
-            want(self.start + Duration::from_secs_f64(at.max(0.0)));
-        }
-        if (self.ctl.look() != look_before || lux_changed) && self.show_panel {
-            // The readouts were drawn before this frame's input moved the view.
-            want(now);
-        }
-        self.next_frame_at = next;
-        Ok(())
     }
 }
 
@@ -651,8 +300,10 @@ impl ApplicationHandler<LoadEvent> for App {
             return;
         }
         let (w, h) = self.initial_size;
+        let n = super::paint::ICON_SIZE;
         let attrs = Window::default_attributes()
             .with_title("viewer")
+            .with_window_icon(Icon::from_rgba(super::paint::icon_rgba(), n, n).ok())
             .with_inner_size(winit::dpi::LogicalSize::new(f64::from(w), f64::from(h)));
         let window = match el.create_window(attrs) {
             Ok(w) => Rc::new(w),
@@ -670,6 +321,18 @@ impl ApplicationHandler<LoadEvent> for App {
                 return;
             }
         };
+        // Animation and key turns at the display's refresh (60 Hz where unknown).
+        let hz = window
+            .current_monitor()
+            .and_then(|m| m.refresh_rate_millihertz())
+            .map(|mhz| f64::from(mhz) / 1000.0)
+            .filter(|hz| (10.0..=1000.0).contains(hz))
+            .unwrap_or(60.0);
+        self.frame_interval = Duration::from_secs_f64(1.0 / hz);
+        self.ctl.set_frame_interval(1.0 / hz);
+        if self.print_view {
+            println!("refresh {hz:.1} Hz");
+        }
         let egui_winit = egui_winit::State::new(
             self.egui_ctx.clone(),
             egui::ViewportId::ROOT,
@@ -713,7 +376,7 @@ impl ApplicationHandler<LoadEvent> for App {
             }
             _ => {
                 if response.repaint {
-                    g.window.request_redraw();
+                    self.want_frame();
                 }
             }
         }

@@ -8,9 +8,15 @@
 //! * A load runs in the background; the current panorama stays until it is done, and
 //!   stays if it fails. A newer load supersedes an older one: the older one's reports
 //!   are ignored.
-//! * A failed load shows its error (and the panel); with nothing to show yet the bundled
-//!   sample opens under the message (its success keeps the message). Any other successful
-//!   load clears the error.
+//! * A failed load shows its error (a notice over the scene); with nothing to show yet the
+//!   bundled sample opens under the message (its success keeps the message). Any other
+//!   successful load clears the error.
+//! * A panorama *opened* (command line, drop, Open dialog, recent list, PageUp/PageDown)
+//!   starts at its own start view: the command line's `--yaw/--pitch/--hfov` for the file
+//!   named there, else the file's GPano start view, else the default. A *reload* (another
+//!   projection, another exposure) keeps the view.
+//! * Exposure changes while an exposure reload runs wait for it, then the latest one
+//!   loads (a slider dragged across the range decodes a few times, not once per frame).
 //! * The panel's projection choice reopens the file it applies to: the current one, or
 //!   the one that failed.
 //! * Paths dropped in one event batch open together: `.ies` files add lights, the rest is
@@ -18,7 +24,7 @@
 
 use super::loader::{LoadRequest, Loaded, Source};
 use super::ui::{LoadStatus, LoadStep, Readouts};
-use lut_core::{Coverage, EnvMap, LoadOptions, Naming, Projection, Tone};
+use lut_core::{Coverage, EnvMap, LoadOptions, Naming, Projection, StartView, Tone};
 use std::path::PathBuf;
 
 /// A report from the loading thread.
@@ -57,6 +63,21 @@ pub enum Effect {
     Stderr(String),
     /// Show the panel: there is something to read in it.
     ShowPanel,
+    /// A panorama was opened: go to its start view.
+    StartView(StartView),
+    /// This file or folder was opened (for the recent list).
+    Opened(PathBuf),
+}
+
+/// The start view given on the command line: each value given overrides the file's.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StartArgs {
+    /// `--yaw`.
+    pub yaw: Option<f64>,
+    /// `--pitch`.
+    pub pitch: Option<f64>,
+    /// `--hfov`.
+    pub hfov: Option<f64>,
 }
 
 /// A load in progress.
@@ -64,6 +85,10 @@ struct Loading {
     id: u64,
     source: Source,
     status: LoadStatus,
+    /// Opened (not a reload): goes to its start view.
+    opening: bool,
+    /// A reload for another exposure.
+    exposure: bool,
 }
 
 /// The document state (see the module docs for its rules).
@@ -85,6 +110,12 @@ pub struct Document {
     pending_drops: Vec<PathBuf>,
     /// `--coverage`, for the source given on the command line only.
     coverage: Option<(Source, Coverage)>,
+    /// `--yaw/--pitch/--hfov`, for the source given on the command line only.
+    start: Option<(Source, StartArgs)>,
+    /// The exposure asked for while an exposure reload was running.
+    pending_exposure: Option<f64>,
+    /// The last single file opened (shown or failed): PageUp/PageDown step from it.
+    last_file: Option<PathBuf>,
     /// `--max-pixels`: the pixel limit for every panorama opened.
     max_pixels: u64,
     /// Cube face naming from the command line (for every cube opened).
@@ -101,8 +132,6 @@ pub struct PanelParts<'a> {
     pub readouts: &'a Readouts,
     /// The load in progress.
     pub loading: Option<&'a LoadStatus>,
-    /// The last error.
-    pub error: Option<&'a str>,
 }
 
 impl Document {
@@ -120,31 +149,61 @@ impl Document {
             keep_error: false,
             pending_drops: Vec::new(),
             coverage: None,
+            start: None,
+            pending_exposure: None,
+            last_file: None,
             max_pixels,
             naming,
             readouts: Readouts::default(),
         }
     }
 
-    /// Open what the command line names, placed by `coverage` when given.
-    pub fn open(&mut self, source: Source, coverage: Option<Coverage>, exposure_ev: f64) -> Effect {
+    /// Open what the command line names, placed by `coverage` when given, starting at
+    /// `start` where given.
+    pub fn open(
+        &mut self,
+        source: Source,
+        coverage: Option<Coverage>,
+        start: StartArgs,
+        exposure_ev: f64,
+    ) -> Effect {
         self.coverage = coverage.map(|c| (source.clone(), c));
-        self.start_load(source, self.projection, exposure_ev)
+        self.start = (start != StartArgs::default()).then(|| (source.clone(), start));
+        self.start_load(source, self.projection, exposure_ev, true)
     }
 
-    /// Start loading `source`; the current panorama stays until it is done.
+    /// Open a file or folder chosen in the window (the Open dialog, the recent list,
+    /// PageUp/PageDown): as a drop of that one path.
+    pub fn open_path(&mut self, path: PathBuf, exposure_ev: f64) -> Option<Effect> {
+        let source = Source::of_paths(vec![path], false, None)?;
+        Some(self.start_load(source, None, exposure_ev, true))
+    }
+
+    /// Start loading `source`; the current panorama stays until it is done. `opening`:
+    /// a panorama opened (it goes to its start view), not a reload.
     fn start_load(
         &mut self,
         source: Source,
         projection: Option<Projection>,
         exposure_ev: f64,
+        opening: bool,
     ) -> Effect {
         self.next_id += 1;
         let id = self.next_id;
+        if opening && source != Source::Sample {
+            // A folder or six faces: nothing to step from (the sample shown after a
+            // failed load keeps the failed file).
+            self.last_file = source
+                .single_path()
+                .filter(|p| !p.is_dir())
+                .map(|p| p.to_path_buf());
+        }
         self.loading = Some(Loading {
             id,
             source: source.clone(),
             status: LoadStatus::new(source.name()),
+            opening,
+            exposure: false,
         });
         self.keep_error = false;
         let coverage = self
@@ -185,29 +244,49 @@ impl Document {
                 Vec::new()
             }
             LoadEvent::Done { id, result } if Some(id) == current_id => {
-                let source = self.loading.take().map(|l| l.source);
-                match result {
-                    Ok(loaded) => self.show(loaded),
-                    Err(e) => self.failed(e, source, exposure_ev),
+                let Some(l) = self.loading.take() else {
+                    return Vec::new();
+                };
+                let mut fx = match result {
+                    Ok(loaded) => self.show(loaded, l.opening),
+                    Err(e) => self.failed(e, Some(l.source), exposure_ev),
+                };
+                if let Some(ev) = self.pending_exposure.take() {
+                    fx.extend(self.reload_exposure(ev));
                 }
+                fx
             }
             _ => Vec::new(), // from a superseded load
         }
     }
 
-    /// A load succeeded: show it.
-    fn show(&mut self, loaded: Box<Loaded>) -> Vec<Effect> {
+    /// A load succeeded: show it (at its start view when `opening`).
+    fn show(&mut self, loaded: Box<Loaded>, opening: bool) -> Vec<Effect> {
         let mut fx = Vec::new();
         let (mw, mh, proj) = loaded.describe();
         fx.push(Effect::PrintView(format!(
             "loaded {} {mw}x{mh} {proj}",
             loaded.source.name()
         )));
-        self.readouts.map = loaded.label();
+        // Every readout of the last frame belonged to the previous panorama.
+        self.readouts = Readouts {
+            map: loaded.label(),
+            ..Readouts::default()
+        };
+        let size = match loaded.map() {
+            Some(_) => format!("{mw}×{mh}"),
+            None => format!("cube, {mw}px faces"),
+        };
         fx.push(Effect::Title(format!(
-            "viewer: {}",
+            "viewer: {} ({size})",
             loaded.source.short_name()
         )));
+        if opening {
+            fx.push(Effect::StartView(self.start_view_of(&loaded)));
+            if let Some(p) = loaded.source.single_path() {
+                fx.push(Effect::Opened(p.to_path_buf()));
+            }
+        }
         if !std::mem::take(&mut self.keep_error) {
             self.error = None;
             self.projection = loaded.projection;
@@ -225,15 +304,36 @@ impl Document {
         fx
     }
 
+    /// Where `loaded` starts: the command line's values for its source, else the file's
+    /// start view, else yaw 0, pitch 0 and the default hfov (`None`).
+    fn start_view_of(&self, loaded: &Loaded) -> StartView {
+        let file = loaded
+            .map()
+            .and_then(EnvMap::start_view)
+            .unwrap_or(StartView {
+                yaw_deg: 0.0,
+                pitch_deg: 0.0,
+                hfov_deg: None,
+            });
+        match &self.start {
+            Some((s, a)) if *s == loaded.source => StartView {
+                yaw_deg: a.yaw.unwrap_or(file.yaw_deg),
+                pitch_deg: a.pitch.unwrap_or(file.pitch_deg),
+                hfov_deg: a.hfov.or(file.hfov_deg),
+            },
+            _ => file,
+        }
+    }
+
     /// A load failed: keep what is shown, say why; with nothing shown, open the sample.
     fn failed(&mut self, e: String, source: Option<Source>, exposure_ev: f64) -> Vec<Effect> {
-        let mut fx = vec![Effect::Stderr(format!("viewer: {e}")), Effect::ShowPanel];
+        let mut fx = vec![Effect::Stderr(format!("viewer: {e}"))];
         self.error = Some(e);
         // A projection chosen next retries this file.
         self.projection_source = source;
         if self.current.is_none() {
             // Nothing to keep showing: fall back to the bundled sample.
-            fx.push(self.start_load(Source::Sample, None, exposure_ev));
+            fx.push(self.start_load(Source::Sample, None, exposure_ev, true));
             self.keep_error = true;
         }
         fx
@@ -261,7 +361,7 @@ impl Document {
             fx.push(Effect::ShowPanel);
         }
         if let Some(source) = Source::of_paths(rest, false, None) {
-            fx.push(self.start_load(source, None, exposure_ev));
+            fx.push(self.start_load(source, None, exposure_ev, true));
         }
         fx
     }
@@ -279,18 +379,32 @@ impl Document {
             .projection_source
             .clone()
             .or_else(|| self.current.as_ref().map(|c| c.source.clone()))?;
-        Some(self.start_load(source.as_map(), self.projection, exposure_ev))
+        Some(self.start_load(source.as_map(), self.projection, exposure_ev, false))
     }
 
     /// The exposure changed: decode the current HDR file again with it (the current
-    /// picture stays until it is ready). Nothing for 8-bit images or an unchanged value.
+    /// picture stays until it is ready). Nothing for 8-bit images or an unchanged value;
+    /// while an exposure reload runs the value waits for it (the latest one wins).
     pub fn reload_exposure(&mut self, exposure_ev: f64) -> Option<Effect> {
         let cur = self.current.as_ref().filter(|c| c.hdr)?;
+        if self.loading.as_ref().is_some_and(|l| l.exposure) {
+            self.pending_exposure = Some(exposure_ev);
+            return None;
+        }
         if cur.exposure_ev == exposure_ev && self.loading.is_none() {
             return None;
         }
         let (source, projection) = (cur.source.clone(), cur.projection);
-        Some(self.start_load(source, projection, exposure_ev))
+        let fx = self.start_load(source, projection, exposure_ev, false);
+        if let Some(l) = &mut self.loading {
+            l.exposure = true;
+        }
+        Some(fx)
+    }
+
+    /// The file PageUp/PageDown step from: the last single file opened, shown or not.
+    pub fn last_file(&self) -> Option<&std::path::Path> {
+        self.last_file.as_deref()
     }
 
     /// The panorama shown, if any.
@@ -334,7 +448,6 @@ impl Document {
             projection: &mut self.projection,
             readouts: &self.readouts,
             loading: self.loading.as_ref().map(|l| &l.status),
-            error: self.error.as_deref(),
         }
     }
 

@@ -6,32 +6,40 @@
 //!
 //! * **Grab** drag (default): the world direction under the cursor when the button went
 //!   down stays under the cursor; yaw and pitch are solved from it exactly
-//!   ([`solve_grab`]). Optional inertia continues the last drag velocity after release.
+//!   ([`solve_grab`]). Optional inertia continues the last drag velocity after release
+//!   and stops within about a second ([`INERTIA_DECAY`]).
 //! * **QTVR** drag (the cubic-panorama paper, section 5 (1)): turning speed is
 //!   proportional to the cursor's distance from where the button went down, and continues
 //!   while the button is held.
 //! * **Wheel** zooms by a factor per notch, using the size of the delta (one xdotool notch
 //!   can arrive as two half events), toward the cursor: the direction under the cursor
-//!   stays under it.
+//!   stays under it. A **double-click** zooms in twice toward the point, animated.
 //! * **Held** keys and panel buttons turn or zoom at a steady rate (the paper's (2), (3)).
-//! * **Anti-aliasing** ([`AaMode`]): in *Still only*, a frame whose view moves faster
-//!   than [`FAST_HFOV_PER_S`] is rendered with nearest sampling; [`SETTLE_S`] after the
-//!   motion stops one full-quality frame is due ([`Controller::wake_at`]).
+//! * **Zoom range** ([`Controller::set_zoom_range`]): the window keeps hfov between the
+//!   map's resolution limit and the widest view.
+//! * **Auto-rotate** ([`AutoRotate`]): turns at a steady speed after an idle delay; any
+//!   input stops it until the delay has passed again.
+//! * **Speed**: a frame whose view moves faster than [`FAST_HFOV_PER_S`] is "fast" (the
+//!   window may render it cheaper, `quality.rs`); [`SETTLE_S`] after the motion stops
+//!   one full-quality frame is due ([`Controller::wake_at`]) when the last was degraded.
 
+use super::keys::KeyAction;
+use super::quality::Settings;
 use glam::DVec3;
-use lut_core::{dir_to_lat_long, wrap_deg};
-use lut_core::{
-    Camera, CubeRenderer, IndexStep, LutChoice, Named, RenderOptions, RendererKind, Sampler, View,
-};
+use lut_core::{dir_to_lat_long, wrap_deg, Camera, Named, View};
 
 /// Narrowest horizontal field of view the wheel and keys reach, degrees.
 pub const HFOV_MIN: f64 = 1.0;
 /// Widest horizontal field of view, degrees (rectilinear views stretch badly beyond).
 pub const HFOV_MAX: f64 = 170.0;
-/// hfov of the initial view and of a reset.
+/// hfov of the default start view.
 pub const HFOV_HOME: f64 = 90.0;
 /// hfov is divided by this per wheel notch up (and per + key press).
 pub const ZOOM_PER_NOTCH: f64 = 1.12;
+/// A double-click divides hfov by this.
+pub const DOUBLE_CLICK_ZOOM: f64 = 2.0;
+/// The double-click zoom's animation, seconds.
+pub const DOUBLE_CLICK_S: f64 = 0.25;
 /// Pixels of a pixel-precise wheel delta (touchpads) counted as one notch.
 pub const PIXELS_PER_NOTCH: f64 = 50.0;
 /// Held turn keys and buttons: angular speed in fields of view per second.
@@ -43,18 +51,28 @@ pub const ZOOM_HALVING_S: f64 = 1.0;
 pub const QTVR_GAIN: f64 = 2.0;
 /// QTVR: offsets below this many pixels do not turn (a steady hand is not perfectly still).
 pub const QTVR_DEAD_ZONE_PX: f64 = 3.0;
-/// Inertia: velocity decays as exp(-INERTIA_DECAY · t).
-pub const INERTIA_DECAY: f64 = 4.0;
+/// Inertia: velocity decays as exp(-INERTIA_DECAY · t). With the stop speed and the
+/// speed cap below, the fastest throw stops within a second, as Pannellum's does (its
+/// friction 0.15 per 60 Hz frame); a typical flick coasts a third to half a field of view.
+pub const INERTIA_DECAY: f64 = 6.0;
 /// Inertia stops below this speed, in fields of view per second.
-pub const INERTIA_STOP_HFOV_PER_S: f64 = 0.02;
+pub const INERTIA_STOP_HFOV_PER_S: f64 = 0.05;
+/// A throw is capped at this speed, in fields of view per second.
+pub const INERTIA_MAX_HFOV_PER_S: f64 = 8.0;
 /// A view moving faster than this (fields of view per second) counts as "turning fast".
 pub const FAST_HFOV_PER_S: f64 = 0.1;
 /// After the last fast frame, the full-quality frame is due this many seconds later.
 pub const SETTLE_S: f64 = 0.1;
-/// Frame interval while something animates (held keys, QTVR, inertia), seconds.
-pub const ANIMATION_FRAME_S: f64 = 1.0 / 60.0;
+/// Frame interval while something animates where the display's refresh rate is unknown.
+pub const DEFAULT_FRAME_S: f64 = 1.0 / 60.0;
 /// Longest time step applied by one tick (a stalled frame must not jump the view).
 const MAX_TICK_S: f64 = 0.1;
+
+/// Exposure range of the panel slider and the `[` `]` keys, in stops.
+pub const EXPOSURE_RANGE_EV: (f64, f64) = (-8.0, 8.0);
+
+/// Scale factors the export offers: the scene's size times this.
+pub const EXPORT_SCALES: [u32; 3] = [1, 2, 4];
 
 /// The view as the user steers it, in degrees.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,18 +118,6 @@ pub enum DragStyle {
     Qtvr,
 }
 
-/// When to spend time on anti-aliasing (the paper's three modes).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum AaMode {
-    /// Always the chosen sampler (trilinear by default) with index interpolation.
-    Always,
-    /// Nearest sampling while the view turns fast, full quality once it stops.
-    #[default]
-    StillOnly,
-    /// Always nearest sampling.
-    Off,
-}
-
 impl Named for DragStyle {
     const ALL: &'static [Self] = &[DragStyle::Grab, DragStyle::Qtvr];
     fn name(self) -> &'static str {
@@ -128,97 +134,23 @@ impl Named for DragStyle {
     }
 }
 
-/// The labels in the panel and docs.
-impl Named for AaMode {
-    const ALL: &'static [Self] = &[AaMode::Always, AaMode::StillOnly, AaMode::Off];
-    fn name(self) -> &'static str {
-        match self {
-            AaMode::Always => "Always",
-            AaMode::StillOnly => "Still only",
-            AaMode::Off => "Off",
-        }
-    }
-    fn help(self) -> &'static str {
-        match self {
-            AaMode::Always => "Always the chosen sampler",
-            AaMode::StillOnly => {
-                "Nearest sampling while the view turns fast, full quality once it stops"
-            }
-            AaMode::Off => "Always nearest sampling",
-        }
-    }
-}
-
-/// Everything the panel lets the user choose that affects motion or rendering.
+/// Auto-rotation: a steady turn after the user has left the view alone for a while.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Settings {
-    /// Drag style.
-    pub drag: DragStyle,
-    /// Keep turning after a grab drag is released.
-    pub inertia: bool,
-    /// Anti-aliasing mode.
-    pub aa: AaMode,
-    /// Sampler of full-quality frames.
-    pub sampler: Sampler,
-    /// LUT index step.
-    pub index_step: IndexStep,
-    /// LUT or exact renderer.
-    pub renderer: RendererKind,
-    /// Which LUT (auto by hfov, or forced).
-    pub lut: LutChoice,
-    /// Cube maps: the paper's basic (per pixel) or accelerated (per scanline) renderer.
-    pub cube_renderer: CubeRenderer,
-    /// HDR panoramas (`.hdr`, `.exr`): exposure in stops (`lut_core::Tone`).
-    pub exposure_ev: f64,
-    /// "Save view…": the export is the scene's size times this (1, 2 or 4).
-    pub export_scale: u32,
-    /// Partial panoramas: keep the view's edges inside the covered area.
-    pub view_limit: bool,
+pub struct AutoRotate {
+    /// On or off.
+    pub enabled: bool,
+    /// Degrees per second; positive turns right.
+    pub speed_deg_s: f64,
+    /// Seconds without input before it starts (again).
+    pub idle_s: f64,
 }
 
-impl Default for Settings {
+impl Default for AutoRotate {
     fn default() -> Self {
-        let o = RenderOptions::default();
-        Settings {
-            drag: DragStyle::Grab,
-            inertia: true,
-            aa: AaMode::default(),
-            // Trilinear: bilinear when zoomed in, anti-aliased from the pyramid when
-            // zoomed out (built on the loader thread).
-            sampler: Sampler::Trilinear,
-            index_step: o.index_step,
-            renderer: o.renderer,
-            lut: o.lut,
-            cube_renderer: CubeRenderer::Accelerated,
-            exposure_ev: 0.0,
-            export_scale: 1,
-            view_limit: true,
-        }
-    }
-}
-
-impl Settings {
-    /// The sampler of a frame: `fast` is true while the view turns fast.
-    pub fn sampler_for(&self, fast: bool) -> Sampler {
-        match self.aa {
-            AaMode::Always => self.sampler,
-            AaMode::StillOnly if fast => Sampler::Nearest,
-            AaMode::StillOnly => self.sampler,
-            AaMode::Off => Sampler::Nearest,
-        }
-    }
-
-    /// Render options of a frame of a map or a cube map (the same options `viewer
-    /// render` takes).
-    pub fn render_options(&self, fast: bool) -> RenderOptions {
-        RenderOptions {
-            renderer: self.renderer,
-            sampler: self.sampler_for(fast),
-            index_step: self.index_step,
-            lut: self.lut,
-            threads: true,
-            cube: self.cube_renderer,
-            ..RenderOptions::default()
+        AutoRotate {
+            enabled: false,
+            speed_deg_s: 5.0,
+            idle_s: 3.0,
         }
     }
 }
@@ -272,81 +204,6 @@ pub enum Turn {
     Down,
 }
 
-/// What a key does.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum KeyAction {
-    /// Turn while held.
-    Turn(Turn),
-    /// One zoom step in.
-    ZoomIn,
-    /// One zoom step out.
-    ZoomOut,
-    /// Back to the initial view (the paper's RESIZE).
-    Reset,
-    /// Toggle fullscreen.
-    ToggleFullscreen,
-    /// Leave fullscreen.
-    LeaveFullscreen,
-    /// Show or hide the panel.
-    TogglePanel,
-    /// Close the window (Ctrl+Q or Ctrl+W).
-    Quit,
-    /// HDR panoramas: exposure down [`EXPOSURE_KEY_STEP_EV`] stops (`[`).
-    ExposureDown,
-    /// HDR panoramas: exposure up [`EXPOSURE_KEY_STEP_EV`] stops (`]`).
-    ExposureUp,
-    /// Save the current view as a PNG (`P`).
-    SaveView,
-}
-
-/// Stops the `[` and `]` keys change the exposure of an HDR panorama by.
-pub const EXPOSURE_KEY_STEP_EV: f64 = 0.5;
-
-/// Exposure range of the panel slider and the `[` `]` keys, in stops.
-pub const EXPOSURE_RANGE_EV: (f64, f64) = (-8.0, 8.0);
-
-/// Scale factors the export offers: the scene's size times this.
-pub const EXPORT_SCALES: [u32; 3] = [1, 2, 4];
-
-/// The key bindings: arrows and WASD turn, + and − zoom (= too, so + works without
-/// Shift), R resets, F toggles fullscreen, Esc leaves it, H or Tab toggles the panel,
-/// Ctrl+Q or Ctrl+W closes the window, `[` and `]` change an HDR panorama's exposure by
-/// half a stop, P saves the view as a PNG. Other Ctrl/Cmd combinations do nothing.
-pub fn key_action(key: egui::Key, modifiers: egui::Modifiers) -> Option<KeyAction> {
-    use egui::Key as K;
-    if modifiers.command || modifiers.ctrl {
-        return matches!(key, K::Q | K::W).then_some(KeyAction::Quit);
-    }
-    Some(match key {
-        K::ArrowLeft | K::A => KeyAction::Turn(Turn::Left),
-        K::ArrowRight | K::D => KeyAction::Turn(Turn::Right),
-        K::ArrowUp | K::W => KeyAction::Turn(Turn::Up),
-        K::ArrowDown | K::S => KeyAction::Turn(Turn::Down),
-        K::Plus | K::Equals => KeyAction::ZoomIn,
-        K::Minus => KeyAction::ZoomOut,
-        K::R => KeyAction::Reset,
-        K::F => KeyAction::ToggleFullscreen,
-        K::Escape => KeyAction::LeaveFullscreen,
-        K::H | K::Tab => KeyAction::TogglePanel,
-        K::OpenBracket => KeyAction::ExposureDown,
-        K::CloseBracket => KeyAction::ExposureUp,
-        K::P => KeyAction::SaveView,
-        _ => return None,
-    })
-}
-
-/// Keys that turn while held, for polling their state each frame.
-pub const TURN_KEYS: [egui::Key; 8] = [
-    egui::Key::ArrowLeft,
-    egui::Key::ArrowRight,
-    egui::Key::ArrowUp,
-    egui::Key::ArrowDown,
-    egui::Key::A,
-    egui::Key::D,
-    egui::Key::W,
-    egui::Key::S,
-];
-
 /// Wheel notches from one wheel event: line deltas are notches, pixel deltas are divided
 /// by [`PIXELS_PER_NOTCH`], page deltas count ten notches a page. Positive = away from
 /// the user = zoom in.
@@ -357,6 +214,21 @@ pub fn wheel_notches(unit: egui::MouseWheelUnit, delta_y: f32) -> f64 {
         egui::MouseWheelUnit::Point => d / PIXELS_PER_NOTCH,
         egui::MouseWheelUnit::Page => d * 10.0,
     }
+}
+
+/// The narrowest hfov at which one map pixel covers `screen_px_per_map_px` screen pixels
+/// at the center of a `scene_width`-pixel view, for a map whose pixels span
+/// `map_px_deg` degrees (360 / width for a map, 90 / face size for a cube map). With
+/// focal length f (pixels), a center pixel spans 1/f radians; f = ratio / map pixel.
+pub fn resolution_hfov(map_px_deg: f64, scene_width: u32, screen_px_per_map_px: f64) -> f64 {
+    let map_px = map_px_deg.to_radians();
+    if !(map_px > 0.0 && screen_px_per_map_px > 0.0) || scene_width == 0 {
+        return HFOV_MIN;
+    }
+    let f = screen_px_per_map_px / map_px;
+    (2.0 * (f64::from(scene_width) / 2.0 / f).atan())
+        .to_degrees()
+        .clamp(HFOV_MIN, HFOV_MAX)
 }
 
 /// World direction (unit) through image-plane point `pos` of a `size` scene for `look`.
@@ -427,12 +299,23 @@ enum Drag {
     },
 }
 
+/// An animated zoom toward a point (double-click).
+#[derive(Debug, Clone, Copy)]
+struct ZoomAnim {
+    dir: DVec3,
+    pos: (f64, f64),
+    size: (u32, u32),
+    from: f64,
+    to: f64,
+    t0: f64,
+}
+
 /// One frame's decision: what to show and whether it may be rendered cheaply.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Frame {
     /// The view to render.
     pub look: Look,
-    /// True while the view turns fast (Still-only mode renders it with nearest sampling).
+    /// True while the view turns fast (the window may render it cheaper).
     pub fast: bool,
 }
 
@@ -443,6 +326,8 @@ pub struct Controller {
     home: Look,
     /// Panel settings (drag style, inertia, AA mode, render options).
     pub settings: Settings,
+    /// Auto-rotation settings.
+    pub auto_rotate: AutoRotate,
     drag: Option<Drag>,
     held: Held,
     /// Inertia velocity, degrees per second (yaw, pitch).
@@ -453,9 +338,21 @@ pub struct Controller {
     /// Time and look of the previous frame, for the speed measurement.
     prev_frame: Option<(f64, Look)>,
     fast_until: f64,
-    last_frame_fast: bool,
+    /// The last frame was rendered below full quality because the view moved.
+    degraded: bool,
     /// The view limit in force: the covered area and the scene size it holds for.
     limit: Option<(lut_core::Coverage, (u32, u32))>,
+    /// hfov range: the map's resolution limit and the widest view.
+    zoom_range: (f64, f64),
+    /// A zoom out was stopped at the widest view (the hook for wide projections).
+    zoomed_past_widest: bool,
+    zoom_anim: Option<ZoomAnim>,
+    /// Frame interval while animating (the display's refresh).
+    frame_s: f64,
+    /// Time of the last user input (auto-rotation waits for the idle delay after it).
+    last_input: f64,
+    /// Auto-rotation is turning the view now.
+    rotating: bool,
 }
 
 impl Controller {
@@ -465,6 +362,7 @@ impl Controller {
             look: home,
             home,
             settings: Settings::default(),
+            auto_rotate: AutoRotate::default(),
             drag: None,
             held: Held::default(),
             velocity: (0.0, 0.0),
@@ -472,9 +370,66 @@ impl Controller {
             last_tick: None,
             prev_frame: None,
             fast_until: f64::NEG_INFINITY,
-            last_frame_fast: false,
+            degraded: false,
             limit: None,
+            zoom_range: (HFOV_MIN, HFOV_MAX),
+            zoomed_past_widest: false,
+            zoom_anim: None,
+            frame_s: DEFAULT_FRAME_S,
+            last_input: f64::NEG_INFINITY,
+            rotating: false,
         }
+    }
+
+    /// A new panorama: `home` is its start view; the view goes there and every motion
+    /// stops.
+    pub fn set_home(&mut self, home: Look) {
+        self.home = home;
+        self.velocity = (0.0, 0.0);
+        self.zoom_anim = None;
+        // A jump to another panorama is not motion: no speed is measured across it.
+        self.prev_frame = None;
+        self.look = Look::new(home.yaw, home.pitch, self.clamp_hfov(home.hfov));
+        self.apply_limit();
+    }
+
+    /// The start view the view resets to.
+    pub fn home(&self) -> Look {
+        self.home
+    }
+
+    /// Animation frames come every `seconds` (the display's refresh interval).
+    pub fn set_frame_interval(&mut self, seconds: f64) {
+        if seconds.is_finite() && seconds > 0.0 {
+            self.frame_s = seconds;
+        }
+    }
+
+    /// Keep hfov within `min`..=`max` from now on (the map's resolution limit and the
+    /// widest view), and pull the current view in at once.
+    pub fn set_zoom_range(&mut self, min: f64, max: f64) {
+        let max = max.clamp(HFOV_MIN, HFOV_MAX);
+        let min = min.clamp(HFOV_MIN, max);
+        self.zoom_range = (min, max);
+        let h = self.clamp_hfov(self.look.hfov);
+        if h != self.look.hfov {
+            self.look = Look::new(self.look.yaw, self.look.pitch, h);
+        }
+    }
+
+    /// The hfov range in force.
+    pub fn zoom_range(&self) -> (f64, f64) {
+        self.zoom_range
+    }
+
+    /// True (once) when a zoom out was stopped at the widest view since the last call:
+    /// where the window hands over to wide output projections.
+    pub fn take_zoomed_past_widest(&mut self) -> bool {
+        std::mem::take(&mut self.zoomed_past_widest)
+    }
+
+    fn clamp_hfov(&self, hfov: f64) -> f64 {
+        hfov.clamp(self.zoom_range.0, self.zoom_range.1)
     }
 
     /// Keep every edge of a `size` scene inside `coverage` from now on (`None`: no
@@ -484,7 +439,8 @@ impl Controller {
         self.apply_limit();
     }
 
-    /// Apply the view limit; motion that ran into it stops in that direction.
+    /// Apply the view limit; motion that ran into it stops in that direction (and
+    /// auto-rotation turns back).
     fn apply_limit(&mut self) {
         let Some((cov, (w, h))) = self.limit else {
             return;
@@ -497,6 +453,9 @@ impl Controller {
         if l != self.look {
             if l.yaw != self.look.yaw {
                 self.velocity.0 = 0.0;
+                if self.rotating {
+                    self.auto_rotate.speed_deg_s = -self.auto_rotate.speed_deg_s;
+                }
             }
             if l.pitch != self.look.pitch {
                 self.velocity.1 = 0.0;
@@ -515,8 +474,17 @@ impl Controller {
         self.drag.is_some()
     }
 
+    /// The user did something at time `t` (a press, a key, the wheel): auto-rotation
+    /// stops until the idle delay has passed again, and a zoom animation ends.
+    pub fn interacted(&mut self, t: f64) {
+        self.last_input = t;
+        self.rotating = false;
+        self.zoom_anim = None;
+    }
+
     /// The mouse button went down at `pos` in a `size` scene.
     pub fn press(&mut self, pos: (f64, f64), size: (u32, u32), t: f64) {
+        self.interacted(t);
         self.velocity = (0.0, 0.0);
         self.samples.clear();
         self.drag = Some(match self.settings.drag {
@@ -539,6 +507,7 @@ impl Controller {
 
     /// The cursor moved to `pos` with the button down.
     pub fn drag_to(&mut self, pos: (f64, f64), size: (u32, u32), t: f64) {
+        self.last_input = t;
         match &mut self.drag {
             Some(Drag::Grab { dir }) => {
                 let (yaw, pitch) = solve_grab(*dir, pos, size, self.look.hfov, self.look.pitch);
@@ -559,6 +528,7 @@ impl Controller {
 
     /// The mouse button was released.
     pub fn release(&mut self, t: f64) {
+        self.last_input = t;
         if let Some(Drag::Grab { .. }) = self.drag {
             self.velocity = (0.0, 0.0);
             if self.settings.inertia {
@@ -566,7 +536,10 @@ impl Controller {
                     let dt = last.0 - first.0;
                     // A pause before release means the user stopped: no throw.
                     if dt > 0.01 && t - last.0 < 0.05 {
-                        self.velocity = ((last.1 - first.1) / dt, (last.2 - first.2) / dt);
+                        let v = ((last.1 - first.1) / dt, (last.2 - first.2) / dt);
+                        let max = INERTIA_MAX_HFOV_PER_S * self.look.hfov;
+                        let k = (max / v.0.hypot(v.1)).min(1.0);
+                        self.velocity = (v.0 * k, v.1 * k);
                         self.last_tick = Some(t);
                     }
                 }
@@ -583,9 +556,32 @@ impl Controller {
         self.zoom_to(hfov, cursor, size);
     }
 
-    /// Set hfov (clamped), keeping the direction under `cursor` where it is.
+    /// A double-click at `pos` of a `size` scene at time `t`: zoom in by
+    /// [`DOUBLE_CLICK_ZOOM`] toward the point over [`DOUBLE_CLICK_S`].
+    pub fn double_click(&mut self, pos: (f64, f64), size: (u32, u32), t: f64) {
+        self.interacted(t);
+        self.velocity = (0.0, 0.0);
+        let to = self.clamp_hfov(self.look.hfov / DOUBLE_CLICK_ZOOM);
+        if to < self.look.hfov {
+            self.zoom_anim = Some(ZoomAnim {
+                dir: dir_at(&self.look, pos, size),
+                pos,
+                size,
+                from: self.look.hfov,
+                to,
+                t0: t,
+            });
+            self.touch_tick(t);
+        }
+    }
+
+    /// Set hfov (clamped to the zoom range), keeping the direction under `cursor` where
+    /// it is.
     pub fn zoom_to(&mut self, hfov: f64, cursor: Option<(f64, f64)>, size: (u32, u32)) {
-        let hfov = hfov.clamp(HFOV_MIN, HFOV_MAX);
+        if hfov > self.zoom_range.1 && self.look.hfov >= self.zoom_range.1 {
+            self.zoomed_past_widest = true;
+        }
+        let hfov = self.clamp_hfov(hfov);
         if hfov == self.look.hfov {
             return;
         }
@@ -607,8 +603,10 @@ impl Controller {
             KeyAction::ZoomIn => self.zoom_to(self.look.hfov / ZOOM_PER_NOTCH, None, size),
             KeyAction::ZoomOut => self.zoom_to(self.look.hfov * ZOOM_PER_NOTCH, None, size),
             KeyAction::Reset => {
-                self.look = self.home;
+                let h = self.home;
+                self.look = Look::new(h.yaw, h.pitch, self.clamp_hfov(h.hfov));
                 self.velocity = (0.0, 0.0);
+                self.zoom_anim = None;
             }
             _ => {}
         }
@@ -616,16 +614,23 @@ impl Controller {
 
     /// The keys and buttons held during this frame.
     pub fn set_held(&mut self, held: Held, t: f64) {
-        if held.any() && !self.held.any() {
-            self.touch_tick(t);
+        if held.any() {
+            if !self.held.any() {
+                self.touch_tick(t);
+            }
+            self.interacted(t);
         }
         self.held = held;
     }
 
     /// True while the view changes without further input (held keys or buttons, a QTVR
-    /// drag off its press point, inertia).
+    /// drag off its press point, inertia, a zoom animation, auto-rotation).
     pub fn animating(&self) -> bool {
-        self.held.any() || self.qtvr_rate().is_some() || self.velocity != (0.0, 0.0)
+        self.held.any()
+            || self.qtvr_rate().is_some()
+            || self.velocity != (0.0, 0.0)
+            || self.zoom_anim.is_some()
+            || self.rotating
     }
 
     /// QTVR turning rate (deg/s yaw, pitch) when the cursor is off the press point.
@@ -653,17 +658,41 @@ impl Controller {
         }
     }
 
+    /// When auto-rotation starts (again), if it is on and not turning yet.
+    fn rotation_due(&self) -> Option<f64> {
+        let idle = self.drag.is_none() && !self.held.any() && self.velocity == (0.0, 0.0);
+        (self.auto_rotate.enabled && !self.rotating && idle && self.zoom_anim.is_none())
+            .then(|| self.last_input + self.auto_rotate.idle_s.max(0.0))
+    }
+
     /// Advance continuous motion to time `t`. Returns true when the view changed.
     pub fn tick(&mut self, t: f64) -> bool {
+        if !self.auto_rotate.enabled {
+            self.rotating = false;
+        } else if self.rotation_due().is_some_and(|at| t >= at) {
+            self.touch_tick(t);
+            self.rotating = true;
+        }
         let dt = match self.last_tick {
             Some(t0) => (t - t0).clamp(0.0, MAX_TICK_S),
             None => 0.0,
         };
         self.last_tick = Some(t);
-        if dt == 0.0 {
-            return false;
-        }
         let before = self.look;
+        if let Some(z) = self.zoom_anim {
+            // Ease in and out, geometric in hfov, the grabbed point fixed under the cursor.
+            let p = ((t - z.t0) / DOUBLE_CLICK_S).clamp(0.0, 1.0);
+            let e = p * p * (3.0 - 2.0 * p);
+            let hfov = z.from * (z.to / z.from).powf(e);
+            let (yaw, pitch) = solve_grab(z.dir, z.pos, z.size, hfov, self.look.pitch);
+            self.look = Look::new(yaw, pitch, hfov);
+            if p >= 1.0 {
+                self.zoom_anim = None;
+            }
+        }
+        if dt == 0.0 {
+            return self.look != before;
+        }
         let mut yaw_rate = 0.0;
         let mut pitch_rate = 0.0;
         let turn = TURN_HFOV_PER_S * self.look.hfov;
@@ -673,6 +702,9 @@ impl Controller {
         if let Some((y, p)) = self.qtvr_rate() {
             yaw_rate += y;
             pitch_rate += p;
+        }
+        if self.rotating {
+            yaw_rate += self.auto_rotate.speed_deg_s;
         }
         if self.velocity != (0.0, 0.0) && self.drag.is_none() {
             yaw_rate += self.velocity.0;
@@ -686,12 +718,15 @@ impl Controller {
         }
         let zoom = f64::from(u8::from(h.zoom_out)) - f64::from(u8::from(h.zoom_in));
         let hfov = self.look.hfov * (zoom * dt * std::f64::consts::LN_2 / ZOOM_HALVING_S).exp();
+        if hfov > self.zoom_range.1 && h.zoom_out {
+            self.zoomed_past_widest = true;
+        }
         let pitch = self.look.pitch + pitch_rate * dt;
         if pitch.abs() >= 90.0 {
             // At the pole, throwing further up does nothing: drop the vertical inertia.
             self.velocity.1 = 0.0;
         }
-        self.look = Look::new(self.look.yaw + yaw_rate * dt, pitch, hfov);
+        self.look = Look::new(self.look.yaw + yaw_rate * dt, pitch, self.clamp_hfov(hfov));
         self.look != before
     }
 
@@ -714,25 +749,31 @@ impl Controller {
             }
         }
         self.prev_frame = Some((t, self.look));
-        let fast = t < self.fast_until;
-        self.last_frame_fast = fast && self.settings.aa == AaMode::StillOnly;
         Frame {
             look: self.look,
-            fast,
+            fast: t < self.fast_until,
         }
     }
 
-    /// When the next frame is due without new input: the next animation frame, or the
-    /// full-quality frame after fast motion stopped; `None` when nothing is pending.
+    /// The window rendered the last frame below the quality a still view gets
+    /// (`degraded`): a full-quality frame is due once the view settles.
+    pub fn rendered(&mut self, degraded: bool) {
+        self.degraded = degraded;
+    }
+
+    /// When the next frame is due without new input: the next animation frame, the
+    /// full-quality frame after degraded motion, or the start of auto-rotation; `None`
+    /// when nothing is pending.
     pub fn wake_at(&self) -> Option<f64> {
         let last = self.prev_frame.map(|(t, _)| t);
         if self.animating() {
-            return Some(last.map_or(0.0, |t| t + ANIMATION_FRAME_S));
+            return Some(last.map_or(0.0, |t| t + self.frame_s));
         }
-        if self.last_frame_fast {
-            return Some(self.fast_until);
+        let refine = self.degraded.then_some(self.fast_until);
+        match (refine, self.rotation_due()) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
         }
-        None
     }
 }
 
@@ -745,6 +786,8 @@ impl Default for Controller {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::window::quality::{frame_level, AaMode, FrameTimes, Level, FRAME_BUDGET_MS};
+    use lut_core::Sampler;
 
     const SIZE: (u32, u32) = (800, 500);
     const CENTER: (f64, f64) = (400.0, 250.0);
@@ -772,6 +815,14 @@ mod tests {
             c.frame(t);
         }
         t
+    }
+
+    /// Hold `held` from `t0` for `frames` frames at 60 Hz.
+    fn hold(c: &mut Controller, held: Held, t0: f64, frames: u32) {
+        c.set_held(held, t0);
+        for i in 1..=frames {
+            c.frame(t0 + f64::from(i) / 60.0);
+        }
     }
 
     #[test]
@@ -952,7 +1003,7 @@ mod tests {
         let mut paths = Vec::new();
         // Zoom in notch by notch from 90° to well below the switch.
         while c.look().hfov > 40.0 {
-            let opts = c.settings.render_options(false);
+            let opts = c.settings.render_options(Level::Full);
             let report = r
                 .render(
                     lut_core::Scene::Map(&map),
@@ -974,10 +1025,20 @@ mod tests {
         assert!(paths.contains(&lut_core::RenderPath::LutHigh));
     }
 
+    /// What the window does with a frame: pick its level and tell the controller
+    /// whether a full-quality frame is still owed; the sampler it rendered with.
+    fn render(c: &mut Controller, f: Frame, times: &FrameTimes) -> Sampler {
+        let px = u64::from(SIZE.0) * u64::from(SIZE.1);
+        let (level, degraded) = frame_level(c.settings.aa, f.fast, times, px, FRAME_BUDGET_MS);
+        c.rendered(degraded);
+        level.sampler(c.settings.sampler)
+    }
+
     #[test]
     fn still_only_renders_nearest_while_fast_then_one_full_frame() {
         let mut c = Controller::default();
         c.settings.aa = AaMode::StillOnly;
+        let times = FrameTimes::default();
         c.frame(0.0);
         // A fast drag: 300 px in 0.25 s.
         c.press(CENTER, SIZE, 0.0);
@@ -987,7 +1048,7 @@ mod tests {
             c.drag_to((CENTER.0 + 20.0 * f64::from(i), CENTER.1), SIZE, t);
             let f = c.frame(t);
             assert!(f.fast, "frame at {t} is fast");
-            assert_eq!(c.settings.sampler_for(f.fast), Sampler::Nearest);
+            assert_eq!(render(&mut c, f, &times), Sampler::Nearest);
         }
         c.release(t + 0.2); // paused before release: no inertia
                             // Nothing moves now; a full-quality frame is due within ~150 ms.
@@ -995,8 +1056,40 @@ mod tests {
         assert!(due > t && due <= t + 0.15, "due {due}, stopped at {t}");
         let f = c.frame(due);
         assert!(!f.fast);
-        assert_eq!(c.settings.sampler_for(f.fast), Sampler::Trilinear);
+        assert_eq!(render(&mut c, f, &times), Sampler::Trilinear);
         // Exactly one: after it, nothing is pending.
+        assert_eq!(c.wake_at(), None);
+    }
+
+    #[test]
+    fn adaptive_moves_at_full_quality_when_it_fits_and_owes_nothing_after() {
+        let mut c = Controller::default();
+        assert_eq!(c.settings.aa, AaMode::Adaptive);
+        let mut times = FrameTimes::default();
+        times.record(Level::Full, 7.0, u64::from(SIZE.0 * SIZE.1));
+        c.frame(0.0);
+        c.press(CENTER, SIZE, 0.0);
+        let mut t = 0.0;
+        for i in 1..=15 {
+            t = f64::from(i) / 60.0;
+            c.drag_to((CENTER.0 + 20.0 * f64::from(i), CENTER.1), SIZE, t);
+            let f = c.frame(t);
+            assert!(f.fast);
+            assert_eq!(render(&mut c, f, &times), Sampler::Trilinear, "no pop");
+        }
+        c.release(t + 0.2);
+        assert_eq!(c.wake_at(), None, "the last frame was already full quality");
+        // A full frame over the budget: moving frames degrade, then one full frame.
+        times.record(Level::Full, 40.0, u64::from(SIZE.0 * SIZE.1));
+        c.press(CENTER, SIZE, t + 0.3);
+        c.drag_to((CENTER.0 - 100.0, CENTER.1), SIZE, t + 0.32);
+        let f = c.frame(t + 0.32);
+        assert!(f.fast);
+        assert_ne!(render(&mut c, f, &times), Sampler::Trilinear);
+        c.release(t + 0.6);
+        let due = c.wake_at().expect("a full-quality frame is owed");
+        let f = c.frame(due);
+        assert_eq!(render(&mut c, f, &times), Sampler::Trilinear);
         assert_eq!(c.wake_at(), None);
     }
 
@@ -1023,53 +1116,18 @@ mod tests {
         };
         assert_eq!(s.sampler_for(false), Sampler::Nearest);
         // Always and Off never schedule a refinement frame.
-        let mut c = Controller::default();
-        c.settings.aa = AaMode::Always;
-        c.frame(0.0);
-        c.press(CENTER, SIZE, 0.0);
-        c.drag_to((CENTER.0 + 300.0, CENTER.1), SIZE, 0.05);
-        assert!(c.frame(0.05).fast);
-        c.release(0.5);
-        assert_eq!(c.wake_at(), None);
-    }
-
-    #[test]
-    fn key_bindings() {
-        use egui::Key as K;
-        let cases = [
-            (K::ArrowLeft, KeyAction::Turn(Turn::Left)),
-            (K::A, KeyAction::Turn(Turn::Left)),
-            (K::ArrowRight, KeyAction::Turn(Turn::Right)),
-            (K::D, KeyAction::Turn(Turn::Right)),
-            (K::ArrowUp, KeyAction::Turn(Turn::Up)),
-            (K::W, KeyAction::Turn(Turn::Up)),
-            (K::ArrowDown, KeyAction::Turn(Turn::Down)),
-            (K::S, KeyAction::Turn(Turn::Down)),
-            (K::Plus, KeyAction::ZoomIn),
-            (K::Equals, KeyAction::ZoomIn),
-            (K::Minus, KeyAction::ZoomOut),
-            (K::R, KeyAction::Reset),
-            (K::F, KeyAction::ToggleFullscreen),
-            (K::Escape, KeyAction::LeaveFullscreen),
-            (K::H, KeyAction::TogglePanel),
-            (K::Tab, KeyAction::TogglePanel),
-            (K::OpenBracket, KeyAction::ExposureDown),
-            (K::CloseBracket, KeyAction::ExposureUp),
-            (K::P, KeyAction::SaveView),
-        ];
-        let none = egui::Modifiers::NONE;
-        for (k, a) in cases {
-            assert_eq!(key_action(k, none), Some(a), "{k:?}");
+        for aa in [AaMode::Always, AaMode::Off] {
+            let mut c = Controller::default();
+            c.settings.aa = aa;
+            c.frame(0.0);
+            c.press(CENTER, SIZE, 0.0);
+            c.drag_to((CENTER.0 + 300.0, CENTER.1), SIZE, 0.05);
+            let f = c.frame(0.05);
+            assert!(f.fast);
+            render(&mut c, f, &FrameTimes::default());
+            c.release(0.5);
+            assert_eq!(c.wake_at(), None, "{aa:?}");
         }
-        assert_eq!(key_action(K::Q, none), None);
-        assert_eq!(key_action(K::Space, none), None);
-        for k in TURN_KEYS {
-            assert!(matches!(key_action(k, none), Some(KeyAction::Turn(_))));
-        }
-        let ctrl = egui::Modifiers::CTRL;
-        assert_eq!(key_action(K::Q, ctrl), Some(KeyAction::Quit));
-        assert_eq!(key_action(K::W, ctrl), Some(KeyAction::Quit));
-        assert_eq!(key_action(K::A, ctrl), None, "Ctrl+A does not turn");
     }
 
     #[test]
@@ -1226,6 +1284,166 @@ mod tests {
         let t = drag(&mut c, CENTER, (CENTER.0 - 200.0, CENTER.1), 10, 0.0);
         c.release(t);
         assert!(!c.animating());
+    }
+
+    #[test]
+    fn a_flick_stops_within_a_second() {
+        // The fastest throw (capped) and a typical one both stop within about a second,
+        // and a typical one coasts less than a field of view (Pannellum's feel).
+        for (px, frames) in [(2000.0, 6), (300.0, 10)] {
+            let mut c = Controller::default();
+            c.frame(0.0);
+            let t = drag(&mut c, CENTER, (CENTER.0 - px, CENTER.1), frames, 0.0);
+            let y0 = c.look().yaw;
+            c.release(t);
+            assert!(c.animating(), "thrown");
+            let mut tt = t;
+            while c.animating() {
+                tt += 1.0 / 60.0;
+                c.frame(tt);
+                assert!(tt - t < 1.05, "still coasting after {:.2} s", tt - t);
+            }
+            let coast = wrap_deg(c.look().yaw - y0).abs();
+            assert!(coast > 1.0, "{px} px flick coasted only {coast}°");
+            if px < 1000.0 {
+                assert!(coast < 90.0, "a typical flick coasted {coast}°");
+            }
+        }
+    }
+
+    #[test]
+    fn resolution_limit_is_two_screen_pixels_per_map_pixel() {
+        // 1024-pixel map (0.3516° per pixel) in an 800-pixel view: at the limit a map
+        // pixel spans two screen pixels at the center.
+        let hfov = resolution_hfov(360.0 / 1024.0, 800, 2.0);
+        let f = 400.0 / (hfov.to_radians() / 2.0).tan();
+        close(
+            (360.0f64 / 1024.0).to_radians() * f,
+            2.0,
+            1e-9,
+            "screen pixels per map pixel",
+        );
+        assert!((101.0..102.0).contains(&hfov), "{hfov}");
+        // A sharper map zooms further in; one screen pixel per map pixel (Marzipano's
+        // limit) stops earlier.
+        assert!(resolution_hfov(360.0 / 8192.0, 800, 2.0) < 20.0);
+        assert!(resolution_hfov(360.0 / 1024.0, 800, 1.0) > hfov);
+        // Nonsense gives the global minimum.
+        assert_eq!(resolution_hfov(0.0, 800, 2.0), HFOV_MIN);
+        assert_eq!(resolution_hfov(0.35, 0, 2.0), HFOV_MIN);
+    }
+
+    #[test]
+    fn zoom_range_holds_against_wheel_keys_buttons_and_reset() {
+        let mut c = Controller::new(Look::new(0.0, 0.0, 60.0));
+        c.set_zoom_range(80.0, 120.0);
+        assert_eq!(c.look().hfov, 80.0, "pulled out to the limit at once");
+        for _ in 0..50 {
+            c.wheel(1.0, Some((100.0, 100.0)), SIZE);
+        }
+        assert_eq!(c.look().hfov, 80.0);
+        c.key(KeyAction::Reset);
+        assert_eq!(
+            c.look().hfov,
+            80.0,
+            "the 60° start view is narrower than allowed"
+        );
+        assert!(!c.take_zoomed_past_widest());
+        for _ in 0..50 {
+            c.key(KeyAction::ZoomOut);
+        }
+        assert_eq!(c.look().hfov, 120.0);
+        assert!(c.take_zoomed_past_widest(), "the hook for wide projections");
+        assert!(!c.take_zoomed_past_widest(), "reported once");
+        c.frame(0.0);
+        let zoom_in = Held {
+            zoom_in: true,
+            ..Held::default()
+        };
+        hold(&mut c, zoom_in, 0.0, 120);
+        assert_eq!(c.look().hfov, 80.0);
+        // Off for inspection: the global range.
+        c.set_zoom_range(HFOV_MIN, HFOV_MAX);
+        c.wheel(30.0, None, SIZE);
+        assert!(c.look().hfov < 10.0);
+    }
+
+    #[test]
+    fn double_click_zooms_in_toward_the_point_animated() {
+        let mut c = Controller::default();
+        c.frame(0.0);
+        let p = (600.0, 150.0);
+        let dir = dir_at(&c.look(), p, SIZE);
+        c.double_click(p, SIZE, 0.0);
+        assert!(c.animating());
+        let mut t = 0.0;
+        let mut prev = c.look().hfov;
+        while c.animating() {
+            t += 1.0 / 60.0;
+            c.frame(t);
+            assert!(c.look().hfov <= prev, "zooms in monotonically");
+            prev = c.look().hfov;
+            let q = screen_pos(&c.look(), dir);
+            close(q.0, p.0, 1e-6, "x under the cursor");
+            close(q.1, p.1, 1e-6, "y under the cursor");
+            assert!(t < DOUBLE_CLICK_S + 0.1);
+        }
+        close(c.look().hfov, 90.0 / DOUBLE_CLICK_ZOOM, 1e-9, "halved");
+        // At the limit a double-click does nothing.
+        let mut c = Controller::default();
+        c.set_zoom_range(90.0, HFOV_MAX);
+        c.double_click(p, SIZE, 0.0);
+        assert!(!c.animating());
+    }
+
+    #[test]
+    fn auto_rotate_starts_after_the_idle_delay_and_stops_on_input() {
+        let mut c = Controller {
+            auto_rotate: AutoRotate {
+                enabled: true,
+                idle_s: 2.0,
+                ..AutoRotate::default()
+            },
+            ..Controller::default()
+        };
+        let speed = c.auto_rotate.speed_deg_s;
+        c.interacted(0.0);
+        c.frame(0.0);
+        assert!(!c.animating());
+        assert_eq!(c.wake_at(), Some(2.0), "wakes when the idle delay ends");
+        c.frame(1.0);
+        assert_eq!(c.look().yaw, 0.0, "nothing before the delay");
+        c.frame(2.0);
+        assert!(c.animating());
+        let mut t = 2.0;
+        for _ in 0..60 {
+            t += 1.0 / 60.0;
+            c.frame(t);
+        }
+        close(c.look().yaw, speed, 1e-6, "one second of rotation");
+        // At the default speed the view does not count as moving fast.
+        assert!(!c.frame(t).fast);
+        // A key stops it; it resumes after the delay.
+        c.interacted(t);
+        assert!(!c.animating());
+        c.frame(t + 1.0);
+        close(c.look().yaw, speed, 1e-6, "stopped");
+        assert_eq!(c.wake_at(), Some(t + 2.0));
+        c.auto_rotate.enabled = false;
+        assert_eq!(c.wake_at(), None);
+    }
+
+    #[test]
+    fn a_new_home_is_the_start_view_and_reset_returns_to_it() {
+        let mut c = Controller::default();
+        let t = drag(&mut c, CENTER, (CENTER.0 - 200.0, CENTER.1), 10, 0.0);
+        c.release(t);
+        c.set_home(Look::new(120.0, -10.0, 70.0));
+        assert_eq!(c.look(), Look::new(120.0, -10.0, 70.0));
+        assert!(!c.animating(), "the old file's inertia does not carry over");
+        c.wheel(2.0, None, SIZE);
+        c.key(KeyAction::Reset);
+        assert_eq!(c.look(), c.home());
     }
 
     #[test]

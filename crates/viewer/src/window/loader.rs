@@ -42,6 +42,15 @@ impl Source {
         }
     }
 
+    /// The one file or folder this source is (`None`: the sample, or several face files).
+    pub fn single_path(&self) -> Option<&std::path::Path> {
+        match self {
+            Source::File(p) => Some(p),
+            Source::Cube { paths, .. } if paths.len() == 1 => Some(&paths[0]),
+            _ => None,
+        }
+    }
+
     /// The short name in the title and the map readout.
     pub fn short_name(&self) -> String {
         let file_name = |p: &PathBuf| {

@@ -1,10 +1,19 @@
 //! The interactive window: `viewer [PANORAMA]`.
 //!
-//! * [`input`]: drag, wheel, keys and held buttons → the view (pure, unit-tested).
-//! * [`document`]: what is shown, loading, the last error, drops (pure state machine,
-//!   unit-tested); [`loader`]: what is opened and the loading thread's work.
-//! * [`ui`]: the egui panel (pure immediate-mode drawing from plain data).
-//! * [`paint`]: the scene and the panel composed on the CPU into one 0RGB buffer.
+//! * [`input`]: drag, wheel, double-click, held buttons, auto-rotation, zoom range →
+//!   the view (pure, unit-tested).
+//! * [`keys`]: the one table of key bindings (input and the help read it) and the
+//!   routing of shortcut keys past egui's focus.
+//! * [`quality`]: render settings, anti-aliasing modes and the adaptive quality rule.
+//! * [`document`]: what is shown, loading, the last error, drops, start views (pure
+//!   state machine, unit-tested); [`loader`]: what is opened and the loading thread's
+//!   work; [`folder`]: the next and previous panorama in a folder.
+//! * [`ui`]: the engineering panel in sections; [`overlay`]: the viewing UI over the
+//!   scene (toolbar, compass, notices, help); [`notices`]: the messages' state;
+//!   [`dialogs`]: the Open and Save dialogs.
+//! * [`prefs`]: settings kept between runs in the user's config folder.
+//! * [`paint`]: the scene and the UI composed on the CPU into one 0RGB buffer; the
+//!   upscaling of degraded frames; the window icon.
 //! * [`export`]: HDR exposure steps and the "Save view…" size and file name (pure).
 //! * `app`: the winit event loop and softbuffer surface; it runs the document's effects.
 //!
@@ -14,14 +23,21 @@
 //! the same options `viewer render` makes, so the window shows what `viewer render` writes.
 
 mod app;
+pub mod dialogs;
 pub mod document;
 pub mod export;
+pub mod folder;
 pub mod input;
+pub mod keys;
 pub mod loader;
+pub mod notices;
+pub mod overlay;
 pub mod paint;
+pub mod prefs;
+pub mod quality;
 pub mod ui;
 
-use crate::args::{parse_size, InputArgs, MaxPixelsArg, ProjectionArg};
+use crate::args::{parse_angle, parse_size, InputArgs, MaxPixelsArg, ProjectionArg};
 use crate::lighting::LightArgs;
 use clap::Args;
 use std::path::PathBuf;
@@ -36,6 +52,16 @@ pub struct OpenArgs {
     /// How to read the panorama (the same options as `viewer render`).
     #[command(flatten)]
     pub input: InputArgs,
+    /// Start yaw in degrees (default: the file's GPano start view, else 0).
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub yaw: Option<f64>,
+    /// Start pitch in degrees, clamped to [-90, 90] (default: the file's, else 0).
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub pitch: Option<f64>,
+    /// Start horizontal field of view in degrees, in (0, 180) (default: the file's, else
+    /// 90; the zoom limit may widen it).
+    #[arg(long, value_parser = parse_hfov, allow_hyphen_values = true)]
+    pub hfov: Option<f64>,
     /// Initial window size in logical pixels, WIDTHxHEIGHT.
     #[arg(long, value_name = "WxH", default_value = "1024x640", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -52,6 +78,16 @@ pub struct OpenArgs {
     /// Luminaires lighting the scene (also added, moved and removed in the panel).
     #[command(flatten)]
     pub lights: LightArgs,
+}
+
+/// A start hfov: a finite angle in (0, 180).
+fn parse_hfov(s: &str) -> Result<f64, String> {
+    let v = parse_angle(s)?;
+    if v > 0.0 && v < 180.0 {
+        Ok(v)
+    } else {
+        Err(format!("hfov '{s}' must be in (0, 180) degrees"))
+    }
 }
 
 /// Open the window on the panorama (or the sample) and run until it is closed.

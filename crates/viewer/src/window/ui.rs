@@ -1,10 +1,13 @@
-//! The egui control panel (right side): the paper's turn and zoom buttons, the settings,
-//! the readouts, and the load status. Immediate mode: drawn from plain data each frame,
-//! so a test can paint it offscreen without a window.
+//! The engineering panel (right side, key H): the paper's turn and zoom buttons, the
+//! render settings, the readouts, navigation, the image and the lights, in sections
+//! ([`SECTIONS`]); and the load status. Immediate mode: drawn from plain data each frame,
+//! so a test can paint it offscreen without a window. The viewing overlay (toolbar,
+//! compass, notices, help) is `overlay.rs`.
 
-use super::input::{Held, Look, Settings};
+use super::input::{AutoRotate, Held, Look};
+use super::quality::{Level, Settings, FRAME_BUDGET_MS};
 use crate::lighting::{format_lux, LightsState};
-use lut_core::{CubeRenderer, Named, Projection, RenderPath};
+use lut_core::{CubeRenderer, Named, Projection, RenderPath, Sampler};
 
 /// Width of the panel, in points.
 pub const PANEL_WIDTH: f32 = 230.0;
@@ -13,7 +16,8 @@ pub const PANEL_WIDTH: f32 = 230.0;
 /// (Glyphs the default egui fonts have: a test checks.)
 pub const BUTTON_LABELS: [&str; 7] = ["⬆", "⬅", "R", "➡", "⬇", "+", "−"];
 
-/// Numbers shown under "Readouts".
+/// What the readouts show: the last rendered frame's numbers (reset when another
+/// panorama is shown, so nothing of the previous one is left).
 #[derive(Debug, Clone, Default)]
 pub struct Readouts {
     /// Renderer path of the last rendered frame.
@@ -28,18 +32,22 @@ pub struct Readouts {
     pub render_ms: f64,
     /// Milliseconds the last UI pass and paint took.
     pub ui_ms: f64,
-    /// Frames per second while frames are being drawn (0 when idle).
+    /// Scenes rendered in the last second (0 when idle).
     pub fps: f64,
     /// Scene size in pixels.
     pub scene: (u32, u32),
+    /// The quality of the last rendered frame.
+    pub level: Option<Level>,
+    /// The sampler that rendered it.
+    pub sampler: Option<Sampler>,
+    /// The last full-quality frame's time at the current size (for the budget readout).
+    pub full_ms: Option<f64>,
     /// Panorama description: name, size, projection.
     pub map: String,
     /// The scene is a cube map, rendered by this renderer (`None`: a LUT-rendered map).
     pub cube: Option<CubeRenderer>,
     /// The panorama is an HDR file (`.hdr`, `.exr`): the exposure slider is enabled.
     pub hdr: bool,
-    /// The last "Save view…": "saved PATH" or the error.
-    pub export_status: Option<String>,
     /// A partial panorama: what it covers (the view-limit checkbox is shown).
     pub partial: Option<String>,
     /// Compass heading of the map's longitude 0 (GPano `PoseHeadingDegrees`).
@@ -211,8 +219,10 @@ pub struct PanelModel<'a> {
     pub readouts: &'a Readouts,
     /// A load in progress.
     pub loading: Option<&'a LoadStatus>,
-    /// The last load error.
-    pub error: Option<&'a str>,
+    /// Zoom limit in screen pixels per map pixel (`None`: off).
+    pub zoom_limit: &'a mut Option<f64>,
+    /// Auto-rotation.
+    pub auto_rotate: &'a mut AutoRotate,
     /// The luminaires and their shading; the "Lights" section edits them.
     pub lights: &'a mut LightsState,
 }
@@ -226,10 +236,8 @@ pub struct PanelOutput {
     pub reset: bool,
     /// The projection choice changed: reload with it.
     pub projection_changed: bool,
-    /// The error was dismissed.
-    pub dismiss_error: bool,
-    /// The exposure slider was released (or typed into) with a new value: re-decode.
-    pub exposure_commit: bool,
+    /// The exposure changed (also while the slider is dragged): re-decode.
+    pub exposure_changed: bool,
     /// "Save view…" was pressed.
     pub save_view: bool,
 }
@@ -252,6 +260,56 @@ pub fn path_label(p: Option<RenderPath>) -> &'static str {
         Some(RenderPath::Cube(_)) => "cube map",
         None => "none yet",
     }
+}
+
+/// The readout rows (label, value) the panel shows, in order; `--print-view` prints the
+/// same strings, so a test reads what is drawn.
+pub fn readout_rows(look: &Look, r: &Readouts) -> Vec<(&'static str, String)> {
+    let mut rows = vec![
+        ("yaw", format!("{:8.2}°", look.yaw)),
+        ("pitch", format!("{:8.2}°", look.pitch)),
+        ("hfov", format!("{:8.2}°", look.hfov)),
+    ];
+    if let Some(p) = r.pose_heading {
+        let h = lut_core::compass_heading(p, look.yaw);
+        rows.push((
+            "heading",
+            format!("{h:8.2}° {}", lut_core::compass_point(h)),
+        ));
+    }
+    rows.push(("in use", in_use_label(r)));
+    rows.push((
+        "quality",
+        match (r.level, r.sampler) {
+            (Some(l), Some(s)) => format!("{} ({})", s.name(), l.label()),
+            _ => "none yet".into(),
+        },
+    ));
+    rows.push(("table", kib(r.table_bytes)));
+    if r.pixels > 0 && r.exact_pixels > 0 {
+        rows.push((
+            "exact px",
+            format!("{:.1}%", 100.0 * r.exact_pixels as f64 / r.pixels as f64),
+        ));
+    }
+    rows.push(("scene", format!("{}×{}", r.scene.0, r.scene.1)));
+    rows.push(("render", format!("{:6.2} ms", r.render_ms)));
+    if let Some(f) = r.full_ms {
+        rows.push((
+            "full frame",
+            format!(
+                "{f:6.2} ms {}",
+                if f <= FRAME_BUDGET_MS {
+                    "fits"
+                } else {
+                    "over budget"
+                }
+            ),
+        ));
+    }
+    rows.push(("UI", format!("{:6.2} ms", r.ui_ms)));
+    rows.push(("fps", format!("{:4.0}", r.fps)));
+    rows
 }
 
 /// A combo box of every value of `T`, by name, each with its help as the tooltip.
@@ -277,201 +335,238 @@ fn kib(bytes: usize) -> String {
     }
 }
 
+/// A panel section: draws its own collapsible header and contents.
+pub type Section = fn(&mut egui::Ui, &mut PanelModel<'_>, &mut PanelOutput);
+
+/// The panel's sections, top to bottom. A feature adds its section here (a function
+/// drawing a `CollapsingHeader`).
+pub const SECTIONS: &[Section] = &[
+    view_section,
+    readouts_section,
+    rendering_section,
+    navigation_section,
+    image_section,
+    save_section,
+    lights_section,
+];
+
 /// Draw the panel on the right of `ui`; the rest of `ui` is left for the scene.
-pub fn side_panel(ui: &mut egui::Ui, m: PanelModel<'_>) -> PanelOutput {
+pub fn side_panel(ui: &mut egui::Ui, mut m: PanelModel<'_>) -> PanelOutput {
     let mut out = PanelOutput::default();
     egui::Panel::right("controls")
         .resizable(false)
         .exact_size(PANEL_WIDTH)
         .show_inside(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| panel_contents(ui, m, &mut out));
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                ui.heading("Engineering panel");
+                ui.label(&m.readouts.map);
+                if let Some(l) = m.loading {
+                    ui.separator();
+                    load_progress(ui, l);
+                }
+                for section in SECTIONS {
+                    section(ui, &mut m, &mut out);
+                }
+                ui.small("H hides this panel; ? or F1 lists every key.");
+            });
         });
     out
 }
 
-fn panel_contents(ui: &mut egui::Ui, m: PanelModel<'_>, out: &mut PanelOutput) {
-    ui.heading("Panorama viewer");
-    ui.label(&m.readouts.map);
+fn section(ui: &mut egui::Ui, title: &str, open: bool, body: impl FnOnce(&mut egui::Ui)) {
+    egui::CollapsingHeader::new(title)
+        .id_salt(title)
+        .default_open(open)
+        .show(ui, body);
+}
 
-    if let Some(l) = m.loading {
-        ui.separator();
-        load_progress(ui, l);
-    }
-    if let Some(e) = m.error {
-        ui.separator();
-        ui.colored_label(egui::Color32::from_rgb(255, 120, 100), e);
-        if ui.small_button("Dismiss").clicked() {
-            out.dismiss_error = true;
-        }
-    }
-
-    ui.separator();
-    // The paper's direction buttons: turn at a steady speed while held.
-    let held_btn = |ui: &mut egui::Ui, text: &str, hint: &str| {
-        ui.add_sized([44.0, 28.0], egui::Button::new(text))
-            .on_hover_text(hint)
-            .is_pointer_button_down_on()
-    };
-    egui::Grid::new("turn").spacing([4.0, 4.0]).show(ui, |ui| {
-        ui.label("");
-        out.held.up = held_btn(ui, BUTTON_LABELS[0], "Look up (hold)");
-        ui.label("");
-        out.held.zoom_in = held_btn(ui, BUTTON_LABELS[5], "Zoom in (hold)");
-        ui.end_row();
-        out.held.left = held_btn(ui, BUTTON_LABELS[1], "Turn left (hold)");
-        out.reset = ui
-            .add_sized([44.0, 28.0], egui::Button::new(BUTTON_LABELS[2]))
-            .on_hover_text("Reset the view")
-            .clicked();
-        out.held.right = held_btn(ui, BUTTON_LABELS[3], "Turn right (hold)");
-        out.held.zoom_out = held_btn(ui, BUTTON_LABELS[6], "Zoom out (hold)");
-        ui.end_row();
-        ui.label("");
-        out.held.down = held_btn(ui, BUTTON_LABELS[4], "Look down (hold)");
-        ui.end_row();
-    });
-
-    ui.separator();
-    let r = m.readouts;
-    egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
-        let mut row = |k: &str, v: String| {
-            ui.label(k);
-            ui.monospace(v);
-            ui.end_row();
+/// The paper's direction buttons (turn at a steady speed while held) and the view.
+fn view_section(ui: &mut egui::Ui, _m: &mut PanelModel<'_>, out: &mut PanelOutput) {
+    section(ui, "View", true, |ui| {
+        let held_btn = |ui: &mut egui::Ui, text: &str, hint: &str| {
+            ui.add_sized([44.0, 28.0], egui::Button::new(text))
+                .on_hover_text(hint)
+                .is_pointer_button_down_on()
         };
-        row("yaw", format!("{:8.2}°", m.look.yaw));
-        row("pitch", format!("{:8.2}°", m.look.pitch));
-        row("hfov", format!("{:8.2}°", m.look.hfov));
-        if let Some(p) = r.pose_heading {
-            let h = lut_core::compass_heading(p, m.look.yaw);
-            row(
-                "heading",
-                format!("{h:8.2}° {}", lut_core::compass_point(h)),
-            );
-        }
-        row("in use", in_use_label(r));
-        row("table", kib(r.table_bytes));
-        if r.pixels > 0 && r.exact_pixels > 0 {
-            row(
-                "exact px",
-                format!("{:.1}%", 100.0 * r.exact_pixels as f64 / r.pixels as f64),
-            );
-        }
-        row("scene", format!("{}×{}", r.scene.0, r.scene.1));
-        row("render", format!("{:6.2} ms", r.render_ms));
-        row("UI", format!("{:6.2} ms", r.ui_ms));
-        row("fps", format!("{:6.1}", r.fps));
+        egui::Grid::new("turn").spacing([4.0, 4.0]).show(ui, |ui| {
+            ui.label("");
+            out.held.up = held_btn(ui, BUTTON_LABELS[0], "Look up (hold)");
+            ui.label("");
+            out.held.zoom_in = held_btn(ui, BUTTON_LABELS[5], "Zoom in (hold)");
+            ui.end_row();
+            out.held.left = held_btn(ui, BUTTON_LABELS[1], "Turn left (hold)");
+            out.reset = ui
+                .add_sized([44.0, 28.0], egui::Button::new(BUTTON_LABELS[2]))
+                .on_hover_text("Back to the start view")
+                .clicked();
+            out.held.right = held_btn(ui, BUTTON_LABELS[3], "Turn right (hold)");
+            out.held.zoom_out = held_btn(ui, BUTTON_LABELS[6], "Zoom out (hold)");
+            ui.end_row();
+            ui.label("");
+            out.held.down = held_btn(ui, BUTTON_LABELS[4], "Look down (hold)");
+            ui.end_row();
+        });
     });
+}
 
-    if let Some(p) = &r.partial {
-        ui.separator();
-        ui.label(format!("Partial panorama: {p}"));
-        ui.checkbox(&mut m.settings.view_limit, "Keep the view inside")
-            .on_hover_text(
-                "Limit pitch, yaw and zoom so the view's edges stay in the covered area",
-            );
-    }
+fn readouts_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, _out: &mut PanelOutput) {
+    section(ui, "Readouts", true, |ui| {
+        egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
+            for (k, v) in readout_rows(&m.look, m.readouts) {
+                ui.label(k);
+                ui.monospace(v);
+                ui.end_row();
+            }
+        });
+    });
+}
 
-    ui.separator();
+fn rendering_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, _out: &mut PanelOutput) {
     let s = &mut *m.settings;
-    egui::Grid::new("settings").num_columns(2).show(ui, |ui| {
-        ui.label("Anti-aliasing");
-        named_combo(ui, "aa", &mut s.aa);
-        ui.end_row();
-
-        ui.label("Sampler");
-        named_combo(ui, "sampler", &mut s.sampler);
-        ui.end_row();
-
-        ui.label("Index step");
-        named_combo(ui, "step", &mut s.index_step);
-        ui.end_row();
-
-        ui.label("Drag");
-        named_combo(ui, "drag", &mut s.drag);
-        ui.end_row();
-
-        ui.label("Inertia");
-        ui.checkbox(&mut s.inertia, "after grab");
-        ui.end_row();
-
-        ui.label("Renderer");
-        named_combo(ui, "renderer", &mut s.renderer);
-        ui.end_row();
-
-        ui.label("Cube");
-        named_combo(ui, "cube_renderer", &mut s.cube_renderer)
-            .on_hover_text("Renderer for cube maps: basic (per pixel) or scanline");
-        ui.end_row();
-
-        ui.label("LUT");
-        named_combo(ui, "lut", &mut s.lut);
-        ui.end_row();
-
-        ui.label("Projection");
-        let before = *m.projection;
-        egui::ComboBox::from_id_salt("projection")
-            .selected_text(m.projection.map_or("auto", Projection::name))
-            .show_ui(ui, |ui| {
-                ui.selectable_value(m.projection, None, "auto");
-                for p in Projection::ALL {
-                    ui.selectable_value(m.projection, Some(p), p.name())
-                        .on_hover_text(Named::help(p));
-                }
-            })
-            .response
-            .on_hover_text("How the image maps the sphere; auto takes 2:1 images as equirect");
-        out.projection_changed = *m.projection != before;
-        ui.end_row();
-
-        ui.label("Exposure (EV)");
-        ui.spacing_mut().slider_width = 64.0;
-        let (lo, hi) = super::input::EXPOSURE_RANGE_EV;
-        let slider = ui
-            .add_enabled(
-                m.readouts.hdr,
-                egui::Slider::new(&mut s.exposure_ev, lo..=hi)
-                    .step_by(0.1)
-                    .max_decimals(1),
-            )
-            .on_hover_text("HDR panoramas (.hdr, .exr): stops of exposure; keys [ and ]")
-            .on_disabled_hover_text("Only for HDR panoramas (.hdr, .exr)");
-        out.exposure_commit =
-            slider.drag_stopped() || (slider.changed() && !slider.is_pointer_button_down_on());
-        ui.end_row();
-
-        ui.label("Export scale");
-        egui::ComboBox::from_id_salt("export_scale")
-            .selected_text(format!("{}x", s.export_scale))
-            .show_ui(ui, |ui| {
-                for k in super::input::EXPORT_SCALES {
-                    ui.selectable_value(&mut s.export_scale, k, format!("{k}x"));
-                }
-            })
-            .response
-            .on_hover_text("Size of the saved view: the scene's size times this");
-        ui.end_row();
+    section(ui, "Rendering", true, |ui| {
+        egui::Grid::new("rendering").num_columns(2).show(ui, |ui| {
+            ui.label("Anti-aliasing");
+            named_combo(ui, "aa", &mut s.aa);
+            ui.end_row();
+            ui.label("Sampler");
+            named_combo(ui, "sampler", &mut s.sampler);
+            ui.end_row();
+            ui.label("Index step");
+            named_combo(ui, "step", &mut s.index_step);
+            ui.end_row();
+            ui.label("Renderer");
+            named_combo(ui, "renderer", &mut s.renderer);
+            ui.end_row();
+            ui.label("Cube");
+            named_combo(ui, "cube_renderer", &mut s.cube_renderer)
+                .on_hover_text("Renderer for cube maps: basic (per pixel) or scanline");
+            ui.end_row();
+            ui.label("LUT");
+            named_combo(ui, "lut", &mut s.lut);
+            ui.end_row();
+        });
     });
-    ui.horizontal(|ui| {
+}
+
+/// Zoom limit choices: (label, screen pixels per map pixel).
+pub const ZOOM_LIMITS: [(&str, Option<f64>); 4] = [
+    ("1 map px : 1 screen px", Some(1.0)),
+    ("1 map px : 2 screen px", Some(2.0)),
+    ("1 map px : 4 screen px", Some(4.0)),
+    ("off (inspection)", None),
+];
+
+fn navigation_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, _out: &mut PanelOutput) {
+    section(ui, "Navigation", false, |ui| {
+        ui.spacing_mut().slider_width = 90.0;
+        egui::Grid::new("navigation").num_columns(2).show(ui, |ui| {
+            let s = &mut *m.settings;
+            ui.label("Drag");
+            named_combo(ui, "drag", &mut s.drag);
+            ui.end_row();
+            ui.label("Inertia");
+            ui.checkbox(&mut s.inertia, "after grab");
+            ui.end_row();
+            ui.label("Zoom limit");
+            let label = ZOOM_LIMITS
+                .iter()
+                .find(|z| z.1 == *m.zoom_limit)
+                .map_or("custom", |z| z.0);
+            egui::ComboBox::from_id_salt("zoom_limit")
+                .selected_text(label)
+                .show_ui(ui, |ui| {
+                    for (l, v) in ZOOM_LIMITS {
+                        ui.selectable_value(m.zoom_limit, v, l);
+                    }
+                })
+                .response
+                .on_hover_text(
+                    "The narrowest view: how many screen pixels one map pixel may cover",
+                );
+            ui.end_row();
+            let a = &mut *m.auto_rotate;
+            ui.label("Auto-rotate");
+            ui.checkbox(&mut a.enabled, "on (Space)");
+            ui.end_row();
+            ui.label("Speed");
+            ui.add(egui::Slider::new(&mut a.speed_deg_s, -30.0..=30.0).suffix("°/s"));
+            ui.end_row();
+            ui.label("After idle");
+            ui.add(egui::Slider::new(&mut a.idle_s, 0.0..=60.0).suffix(" s"));
+            ui.end_row();
+        });
+    });
+}
+
+fn image_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, out: &mut PanelOutput) {
+    section(ui, "Image", false, |ui| {
+        egui::Grid::new("image").num_columns(2).show(ui, |ui| {
+            ui.label("Projection");
+            let before = *m.projection;
+            egui::ComboBox::from_id_salt("projection")
+                .selected_text(m.projection.map_or("auto", Projection::name))
+                .show_ui(ui, |ui| {
+                    ui.selectable_value(m.projection, None, "auto");
+                    for p in Projection::ALL {
+                        ui.selectable_value(m.projection, Some(p), p.name())
+                            .on_hover_text(Named::help(p));
+                    }
+                })
+                .response
+                .on_hover_text("How the image maps the sphere; auto takes 2:1 images as equirect");
+            out.projection_changed = *m.projection != before;
+            ui.end_row();
+
+            ui.label("Exposure (EV)");
+            ui.spacing_mut().slider_width = 64.0;
+            let (lo, hi) = super::input::EXPOSURE_RANGE_EV;
+            let slider = ui
+                .add_enabled(
+                    m.readouts.hdr,
+                    egui::Slider::new(&mut m.settings.exposure_ev, lo..=hi)
+                        .step_by(0.1)
+                        .max_decimals(1),
+                )
+                .on_hover_text("HDR panoramas (.hdr, .exr): stops of exposure; keys [ and ]")
+                .on_disabled_hover_text("Only for HDR panoramas (.hdr, .exr)");
+            out.exposure_changed = slider.changed();
+            ui.end_row();
+        });
+        if let Some(p) = &m.readouts.partial {
+            ui.label(format!("Partial panorama: {p}"));
+            ui.checkbox(&mut m.settings.view_limit, "Keep the view inside")
+                .on_hover_text(
+                    "Limit pitch, yaw and zoom so the view's edges stay in the covered area",
+                );
+        }
+    });
+}
+
+fn save_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, out: &mut PanelOutput) {
+    section(ui, "Save", false, |ui| {
+        ui.horizontal(|ui| {
+            ui.label("Size");
+            egui::ComboBox::from_id_salt("export_scale")
+                .selected_text(format!("{}x", m.settings.export_scale))
+                .show_ui(ui, |ui| {
+                    for k in super::input::EXPORT_SCALES {
+                        ui.selectable_value(&mut m.settings.export_scale, k, format!("{k}x"));
+                    }
+                })
+                .response
+                .on_hover_text("Size of the saved view: the scene's size times this");
+        });
         out.save_view = ui
             .button("Save view…")
-            .on_hover_text("Write the view to view-N.png in the current directory (key P)")
+            .on_hover_text("Choose a file and write the view to it (Ctrl+S or P)")
             .clicked();
     });
-    if let Some(st) = &m.readouts.export_status {
-        ui.label(st);
-    }
-
-    ui.separator();
-    lights_section(ui, m.lights);
-
-    ui.separator();
-    ui.small("Drag to look, wheel to zoom. Keys: arrows/WASD turn, +/− zoom, R reset, [ ] exposure (HDR), P save view, F fullscreen, Esc leave it, H/Tab panel. Drop an image or a cube folder to open it, an .ies file to add a light.");
 }
 
 /// The "Lights" section: add, place, aim and remove luminaires; multiplier, exposure,
 /// false colour; the lux at the pointer.
-fn lights_section(ui: &mut egui::Ui, l: &mut LightsState) {
+fn lights_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, _out: &mut PanelOutput) {
+    let l = &mut *m.lights;
     egui::CollapsingHeader::new(format!("Lights ({})", l.lights.len()))
         .id_salt("lights")
         .default_open(!l.lights.is_empty())

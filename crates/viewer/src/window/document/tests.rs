@@ -43,6 +43,13 @@ fn done(id: u64, result: Result<Box<Loaded>, String>) -> LoadEvent {
     LoadEvent::Done { id, result }
 }
 
+/// The start view of a file without one.
+const DEFAULT_START: StartView = StartView {
+    yaw_deg: 0.0,
+    pitch_deg: 0.0,
+    hfov_deg: None,
+};
+
 fn doc() -> Document {
     Document::new(None, 1000, None)
 }
@@ -50,7 +57,7 @@ fn doc() -> Document {
 #[test]
 fn a_load_starts_reports_progress_and_shows_its_panorama() {
     let mut d = doc();
-    let r = request(d.open(file("a.png"), None, 0.5));
+    let r = request(d.open(file("a.png"), None, StartArgs::default(), 0.5));
     assert_eq!(r.id, 1);
     assert_eq!(r.source, file("a.png"));
     assert_eq!(r.opts.max_pixels, 1000);
@@ -83,7 +90,9 @@ fn a_load_starts_reports_progress_and_shows_its_panorama() {
         fx,
         [
             Effect::PrintView("loaded a.png 64x32 equirect".into()),
-            Effect::Title("viewer: a.png".into()),
+            Effect::Title("viewer: a.png (64×32)".into()),
+            Effect::StartView(DEFAULT_START),
+            Effect::Opened(PathBuf::from("a.png")),
         ]
     );
     assert!(d.loading().is_none());
@@ -101,7 +110,7 @@ fn a_load_starts_reports_progress_and_shows_its_panorama() {
 #[test]
 fn a_drop_while_loading_supersedes_the_load() {
     let mut d = doc();
-    d.open(file("a.png"), None, 0.0);
+    d.open(file("a.png"), None, StartArgs::default(), 0.0);
     d.drop_path(PathBuf::from("b.png"));
     assert!(d.has_drops());
     let fx = d.open_drops(0.0);
@@ -134,7 +143,7 @@ fn a_drop_while_loading_supersedes_the_load() {
 #[test]
 fn a_second_drop_keeps_the_picture_until_ready_and_after_it_fails() {
     let mut d = doc();
-    d.open(file("a.png"), None, 0.0);
+    d.open(file("a.png"), None, StartArgs::default(), 0.0);
     d.on_event(done(1, Ok(loaded(file("a.png"), 64, false, 0.0))), 0.0);
     d.drop_path(PathBuf::from("c.jpg"));
     let r = request(d.open_drops(0.0).remove(0));
@@ -146,11 +155,13 @@ fn a_second_drop_keeps_the_picture_until_ready_and_after_it_fails() {
     let fx = d.on_event(done(r.id, Err("c.jpg: not 2:1".into())), 0.0);
     assert_eq!(
         fx,
-        [
-            Effect::Stderr("viewer: c.jpg: not 2:1".into()),
-            Effect::ShowPanel
-        ],
+        [Effect::Stderr("viewer: c.jpg: not 2:1".into())],
         "no fallback: a is still shown"
+    );
+    assert_eq!(
+        d.last_file(),
+        Some(Path::new("c.jpg")),
+        "PageDown steps from c"
     );
     assert_eq!(d.current().unwrap().source, file("a.png"));
     assert_eq!(d.error(), Some("c.jpg: not 2:1"));
@@ -172,21 +183,23 @@ fn a_second_drop_keeps_the_picture_until_ready_and_after_it_fails() {
 #[test]
 fn a_failed_first_load_opens_the_sample_and_keeps_the_error() {
     let mut d = Document::new(Some(Projection::Sine), 1000, None);
-    let r = request(d.open(file("bad.png"), None, 0.0));
+    let r = request(d.open(file("bad.png"), None, StartArgs::default(), 0.0));
     assert_eq!(r.opts.projection, Some(Projection::Sine));
     let fx = d.on_event(done(r.id, Err("bad.png: truncated".into())), 2.0);
-    assert_eq!(fx.len(), 3);
+    assert_eq!(fx.len(), 2);
     assert_eq!(
-        fx[..2],
-        [
-            Effect::Stderr("viewer: bad.png: truncated".into()),
-            Effect::ShowPanel
-        ]
+        fx[..1],
+        [Effect::Stderr("viewer: bad.png: truncated".into())]
     );
     let sample = loads(&fx)[0].clone();
     assert_eq!((sample.id, &sample.source), (2, &Source::Sample));
     assert_eq!(sample.opts.projection, None, "the sample in auto");
     assert_eq!(sample.opts.tone.exposure_ev, 2.0);
+    assert_eq!(
+        d.last_file(),
+        Some(Path::new("bad.png")),
+        "PageDown steps from the failed file, not the sample"
+    );
     // The sample's success keeps the message, and the projection still applies to the
     // failed file.
     d.on_event(done(2, Ok(loaded(Source::Sample, 64, false, 0.0))), 0.0);
@@ -204,7 +217,7 @@ fn a_failed_first_load_opens_the_sample_and_keeps_the_error() {
 #[test]
 fn the_next_success_clears_a_kept_error() {
     let mut d = doc();
-    let r = request(d.open(file("bad.png"), None, 0.0));
+    let r = request(d.open(file("bad.png"), None, StartArgs::default(), 0.0));
     d.on_event(done(r.id, Err("bad".into())), 0.0);
     d.on_event(done(2, Ok(loaded(Source::Sample, 64, false, 0.0))), 0.0);
     assert!(d.error().is_some());
@@ -258,7 +271,7 @@ fn dropped_ies_files_add_lights_and_six_files_are_a_cube() {
 #[test]
 fn exposure_reloads_hdr_files_only_when_it_changed() {
     let mut d = doc();
-    d.open(file("a.png"), None, 0.0);
+    d.open(file("a.png"), None, StartArgs::default(), 0.0);
     d.on_event(done(1, Ok(loaded(file("a.png"), 64, false, 0.0))), 0.0);
     assert_eq!(d.reload_exposure(1.0), None, "8-bit images ignore it");
     d.drop_path(PathBuf::from("sky.hdr"));
@@ -272,16 +285,88 @@ fn exposure_reloads_hdr_files_only_when_it_changed() {
     assert_eq!(r.source, file("sky.hdr"));
     assert_eq!(r.opts.tone.exposure_ev, 1.5);
     assert_eq!(r.opts.projection, Some(Projection::Equirect));
-    // While that load runs, going back to the shown exposure loads again (the running
-    // load would show 1.5).
-    assert!(d.reload_exposure(0.0).is_some());
+    // While that load runs, a slider dragged on waits for it; then the latest value
+    // loads (the running load would show 1.5, the user asked for 0).
+    assert_eq!(d.reload_exposure(0.5), None);
+    assert_eq!(d.reload_exposure(0.0), None);
+    let mut at = loaded(file("sky.hdr"), 64, true, 1.5);
+    at.projection = Some(Projection::Equirect);
+    let fx = d.on_event(done(r.id, Ok(at)), 0.0);
+    let again = loads(&fx);
+    assert_eq!(again.len(), 1);
+    assert_eq!(again[0].opts.tone.exposure_ev, 0.0);
+    // A reload keeps the view: no start view.
+    assert!(!fx.iter().any(|e| matches!(e, Effect::StartView(_))));
+}
+
+#[test]
+fn opened_files_start_at_their_own_view_reloads_keep_it() {
+    let mut d = doc();
+    let args = StartArgs {
+        yaw: Some(30.0),
+        pitch: None,
+        hfov: Some(50.0),
+    };
+    let r = request(d.open(file("a.jpg"), None, args, 0.0));
+    // The file's own start view, partly overridden by the command line.
+    let mut a = loaded(file("a.jpg"), 64, false, 0.0);
+    if let Scene::Map { map, .. } = &mut a.scene {
+        map.set_start_view(Some(StartView {
+            yaw_deg: -100.0,
+            pitch_deg: 12.0,
+            hfov_deg: Some(70.0),
+        }));
+    }
+    let fx = d.on_event(done(r.id, Ok(a)), 0.0);
+    let want = StartView {
+        yaw_deg: 30.0,
+        pitch_deg: 12.0,
+        hfov_deg: Some(50.0),
+    };
+    assert!(fx.contains(&Effect::StartView(want)), "{fx:?}");
+    // Another projection: a reload, the view stays.
+    *d.panel_parts().projection = Some(Projection::Equirect);
+    let r = request(d.projection_changed(0.0).unwrap());
+    let fx = d.on_event(done(r.id, Ok(loaded(file("a.jpg"), 64, false, 0.0))), 0.0);
+    assert!(!fx.iter().any(|e| matches!(e, Effect::StartView(_))));
+    // The next file opened: its own (default) view, not a.jpg's or the command line's.
+    let r = request(d.open_path(PathBuf::from("b.jpg"), 0.0).unwrap());
+    assert!(r.coverage.is_none());
+    let fx = d.on_event(done(r.id, Ok(loaded(file("b.jpg"), 64, false, 0.0))), 0.0);
+    assert!(fx.contains(&Effect::StartView(DEFAULT_START)));
+    assert!(fx.contains(&Effect::Opened(PathBuf::from("b.jpg"))));
+    assert_eq!(d.last_file(), Some(Path::new("b.jpg")));
+    // A folder (a cube map) is opened: there is no file to step from.
+    let dir = tempfile::tempdir().unwrap();
+    let r = request(d.open_path(dir.path().to_path_buf(), 0.0).unwrap());
+    assert!(matches!(r.source, Source::Cube { .. }));
+    assert_eq!(d.last_file(), None);
+    // The sample is not a recent file.
+    let r = request(d.open(Source::Sample, None, StartArgs::default(), 0.0));
+    let fx = d.on_event(done(r.id, Ok(loaded(Source::Sample, 64, false, 0.0))), 0.0);
+    assert!(!fx.iter().any(|e| matches!(e, Effect::Opened(_))));
+}
+
+#[test]
+fn readouts_of_the_previous_panorama_go_with_it() {
+    let mut d = doc();
+    d.readouts.table_bytes = 12345;
+    d.readouts.scene = (800, 500);
+    d.readouts.render_ms = 7.0;
+    d.readouts.path = Some(lut_core::RenderPath::LutWide);
+    let r = request(d.open_path(PathBuf::from("c.png"), 0.0).unwrap());
+    d.on_event(done(r.id, Ok(loaded(file("c.png"), 32, false, 0.0))), 0.0);
+    assert_eq!(d.readouts.table_bytes, 0);
+    assert_eq!(d.readouts.path, None);
+    assert_eq!(d.readouts.render_ms, 0.0);
+    assert_eq!(d.readouts.map, "c.png (32×16, equirect, 0.0 MiB in memory)");
 }
 
 #[test]
 fn coverage_applies_to_the_command_line_source_only() {
     let mut d = doc();
     let cov: Coverage = "180x90".parse().unwrap();
-    let r = request(d.open(file("strip.jpg"), Some(cov), 0.0));
+    let r = request(d.open(file("strip.jpg"), Some(cov), StartArgs::default(), 0.0));
     assert_eq!(r.coverage, Some(cov));
     d.on_event(done(r.id, Err("x".into())), 0.0);
     d.drop_path(PathBuf::from("other.jpg"));
@@ -302,11 +387,21 @@ fn readouts_of_a_partial_panorama() {
         .unwrap();
     // The document's pixel limit goes to the loader: 1000 pixels refuse this image.
     let cov: Coverage = "180x90+90+0".parse().unwrap();
-    let r = request(doc().open(Source::File(p.clone()), Some(cov), 0.0));
+    let r = request(doc().open(
+        Source::File(p.clone()),
+        Some(cov),
+        StartArgs::default(),
+        0.0,
+    ));
     let e = super::super::loader::load(r, &mut |_, _| {}).err().unwrap();
     assert!(e.contains("above the limit of 1000 pixels"), "{e}");
     let mut d = Document::new(None, lut_core::DEFAULT_MAX_PIXELS, None);
-    let r = request(d.open(Source::File(p.clone()), Some(cov), 0.0));
+    let r = request(d.open(
+        Source::File(p.clone()),
+        Some(cov),
+        StartArgs::default(),
+        0.0,
+    ));
     let loaded = super::super::loader::load(r.clone(), &mut |_, _| {}).unwrap();
     let fx = d.on_event(done(r.id, Ok(loaded)), 0.0);
     let partial = d.readouts.partial.clone().expect("a partial map");
@@ -334,13 +429,11 @@ fn readouts_of_a_partial_panorama() {
 #[test]
 fn a_load_that_cannot_start_is_an_error() {
     let mut d = doc();
-    let r = request(d.open(file("a.png"), None, 0.0));
+    let r = request(d.open(file("a.png"), None, StartArgs::default(), 0.0));
     d.load_not_started(r.id + 1, "stale");
     assert!(d.loading().is_some());
     d.load_not_started(r.id, "no threads");
     assert!(d.loading().is_none());
     assert_eq!(d.error(), Some("cannot start loading: no threads"));
-    let parts = d.panel_parts();
-    assert_eq!(parts.error, Some("cannot start loading: no threads"));
-    assert!(parts.loading.is_none());
+    assert!(d.panel_parts().loading.is_none());
 }

@@ -1,0 +1,495 @@
+//! One frame: route the keys, run the UI pass (panel, scene input, overlays, dialogs),
+//! apply what the user did, render the scene at the quality the rule picks, compose it
+//! with egui, and decide when the next frame is due.
+
+use super::{App, SceneKey};
+use crate::scene::render_scene;
+use crate::window::dialogs::Chosen;
+use crate::window::input::{resolution_hfov, wheel_notches, Held, Look, HFOV_MAX};
+use crate::window::keys::{KeyAction, Route};
+use crate::window::overlay::{self, NoticesOutput, ToolbarModel};
+use crate::window::paint::SceneRect;
+use crate::window::quality::{frame_level, FRAME_BUDGET_MS};
+use crate::window::ui::{self, PanelModel, PanelOutput};
+use anyhow::{anyhow, Result};
+use lut_core::{CubeRenderer, RenderPath};
+use std::num::NonZeroU32;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+use winit::event_loop::ActiveEventLoop;
+
+/// Things the UI pass asks the app to do after it.
+#[derive(Default)]
+pub(super) struct FrameRequests {
+    /// Key, toolbar and panel actions, in order.
+    pub keys: Vec<KeyAction>,
+    pub held: Held,
+    pub panel: PanelOutput,
+    pub open_recent: Option<PathBuf>,
+    pub notices: NoticesOutput,
+    pub chosen: Option<Chosen>,
+    pub scene_rect: Option<SceneRect>,
+    /// The pointer over the scene, in scene pixels.
+    pub cursor: Option<(f64, f64)>,
+}
+
+/// The widest hfov of the output view. Wide output projections (issue 12) hand over
+/// here: when they land, this returns the chosen projection's widest view, and
+/// `Controller::take_zoomed_past_widest` says when the user zoomed out past it.
+fn widest_hfov() -> f64 {
+    HFOV_MAX
+}
+
+impl App {
+    /// Build this frame's UI and collect what the user did.
+    fn build_ui(&mut self, ui: &mut egui::Ui, t: f64, win: (u32, u32)) -> FrameRequests {
+        let mut req = FrameRequests::default();
+        let ppp = ui.ctx().pixels_per_point();
+        if self.prefs.panel {
+            let look = self.ctl.look();
+            let doc = self.doc.panel_parts();
+            self.drawn_readouts = ui::readout_rows(&look, doc.readouts);
+            req.panel = ui::side_panel(
+                ui,
+                PanelModel {
+                    settings: &mut self.ctl.settings,
+                    projection: doc.projection,
+                    look,
+                    readouts: doc.readouts,
+                    loading: doc.loading,
+                    zoom_limit: &mut self.prefs.zoom_limit,
+                    auto_rotate: &mut self.ctl.auto_rotate,
+                    lights: &mut self.lights,
+                },
+            );
+        }
+        // The scene: everything the panel leaves. Drags and wheel go through egui so a
+        // click on the panel or an overlay is never taken for a drag.
+        let rect = ui.available_rect_before_wrap();
+        let resp = ui.interact(rect, egui::Id::new("scene"), egui::Sense::click_and_drag());
+        self.overlays(ui.ctx(), rect, &mut req);
+        if let Some(l) = self.doc.loading() {
+            if !self.prefs.panel || self.doc.current().is_none() {
+                // Nothing else shows the load: a box over the scene.
+                ui::loading_overlay(ui.ctx(), l);
+            }
+        }
+        let export = self.doc.readouts.scene;
+        req.chosen = self
+            .dialogs
+            .update(ui.ctx(), &mut self.ctl.settings.export_scale, &|k| {
+                crate::window::export::export_size(export, k)
+            });
+        req.scene_rect = SceneRect::from_points(rect, ppp, win.0, win.1);
+        let Some(sr) = req.scene_rect else {
+            return req;
+        };
+        let size = (sr.w, sr.h);
+        let to_px = |p: egui::Pos2| {
+            (
+                f64::from(p.x * ppp) - f64::from(sr.x),
+                f64::from(p.y * ppp) - f64::from(sr.y),
+            )
+        };
+        req.cursor = resp.hover_pos().map(to_px);
+        let primary = egui::PointerButton::Primary;
+        if resp.drag_started_by(primary) {
+            let origin = ui
+                .input(|i| i.pointer.press_origin())
+                .or(resp.interact_pointer_pos());
+            if let Some(o) = origin {
+                self.ctl.press(to_px(o), size, t);
+            }
+        }
+        if self.ctl.dragging() {
+            match resp.interact_pointer_pos() {
+                Some(p) if resp.dragged_by(primary) => self.ctl.drag_to(to_px(p), size, t),
+                // Released, or the drag ended some other way (pointer gone): never leave
+                // a QTVR turn running.
+                _ => self.ctl.release(t),
+            }
+        }
+        if resp.double_clicked() {
+            if let Some(p) = resp.interact_pointer_pos() {
+                self.ctl.double_click(to_px(p), size, t);
+            }
+        }
+        if resp.contains_pointer() {
+            let notches: f64 = ui.input(|i| {
+                i.events
+                    .iter()
+                    .map(|e| match e {
+                        egui::Event::MouseWheel { unit, delta, .. } => {
+                            wheel_notches(*unit, delta.y)
+                        }
+                        _ => 0.0,
+                    })
+                    .sum()
+            });
+            if notches != 0.0 {
+                self.ctl.interacted(t);
+                let cursor = resp.hover_pos().map(to_px);
+                self.ctl.wheel(notches, cursor, size);
+                if let Some(p) = resp.interact_pointer_pos().filter(|_| self.ctl.dragging()) {
+                    // Keep a grab in progress consistent with the new zoom.
+                    self.ctl.press(to_px(p), size, t);
+                }
+            }
+        }
+        req
+    }
+
+    /// The viewing UI over the scene: toolbar, compass, notices, help (only the notices
+    /// while a dialog is open: it is modal, and drawn below egui's foreground).
+    fn overlays(&mut self, ctx: &egui::Context, scene: egui::Rect, req: &mut FrameRequests) {
+        req.notices = overlay::notices(ctx, scene, self.doc.error(), &self.notices);
+        if self.dialogs.is_open() {
+            return;
+        }
+        let bar = overlay::toolbar(
+            ctx,
+            ToolbarModel {
+                scene,
+                title: &self.title,
+                recent: &self.prefs.recent,
+                panel: self.prefs.panel,
+                help: self.show_help,
+            },
+        );
+        for (on, a) in [
+            (bar.open, KeyAction::Open),
+            (bar.save, KeyAction::SaveView),
+            (bar.zoom_out, KeyAction::ZoomOut),
+            (bar.zoom_in, KeyAction::ZoomIn),
+            (bar.reset, KeyAction::Reset),
+            (bar.fullscreen, KeyAction::ToggleFullscreen),
+            (bar.panel, KeyAction::TogglePanel),
+            (bar.help, KeyAction::Help),
+        ] {
+            if on {
+                req.keys.push(a);
+            }
+        }
+        req.open_recent = bar.open_recent;
+        let pose = self.doc.readouts.pose_heading;
+        overlay::compass(ctx, scene, &self.ctl.look(), pose);
+        if self.show_help && overlay::help(ctx, scene) {
+            req.keys.push(KeyAction::Help);
+        }
+    }
+
+    /// The hfov range for the current panorama in a `scene_width`-pixel scene: the zoom
+    /// limit from the map's resolution (off: the global minimum) to the widest view.
+    pub(super) fn update_zoom_range(&mut self) {
+        let map_px_deg = self.doc.current().map(|c| match c.map() {
+            Some(m) => 360.0 / f64::from(m.width()),
+            None => 90.0 / f64::from(c.describe().0.max(1)),
+        });
+        let min = match (self.prefs.zoom_limit, map_px_deg) {
+            (Some(ratio), Some(deg)) => resolution_hfov(deg, self.scene_width, ratio),
+            _ => 0.0,
+        };
+        self.ctl.set_zoom_range(min, widest_hfov());
+    }
+
+    pub(super) fn redraw(&mut self, el: &ActiveEventLoop) -> Result<()> {
+        let t = self.now();
+        let Some(g) = self.gfx.as_mut() else {
+            return Ok(());
+        };
+        let size = g.window.inner_size();
+        let (w, h) = (size.width, size.height);
+        let (Some(nw), Some(nh)) = (NonZeroU32::new(w), NonZeroU32::new(h)) else {
+            // Minimized (0×0): draw nothing, and run no UI pass whose texture updates
+            // would be lost.
+            return Ok(());
+        };
+        self.last_redraw = Some(Instant::now());
+        let ui_t0 = Instant::now();
+        let mut raw = g.egui_winit.take_egui_input(&g.window);
+        let ctx = self.egui_ctx.clone();
+        // Shortcuts first, whatever egui has focused; a text field or a dialog gets them.
+        let route = if self.dialogs.is_open() {
+            Route::Modal
+        } else if ctx.text_edit_focused() {
+            Route::TextEditing
+        } else {
+            Route::Shortcuts
+        };
+        let keys = self.shortcuts.route(&mut raw.events, route);
+        let look_before = self.ctl.look();
+        let mut req = FrameRequests::default();
+        let full = ctx.run_ui(raw, |ui| req = self.build_ui(ui, t, (w, h)));
+        req.keys.splice(0..0, keys);
+        req.held = self.shortcuts.held();
+        let (scene_rect, cursor) = (req.scene_rect, req.cursor);
+        self.apply_requests(req, t, el);
+        if let Some(r) = scene_rect {
+            self.scene_width = r.w;
+        }
+        self.update_zoom_range();
+        // The view limit: a partial map's coverage at the scene's size, when the panel's
+        // "Keep the view inside" is on.
+        let limit = match (scene_rect, self.doc.partial_coverage()) {
+            (Some(r), Some(c)) if self.ctl.settings.view_limit => Some((c, (r.w, r.h))),
+            _ => None,
+        };
+        self.ctl.set_limit(limit);
+        let frame = self.ctl.frame(t);
+        let mut ui_ms = ui_t0.elapsed().as_secs_f64() * 1e3;
+        if let Some(r) = scene_rect {
+            self.render_scene(r, frame.look, frame.fast);
+        }
+        let lux_changed = self.update_lux(cursor, scene_rect, frame.look);
+        let Some(g) = self.gfx.as_mut() else {
+            return Ok(());
+        };
+        g.egui_winit
+            .handle_platform_output(&g.window, full.platform_output);
+        let t1 = Instant::now();
+        let prims = ctx.tessellate(full.shapes, full.pixels_per_point);
+        if g.surface_size != (w, h) {
+            g.surface
+                .resize(nw, nh)
+                .map_err(|e| anyhow!("cannot resize the drawing surface to {w}x{h}: {e}"))?;
+            g.surface_size = (w, h);
+        }
+        let mut buffer = g
+            .surface
+            .buffer_mut()
+            .map_err(|e| anyhow!("cannot get the drawing buffer: {e}"))?;
+        let scene = match (scene_rect, &self.scene_key) {
+            (Some(r), Some(k)) if k.size == (r.w, r.h) => Some((self.scene.as_slice(), r)),
+            _ => None,
+        };
+        self.compositor.compose(
+            &mut buffer,
+            w,
+            h,
+            scene,
+            &prims,
+            &full.textures_delta,
+            full.pixels_per_point,
+        );
+        ui_ms += t1.elapsed().as_secs_f64() * 1e3;
+        buffer
+            .present()
+            .map_err(|e| anyhow!("cannot show the frame: {e}"))?;
+        self.doc.readouts.ui_ms = ui_ms;
+        let now = Instant::now();
+        self.count_fps(now);
+        self.print_readouts();
+        self.save_prefs(false);
+
+        // When is the next frame due?
+        let mut next: Option<Instant> = None;
+        let mut want = |at: Instant| next = Some(next.map_or(at, |n: Instant| n.min(at)));
+        let delay = full
+            .viewport_output
+            .get(&egui::ViewportId::ROOT)
+            .map_or(Duration::MAX, |v| v.repaint_delay);
+        if delay < Duration::from_secs(3600) {
+            want(now + delay);
+        }
+        let at = |s: f64| self.start + Duration::from_secs_f64(s.max(0.0));
+        if let Some(s) = self.ctl.wake_at() {
+            want(at(s));
+        }
+        if let Some(s) = self.notices.next_expiry() {
+            want(at(s));
+        }
+        if self.prefs.panel {
+            let rows = ui::readout_rows(&self.ctl.look(), &self.doc.readouts);
+            if self.ctl.look() != look_before
+                || lux_changed
+                || !same_rows(&rows, &self.drawn_readouts)
+            {
+                // The readouts were drawn before this frame's input and render.
+                want(now);
+            }
+            if let Some(&last) = self.renders.back() {
+                // The fps readout falls to 0 one second after the last render.
+                want(last + Duration::from_millis(1010));
+            }
+        }
+        if self.notices.expire(t) {
+            want(now);
+        }
+        if let Some(n) = next {
+            // At most one frame per display refresh, whoever asks.
+            let n = n.max(now + self.frame_interval);
+            self.next_frame_at = Some(self.next_frame_at.map_or(n, |o| o.min(n)));
+        }
+        Ok(())
+    }
+
+    /// Scenes rendered in the last second.
+    fn count_fps(&mut self, now: Instant) {
+        while self
+            .renders
+            .front()
+            .is_some_and(|&f| now.duration_since(f) > Duration::from_secs(1))
+        {
+            self.renders.pop_front();
+        }
+        self.doc.readouts.fps = self.renders.len() as f64;
+    }
+
+    /// `--print-view`: the readouts as the panel drew them, when they changed.
+    fn print_readouts(&mut self) {
+        if !(self.print_view && self.prefs.panel) {
+            return;
+        }
+        let line: Vec<String> = self
+            .drawn_readouts
+            .iter()
+            .filter(|(k, _)| *k != "UI")
+            .map(|(k, v)| format!("{k}={}", v.trim()))
+            .collect();
+        let line = format!("readouts {}", line.join("; "));
+        if line != self.printed_readouts {
+            println!("{line}");
+            self.printed_readouts = line;
+        }
+    }
+
+    /// Render the scene for `rect` at the quality the rule picks (unless the cached one
+    /// already shows it), then light it when there are luminaires.
+    fn render_scene(&mut self, rect: SceneRect, look: Look, fast: bool) {
+        let generation = self.doc.generation();
+        let pixels = u64::from(rect.w) * u64::from(rect.h);
+        let s = self.ctl.settings;
+        let (level, degraded) = frame_level(s.aa, fast, &self.times, pixels, FRAME_BUDGET_MS);
+        let Some(cur) = self.doc.current_mut() else {
+            return;
+        };
+        let opts = s.render_options(level);
+        let key = SceneKey {
+            look,
+            size: (rect.w, rect.h),
+            level,
+            renderer: opts.renderer,
+            sampler: opts.sampler,
+            index_step: opts.index_step,
+            lut: opts.lut,
+            cube_renderer: opts.cube,
+            map_generation: generation,
+            lights: self.lights.key(),
+        };
+        if self.scene_key.as_ref() == Some(&key) {
+            return;
+        }
+        self.scene.resize(rect.w as usize * rect.h as usize, 0);
+        let t0 = Instant::now();
+        let view = look.view();
+        let k = level.scale();
+        let result = if k == 1 {
+            render_scene(
+                cur.scene.as_mut(),
+                view,
+                &opts,
+                &mut self.scene,
+                rect.w,
+                rect.h,
+            )
+        } else {
+            let (sw, sh) = (rect.w.div_ceil(k), rect.h.div_ceil(k));
+            self.small.resize(sw as usize * sh as usize, 0);
+            let r = render_scene(cur.scene.as_mut(), view, &opts, &mut self.small, sw, sh);
+            crate::window::paint::upscale_bilinear(
+                &self.small,
+                sw,
+                sh,
+                &mut self.scene,
+                rect.w,
+                rect.h,
+            );
+            r
+        };
+        let report = match result {
+            Ok(r) => r,
+            Err(e) => {
+                self.doc.set_error(format!("render failed: {e}"));
+                self.scene_key = None;
+                return;
+            }
+        };
+        self.light_scene(view, rect);
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        self.times.record(level, ms, pixels);
+        self.ctl.rendered(degraded);
+        self.renders.push_back(Instant::now());
+        let r = &mut self.doc.readouts;
+        r.table_bytes = report.table_bytes;
+        r.exact_pixels = report.exact_pixels;
+        r.pixels = report.pixels;
+        let path = match report.path {
+            RenderPath::Cube(kind) => {
+                (r.path, r.cube) = (None, Some(kind));
+                match kind {
+                    CubeRenderer::Basic => "CubeBasic".to_string(),
+                    CubeRenderer::Accelerated => "CubeScanline".to_string(),
+                }
+            }
+            path => {
+                (r.path, r.cube) = (Some(path), None);
+                format!("{path:?}")
+            }
+        };
+        r.render_ms = ms;
+        r.scene = (rect.w, rect.h);
+        r.level = Some(level);
+        r.sampler = Some(opts.sampler);
+        r.full_ms = self.times.full_ms(pixels);
+        self.scene_key = Some(key);
+        if self.print_view {
+            println!(
+                "view yaw={:.4} pitch={:.4} hfov={:.4} path={path} sampler={} level={} fast={} \
+                 ms={ms:.2} size={}x{} lights={}",
+                look.yaw,
+                look.pitch,
+                look.hfov,
+                opts.sampler.name(),
+                level.label().replace(' ', "-"),
+                fast,
+                rect.w,
+                rect.h,
+                self.lights.lights.len()
+            );
+        }
+    }
+
+    /// Light the freshly rendered scene (as `viewer render --light ...` does); a scene
+    /// that cannot be built (a light outside the room) is reported in the panel and the
+    /// frame is left unlit.
+    fn light_scene(&mut self, view: lut_core::View, rect: SceneRect) {
+        let result = self
+            .lights
+            .light_frame(view, &mut self.scene, rect.w, rect.h);
+        self.lights.scene_error = result.err();
+    }
+
+    /// The illuminance at the pointer for the readout; true when it changed.
+    fn update_lux(
+        &mut self,
+        cursor: Option<(f64, f64)>,
+        rect: Option<SceneRect>,
+        look: Look,
+    ) -> bool {
+        let lux = match (cursor, rect, self.lights.scene()) {
+            (Some((x, y)), Some(r), Ok(Some(scene))) if r.w > 0 && r.h > 0 => Some(
+                lut_core::lux_at(&scene, &lut_core::Camera::new(look.view(), r.w, r.h), x, y),
+            ),
+            _ => None,
+        };
+        let changed = lux.map(f64::to_bits) != self.lights.lux_at_cursor.map(f64::to_bits);
+        self.lights.lux_at_cursor = lux;
+        changed
+    }
+}
+
+/// Readout rows equal but for the UI time (which every frame changes).
+fn same_rows(a: &[(&'static str, String)], b: &[(&'static str, String)]) -> bool {
+    let keep = |r: &&(&str, String)| r.0 != "UI";
+    a.iter().filter(keep).eq(b.iter().filter(keep))
+}

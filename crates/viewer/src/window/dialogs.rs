@@ -1,0 +1,134 @@
+//! The Open and Save dialogs: `egui-file-dialog`, drawn by egui like the rest of the
+//! window (so they work wherever the window does, bare X servers and the Xvfb tests
+//! included, with no desktop portal), modal, keyboard-driven (arrows, Enter, Esc, `/`
+//! to type a path). The Open dialog lists the panorama formats the loader decodes; the
+//! Save dialog offers PNG and JPEG and, beside the files, the size of the saved view.
+
+use super::folder::PANORAMA_EXTENSIONS;
+use egui_file_dialog::{DialogState, FileDialog};
+use std::path::{Path, PathBuf};
+
+/// What a dialog is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Purpose {
+    Open,
+    Save,
+}
+
+/// What the user chose.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Chosen {
+    /// Open this file.
+    Open(PathBuf),
+    /// Save the view to this file.
+    Save(PathBuf),
+}
+
+/// The window's file dialogs (one at a time).
+pub struct Dialogs {
+    dialog: FileDialog,
+    purpose: Option<Purpose>,
+}
+
+impl Default for Dialogs {
+    fn default() -> Self {
+        Dialogs::new()
+    }
+}
+
+impl Dialogs {
+    /// The dialogs, closed.
+    pub fn new() -> Dialogs {
+        let dialog = FileDialog::new()
+            .add_file_filter_extensions("Panoramas", PANORAMA_EXTENSIONS.to_vec())
+            .default_file_filter("Panoramas")
+            .add_save_extension("PNG", "png")
+            .add_save_extension("JPEG", "jpg")
+            .default_save_extension("PNG")
+            .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO);
+        Dialogs {
+            dialog,
+            purpose: None,
+        }
+    }
+
+    /// True while a dialog is open (every key goes to it).
+    pub fn is_open(&self) -> bool {
+        self.purpose.is_some()
+    }
+
+    /// Fit the dialog in a `screen`-sized window (points) and take the keyboard from
+    /// whatever egui widget had it (the dialog's own keys ignore input while another
+    /// widget is focused).
+    fn prepare(&mut self, ctx: &egui::Context) {
+        let screen = ctx.content_rect().size();
+        let c = self.dialog.config_mut();
+        c.default_size = egui::vec2(720.0, 440.0).min(screen - egui::vec2(24.0, 24.0));
+        c.max_size = Some(screen - egui::vec2(8.0, 8.0));
+        c.min_size = egui::vec2(200.0, 160.0).min(screen);
+        ctx.memory_mut(|m| {
+            if let Some(id) = m.focused() {
+                m.surrender_focus(id);
+            }
+        });
+    }
+
+    /// Show the Open dialog in `dir`.
+    pub fn open_panorama(&mut self, ctx: &egui::Context, dir: &Path) {
+        self.prepare(ctx);
+        let c = self.dialog.config_mut();
+        c.initial_directory = dir.to_path_buf();
+        c.title = Some("Open a panorama".into());
+        self.dialog.pick_file();
+        self.purpose = Some(Purpose::Open);
+    }
+
+    /// Show the Save dialog in `dir` with the file name `name`.
+    pub fn save_view(&mut self, ctx: &egui::Context, dir: &Path, name: &str) {
+        self.prepare(ctx);
+        let c = self.dialog.config_mut();
+        c.initial_directory = dir.to_path_buf();
+        c.default_file_name = name.to_string();
+        c.title = Some("Save the view".into());
+        self.dialog.save_file();
+        self.purpose = Some(Purpose::Save);
+    }
+
+    /// Draw the open dialog (if any) and return what was chosen. `scale` is the Save
+    /// dialog's size choice (the scene's size times it), `size_of` the image size for a
+    /// scale.
+    pub fn update(
+        &mut self,
+        ctx: &egui::Context,
+        scale: &mut u32,
+        size_of: &dyn Fn(u32) -> (u32, u32),
+    ) -> Option<Chosen> {
+        let purpose = self.purpose?;
+        if purpose == Purpose::Save {
+            self.dialog.update_with_right_panel_ui(ctx, &mut |ui, _| {
+                ui.heading("Size");
+                for k in super::input::EXPORT_SCALES {
+                    let (w, h) = size_of(k);
+                    ui.radio_value(scale, k, format!("{k}x: {w}×{h}"));
+                }
+            });
+        } else {
+            self.dialog.update(ctx);
+        }
+        match self.dialog.state() {
+            DialogState::Open => None,
+            DialogState::Picked(p) => {
+                let p = p.clone();
+                self.purpose = None;
+                Some(match purpose {
+                    Purpose::Open => Chosen::Open(p),
+                    Purpose::Save => Chosen::Save(p),
+                })
+            }
+            _ => {
+                self.purpose = None;
+                None
+            }
+        }
+    }
+}
