@@ -101,8 +101,8 @@ fn a_scene_round_trips_through_its_file() {
         .map(|i| (i * 7919) as u32 & 0xff_ffff)
         .collect();
     let (mut a, mut b) = (base.clone(), base);
-    st.light_frame(v, &mut a, 64, 40).unwrap();
-    st2.light_frame(v, &mut b, 64, 40).unwrap();
+    st.clone().light_frame(v, &mut a, 64, 40).unwrap();
+    st2.clone().light_frame(v, &mut b, 64, 40).unwrap();
     assert_eq!(a, b);
 }
 

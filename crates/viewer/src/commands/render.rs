@@ -69,10 +69,6 @@ pub struct RenderArgs {
     /// The pixel limit.
     #[command(flatten)]
     pub limit: MaxPixelsArg,
-    /// Draw the room box as a wireframe and the luminaires as markers over the view (to
-    /// fit the room to the photograph's walls, floor and ceiling).
-    #[arg(long)]
-    pub show_room: bool,
     /// Draw the false colours' legend (a bar with its lux scale) at the right edge; needs
     /// --false-color (or a scene file with false colours on).
     #[arg(long)]
@@ -150,7 +146,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let mut view = View::new(yaw, pitch, hfov).context("invalid view")?;
     let (w, h) = a.size;
     // The lights first: a bad luminaire or room is reported before the panorama loads.
-    let lights = a.lights.state()?;
+    let mut lights = a.lights.state()?;
     if a.legend && !lights.false_color {
         bail!("--legend draws the false colours' scale: give --false-color too");
     }
@@ -166,7 +162,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     lights
         .light_frame(view, &mut out, w, h)
         .map_err(anyhow::Error::msg)?;
-    if a.show_room {
+    if lights.show_room {
         crate::lighting::overlay::draw_room_and_lights(&lights, view, &mut out, w, h)
             .map_err(anyhow::Error::msg)?;
     }

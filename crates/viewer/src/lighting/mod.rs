@@ -2,11 +2,15 @@
 //! lux` and the window share, the light state ([`LightsState`]) they become, which the
 //! window's panel edits, and scene files ([`SceneFile`]) that save and reopen it.
 
+mod files;
 pub mod legend;
+mod lit;
 pub mod overlay;
 mod scene_file;
 mod state;
 
+pub use files::{file_kind, FileKind};
+pub use lit::LitCache;
 pub use scene_file::{is_scene, is_scene_file, SceneFile, SceneLight, SceneRoom, SceneView};
 pub use state::{
     format_lux, load_table, LightEntry, LightsKey, LightsState, AUTO_EXPOSURE_QUANTILE,
@@ -80,6 +84,11 @@ pub struct LightArgs {
     /// Illuminance at the top (red) of the false-colour scale in lux (default 1000).
     #[arg(long)]
     pub false_color_max: Option<f64>,
+    /// Draw the room box as a wireframe and the luminaires as markers over the view, to
+    /// fit the room to the photograph's walls, floor and ceiling (the window's "Show
+    /// room").
+    #[arg(long)]
+    pub show_room: bool,
 }
 
 /// One `--light FILE.ies@X,Y,Z[:YAW,PITCH]`.
@@ -267,6 +276,7 @@ impl LightArgs {
         if let Some(a) = self.ambient {
             st.ambient = a;
         }
+        st.show_room = self.show_room;
         if self.false_color {
             st.false_color = true;
         }

@@ -151,8 +151,68 @@ pub fn draw_marker(frame: &mut [u32], w: u32, h: u32, at: (f64, f64), radius: f6
     }
 }
 
+/// The luminaire of `st` whose marker is nearest to (px, py) in a `w × h` frame of
+/// `view`, if within `radius` pixels.
+pub fn pick_light(
+    st: &super::LightsState,
+    view: lut_core::View,
+    w: u32,
+    h: u32,
+    (px, py): (f64, f64),
+    radius: f64,
+) -> Option<usize> {
+    let room = st.room_box().ok()?;
+    let cam = Camera::new(view, w, h);
+    st.lights
+        .iter()
+        .enumerate()
+        .filter_map(|(i, l)| {
+            let (x, y) = project_point(&room, &cam, DVec3::from(l.position))?;
+            let d = ((x - px).powi(2) + (y - py).powi(2)).sqrt();
+            (d <= radius).then_some((i, d))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| i)
+}
+
+/// Where a luminaire at `position` moves when dragged to (px, py) of a `cam` frame: along
+/// the room face it is nearest to (the ceiling, a wall or the floor), keeping its
+/// distance from that face, to the point under the cursor; kept 1 cm inside the room.
+/// `None` when the cursor's ray does not meet that plane in front of the camera.
+pub fn drag_on_surface(
+    room: &Room,
+    cam: &Camera,
+    position: DVec3,
+    (px, py): (f64, f64),
+) -> Option<DVec3> {
+    let (lo, hi) = room.bounds();
+    // The nearest face: its axis and the plane through the light parallel to it.
+    let dist = [
+        (position.x - lo.x).min(hi.x - position.x),
+        (position.y - lo.y).min(hi.y - position.y),
+        (position.z - lo.z).min(hi.z - position.z),
+    ];
+    let axis = (0..3).min_by(|&a, &b| dist[a].total_cmp(&dist[b]))?;
+    let o = room.camera_position();
+    let d = room.to_room(cam.world_ray(px, py));
+    if d[axis].abs() < 1e-12 {
+        return None;
+    }
+    let t = (position[axis] - o[axis]) / d[axis];
+    if !(t > 0.0 && t.is_finite()) {
+        return None;
+    }
+    let p = o + d * t;
+    let m = DVec3::splat(0.01);
+    let mut q = p.clamp(lo + m, hi - m);
+    q[axis] = position[axis];
+    Some(q)
+}
+
 /// Draw the room's wireframe and the lights' markers of `st` over a rendered `w × h`
-/// frame of `view` (what `viewer render --show-room` adds).
+/// frame of `view` (what `viewer render --show-room` adds and the window shows with
+/// "Show room"); the selected light ([`super::LightsState::selected`]) is drawn larger,
+/// in white.
 ///
 /// # Errors
 /// A room the state cannot build.
@@ -169,7 +229,8 @@ pub fn draw_room_and_lights(
     for s in room_edges(&room, &cam) {
         draw_segment(frame, w, h, s, 2.0 * scale, ROOM_COLOR);
     }
-    for l in &st.lights {
+    for (i, l) in st.lights.iter().enumerate() {
+        let selected = st.selected == Some(i);
         let mut lum = lut_core::Luminaire::new(l.table.clone(), DVec3::from(l.position));
         lum.yaw_deg = l.yaw;
         lum.pitch_deg = l.pitch;
@@ -177,8 +238,13 @@ pub fn draw_room_and_lights(
             if let Some(s) = stroke {
                 draw_segment(frame, w, h, s, 2.0 * scale, LIGHT_COLOR);
             }
-            let color = if l.enabled { LIGHT_COLOR } else { 0x808080 };
-            draw_marker(frame, w, h, at, 5.0 * scale, color);
+            let color = match (selected, l.enabled) {
+                (true, _) => SELECTED_COLOR,
+                (false, true) => LIGHT_COLOR,
+                (false, false) => 0x808080,
+            };
+            let r = if selected { 7.0 } else { 5.0 };
+            draw_marker(frame, w, h, at, r * scale, color);
         }
     }
     Ok(())
@@ -188,6 +254,8 @@ pub fn draw_room_and_lights(
 pub const ROOM_COLOR: u32 = 0x40e0ff;
 /// The lights' marker colour.
 pub const LIGHT_COLOR: u32 = 0xffd040;
+/// The selected light's marker colour.
+pub const SELECTED_COLOR: u32 = 0xffffff;
 
 #[cfg(test)]
 mod tests {
@@ -247,6 +315,54 @@ mod tests {
         );
         let (a, b) = (a.unwrap(), b.unwrap());
         assert!((a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_dragged_light_follows_the_cursor_on_its_face() {
+        // A light on the ceiling of a turned, off-centre room, dragged to where another
+        // ceiling point appears: it moves there, at the same height.
+        let room = Room::new(4.0, 6.0, 3.0, 1.5)
+            .unwrap()
+            .with_yaw(25.0)
+            .unwrap()
+            .with_center(0.4, -0.3)
+            .unwrap();
+        let cam = Camera::new(View::new(20.0, 50.0, 100.0).unwrap(), 320, 200);
+        let light = DVec3::new(0.5, 2.9, 0.2);
+        let target = DVec3::new(-0.7, 2.9, 1.1);
+        let at = project_point(&room, &cam, target).unwrap();
+        let moved = drag_on_surface(&room, &cam, light, at).unwrap();
+        assert!((moved - target).length() < 1e-9, "{moved}");
+        // On a wall: it slides along the wall.
+        let (lo, _) = room.bounds();
+        let wall = DVec3::new(lo.x + 0.05, 2.0, 0.0);
+        let goal = DVec3::new(lo.x + 0.05, 1.2, 0.8);
+        let cam = Camera::new(View::new(-90.0, 0.0, 100.0).unwrap(), 320, 200);
+        let at = project_point(&room, &cam, goal).unwrap();
+        let moved = drag_on_surface(&room, &cam, wall, at).unwrap();
+        assert!((moved - goal).length() < 1e-9, "{moved}");
+        // Past the room's edge: kept inside.
+        let far = drag_on_surface(&room, &cam, wall, (0.0, 0.0)).unwrap();
+        assert!(room.contains(far));
+    }
+
+    #[test]
+    fn markers_are_picked_near_the_cursor() {
+        let mut st = crate::lighting::LightsState::default();
+        st.load_and_add(&crate::lighting::sample_path()).unwrap();
+        st.load_and_add(&crate::lighting::sample_path()).unwrap();
+        let view = View::new(0.0, 60.0, 120.0).unwrap();
+        let room = st.room_box().unwrap();
+        let cam = Camera::new(view, 400, 300);
+        let p1 = project_point(&room, &cam, DVec3::from(st.lights[1].position)).unwrap();
+        assert_eq!(
+            pick_light(&st, view, 400, 300, (p1.0 + 3.0, p1.1), 10.0),
+            Some(1)
+        );
+        assert_eq!(
+            pick_light(&st, view, 400, 300, (p1.0 + 30.0, p1.1 + 30.0), 10.0),
+            None
+        );
     }
 
     #[test]

@@ -2,8 +2,8 @@
 //! `viewer render --light ...` builds from its options, turned into the `lut_core::light`
 //! scene and shading options. Pure data (no window), so the conversions are unit-tested.
 
-use lut_core::{shade_frame, Interpolation, LightScene, LightTable, Luminaire, Room, ShadeOptions};
-use lut_core::{Camera, Photometry, TableOptions, View};
+use lut_core::{Interpolation, LightScene, LightTable, Luminaire, Room, ShadeOptions};
+use lut_core::{Photometry, TableOptions};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -82,6 +82,10 @@ pub struct LightsState {
     pub scene_error: Option<String>,
     /// Illuminance at the pointer (lights only), when the pointer is over the scene.
     pub lux_at_cursor: Option<f64>,
+    /// Draw the room box and the luminaires over the view (the window's "Show room").
+    pub show_room: bool,
+    /// The luminaire selected in the view or the panel.
+    pub selected: Option<usize>,
 }
 
 impl Default for LightsState {
@@ -104,6 +108,8 @@ impl Default for LightsState {
             error: None,
             scene_error: None,
             lux_at_cursor: None,
+            show_room: false,
+            selected: None,
         }
     }
 }
@@ -317,24 +323,13 @@ impl LightsState {
         }
     }
 
-    /// Light a rendered `width × height` frame of `view` in place; a no-op with no
-    /// luminaire.
-    ///
-    /// # Errors
-    /// As [`LightsState::scene`], or a frame that is not `width × height`.
-    pub fn light_frame(
-        &self,
-        view: View,
-        frame: &mut [u32],
-        width: u32,
-        height: u32,
-    ) -> Result<(), String> {
-        let Some(scene) = self.scene()? else {
-            return Ok(());
-        };
-        let cam = Camera::new(view, width, height);
-        shade_frame(&scene, &cam, frame, width, height, &self.shade_options())
-            .map_err(|e| e.to_string())
+    /// What the illuminance map depends on: the luminaires and the room, not the
+    /// shading.
+    pub fn geometry_key(&self) -> LightsKey {
+        LightsKey {
+            shade: None,
+            ..self.key()
+        }
     }
 
     /// What the lit frame depends on.
@@ -400,6 +395,7 @@ pub fn format_lux(lux: Option<f64>) -> String {
 mod tests {
     use super::*;
     use crate::lighting::sample_path;
+    use lut_core::{Camera, View};
 
     #[test]
     fn no_light_no_scene() {

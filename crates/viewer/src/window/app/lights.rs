@@ -1,0 +1,193 @@
+//! The lights in the window: the lit scene from the illuminance map, the room and
+//! luminaires drawn over it, picking and dragging luminaires in the view, and scene files
+//! opened and saved.
+
+use super::App;
+use crate::lighting::overlay::{drag_on_surface, draw_room_and_lights, pick_light};
+use crate::lighting::{legend::draw_legend, SceneFile, SceneView};
+use crate::window::document::StartArgs;
+use crate::window::loader::Source;
+use crate::window::paint::SceneRect;
+use lut_core::{Camera, IlluminanceMap, View};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// How near (scene pixels) a click or press must be to a luminaire's marker to take it.
+pub(super) const PICK_RADIUS: f64 = 12.0;
+
+impl App {
+    /// The illuminance map for this frame (rebuilt, coarse first, when the lights
+    /// changed); a scene that cannot be lit (a light outside the room) is reported in the
+    /// panel.
+    pub(super) fn update_lit(&mut self) -> Option<Arc<IlluminanceMap>> {
+        match self.lit.update(&mut self.lights, true) {
+            Ok(map) => {
+                self.lights.scene_error = None;
+                map
+            }
+            Err(e) => {
+                self.lights.scene_error = Some(e);
+                None
+            }
+        }
+    }
+
+    /// Light the freshly rendered scene from `map` (as `viewer render` does), then draw
+    /// the room and luminaires ("Show room") and the false colours' legend over it.
+    pub(super) fn light_scene(&mut self, map: Option<&IlluminanceMap>, view: View, r: SceneRect) {
+        let (w, h) = (r.w, r.h);
+        if let Some(map) = map {
+            let cam = Camera::new(view, w, h);
+            let opts = self.lights.shade_options();
+            if let Err(e) = map.shade_frame(&cam, &mut self.scene, w, h, &opts) {
+                self.lights.scene_error = Some(e.to_string());
+            }
+        }
+        let l = &self.lights;
+        let mut result = Ok(());
+        if l.show_room {
+            result = draw_room_and_lights(l, view, &mut self.scene, w, h);
+        }
+        if l.false_color && map.is_some() {
+            result = result.and(draw_legend(&mut self.scene, w, h, l.false_color_max));
+        }
+        if let Err(e) = result {
+            self.lights.scene_error = Some(e);
+        }
+    }
+
+    /// A click on the scene at `at` (scene pixels): select the luminaire whose marker is
+    /// there (the room shown), or clear the selection.
+    pub(super) fn click_scene(&mut self, at: (f64, f64), size: (u32, u32)) {
+        if !self.lights.show_room {
+            return;
+        }
+        let view = self.ctl.look().view();
+        self.lights.selected = pick_light(&self.lights, view, size.0, size.1, at, PICK_RADIUS);
+    }
+
+    /// A drag starts at `at`: on a luminaire's marker (the room shown) it moves that
+    /// luminaire instead of turning the view. True when a luminaire was taken.
+    pub(super) fn press_light(&mut self, at: (f64, f64), size: (u32, u32)) -> bool {
+        if !self.lights.show_room {
+            return false;
+        }
+        let view = self.ctl.look().view();
+        self.light_drag = pick_light(&self.lights, view, size.0, size.1, at, PICK_RADIUS);
+        if self.light_drag.is_some() {
+            self.lights.selected = self.light_drag;
+        }
+        self.light_drag.is_some()
+    }
+
+    /// The dragged luminaire follows the cursor along the face it is nearest to.
+    pub(super) fn drag_light(&mut self, at: (f64, f64), size: (u32, u32)) {
+        let Some(i) = self.light_drag else {
+            return;
+        };
+        let Ok(room) = self.lights.room_box() else {
+            return;
+        };
+        let cam = Camera::new(self.ctl.look().view(), size.0, size.1);
+        if let Some(l) = self.lights.lights.get_mut(i) {
+            if let Some(p) = drag_on_surface(&room, &cam, l.position.into(), at) {
+                l.position = p.into();
+            }
+        }
+    }
+
+    /// Open a scene file: its room, luminaires and exposure replace the panel's; its
+    /// panorama (if it names one) opens at its view. Errors are notices.
+    pub(super) fn open_scene(&mut self, path: PathBuf) {
+        let t = self.now();
+        let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+        let loaded = SceneFile::load(&path).and_then(|f| Ok((f.to_state(&dir)?, f)));
+        let (mut state, file) = match loaded {
+            Ok(x) => x,
+            Err(e) => {
+                self.notices.error(format!("{e:#}"), t);
+                return;
+            }
+        };
+        state.path_input = std::mem::take(&mut self.lights.path_input);
+        state.show_room = self.lights.show_room;
+        self.lights = state;
+        self.scene_file = Some(path.clone());
+        self.prefs.panel = true;
+        self.notices.info(format!("scene {}", path.display()), t);
+        if let Some(p) = file.panorama_path(&dir) {
+            let start = file.view.map_or_else(StartArgs::default, |v| StartArgs {
+                yaw: Some(v.yaw),
+                pitch: Some(v.pitch),
+                hfov: Some(v.hfov),
+            });
+            let source = Source::of_paths(vec![p.clone()], false, None).unwrap_or(Source::File(p));
+            let fx = self
+                .doc
+                .open(source, None, start, self.ctl.settings.exposure_ev);
+            self.apply(vec![fx]);
+        }
+    }
+
+    /// The Save dialog for a scene file, beside the scene opened last (else the
+    /// panorama's folder).
+    pub(super) fn start_save_scene_dialog(&mut self) {
+        let near = self
+            .scene_file
+            .clone()
+            .or(self.doc.last_file().map(Path::to_path_buf));
+        let dir = near
+            .as_deref()
+            .and_then(Path::parent)
+            .filter(|d| d.is_dir())
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+        let name = match (&self.scene_file, self.doc.last_file()) {
+            (Some(s), _) => s.file_name().map(|n| n.to_string_lossy().into_owned()),
+            (None, Some(p)) => p
+                .file_stem()
+                .map(|s| format!("{}.json", s.to_string_lossy())),
+            (None, None) => None,
+        };
+        let name = name.unwrap_or_else(|| "scene.json".into());
+        self.dialogs.save_scene(&self.egui_ctx, &dir, &name);
+        if self.print_view {
+            println!("dialog save-scene {}", dir.display());
+        }
+    }
+
+    /// Write the scene (the panorama shown, the view, the panel's lights) to `path`.
+    pub(super) fn save_scene_to(&mut self, path: &Path, t: f64) {
+        let panorama = self
+            .doc
+            .current()
+            .and_then(|c| c.source.single_path())
+            .map(Path::to_path_buf);
+        let look = self.ctl.look();
+        let view = SceneView {
+            yaw: look.yaw,
+            pitch: look.pitch,
+            hfov: look.hfov,
+        };
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        let file = SceneFile::from_state(&self.lights, panorama.as_deref(), Some(view), dir);
+        let status = match file.save(path) {
+            Ok(()) => {
+                self.scene_file = Some(path.to_path_buf());
+                let msg = format!("saved scene {}", path.display());
+                self.notices.info(&msg, t);
+                msg
+            }
+            Err(e) => {
+                let msg = format!("save failed: {e:#}");
+                self.notices.error(&msg, t);
+                msg
+            }
+        };
+        if self.print_view {
+            println!("{status}");
+        }
+    }
+}
