@@ -7,7 +7,7 @@
 //! luminaire: E from a source at distance R varies on the scale of R (its inverse-square
 //! and cosine falloff has a curvature about 3E/R² under the source), so bilinear
 //! interpolation between nodes s apart is off by about (3/8)(s/R)² of E. The default
-//! spacing 0.15 R, clamped to 5 mm … 40 mm, keeps that below 1 %, and a tile far from
+//! spacing 0.15 R, clamped to 5 mm … 30 mm, keeps that below 1 %, and a tile far from
 //! every light costs a 13 × 13 grid. Nodes lie exactly on the faces and tiles end exactly
 //! at the room's edges, so a frame that picks the face by the exact ray/box intersection
 //! keeps the room's edges sharp: E is never interpolated across a corner.

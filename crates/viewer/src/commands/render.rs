@@ -159,9 +159,20 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if a.verbose {
         print_report(&a, &scene, &report, view);
     }
+    let mut lit = crate::lighting::LitCache::default();
+    let t0 = std::time::Instant::now();
     lights
-        .light_frame(view, &mut out, w, h)
+        .light_frame_with(&mut lit, false, view, &mut out, w, h)
         .map_err(anyhow::Error::msg)?;
+    if a.verbose && !lights.lights.is_empty() {
+        eprintln!(
+            "lit from an illuminance map of {:.1} KiB ({} luminaires, map and shading {:.0} ms, exposure {:.0} lx)",
+            lit.bytes() as f64 / 1024.0,
+            lights.lights.len(),
+            t0.elapsed().as_secs_f64() * 1e3,
+            lights.exposure_lux
+        );
+    }
     if lights.show_room {
         crate::lighting::overlay::draw_room_and_lights(&lights, view, &mut out, w, h)
             .map_err(anyhow::Error::msg)?;

@@ -120,7 +120,12 @@ pub fn run(mut a: OpenArgs) -> anyhow::Result<()> {
     }
     // Lights given on the command line: loaded now, so a bad file or position is
     // reported before any window opens (as `viewer render` reports it).
-    let lights = a.lights.state()?;
+    let mut lights = a.lights.state()?;
+    if a.lights.exposure_lux.is_none() && a.lights.room.scene.is_none() {
+        // The window's default: the exposure follows the lights, so a light added or
+        // dropped brightens the room without blowing it out.
+        lights.auto_exposure = true;
+    }
     let has_display = ["DISPLAY", "WAYLAND_DISPLAY"]
         .iter()
         .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()));
