@@ -121,6 +121,8 @@ struct App {
     light_drag: Option<usize>,
     /// The scene file opened or saved last.
     scene_file: Option<PathBuf>,
+    /// The luminaires' marker positions as last printed (`--print-view`).
+    printed_markers: String,
 }
 
 /// Open the window and run until it is closed.
@@ -183,6 +185,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         lit: LitCache::default(),
         light_drag: None,
         scene_file: args.lights.room.scene.clone(),
+        printed_markers: String::new(),
     };
     app.take_prefs();
     app.ctl.settings.view_limit = !args.no_view_limit;

@@ -107,7 +107,7 @@ impl App {
         if self.light_drag.is_some() {
             match resp.interact_pointer_pos() {
                 Some(p) if resp.dragged_by(primary) => self.drag_light(to_px(p), size),
-                _ => self.light_drag = None,
+                _ => self.end_light_drag(),
             }
         }
         if resp.clicked_by(primary) {

@@ -3,7 +3,7 @@
 //! opened and saved.
 
 use super::App;
-use crate::lighting::overlay::{drag_on_surface, draw_room_and_lights, pick_light};
+use crate::lighting::overlay::{drag_on_surface, draw_room_and_lights, pick_light, project_point};
 use crate::lighting::{legend::draw_legend, SceneFile, SceneView};
 use crate::window::document::StartArgs;
 use crate::window::loader::Source;
@@ -54,6 +54,43 @@ impl App {
         if let Err(e) = result {
             self.lights.scene_error = Some(e);
         }
+        if self.print_view && self.lights.show_room {
+            self.print_markers(view, r);
+        }
+    }
+
+    /// `--print-view`: where each luminaire's marker is in the scene (pixels), when that
+    /// changed: "markers 1=X,Y 2=X,Y" (lights behind the camera left out).
+    fn print_markers(&mut self, view: View, r: SceneRect) {
+        let Ok(room) = self.lights.room_box() else {
+            return;
+        };
+        let cam = Camera::new(view, r.w, r.h);
+        let line: Vec<String> = self
+            .lights
+            .lights
+            .iter()
+            .enumerate()
+            .filter_map(|(i, l)| {
+                let (x, y) = project_point(&room, &cam, l.position.into())?;
+                Some(format!("{}={x:.0},{y:.0}", i + 1))
+            })
+            .collect();
+        let line = format!("markers {}", line.join(" "));
+        if line != self.printed_markers {
+            println!("{line}");
+            self.printed_markers = line;
+        }
+    }
+
+    /// `--print-view`: the selection.
+    fn print_selection(&self) {
+        if self.print_view {
+            match self.lights.selected {
+                Some(i) => println!("light {} selected", i + 1),
+                None => println!("no light selected"),
+            }
+        }
     }
 
     /// A click on the scene at `at` (scene pixels): select the luminaire whose marker is
@@ -64,6 +101,7 @@ impl App {
         }
         let view = self.ctl.look().view();
         self.lights.selected = pick_light(&self.lights, view, size.0, size.1, at, PICK_RADIUS);
+        self.print_selection();
     }
 
     /// A drag starts at `at`: on a luminaire's marker (the room shown) it moves that
@@ -76,8 +114,19 @@ impl App {
         self.light_drag = pick_light(&self.lights, view, size.0, size.1, at, PICK_RADIUS);
         if self.light_drag.is_some() {
             self.lights.selected = self.light_drag;
+            self.print_selection();
         }
         self.light_drag.is_some()
+    }
+
+    /// The drag of a luminaire ended (`--print-view`: where it is now).
+    pub(super) fn end_light_drag(&mut self) {
+        if let (Some(i), true) = (self.light_drag.take(), self.print_view) {
+            if let Some(l) = self.lights.lights.get(i) {
+                let [x, y, z] = l.position;
+                println!("light {} moved to {x:.3},{y:.3},{z:.3}", i + 1);
+            }
+        }
     }
 
     /// The dragged luminaire follows the cursor along the face it is nearest to.
