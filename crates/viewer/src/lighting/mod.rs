@@ -11,7 +11,10 @@ mod state;
 
 pub use files::{file_kind, FileKind};
 pub use lit::LitCache;
-pub use scene_file::{is_scene, is_scene_file, SceneFile, SceneLight, SceneRoom, SceneView};
+pub use scene_file::{
+    is_scene, is_scene_file, SceneFile, SceneLight, SceneRoom, SceneView, FORMAT as SCENE_FORMAT,
+    VERSION as SCENE_VERSION,
+};
 pub use state::{
     format_lux, load_table, LightEntry, LightsKey, LightsState, AUTO_EXPOSURE_QUANTILE,
     DEFAULT_CAMERA_HEIGHT, DEFAULT_EXPOSURE_LUX, DEFAULT_ROOM,

@@ -101,9 +101,9 @@ fn yes() -> bool {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
-    /// Always [`FORMAT`]: recognizes a scene file by content.
+    /// Always `"lutpano-scene"` ([`FORMAT`](super::SCENE_FORMAT)): recognizes a scene file by content.
     pub format: String,
-    /// [`VERSION`].
+    /// The version ([`VERSION`](super::SCENE_VERSION)).
     pub version: u32,
     /// The panorama (a file, or a folder of cube faces); none for the bundled sample.
     #[serde(default, skip_serializing_if = "Option::is_none")]
