@@ -16,7 +16,7 @@
 #   saves the view where the settings say; docs/screenshot.png is taken here.
 # Run 3 (panel hidden): a scene file with --show-room opens its panorama at its view with
 #   its five luminaires; a click on a marker selects that light, dragging it moves it
-#   along the ceiling without turning the view.
+#   along the ceiling without turning the view; dragging a room edge resizes the room.
 #
 # Screenshots and logs: target/window-smoke/ (kept as CI artifacts). The settings live
 # in a temporary config folder (LUTPANO_CONFIG_DIR), never the real home.
@@ -410,6 +410,23 @@ log "$MOVED"
   fail "a ceiling light should stay 2.680 m up: $MOVED"
 [ "$(field yaw)" = "$YAW0" ] && [ "$(field pitch)" = "$PITCH0" ] ||
   fail "dragging a light turned the view: yaw $YAW0 -> $(field yaw), pitch $PITCH0 -> $(field pitch)"
+# Drag a room edge (its middle, clear of the toolbar): the room changes, the view does not.
+EDGE=$(grep '^edges ' "$VIEWLOG" | tail -n 1 | tr ' ' '\n' | grep '=' |
+  awk -F'[=,]' -v w="$SW" -v h="$SH" '$2 > 60 && $2 < w - 60 && $3 > 80 && $3 < h - 60 { print; exit }')
+[ -n "$EDGE" ] || fail "no room edge inside the view: $(grep '^edges ' "$VIEWLOG" | tail -n 1)"
+EXY=${EDGE#*=}; EX=$((X + ${EXY%,*})); EY=$((Y + ${EXY#*,}))
+log "room edge ${EDGE%%=*} at $EX,$EY"
+N=$(lines)
+xdotool mousemove "$EX" "$EY"; sleep 0.2; xdotool mousedown 1; sleep 0.1
+for i in 1 2 3 4 5 6; do xdotool mousemove $((EX - 4 * i)) $((EY + 6 * i)); sleep 0.05; done
+sleep 0.2; xdotool mouseup 1
+wait_for "^room " "$N" 5
+settle
+log "$(grep '^room ' "$VIEWLOG" | tail -n 1)"
+grep -q '^room 4.170x2.990x2.700 centre 0.485,0.045' "$VIEWLOG" &&
+  fail "dragging a room edge left the room as it was"
+[ "$(field yaw)" = "$YAW0" ] && [ "$(field pitch)" = "$PITCH0" ] ||
+  fail "dragging a room edge turned the view"
 sleep 0.3
 $IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/lights.png"
 quit_viewer

@@ -209,6 +209,81 @@ pub fn drag_on_surface(
     Some(q)
 }
 
+/// The room edge (an index into [`Room::EDGES`]) drawn nearest to (px, py) in a `cam`
+/// frame, if within `radius` pixels.
+pub fn pick_room_edge(
+    room: &Room,
+    cam: &Camera,
+    (px, py): (f64, f64),
+    radius: f64,
+) -> Option<usize> {
+    let c = room.corners();
+    Room::EDGES
+        .iter()
+        .enumerate()
+        .filter_map(|(k, &(i, j))| {
+            let s = project_segment(room, cam, c[i], c[j])?;
+            let d = segment_distance(s, px, py);
+            (d <= radius).then_some((k, d))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(k, _)| k)
+}
+
+/// The room box after its edge `edge` (an index into [`Room::EDGES`]) is dragged to
+/// (px, py) of a `cam` frame, as (width, depth, centre x, centre z); the height, camera
+/// height and turn stay. An edge along the floor or the ceiling moves its wall to where
+/// the cursor's ray meets the floor or ceiling; a vertical edge (a corner between two
+/// walls) turns about the camera to the cursor's bearing at its distance, moving both
+/// walls. The camera stays at least 5 cm inside. `None` when the cursor's ray does not
+/// meet the floor or ceiling in front of the camera.
+pub fn drag_room_edge(
+    room: &Room,
+    cam: &Camera,
+    edge: usize,
+    (px, py): (f64, f64),
+) -> Option<(f64, f64, f64, f64)> {
+    const INSIDE: f64 = 0.05;
+    let (i, j) = *Room::EDGES.get(edge)?;
+    let axis = (i ^ j).trailing_zeros() as usize;
+    let high = |bit: usize| i & (1 << bit) != 0;
+    let (mut lo, mut hi) = room.bounds();
+    let (floor, ceiling) = (lo.y, hi.y);
+    let o = room.camera_position();
+    let d = room.to_room(cam.world_ray(px, py));
+    let mut set = |a: usize, v: f64| {
+        if high(a) {
+            hi[a] = v.max(INSIDE);
+        } else {
+            lo[a] = v.min(-INSIDE);
+        }
+    };
+    if axis == 1 {
+        let c = room.corners()[i];
+        let bearing = DVec3::new(d.x, 0.0, d.z);
+        if bearing.length() < 1e-9 {
+            return None;
+        }
+        let p = bearing.normalize() * c.x.hypot(c.z);
+        set(0, p.x);
+        set(2, p.z);
+    } else {
+        let y = if high(1) { ceiling } else { floor };
+        let t = (y - o.y) / d.y;
+        if !(t > 0.0 && t.is_finite()) {
+            return None;
+        }
+        let wall = 2 - axis;
+        set(wall, o[wall] + d[wall] * t);
+    }
+    Some((
+        hi.x - lo.x,
+        hi.z - lo.z,
+        (lo.x + hi.x) / 2.0,
+        (lo.z + hi.z) / 2.0,
+    ))
+}
+
 /// Draw the room's wireframe and the lights' markers of `st` over a rendered `w × h`
 /// frame of `view` (what `viewer render --show-room` adds and the window shows with
 /// "Show room"); the selected light ([`super::LightsState::selected`]) is drawn larger,
@@ -344,6 +419,55 @@ mod tests {
         // Past the room's edge: kept inside.
         let far = drag_on_surface(&room, &cam, wall, (0.0, 0.0)).unwrap();
         assert!(room.contains(far));
+    }
+
+    #[test]
+    fn dragged_room_edges_move_their_walls() {
+        let room = Room::new(4.0, 6.0, 2.8, 1.5)
+            .unwrap()
+            .with_yaw(20.0)
+            .unwrap()
+            .with_center(0.3, -0.4)
+            .unwrap();
+        let (lo, hi) = room.bounds();
+        let rebuilt = |(w, d, cx, cz): (f64, f64, f64, f64)| {
+            Room::new(w, d, 2.8, 1.5)
+                .unwrap()
+                .with_yaw(20.0)
+                .unwrap()
+                .with_center(cx, cz)
+                .unwrap()
+        };
+        // The floor edge of the front wall (z high, y 0, along X): dragged to a floor
+        // point 40 cm further, the front wall moves there; the others stay.
+        let k = Room::EDGES
+            .iter()
+            .position(|&(i, j)| (i ^ j) == 1 && i & 2 == 0 && i & 4 != 0)
+            .unwrap();
+        let cam = Camera::new(View::new(20.0, -30.0, 100.0).unwrap(), 320, 200);
+        let target = DVec3::new(0.2, 0.0, hi.z + 0.4);
+        let at = project_point(&room, &cam, target).unwrap();
+        assert_eq!(pick_room_edge(&room, &cam, at, 200.0).is_some(), true);
+        let (lo2, hi2) = rebuilt(drag_room_edge(&room, &cam, k, at).unwrap()).bounds();
+        assert!((hi2.z - target.z).abs() < 1e-9, "{hi2}");
+        assert!((lo2 - lo).length() < 1e-9 && (hi2.x - hi.x).abs() < 1e-9);
+        // A vertical edge (x low, z high) dragged to a bearing 5° round at the same
+        // distance: the corner goes there, both walls move.
+        let k = Room::EDGES
+            .iter()
+            .position(|&(i, j)| (i ^ j) == 2 && i & 1 == 0 && i & 4 != 0)
+            .unwrap();
+        let c = DVec3::new(lo.x, 0.0, hi.z);
+        let turned = glam::DQuat::from_rotation_y(5f64.to_radians()) * c;
+        let cam = Camera::new(View::new(-10.0, 0.0, 100.0).unwrap(), 320, 200);
+        let at = project_point(&room, &cam, turned + DVec3::Y * 1.2).unwrap();
+        let (lo2, hi2) = rebuilt(drag_room_edge(&room, &cam, k, at).unwrap()).bounds();
+        assert!((lo2.x - turned.x).abs() < 1e-9 && (hi2.z - turned.z).abs() < 1e-9);
+        assert!((hi2.x - hi.x).abs() < 1e-9 && (lo2.z - lo.z).abs() < 1e-9);
+        // Never past the camera.
+        let far = drag_room_edge(&room, &cam, k, (319.0, 100.0)).unwrap();
+        let (lo3, hi3) = rebuilt(far).bounds();
+        assert!(lo3.x <= -0.05 + 1e-12 && hi3.z >= 0.05 - 1e-12);
     }
 
     #[test]

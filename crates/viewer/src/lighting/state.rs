@@ -145,7 +145,8 @@ impl LightsState {
             path,
             table,
             position: [
-                (self.room_center.0 + x).clamp(-half, half),
+                (self.room_center.0 + x)
+                    .clamp(self.room_center.0 - half, self.room_center.0 + half),
                 y,
                 self.room_center.1,
             ],
@@ -506,6 +507,22 @@ mod tests {
         assert!((s.shade_options().exposure - 1.0 / 250.0).abs() < 1e-15);
         s.exposure_lux = 0.0;
         assert_eq!(s.shade_options().exposure, 0.0);
+    }
+
+    #[test]
+    fn added_lights_stay_in_an_off_centre_room() {
+        let mut s = LightsState {
+            room: (2.0, 3.0, 2.7),
+            room_center: (0.8, -0.5),
+            camera_height: 1.2,
+            ..LightsState::default()
+        };
+        for _ in 0..6 {
+            s.load_and_add(&sample_path()).unwrap();
+        }
+        let room = s.room_box().unwrap();
+        assert!(s.lights.iter().all(|l| room.contains(l.position.into())));
+        assert!(s.scene().is_ok());
     }
 
     #[test]

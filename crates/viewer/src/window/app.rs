@@ -119,6 +119,8 @@ struct App {
     lit: LitCache,
     /// The luminaire being dragged in the view.
     light_drag: Option<usize>,
+    /// The room edge being dragged (an index into `lut_core::Room::EDGES`).
+    edge_drag: Option<usize>,
     /// The scene file opened or saved last.
     scene_file: Option<PathBuf>,
     /// The luminaires' marker positions as last printed (`--print-view`).
@@ -184,6 +186,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         lights,
         lit: LitCache::default(),
         light_drag: None,
+        edge_drag: None,
         scene_file: args.lights.room.scene.clone(),
         printed_markers: String::new(),
     };

@@ -242,6 +242,10 @@ pub const MOUSE_HELP: &[(&str, &str)] = &[
     ("drop a scene file", "open its panorama, room and lights"),
     ("click a light", "select it (Show room on)"),
     ("drag a light", "move it along the ceiling or its wall"),
+    (
+        "drag a room edge",
+        "move its walls to fit the photo (Show room on)",
+    ),
     ("Tab, Enter", "focus and press the buttons"),
 ];
 

@@ -59,8 +59,8 @@ pub fn lights_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, out: &mut Panel
 fn room_fields(ui: &mut egui::Ui, l: &mut crate::lighting::LightsState) {
     ui.checkbox(&mut l.show_room, "Show room").on_hover_text(
         "Draw the room box and the luminaires over the view; fit the box's edges to \
-             the photograph's walls, floor and ceiling. Click a luminaire to select it, \
-             drag it to move it along the ceiling or its wall.",
+             the photograph's walls, floor and ceiling (drag an edge onto them). Click a \
+             luminaire to select it, drag it to move it along the ceiling or its wall.",
     );
     ui.horizontal(|ui| {
         ui.label("Room");

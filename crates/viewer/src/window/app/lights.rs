@@ -3,7 +3,10 @@
 //! opened and saved.
 
 use super::App;
-use crate::lighting::overlay::{drag_on_surface, draw_room_and_lights, pick_light, project_point};
+use crate::lighting::overlay::{
+    drag_on_surface, drag_room_edge, draw_room_and_lights, pick_light, pick_room_edge,
+    project_point,
+};
 use crate::lighting::{legend::draw_legend, SceneFile, SceneView};
 use crate::window::document::StartArgs;
 use crate::window::loader::Source;
@@ -14,6 +17,8 @@ use std::sync::Arc;
 
 /// How near (scene pixels) a click or press must be to a luminaire's marker to take it.
 pub(super) const PICK_RADIUS: f64 = 12.0;
+/// How near (scene pixels) a press must be to a room edge to drag it.
+pub(super) const EDGE_RADIUS: f64 = 6.0;
 
 impl App {
     /// The illuminance map for this frame (rebuilt, coarse first, when the lights
@@ -76,7 +81,20 @@ impl App {
                 Some(format!("{}={x:.0},{y:.0}", i + 1))
             })
             .collect();
-        let line = format!("markers {}", line.join(" "));
+        // And the middle of each room edge in view: "edges K=X,Y" (K into Room::EDGES).
+        let c = room.corners();
+        let edges: Vec<String> = lut_core::Room::EDGES
+            .iter()
+            .enumerate()
+            .filter_map(|(k, &(i, j))| {
+                let ((x0, y0), (x1, y1)) =
+                    crate::lighting::overlay::project_segment(&room, &cam, c[i], c[j])?;
+                let (x, y) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+                let inside = x >= 0.0 && y >= 0.0 && x < r.w as f64 && y < r.h as f64;
+                inside.then(|| format!("{k}={x:.0},{y:.0}"))
+            })
+            .collect();
+        let line = format!("markers {}\nedges {}", line.join(" "), edges.join(" "));
         if line != self.printed_markers {
             println!("{line}");
             self.printed_markers = line;
@@ -105,7 +123,8 @@ impl App {
     }
 
     /// A drag starts at `at`: on a luminaire's marker (the room shown) it moves that
-    /// luminaire instead of turning the view. True when a luminaire was taken.
+    /// luminaire, on an edge of the room box it moves that edge's walls, instead of
+    /// turning the view. True when a luminaire or an edge was taken.
     pub(super) fn press_light(&mut self, at: (f64, f64), size: (u32, u32)) -> bool {
         if !self.lights.show_room {
             return false;
@@ -115,32 +134,53 @@ impl App {
         if self.light_drag.is_some() {
             self.lights.selected = self.light_drag;
             self.print_selection();
+            return true;
         }
-        self.light_drag.is_some()
+        let cam = Camera::new(view, size.0, size.1);
+        self.edge_drag = self
+            .lights
+            .room_box()
+            .ok()
+            .and_then(|room| pick_room_edge(&room, &cam, at, EDGE_RADIUS));
+        self.edge_drag.is_some()
     }
 
-    /// The drag of a luminaire ended (`--print-view`: where it is now).
-    pub(super) fn end_light_drag(&mut self) {
-        if let (Some(i), true) = (self.light_drag.take(), self.print_view) {
-            if let Some(l) = self.lights.lights.get(i) {
-                let [x, y, z] = l.position;
-                println!("light {} moved to {x:.3},{y:.3},{z:.3}", i + 1);
-            }
-        }
-    }
-
-    /// The dragged luminaire follows the cursor along the face it is nearest to.
+    /// The dragged luminaire follows the cursor along the face it is nearest to; a
+    /// dragged room edge moves its walls to the cursor.
     pub(super) fn drag_light(&mut self, at: (f64, f64), size: (u32, u32)) {
-        let Some(i) = self.light_drag else {
-            return;
-        };
         let Ok(room) = self.lights.room_box() else {
             return;
         };
         let cam = Camera::new(self.ctl.look().view(), size.0, size.1);
+        if let Some(e) = self.edge_drag {
+            if let Some((w, d, cx, cz)) = drag_room_edge(&room, &cam, e, at) {
+                self.lights.room.0 = w;
+                self.lights.room.1 = d;
+                self.lights.room_center = (cx, cz);
+            }
+            return;
+        }
+        let Some(i) = self.light_drag else {
+            return;
+        };
         if let Some(l) = self.lights.lights.get_mut(i) {
             if let Some(p) = drag_on_surface(&room, &cam, l.position.into(), at) {
                 l.position = p.into();
+            }
+        }
+    }
+
+    /// The drag of a luminaire ended (`--print-view`: where it is now).
+    pub(super) fn end_light_drag(&mut self) {
+        if let (Some(_), true) = (self.edge_drag.take(), self.print_view) {
+            let (w, d, h) = self.lights.room;
+            let (cx, cz) = self.lights.room_center;
+            println!("room {w:.3}x{d:.3}x{h:.3} centre {cx:.3},{cz:.3}");
+        }
+        if let (Some(i), true) = (self.light_drag.take(), self.print_view) {
+            if let Some(l) = self.lights.lights.get(i) {
+                let [x, y, z] = l.position;
+                println!("light {} moved to {x:.3},{y:.3},{z:.3}", i + 1);
             }
         }
     }
