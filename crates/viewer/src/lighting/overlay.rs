@@ -447,7 +447,7 @@ mod tests {
         let cam = Camera::new(View::new(20.0, -30.0, 100.0).unwrap(), 320, 200);
         let target = DVec3::new(0.2, 0.0, hi.z + 0.4);
         let at = project_point(&room, &cam, target).unwrap();
-        assert_eq!(pick_room_edge(&room, &cam, at, 200.0).is_some(), true);
+        assert!(pick_room_edge(&room, &cam, at, 200.0).is_some());
         let (lo2, hi2) = rebuilt(drag_room_edge(&room, &cam, k, at).unwrap()).bounds();
         assert!((hi2.z - target.z).abs() < 1e-9, "{hi2}");
         assert!((lo2 - lo).length() < 1e-9 && (hi2.x - hi.x).abs() < 1e-9);
