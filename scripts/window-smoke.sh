@@ -310,6 +310,37 @@ $IMPORT -window root "$OUT/4-help.png"
 xdotool key question
 wait_for '^help hidden' "$N" 5
 
+# L glides into the little planet (stereographic, pitch -90, hfov 300) and back to the
+# view it left; V cycles the projections; E shows the error heat map with its max in the
+# readouts (the LUT's sampling error: within the 0.05 px budget).
+BEFORE="$(field yaw) $(field pitch) $(field hfov)"
+N=$(views)
+press l
+settle
+log "after L: proj=$(field proj) pitch=$(field pitch) hfov=$(field hfov), $(($(views) - N)) frames"
+[ "$(field proj)" = stereographic ] && [ "$(field pitch)" = -90.0000 ] && [ "$(field hfov)" = 300.0000 ] ||
+  fail "L should show the little planet (stereographic, pitch -90, hfov 300)"
+[ $(($(views) - N)) -ge 5 ] || fail "the little planet should be an animated transition"
+$IMPORT -window root "$OUT/4-planet.png"
+press l
+settle
+[ "$(field proj)" = rectilinear ] && [ "$(field yaw) $(field pitch) $(field hfov)" = "$BEFORE" ] ||
+  fail "L again should return to $BEFORE (rectilinear), not $(field yaw) $(field pitch) $(field hfov) $(field proj)"
+for want in stereographic fisheye equisolid pannini rectilinear; do
+  press v
+  settle
+  [ "$(field proj)" = "$want" ] || fail "V should switch to $want, not $(field proj)"
+done
+N=$(lines)
+press e
+wait_for "^readouts .*error max=" "$N" 10
+HEAT=$(readout 'error max' | sed 's/ px//')
+log "heat map: error max $HEAT px"
+awk -v e="$HEAT" 'BEGIN { exit !(e >= 0 && e <= 0.05) }' || fail "heat map max $HEAT px is not within 0.05"
+$IMPORT -window root "$OUT/4-heat.png"
+press e
+settle
+
 # Ctrl+O opens the dialog; / edits its path; the typed file loads.
 N=$(lines)
 chord ctrl o

@@ -95,13 +95,16 @@ pub use error::{
 pub use named::{name_list, parse_name, Named};
 
 // Geometry.
-pub use geom::accuracy::{compare_positions, position_error, raw_error, ErrorStats};
+pub use geom::accuracy::{
+    compare_positions, position_error, position_errors, raw_error, ErrorStats,
+};
 pub use geom::camera::{check_size, dir_to_lat_long, lat_long_to_dir, wrap_deg, Camera, View};
 pub use geom::coverage::{compass_heading, compass_point, Coverage, Crop, StartView};
 pub use geom::fixed::{from_fx, to_fx, Fx, FX_BITS, FX_HALF, FX_ONE};
 pub use geom::limits::{MAX_MAP_HEIGHT, MAX_MAP_PIXELS, MAX_MAP_WIDTH, MAX_OUTPUT_SIDE};
 pub use geom::mapping::{exact_uv, exact_uv_at};
 pub use geom::projection::{wrap_pi, Projection};
+pub use geom::view_projection::{ViewProjection, PANNINI_D_DEFAULT, PANNINI_D_MAX};
 pub use geom::viewlimit::{frame_extent, limit_view, view_inside, FrameExtent};
 
 // Maps.
@@ -118,6 +121,10 @@ pub use lut::{LutTable, Surface, TableKind, TableSpec, TABLE_ERROR_BUDGET};
 pub use render::cube::{scanline_runs, CubeRenderer};
 pub use render::exact::{render_exact, render_exact_supersampled, sample_at, sample_at_lod};
 pub use render::frame::Frame;
+pub use render::grid::{GRID_CELL, GRID_CELL_BUDGET, GRID_MIN_CELL};
+pub use render::heat::{
+    heat_color, heat_scale, ErrorMap, HEAT_BACKGROUND, HEAT_MAX, HEAT_MIN, HEAT_MISMATCH,
+};
 pub use render::steps::{ADAPTIVE_MAX_STEP, SPAN_ERROR_BUDGET};
 pub use render::{
     IndexStep, LutChoice, Positions, RenderOptions, RenderPath, RenderReport, Renderer,

@@ -209,8 +209,19 @@ impl IlluminanceMap {
         }
     }
 
+    /// The map's illuminance at pixel (x, y) of `cam`'s image through its own ray (any
+    /// view projection); `None` where the projection has no direction.
+    #[inline]
+    fn pixel_lux(&self, cam: &Camera, x: usize, y: usize) -> Option<f32> {
+        let d = cam.ray(x as f64 + 0.5, y as f64 + 0.5)?;
+        Some(self.probe(self.room().to_room(d)).e)
+    }
+
     /// The illuminance in lux (lights only) the map gives each pixel of `cam`'s image,
     /// row by row, as [`IlluminanceMap::shade_frame`] uses it (for tests, and exports).
+    /// Rectilinear views interpolate it over blocks (see the module docs); the other view
+    /// projections (not linear in the pixel coordinates) probe the map at every pixel,
+    /// NaN where the projection has no direction (outside a fisheye's disc).
     ///
     /// # Errors
     /// [`LightError::BufferSize`] when `out` does not hold the camera's pixels.
@@ -225,6 +236,14 @@ impl IlluminanceMap {
             });
         }
         if w == 0 {
+            return Ok(());
+        }
+        if !cam.projection().is_rectilinear() {
+            out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+                for (x, e) in row.iter_mut().enumerate() {
+                    *e = self.pixel_lux(cam, x, y).unwrap_or(f32::NAN);
+                }
+            });
             return Ok(());
         }
         let rays = Rays::new(self, cam);
@@ -258,6 +277,25 @@ impl IlluminanceMap {
         let enc = encode_lut();
         let (ambient, exposure) = (opts.ambient as f32, opts.exposure as f32);
         let w = w as usize;
+        if !cam.projection().is_rectilinear() {
+            // Each pixel through its own ray; pixels with no direction stay as rendered.
+            frame.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+                for (x, px) in row.iter_mut().enumerate() {
+                    let Some(e) = self.pixel_lux(cam, x, y) else {
+                        continue;
+                    };
+                    let shaded = shade_pixel(*px, ambient + exposure * e, dec, enc);
+                    *px = if opts.false_color {
+                        let c =
+                            false_color(false_color_position(e as f64, opts.false_color_max_lux));
+                        blend(c, shaded, 0.65)
+                    } else {
+                        shaded
+                    };
+                }
+            });
+            return Ok(());
+        }
         let rays = Rays::new(self, cam);
         frame.par_chunks_mut(w * BLOCK.1).enumerate().for_each_init(
             || vec![0f32; w * BLOCK.1],

@@ -373,7 +373,11 @@ pub fn shade_frame(
         .for_each(|(y, row)| {
             let py = y as f64 + 0.5;
             for (x, px) in row.iter_mut().enumerate() {
-                let dir = scene.room.to_room(cam.world_ray(x as f64 + 0.5, py));
+                // Pixels with no direction (outside a fisheye's disc) stay as rendered.
+                let Some(ray) = cam.ray(x as f64 + 0.5, py) else {
+                    continue;
+                };
+                let dir = scene.room.to_room(ray);
                 let (p, n) = scene.room.hit(origin, dir);
                 let e = scene.illuminance(p, n);
                 let k = (opts.ambient + opts.exposure * e) as f32;
@@ -404,8 +408,12 @@ pub(crate) fn blend(a: u32, b: u32, t: f32) -> u32 {
 
 /// Illuminance in lux (lights only, no ambient) at the room surface seen through image
 /// point (px, py) (pixel coordinates, centres at +0.5) of `cam`.
+/// 0 where the view's projection has no direction.
 pub fn lux_at(scene: &LightScene, cam: &Camera, px: f64, py: f64) -> f64 {
-    let (p, n) = scene.scene_point(cam.world_ray(px, py));
+    let Some(dir) = cam.ray(px, py) else {
+        return 0.0;
+    };
+    let (p, n) = scene.scene_point(dir);
     scene.illuminance(p, n)
 }
 

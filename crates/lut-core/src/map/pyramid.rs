@@ -121,11 +121,12 @@ fn build_levels(map: &EnvMap) -> Vec<EnvMap> {
         px.par_chunks_mut(nw).enumerate().for_each(|(j, row)| {
             for (i, p) in row.iter_mut().enumerate() {
                 let (x, y) = (2 * i as u32, 2 * j as u32);
+                // (Elliptical and diamond maps: pixels on the sphere only.)
                 *p = average4(
-                    prev.pixel(x, y),
-                    prev.pixel(x + 1, y),
-                    prev.pixel(x, y + 1),
-                    prev.pixel(x + 1, y + 1),
+                    prev.pixel_on_sphere(x, y),
+                    prev.pixel_on_sphere(x + 1, y),
+                    prev.pixel_on_sphere(x, y + 1),
+                    prev.pixel_on_sphere(x + 1, y + 1),
                 );
             }
         });

@@ -3,7 +3,7 @@
 //! never per pixel; a trilinear sink that sets its level of detail once per span; and a
 //! sink of sampling positions, for measuring them against the exact mapping.
 
-use super::exact::{sample_at, sample_at_lod};
+use super::exact::{sample_at, sample_at_lod, ExactFootprint};
 use super::kernel::{sample_span, trilinear_span};
 use super::scanline::wrap_u;
 use super::steps::STEP_REGIONS;
@@ -28,6 +28,10 @@ pub(crate) trait Sink {
     /// footprint): the trilinear sink picks its pyramid level from it.
     #[inline(always)]
     fn footprint(&mut self, _dl: Fx, _dv: Fx, _region: usize) {}
+    /// The pixel footprint (level-0 map pixels) of the spans that follow, known as a whole
+    /// (the grid renderer's cells): the trilinear sink picks its pyramid level from it.
+    #[inline(always)]
+    fn set_footprint(&mut self, _footprint: f64) {}
 }
 
 /// [`Sink::span`] pixel by pixel through [`Sink::put`].
@@ -90,13 +94,16 @@ impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CR
 }
 
 /// Trilinear sampling (see `map/pyramid.rs`): the level of detail is set per span from
-/// the span's step and the scanline's vertical footprint.
+/// the span's step and the scanline's vertical footprint; pixels evaluated exactly get
+/// the exact renderer's level of detail, from their own exact footprint.
 pub(crate) struct TriSink<'a> {
     pub(crate) row: &'a mut [u32],
     pub(crate) map: &'a EnvMap,
     /// Vertical footprint per region of this scanline, in level-0 map pixels.
     pub(crate) fy: [f32; STEP_REGIONS],
     pub(crate) lod: i32,
+    /// The frame's exact footprints and this row's index.
+    pub(crate) exact: (&'a ExactFootprint, usize),
 }
 
 impl Sink for TriSink<'_> {
@@ -114,14 +121,20 @@ impl Sink for TriSink<'_> {
     }
     #[inline]
     fn exact(&mut self, x: usize, uv: Option<(f64, f64)>) {
-        // Pole zones and pixels beyond the table: the footprint of the nearest span (or
-        // of the scanline, before the first span).
-        self.row[x] = sample_at_lod(self.map, uv, self.lod);
+        // Pole zones, pixels beyond the table: their own exact footprint, as the exact
+        // renderer (a span's or the scanline's footprint can be far off there: at hfov
+        // 170 the edge columns beyond the wide table see a fraction of the centre's).
+        let (fp, y) = self.exact;
+        self.row[x] = sample_at_lod(self.map, uv, fp.lod(x, y, uv));
     }
     #[inline(always)]
     fn footprint(&mut self, dl: Fx, dv: Fx, region: usize) {
         let fx = dl.unsigned_abs().max(dv.unsigned_abs()) as f64 / FX_ONE as f64;
         self.lod = lod_q8(fx.max(self.fy[region] as f64));
+    }
+    #[inline(always)]
+    fn set_footprint(&mut self, footprint: f64) {
+        self.lod = lod_q8(footprint);
     }
 }
 
@@ -139,5 +152,71 @@ impl Sink for PosSink<'_> {
     }
     fn exact(&mut self, x: usize, uv: Option<(f64, f64)>) {
         self.row[x] = uv;
+    }
+}
+
+/// The sinks of a frame, one per output row, for renderers that draw across rows (the
+/// grid renderer's cells).
+pub(crate) trait RowSinks: Sync {
+    /// The output element: a pixel or a position.
+    type Px: Send;
+    /// The sink of one row.
+    type S<'r>: Sink
+    where
+        Self: 'r;
+    /// The sink writing `row`, output row `y`.
+    fn sink<'r>(&'r self, row: &'r mut [Self::Px], y: usize) -> Self::S<'r>;
+}
+
+/// [`PixelSink`]s of a map.
+pub(crate) struct PixelRows<'a, const BILINEAR: bool, const CROP: bool> {
+    pub(crate) map: &'a EnvMap,
+}
+
+impl<const BILINEAR: bool, const CROP: bool> RowSinks for PixelRows<'_, BILINEAR, CROP> {
+    type Px = u32;
+    type S<'r>
+        = PixelSink<'r, BILINEAR, CROP>
+    where
+        Self: 'r;
+    #[inline]
+    fn sink<'r>(&'r self, row: &'r mut [u32], _y: usize) -> Self::S<'r> {
+        PixelSink { row, map: self.map }
+    }
+}
+
+/// [`TriSink`]s of a map, their level of detail set per cell ([`Sink::set_footprint`]).
+pub(crate) struct TriRows<'a> {
+    pub(crate) map: &'a EnvMap,
+    pub(crate) exact: &'a ExactFootprint,
+}
+
+impl RowSinks for TriRows<'_> {
+    type Px = u32;
+    type S<'r>
+        = TriSink<'r>
+    where
+        Self: 'r;
+    #[inline]
+    fn sink<'r>(&'r self, row: &'r mut [u32], y: usize) -> Self::S<'r> {
+        TriSink {
+            row,
+            map: self.map,
+            fy: [0.0; STEP_REGIONS],
+            lod: 0,
+            exact: (self.exact, y),
+        }
+    }
+}
+
+/// [`PosSink`]s.
+pub(crate) struct PosRows;
+
+impl RowSinks for PosRows {
+    type Px = Option<(f64, f64)>;
+    type S<'r> = PosSink<'r>;
+    #[inline]
+    fn sink<'r>(&'r self, row: &'r mut [Option<(f64, f64)>], _y: usize) -> Self::S<'r> {
+        PosSink { row }
     }
 }

@@ -16,7 +16,9 @@ pub type Segment = ((f64, f64), (f64, f64));
 /// The camera-space depth of a panorama-frame direction: its component along the view
 /// axis.
 fn depth(cam: &Camera, d: DVec3) -> f64 {
-    let f = cam.world_ray(cam.width as f64 / 2.0, cam.height as f64 / 2.0);
+    let f = cam
+        .ray(cam.width as f64 / 2.0, cam.height as f64 / 2.0)
+        .unwrap_or(DVec3::Z);
     d.dot(f) / f.length()
 }
 
@@ -39,19 +41,48 @@ pub fn project_segment(room: &Room, cam: &Camera, a: DVec3, b: DVec3) -> Option<
     Some((cam.project(wa)?, cam.project(wb)?))
 }
 
-/// The room box's 12 edges as seen by `cam` (those in front of it).
+/// Pieces of an edge of a view projection that bends straight lines (fisheye, little
+/// planet, Pannini).
+const CURVE_PIECES: usize = 48;
+
+/// The 3-D segment `a`–`b` (room coordinates) as drawn in `cam`'s image: one clipped
+/// segment for a rectilinear view, else [`CURVE_PIECES`] pieces of the curve it becomes
+/// (pieces the view does not show, or that jump across the image where the projection
+/// wraps, are left out).
+pub fn edge_pieces(room: &Room, cam: &Camera, a: DVec3, b: DVec3) -> Vec<Segment> {
+    if cam.projection().is_rectilinear() {
+        return project_segment(room, cam, a, b).into_iter().collect();
+    }
+    let o = room.camera_position();
+    let at = |t: f64| cam.project(room.to_world(a + (b - a) * t - o));
+    let jump = (cam.width + cam.height) as f64 / 4.0;
+    let mut out = Vec::new();
+    let mut prev = at(0.0);
+    for k in 1..=CURVE_PIECES {
+        let next = at(k as f64 / CURVE_PIECES as f64);
+        if let (Some(p), Some(q)) = (prev, next) {
+            if (p.0 - q.0).hypot(p.1 - q.1) < jump {
+                out.push((p, q));
+            }
+        }
+        prev = next;
+    }
+    out
+}
+
+/// The room box's 12 edges as seen by `cam` (the parts it shows).
 pub fn room_edges(room: &Room, cam: &Camera) -> Vec<Segment> {
     let c = room.corners();
     Room::EDGES
         .iter()
-        .filter_map(|&(i, j)| project_segment(room, cam, c[i], c[j]))
+        .flat_map(|&(i, j)| edge_pieces(room, cam, c[i], c[j]))
         .collect()
 }
 
 /// Where a light (room coordinates) appears in the image, if in front of the camera.
 pub fn project_point(room: &Room, cam: &Camera, p: DVec3) -> Option<(f64, f64)> {
     let w = room.to_world(p - room.camera_position());
-    if depth(cam, w) <= NEAR * w.length() {
+    if cam.projection().is_rectilinear() && depth(cam, w) <= NEAR * w.length() {
         return None;
     }
     cam.project(w)
@@ -66,7 +97,9 @@ pub fn light_marker(
     aim: DVec3,
 ) -> Option<((f64, f64), Option<Segment>)> {
     let at = project_point(room, cam, position)?;
-    let stroke = project_segment(room, cam, position, position + aim * 0.35);
+    let stroke = edge_pieces(room, cam, position, position + aim * 0.35)
+        .into_iter()
+        .reduce(|a, b| (a.0, b.1));
     Some((at, stroke))
 }
 
@@ -194,7 +227,7 @@ pub fn drag_on_surface(
     ];
     let axis = (0..3).min_by(|&a, &b| dist[a].total_cmp(&dist[b]))?;
     let o = room.camera_position();
-    let d = room.to_room(cam.world_ray(px, py));
+    let d = room.to_room(cam.ray(px, py)?);
     if d[axis].abs() < 1e-12 {
         return None;
     }
@@ -222,8 +255,10 @@ pub fn pick_room_edge(
         .iter()
         .enumerate()
         .filter_map(|(k, &(i, j))| {
-            let s = project_segment(room, cam, c[i], c[j])?;
-            let d = segment_distance(s, px, py);
+            let d = edge_pieces(room, cam, c[i], c[j])
+                .into_iter()
+                .map(|s| segment_distance(s, px, py))
+                .min_by(f64::total_cmp)?;
             (d <= radius).then_some((k, d))
         })
         .min_by(|a, b| a.1.total_cmp(&b.1))
@@ -250,7 +285,7 @@ pub fn drag_room_edge(
     let (mut lo, mut hi) = room.bounds();
     let (floor, ceiling) = (lo.y, hi.y);
     let o = room.camera_position();
-    let d = room.to_room(cam.world_ray(px, py));
+    let d = room.to_room(cam.ray(px, py)?);
     let mut set = |a: usize, v: f64| {
         if high(a) {
             hi[a] = v.max(INSIDE);

@@ -51,6 +51,7 @@ struct SceneKey {
     index_step: IndexStep,
     lut: LutChoice,
     cube_renderer: CubeRenderer,
+    heat_map: bool,
     map_generation: u64,
     lights: LightsKey,
     /// The illuminance map's generation, the room shown, the selected light.

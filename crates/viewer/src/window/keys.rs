@@ -47,6 +47,12 @@ pub enum KeyAction {
     ExposureUp,
     /// Auto-rotate on or off.
     AutoRotate,
+    /// The next output projection (rectilinear, stereographic, fisheye, ...).
+    CycleProjection,
+    /// Into the little planet, or back to the view it left.
+    LittlePlanet,
+    /// The error heat map on or off.
+    HeatMap,
     /// Close the window.
     Quit,
 }
@@ -172,6 +178,21 @@ pub const BINDINGS: &[Binding] = &[
         chords: &[plain(Key::Space)],
         action: KeyAction::AutoRotate,
         help: "auto-rotate on/off (starts after the idle delay)",
+    },
+    Binding {
+        chords: &[plain(Key::V)],
+        action: KeyAction::CycleProjection,
+        help: "next projection: rectilinear, stereographic, fisheye, equisolid, Pannini",
+    },
+    Binding {
+        chords: &[plain(Key::L)],
+        action: KeyAction::LittlePlanet,
+        help: "little planet on/off (animated; back to the view it left)",
+    },
+    Binding {
+        chords: &[plain(Key::E)],
+        action: KeyAction::HeatMap,
+        help: "error heat map on/off (sampling error against the exact map)",
     },
     Binding {
         chords: &[ctrl(Key::O)],
@@ -391,6 +412,9 @@ mod tests {
             (K::PageUp, KeyAction::OpenPrevious),
             (K::PageDown, KeyAction::OpenNext),
             (K::Space, KeyAction::AutoRotate),
+            (K::V, KeyAction::CycleProjection),
+            (K::L, KeyAction::LittlePlanet),
+            (K::E, KeyAction::HeatMap),
         ];
         let none = Modifiers::NONE;
         for (k, a) in cases {

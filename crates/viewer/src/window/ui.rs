@@ -9,6 +9,9 @@ use super::quality::{Level, Settings, FRAME_BUDGET_MS};
 use crate::lighting::LightsState;
 use lut_core::{CubeRenderer, Named, Projection, RenderPath, Sampler};
 
+mod projection;
+pub use projection::{heat_label, PANEL_PANNINI_D_MAX};
+
 /// Width of the panel, in points.
 pub const PANEL_WIDTH: f32 = 230.0;
 
@@ -52,6 +55,9 @@ pub struct Readouts {
     pub partial: Option<String>,
     /// Compass heading of the map's longitude 0 (GPano `PoseHeadingDegrees`).
     pub pose_heading: Option<f64>,
+    /// The heat map's (max, mean) sampling-position error, source pixels, while it is
+    /// shown.
+    pub heat: Option<(f64, f64)>,
 }
 
 /// A step of loading a panorama in the window, in order.
@@ -244,6 +250,10 @@ pub struct PanelOutput {
     pub open_scene: bool,
     /// "Save scene…" was pressed.
     pub save_scene: bool,
+    /// An output projection was chosen (or Pannini's d changed).
+    pub view_projection: Option<lut_core::ViewProjection>,
+    /// "Little planet" was pressed.
+    pub planet: bool,
 }
 
 /// The "in use" readout: the cube renderer for a cube map ("cube (scanline)"), else the
@@ -260,8 +270,10 @@ pub fn path_label(p: Option<RenderPath>) -> &'static str {
     match p {
         Some(RenderPath::LutWide) => "wide-FOV LUT",
         Some(RenderPath::LutHigh) => "high-resolution LUT",
+        Some(RenderPath::Grid) => "per-view grid",
         Some(RenderPath::Exact) => "exact (no LUT)",
         Some(RenderPath::Cube(_)) => "cube map",
+        Some(RenderPath::CubeProjected) => "cube map (per pixel)",
         None => "none yet",
     }
 }
@@ -274,6 +286,13 @@ pub fn readout_rows(look: &Look, r: &Readouts) -> Vec<(&'static str, String)> {
         ("pitch", format!("{:8.2}°", look.pitch)),
         ("hfov", format!("{:8.2}°", look.hfov)),
     ];
+    if !look.projection.is_rectilinear() {
+        rows.push(("projection", look.projection.to_string()));
+    }
+    if let Some((max, mean)) = r.heat {
+        rows.push(("error max", format!("{max:.4} px")));
+        rows.push(("error mean", format!("{mean:.5} px")));
+    }
     if let Some(p) = r.pose_heading {
         let h = lut_core::compass_heading(p, look.yaw);
         rows.push((
@@ -350,6 +369,7 @@ pub type Section = fn(&mut egui::Ui, &mut PanelModel<'_>, &mut PanelOutput);
 /// drawing a `CollapsingHeader`).
 pub const SECTIONS: &[Section] = &[
     view_section,
+    projection::projection_section,
     readouts_section,
     rendering_section,
     navigation_section,

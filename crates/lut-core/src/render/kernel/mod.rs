@@ -57,6 +57,10 @@ pub(crate) fn sample_span<const BILINEAR: bool>(
     if m == 0 {
         return;
     }
+    if map.projection.scaled_rows() {
+        // Rows wrap within their own length (`EnvMap::bilinear`): per pixel.
+        return sample_span_slow::<BILINEAR>(map, out, u, v, du, dv);
+    }
     let wfx = (map.width as i64) << FX_BITS;
     let hfx = (map.height as i64) << FX_BITS;
     // Bilinear reads the pixel centres around (u − ½, v − ½).

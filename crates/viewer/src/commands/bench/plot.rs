@@ -64,18 +64,74 @@ pub fn plot(path: &Path, rows: &[Row]) -> Result<()> {
             .map_err(|e| anyhow!("{e}"))?
             .label("budget 0.05 px")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
+        // (renderer, surface, set hfov, sampler): LUT series are the cylinder's by step;
+        // the grid and the diamond table are one point per set (issue 12).
         let series = [
-            ("wide", "bilinear", BLUE, "LUT wide (hfov 90), bilinear"),
-            ("wide", "nearest", CYAN, "LUT wide (hfov 90), nearest"),
-            ("high", "bilinear", GREEN, "LUT high (hfov 50), bilinear"),
-            ("high", "nearest", MAGENTA, "LUT high (hfov 50), nearest"),
+            (
+                "lut",
+                Some("cylinder"),
+                90.0,
+                "bilinear",
+                BLUE,
+                "LUT wide (hfov 90), bilinear",
+            ),
+            (
+                "lut",
+                Some("cylinder"),
+                90.0,
+                "nearest",
+                CYAN,
+                "LUT wide (hfov 90), nearest",
+            ),
+            (
+                "lut",
+                Some("cylinder"),
+                50.0,
+                "bilinear",
+                GREEN,
+                "LUT high (hfov 50), bilinear",
+            ),
+            (
+                "lut",
+                Some("cylinder"),
+                50.0,
+                "nearest",
+                MAGENTA,
+                "LUT high (hfov 50), nearest",
+            ),
+            (
+                "grid",
+                None,
+                90.0,
+                "bilinear",
+                RGBColor(170, 0, 0),
+                "grid (hfov 90), bilinear",
+            ),
+            (
+                "grid",
+                None,
+                50.0,
+                "bilinear",
+                RGBColor(110, 60, 0),
+                "grid (hfov 50), bilinear",
+            ),
+            (
+                "lut",
+                Some("diamond"),
+                90.0,
+                "bilinear",
+                RGBColor(90, 0, 160),
+                "LUT diamond wide (hfov 90), bilinear",
+            ),
         ];
-        for (lut, sampler, color, label) in series {
+        for (renderer, surface, hfov, sampler, color, label) in series {
             let sel: Vec<&Row> = rows
                 .iter()
                 .filter(|r| {
-                    r.renderer == "lut"
-                        && r.lut == Some(lut)
+                    r.renderer == renderer
+                        && r.surface == surface
+                        && r.hfov == hfov
+                        && r.psnr_ss_db.is_none()
                         && r.sampler == sampler
                         && r.max_err_px.is_some()
                 })
@@ -195,6 +251,7 @@ mod tests {
         let lut = |ms: f64, err: f64| Row {
             index_step: serde_json::json!(4),
             lut: Some("wide"),
+            surface: Some("cylinder"),
             max_err_px: Some(err),
             mean_err_px: Some(err / 4.0),
             ..Row::timed(&run, "lut", Sampler::Bilinear, 90.0, 1, &[ms])

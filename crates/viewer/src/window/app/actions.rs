@@ -98,6 +98,12 @@ impl App {
             let fx = self.doc.projection_changed(self.ctl.settings.exposure_ev);
             self.apply(fx.into_iter().collect());
         }
+        if let Some(p) = req.panel.view_projection {
+            self.ctl.set_projection(p);
+        }
+        if req.panel.planet {
+            self.do_action(KeyAction::LittlePlanet, t, el);
+        }
         if req.panel.exposure_changed {
             // Applied while the slider is dragged (the document paces the reloads).
             let fx = self.doc.reload_exposure(self.ctl.settings.exposure_ev);
@@ -180,6 +186,28 @@ impl App {
                     format!("auto-rotate on: starts after {:.0} s idle", a.idle_s)
                 } else {
                     "auto-rotate off".to_string()
+                };
+                self.notices.info(msg, t);
+            }
+            KeyAction::CycleProjection => {
+                let p = self.ctl.cycle_projection(self.ctl.settings.pannini_d);
+                self.notices.info(format!("projection: {p}"), t);
+            }
+            KeyAction::LittlePlanet => {
+                let msg = if self.ctl.toggle_planet(t) {
+                    "little planet (L returns)"
+                } else {
+                    "back from the little planet"
+                };
+                self.notices.info(msg, t);
+            }
+            KeyAction::HeatMap => {
+                let s = &mut self.ctl.settings;
+                s.heat_map = !s.heat_map;
+                let msg = if s.heat_map {
+                    "error heat map on (E: off; legend in the panel)"
+                } else {
+                    "error heat map off"
                 };
                 self.notices.info(msg, t);
             }

@@ -3,16 +3,16 @@
 //! with egui, and decide when the next frame is due.
 
 use super::{App, SceneKey};
-use crate::scene::render_scene;
+use crate::scene::{measure_errors, render_scene};
 use crate::window::dialogs::Chosen;
-use crate::window::input::{resolution_hfov, wheel_notches, Held, Look, HFOV_MAX};
+use crate::window::input::{resolution_hfov, wheel_notches, Held, Look, WIDE_HFOV_MAX};
 use crate::window::keys::{KeyAction, Route};
 use crate::window::overlay::{self, NoticesOutput, ToolbarModel};
 use crate::window::paint::SceneRect;
 use crate::window::quality::{frame_level, FRAME_BUDGET_MS};
 use crate::window::ui::{self, PanelModel, PanelOutput};
 use anyhow::{anyhow, Result};
-use lut_core::{CubeRenderer, RenderPath};
+use lut_core::{CubeRenderer, RenderOptions, RenderPath};
 use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -31,13 +31,6 @@ pub(super) struct FrameRequests {
     pub scene_rect: Option<SceneRect>,
     /// The pointer over the scene, in scene pixels.
     pub cursor: Option<(f64, f64)>,
-}
-
-/// The widest hfov of the output view. Wide output projections (issue 12) hand over
-/// here: when they land, this returns the chosen projection's widest view, and
-/// `Controller::take_zoomed_past_widest` says when the user zoomed out past it.
-fn widest_hfov() -> f64 {
-    HFOV_MAX
 }
 
 impl App {
@@ -203,7 +196,7 @@ impl App {
             (Some(ratio), Some(deg)) => resolution_hfov(deg, self.scene_width, ratio),
             _ => 0.0,
         };
-        self.ctl.set_zoom_range(min, widest_hfov());
+        self.ctl.set_zoom_range(min, WIDE_HFOV_MAX);
     }
 
     pub(super) fn redraw(&mut self, el: &ActiveEventLoop) -> Result<()> {
@@ -250,6 +243,12 @@ impl App {
         };
         self.ctl.set_limit(limit);
         let frame = self.ctl.frame(t);
+        if self.ctl.take_zoomed_past_widest() && frame.look.projection.is_rectilinear() {
+            self.notices.info(
+                "widest rectilinear view: V for a wide projection, L for a little planet",
+                t,
+            );
+        }
         let mut ui_ms = ui_t0.elapsed().as_secs_f64() * 1e3;
         if let Some(r) = scene_rect {
             self.render_scene(r, frame.look, frame.fast);
@@ -392,6 +391,7 @@ impl App {
             index_step: opts.index_step,
             lut: opts.lut,
             cube_renderer: opts.cube,
+            heat_map: s.heat_map,
             map_generation: generation,
             lights: self.lights.key(),
             lit: (
@@ -441,7 +441,12 @@ impl App {
                 return;
             }
         };
-        self.light_scene(lit.as_deref(), view, rect);
+        self.doc.readouts.heat = None;
+        if s.heat_map {
+            self.show_heat_map(view, &opts, rect, k);
+        } else {
+            self.light_scene(lit.as_deref(), view, rect);
+        }
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         self.times.record(level, ms, pixels);
         self.ctl.rendered(degraded);
@@ -472,7 +477,7 @@ impl App {
         if self.print_view {
             println!(
                 "view yaw={:.4} pitch={:.4} hfov={:.4} path={path} sampler={} level={} fast={} \
-                 ms={ms:.2} size={}x{} lights={}",
+                 ms={ms:.2} size={}x{} lights={} proj={}",
                 look.yaw,
                 look.pitch,
                 look.hfov,
@@ -481,8 +486,44 @@ impl App {
                 fast,
                 rect.w,
                 rect.h,
-                self.lights.lights.len()
+                self.lights.lights.len(),
+                look.projection.name()
             );
+        }
+    }
+
+    /// Replace the scene by the heat map of `view` with `opts` (measured at the frame's
+    /// size, `rect` divided by `k`, as the frame was rendered) and put its max and mean in
+    /// the readouts.
+    fn show_heat_map(
+        &mut self,
+        view: lut_core::View,
+        opts: &RenderOptions,
+        rect: SceneRect,
+        k: u32,
+    ) {
+        let Some(cur) = self.doc.current_mut() else {
+            return;
+        };
+        let (sw, sh) = (rect.w.div_ceil(k), rect.h.div_ceil(k));
+        match measure_errors(cur.scene.as_mut(), view, opts, sw, sh) {
+            Ok(em) => {
+                let colors = em.colors();
+                if k == 1 {
+                    self.scene.copy_from_slice(&colors);
+                } else {
+                    crate::window::paint::upscale_bilinear(
+                        &colors,
+                        sw,
+                        sh,
+                        &mut self.scene,
+                        rect.w,
+                        rect.h,
+                    );
+                }
+                self.doc.readouts.heat = Some((em.stats.max, em.stats.mean));
+            }
+            Err(e) => self.doc.set_error(format!("heat map failed: {e}")),
         }
     }
 

@@ -87,8 +87,8 @@ impl App {
             .iter()
             .enumerate()
             .filter_map(|(k, &(i, j))| {
-                let ((x0, y0), (x1, y1)) =
-                    crate::lighting::overlay::project_segment(&room, &cam, c[i], c[j])?;
+                let pieces = crate::lighting::overlay::edge_pieces(&room, &cam, c[i], c[j]);
+                let ((x0, y0), (x1, y1)) = *pieces.get(pieces.len() / 2)?;
                 let (x, y) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
                 let inside = x >= 0.0 && y >= 0.0 && x < r.w as f64 && y < r.h as f64;
                 inside.then(|| format!("{k}={x:.0},{y:.0}"))
