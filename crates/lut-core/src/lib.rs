@@ -148,10 +148,11 @@ pub use cube::{
 
 // Lights.
 pub use light::{
-    detect_format, lux_at, shade_frame, IesError, IesFile, IesFormat, Interpolation, LampSet,
-    LdtError, LdtFile, LdtSymmetry, LdtType, LightError, LightFileFormat, LightScene, LightTable,
-    Luminaire, PhotometricType, Photometry, PhotometrySource, Room, ShadeOptions, Symmetry,
-    TableOptions, Tilt, TiltData, MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES,
+    detect_format, false_color, false_color_position, lux_at, shade_frame, IesError, IesFile,
+    IesFormat, IlluminanceMap, Interpolation, LampSet, LdtError, LdtFile, LdtSymmetry, LdtType,
+    LightError, LightFileFormat, LightScene, LightTable, Luminaire, MapOptions, PhotometricType,
+    Photometry, PhotometrySource, Room, RoomFace, ShadeOptions, Symmetry, TableOptions, Tilt,
+    TiltData, MAP_SHADE_BLOCK, MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES,
 };
 
 /// The module layout's rules, checked from the source: dependencies between the stages
@@ -171,7 +172,7 @@ mod layout {
         ("lut", &["geom", "error", "named"]),
         ("cube", &["geom", "map", "error", "named"]),
         ("render", &["geom", "map", "lut", "cube", "error", "named"]),
-        ("light", &["geom", "render", "error"]),
+        ("light", &["geom", "render", "error", "named"]),
         ("io", &["geom", "map", "lut", "cube", "render", "error"]),
     ];
 

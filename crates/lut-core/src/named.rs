@@ -67,6 +67,7 @@ mod tests {
         round_trip::<Layout>();
         round_trip::<Naming>();
         round_trip::<CubeRenderer>();
+        round_trip::<crate::Interpolation>();
         round_trip::<crate::ViewProjection>();
     }
 

@@ -91,7 +91,21 @@ impl App {
                 .input(|i| i.pointer.press_origin())
                 .or(resp.interact_pointer_pos());
             if let Some(o) = origin {
-                self.ctl.press(to_px(o), size, t);
+                // On a luminaire's marker the drag moves the luminaire.
+                if !self.press_light(to_px(o), size) {
+                    self.ctl.press(to_px(o), size, t);
+                }
+            }
+        }
+        if self.light_drag.is_some() || self.edge_drag.is_some() {
+            match resp.interact_pointer_pos() {
+                Some(p) if resp.dragged_by(primary) => self.drag_light(to_px(p), size),
+                _ => self.end_light_drag(),
+            }
+        }
+        if resp.clicked_by(primary) {
+            if let Some(p) = resp.interact_pointer_pos() {
+                self.click_scene(to_px(p), size);
             }
         }
         if self.ctl.dragging() {
@@ -314,6 +328,10 @@ impl App {
         if self.notices.expire(t) {
             want(now);
         }
+        if self.lit.refining() {
+            // The coarse illuminance map shown: the full one next.
+            want(now);
+        }
         if let Some(n) = next {
             // At most one frame per display refresh, whoever asks.
             let n = n.max(now + self.frame_interval);
@@ -359,10 +377,11 @@ impl App {
         let pixels = u64::from(rect.w) * u64::from(rect.h);
         let s = self.ctl.settings;
         let (level, degraded) = frame_level(s.aa, fast, &self.times, pixels, FRAME_BUDGET_MS);
-        let Some(cur) = self.doc.current_mut() else {
+        if self.doc.current().is_none() {
             return;
-        };
+        }
         let opts = s.render_options(level);
+        let lit = self.update_lit();
         let key = SceneKey {
             look,
             size: (rect.w, rect.h),
@@ -375,10 +394,18 @@ impl App {
             heat_map: s.heat_map,
             map_generation: generation,
             lights: self.lights.key(),
+            lit: (
+                self.lit.generation(),
+                self.lights.show_room,
+                self.lights.selected,
+            ),
         };
         if self.scene_key.as_ref() == Some(&key) {
             return;
         }
+        let Some(cur) = self.doc.current_mut() else {
+            return;
+        };
         self.scene.resize(rect.w as usize * rect.h as usize, 0);
         let t0 = Instant::now();
         let view = look.view();
@@ -418,7 +445,7 @@ impl App {
         if s.heat_map {
             self.show_heat_map(view, &opts, rect, k);
         } else {
-            self.light_scene(view, rect);
+            self.light_scene(lit.as_deref(), view, rect);
         }
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         self.times.record(level, ms, pixels);
@@ -498,16 +525,6 @@ impl App {
             }
             Err(e) => self.doc.set_error(format!("heat map failed: {e}")),
         }
-    }
-
-    /// Light the freshly rendered scene (as `viewer render --light ...` does); a scene
-    /// that cannot be built (a light outside the room) is reported in the panel and the
-    /// frame is left unlit.
-    fn light_scene(&mut self, view: lut_core::View, rect: SceneRect) {
-        let result = self
-            .lights
-            .light_frame(view, &mut self.scene, rect.w, rect.h);
-        self.lights.scene_error = result.err();
     }
 
     /// The illuminance at the pointer for the readout; true when it changed.
