@@ -273,6 +273,7 @@ def main():
     def our(sampler, step):
         for r in ours:
             if (r["renderer"] == "lut" and r["sampler"] == sampler and r["lut"] == "wide"
+                    and r.get("surface", "cylinder") == "cylinder"
                     and r["index_step"] == step and r["hfov"] == 90.0):
                 return r["ms_median"]
         return None

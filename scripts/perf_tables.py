@@ -51,6 +51,13 @@ def run_block(m):
     )
 
 
+def table_name(r):
+    """The table column: wide/high, with the surface when it is not the cylinder."""
+    surface = r.get("surface")
+    name = r["lut"] or "-"
+    return f"{name} {surface}" if surface and surface != "cylinder" else name
+
+
 def bench_table(rows, hfov, lut):
     sel = [r for r in rows if r["hfov"] == hfov and "psnr_ss_db" not in r
            and r["lut"] in (lut, None)]
@@ -65,7 +72,7 @@ def bench_table(rows, hfov, lut):
         ex = r.get("exact_fraction")
         out.append(
             f"| {r['renderer']} | {r['sampler']} | {step_str(r['index_step'])} | "
-            f"{r['lut'] or '-'} | {r['ms_median']:.2f} | {r['ms_min']:.2f} | "
+            f"{table_name(r)} | {r['ms_median']:.2f} | {r['ms_min']:.2f} | "
             f"{r.get('mpix_s', 0):.0f} | {fmt(r['max_err_px'], 4)} | "
             f"{fmt(r['mean_err_px'], 5)} | {fmt(r['psnr_db'], 1)} | "
             f"{'-' if ex is None else f'{ex * 100:.2f}%'} |")

@@ -108,6 +108,43 @@ fn hard_views_within_bound_every_projection() {
     }
 }
 
+/// The diamond table (FIG. 8B) over the hard views, every projection, both tables: the
+/// same bound as the cylinder's.
+#[test]
+fn diamond_table_hard_views_within_bound() {
+    let views = [
+        (0.0, 90.0, 90.0),
+        (37.0, 89.9, 50.0),
+        (-120.0, -89.9, 120.0),
+        (180.0, 0.0, 90.0),
+        (179.9999, 45.0, 100.0),
+        (10.0, 0.0, 1.0),
+        (0.0, -45.0, 150.0),
+        (0.0, 30.0, 170.0),
+    ];
+    for p in Projection::ALL {
+        let (mw, mh) = geometry(p, false);
+        for &(y, pi, hf) in &views {
+            let view = View::new(y, pi, hf).unwrap();
+            for lut in [LutChoice::Auto, LutChoice::Wide, LutChoice::High] {
+                let st = measure(
+                    mw,
+                    mh,
+                    p,
+                    view,
+                    opts(IndexStep::Adaptive, lut, Surface::Diamond),
+                    160,
+                    90,
+                );
+                check(
+                    &format!("diamond {p} {lut:?} yaw {y} pitch {pi} hfov {hf}"),
+                    &st,
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn both_tables_and_the_plane_within_bound() {
     let (mw, mh) = (8192, 4096);
@@ -119,7 +156,7 @@ fn both_tables_and_the_plane_within_bound() {
     ] {
         let view = View::new(y, pi, hf).unwrap();
         for lut in [LutChoice::Wide, LutChoice::High] {
-            for surface in [Surface::Cylinder, Surface::Plane] {
+            for surface in [Surface::Cylinder, Surface::Plane, Surface::Diamond] {
                 let st = measure(
                     mw,
                     mh,
@@ -160,7 +197,8 @@ fn widest_map_supported() {
 proptest! {
     #![proptest_config(ProptestConfig { cases: 96, .. ProptestConfig::default() })]
 
-    /// Random views, sizes, steps and projections: error within the bound everywhere.
+    /// Random views, sizes, steps, projections and table surfaces: error within the bound
+    /// everywhere.
     #[test]
     fn random_views_within_bound(
         yaw in -720.0f64..720.0,
@@ -171,13 +209,15 @@ proptest! {
         step in prop_oneof![Just(1u32), Just(2), Just(4), Just(8), Just(16)],
         pi in 0usize..5,
         big in any::<bool>(),
+        si in prop_oneof![4 => Just(0usize), 1 => Just(1), 2 => Just(2)],
     ) {
         let p = Projection::ALL[pi];
+        let surface = [Surface::Cylinder, Surface::Plane, Surface::Diamond][si];
         let (mw, mh) = geometry(p, big);
         let view = View::new(yaw, pitch, hfov).unwrap();
-        let st = measure(mw, mh, p, view, opts(IndexStep::Fixed(step), LutChoice::Auto, Surface::Cylinder), w, h);
+        let st = measure(mw, mh, p, view, opts(IndexStep::Fixed(step), LutChoice::Auto, surface), w, h);
         prop_assert!(st.max <= BOUND && st.coverage_mismatch == 0,
-            "{p} {mw}x{mh} view {yaw},{pitch},{hfov} {w}x{h} step {step}: max {:.4} at {:?}, mismatches {}",
+            "{p} {mw}x{mh} {surface:?} view {yaw},{pitch},{hfov} {w}x{h} step {step}: max {:.4} at {:?}, mismatches {}",
             st.max, st.worst_pixel, st.coverage_mismatch);
     }
 }

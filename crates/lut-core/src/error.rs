@@ -14,9 +14,32 @@ pub enum ViewError {
         /// The rejected value.
         value: f64,
     },
-    /// hfov is outside the open interval (0, 180).
+    /// hfov is outside the open interval (0, 180) (the rectilinear projection's range).
     #[error("hfov must be in the open interval (0, 180) degrees, got {0}")]
     HfovOutOfRange(f64),
+    /// hfov is outside the range of an output projection other than rectilinear.
+    #[error(
+        "hfov must be in (0, {max}{} degrees for the {projection} view projection, got {hfov}",
+        if *.inclusive { "]" } else { ")" }
+    )]
+    HfovForProjection {
+        /// The rejected hfov.
+        hfov: f64,
+        /// The projection's name.
+        projection: &'static str,
+        /// Its largest hfov.
+        max: f64,
+        /// Whether `max` itself is allowed.
+        inclusive: bool,
+    },
+    /// Pannini's parameter d is negative, not finite or above the limit.
+    #[error("the Pannini parameter d must be a number in [0, {max}], got {d}")]
+    BadPanniniD {
+        /// The rejected value.
+        d: f64,
+        /// The largest accepted.
+        max: f64,
+    },
     /// The output size is zero or above [`crate::MAX_OUTPUT_SIDE`].
     #[error("output size {width}x{height} is invalid: each side must be in 1..={max}")]
     BadSize {

@@ -95,13 +95,16 @@ pub use error::{
 pub use named::{name_list, parse_name, Named};
 
 // Geometry.
-pub use geom::accuracy::{compare_positions, position_error, raw_error, ErrorStats};
+pub use geom::accuracy::{
+    compare_positions, position_error, position_errors, raw_error, ErrorStats,
+};
 pub use geom::camera::{check_size, dir_to_lat_long, lat_long_to_dir, wrap_deg, Camera, View};
 pub use geom::coverage::{compass_heading, compass_point, Coverage, Crop, StartView};
 pub use geom::fixed::{from_fx, to_fx, Fx, FX_BITS, FX_HALF, FX_ONE};
 pub use geom::limits::{MAX_MAP_HEIGHT, MAX_MAP_PIXELS, MAX_MAP_WIDTH, MAX_OUTPUT_SIDE};
 pub use geom::mapping::{exact_uv, exact_uv_at};
 pub use geom::projection::{wrap_pi, Projection};
+pub use geom::view_projection::{ViewProjection, PANNINI_D_DEFAULT, PANNINI_D_MAX};
 pub use geom::viewlimit::{frame_extent, limit_view, view_inside, FrameExtent};
 
 // Maps.
@@ -118,6 +121,10 @@ pub use lut::{LutTable, Surface, TableKind, TableSpec, TABLE_ERROR_BUDGET};
 pub use render::cube::{scanline_runs, CubeRenderer};
 pub use render::exact::{render_exact, render_exact_supersampled, sample_at, sample_at_lod};
 pub use render::frame::Frame;
+pub use render::grid::{GRID_CELL, GRID_CELL_BUDGET, GRID_MIN_CELL};
+pub use render::heat::{
+    heat_color, heat_scale, ErrorMap, HEAT_BACKGROUND, HEAT_MAX, HEAT_MIN, HEAT_MISMATCH,
+};
 pub use render::kernel::{
     active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
     KernelError, KernelInfo, KernelSource, SpanJob, Texels, Window, KERNEL_ENV, MAX_JOBS,
@@ -146,10 +153,11 @@ pub use cube::{
 
 // Lights.
 pub use light::{
-    detect_format, lux_at, shade_frame, IesError, IesFile, IesFormat, Interpolation, LampSet,
-    LdtError, LdtFile, LdtSymmetry, LdtType, LightError, LightFileFormat, LightScene, LightTable,
-    Luminaire, PhotometricType, Photometry, PhotometrySource, Room, ShadeOptions, Symmetry,
-    TableOptions, Tilt, TiltData, MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES,
+    detect_format, false_color, false_color_position, lux_at, shade_frame, IesError, IesFile,
+    IesFormat, IlluminanceMap, Interpolation, LampSet, LdtError, LdtFile, LdtSymmetry, LdtType,
+    LightError, LightFileFormat, LightScene, LightTable, Luminaire, MapOptions, PhotometricType,
+    Photometry, PhotometrySource, Room, RoomFace, ShadeOptions, Symmetry, TableOptions, Tilt,
+    TiltData, MAP_SHADE_BLOCK, MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES,
 };
 
 /// The module layout's rules, checked from the source: dependencies between the stages
@@ -169,7 +177,7 @@ mod layout {
         ("lut", &["geom", "error", "named"]),
         ("cube", &["geom", "map", "error", "named"]),
         ("render", &["geom", "map", "lut", "cube", "error", "named"]),
-        ("light", &["geom", "render", "error"]),
+        ("light", &["geom", "render", "error", "named"]),
         ("io", &["geom", "map", "lut", "cube", "render", "error"]),
     ];
 

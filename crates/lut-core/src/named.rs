@@ -68,12 +68,14 @@ mod tests {
         round_trip::<Naming>();
         round_trip::<CubeRenderer>();
         round_trip::<Kernel>();
+        round_trip::<crate::Interpolation>();
+        round_trip::<crate::ViewProjection>();
     }
 
     #[test]
     fn lists_read_as_prose() {
         assert_eq!(name_list::<Sampler>(), "nearest, bilinear or trilinear");
-        assert_eq!(name_list::<RendererKind>(), "lut or exact");
+        assert_eq!(name_list::<RendererKind>(), "lut, grid or exact");
         assert_eq!(
             unknown_name::<Layout>("layout", "hex"),
             "unknown layout 'hex' (expected files, cross, strip or 3x2)"

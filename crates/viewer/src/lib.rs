@@ -15,6 +15,7 @@
 //! * [`scene`]: a map or a cube map, and [`scene::render_scene`], the one place either
 //!   is rendered.
 //! * [`lighting`]: luminaires lighting a rendered room (`--light`, the panel's lights).
+//! * [`heatmap`]: the error heat map as an image with its legend (`render --error-map`).
 //! * [`output`]: images written atomically.
 //! * [`window`]: winit + softbuffer + egui, all drawn on the CPU.
 
@@ -24,6 +25,7 @@ pub mod args;
 pub mod assets;
 pub mod cli;
 pub mod commands;
+pub mod heatmap;
 pub mod lighting;
 pub mod output;
 pub mod panorama;

@@ -4,7 +4,7 @@
 use clap::Parser;
 use std::process::ExitCode;
 use viewer::cli::{Cli, Command};
-use viewer::commands::{bench, bench_load, convert, ies, render};
+use viewer::commands::{bench, bench_load, convert, ies, lux, render};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -17,6 +17,7 @@ fn main() -> ExitCode {
         Some(Command::Render(a)) => render::run(*a),
         Some(Command::Convert(a)) => convert::run(a),
         Some(Command::Ies(a)) => ies::run(a),
+        Some(Command::Lux(a)) => lux::run(a),
         Some(Command::Bench(a)) => bench::run(a),
         Some(Command::BenchLoad(a)) => bench_load::run(a),
         None => viewer::window::run(cli.open),

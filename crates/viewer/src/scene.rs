@@ -3,7 +3,9 @@
 //! one render entry. `viewer render`, the window (frames and "Save view…") and `viewer
 //! bench` all render through it.
 
-use lut_core::{CubeMap, EnvMap, Frame, RenderOptions, RenderReport, Renderer, View, ViewError};
+use lut_core::{
+    CubeMap, EnvMap, ErrorMap, Frame, RenderOptions, RenderReport, Renderer, View, ViewError,
+};
 
 /// A panorama ready to render, owning its data (and, for a map, its tables).
 pub enum Scene {
@@ -77,6 +79,39 @@ pub fn render_scene(
         SceneRef::Cube(cube) => {
             Renderer::default().render(lut_core::Scene::Cube(cube), view, opts, &mut frame)
         }
+    }
+}
+
+/// The error map ([`lut_core::ErrorMap`]) of the renderer `opts` selects for `view` of
+/// `scene` on a `width × height` output: what `viewer render --error-map` writes and the
+/// window's heat map shows.
+///
+/// # Errors
+/// As [`render_scene`].
+pub fn measure_errors(
+    scene: SceneRef<'_>,
+    view: View,
+    opts: &RenderOptions,
+    width: u32,
+    height: u32,
+) -> Result<ErrorMap, ViewError> {
+    match scene {
+        SceneRef::Map { map, renderer } => ErrorMap::measure(
+            renderer,
+            lut_core::Scene::Map(map),
+            view,
+            opts,
+            width,
+            height,
+        ),
+        SceneRef::Cube(cube) => ErrorMap::measure(
+            &mut Renderer::default(),
+            lut_core::Scene::Cube(cube),
+            view,
+            opts,
+            width,
+            height,
+        ),
     }
 }
 

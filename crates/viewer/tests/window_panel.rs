@@ -26,6 +26,8 @@ struct Overlays<'a> {
     error: Option<&'a str>,
     help: bool,
     toolbar: bool,
+    /// The error heat map on, with these (max, mean) measured.
+    heat: Option<(f64, f64)>,
 }
 
 /// Run `passes` UI passes at `ppp` pixels per point and paint the last one.
@@ -38,7 +40,10 @@ fn paint_panel(
     let ctx = egui::Context::default();
     ctx.set_visuals(egui::Visuals::dark());
     let mut compositor = Compositor::new();
-    let mut settings = Settings::default();
+    let mut settings = Settings {
+        heat_map: over.heat.is_some(),
+        ..Settings::default()
+    };
     let mut projection = None;
     let mut lights = LightsState::default();
     let mut zoom_limit = Some(2.0);
@@ -46,6 +51,7 @@ fn paint_panel(
     let readouts = Readouts {
         map: "test map (256×128, equirect)".into(),
         render_ms: 3.5,
+        heat: over.heat,
         ..Readouts::default()
     };
     let mut frame = vec![0u32; (W * H) as usize];
@@ -258,4 +264,40 @@ fn button_labels_have_glyphs_in_the_default_fonts() {
             );
         }
     }
+}
+
+/// The heat map toggle shows the legend's colour bar in the panel (the colours of
+/// `lut_core::heat_color` from 0.001 to 1 px), and only then.
+#[test]
+fn the_heat_map_legend_is_in_the_panel() {
+    let scale: std::collections::HashSet<u32> = (0..=2000)
+        .map(|i| lut_core::heat_color(10f64.powf(-3.0 + 3.0 * f64::from(i) / 2000.0)))
+        .collect();
+    let count = |over: Overlays<'_>| {
+        let p = paint_panel(1.0, 3, None, over);
+        let scene_w = p.scene.expect("scene").w;
+        p.frame
+            .chunks_exact(W as usize)
+            .flat_map(|row| &row[scene_w as usize + 2..])
+            .filter(|c| scale.contains(c))
+            .count()
+    };
+    let off = count(Overlays::default());
+    let on = count(Overlays {
+        heat: Some((0.0123, 0.0014)),
+        ..Overlays::default()
+    });
+    // A 200×12 point bar, less the budget mark.
+    assert!(on > 1500, "legend pixels {on}");
+    assert!(off < 50, "no legend without the heat map: {off}");
+    let rows = ui::readout_rows(
+        &Look::new(0.0, 0.0, 90.0),
+        &Readouts {
+            heat: Some((0.0123, 0.0014)),
+            ..Readouts::default()
+        },
+    );
+    let row = |k: &str| rows.iter().find(|r| r.0 == k).map(|r| r.1.as_str());
+    assert_eq!(row("error max"), Some("0.0123 px"));
+    assert_eq!(row("error mean"), Some("0.00140 px"));
 }

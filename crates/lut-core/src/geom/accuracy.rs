@@ -11,6 +11,7 @@
 use crate::geom::camera::{Camera, View};
 use crate::geom::mapping::exact_uv;
 use crate::geom::projection::Projection;
+use rayon::prelude::*;
 
 /// Angular-metric position error of `got` against `exact` at latitude `phi`.
 #[inline]
@@ -24,13 +25,20 @@ pub fn position_error(
 ) -> f64 {
     let s = p.row_scale(phi);
     let du = wrap_du(p, w, s, got.0 - exact.0);
-    let scale = if s > 1e-9 {
+    let dv = got.1 - exact.1;
+    ((du * u_scale(p, phi)).powi(2) + dv * dv).sqrt()
+}
+
+/// The factor the metric scales a u difference by at latitude `phi`: `cos φ / s(φ)`
+/// (at most 2; 1 where the row scale vanishes).
+#[inline]
+pub(crate) fn u_scale(p: Projection, phi: f64) -> f64 {
+    let s = p.row_scale(phi);
+    if s > 1e-9 {
         (phi.cos() / s).min(2.0)
     } else {
         1.0
-    };
-    let dv = got.1 - exact.1;
-    ((du * scale).powi(2) + dv * dv).sqrt()
+    }
 }
 
 /// A u difference reduced around the row's wrap: W for 360° maps, s(φ)·W for elliptical
@@ -93,7 +101,8 @@ impl ErrorStats {
 }
 
 /// Compare per-pixel positions (row-major, `None` = background) against the exact map of
-/// `view` for a map of `map_w × map_h` in projection `p`.
+/// `view` for a map of `map_w × map_h` in projection `p` (the summary of
+/// [`position_errors`]).
 pub fn compare_positions(
     positions: &[Option<(f64, f64)>],
     view: View,
@@ -103,41 +112,69 @@ pub fn compare_positions(
     map_w: u32,
     map_h: u32,
 ) -> ErrorStats {
+    position_errors(positions, view, width, height, p, map_w, map_h).1
+}
+
+/// Per-pixel sampling-position errors of `positions` (row-major, `None` = background)
+/// against the exact map of `view`, and their summary: `Some(error)` (angular metric,
+/// source pixels) where both have a map position, `Some(∞)` where only one has (a
+/// coverage mismatch, unless the covered side is within half a pixel of the map's edge:
+/// then `None`), `None` where both show the background. Rows run in parallel; the
+/// summary merges them in row order, so it does not depend on the thread count.
+pub fn position_errors(
+    positions: &[Option<(f64, f64)>],
+    view: View,
+    width: u32,
+    height: u32,
+    p: Projection,
+    map_w: u32,
+    map_h: u32,
+) -> (Vec<Option<f64>>, ErrorStats) {
     let cam = Camera::new(view, width, height);
     let (w, h) = (map_w as f64, map_h as f64);
-    let mut st = ErrorStats::default();
-    let mut sum = 0.0;
-    for y in 0..height {
-        for x in 0..width {
-            let got = positions[(y * width + x) as usize];
-            let ex = exact_uv(&cam, p, w, h, x, y);
-            match (ex, got) {
-                (Some(e), Some(g)) => {
-                    let (_, phi) = cam.pixel_lat_long(x, y);
-                    let err = position_error(p, w, h, phi, e, g);
-                    let raw = raw_error(p, w, phi, e, g);
-                    st.count += 1;
-                    sum += err;
-                    if err > st.max || !err.is_finite() {
-                        st.max = if err.is_finite() { err } else { f64::INFINITY };
-                        st.worst_pixel = (x, y);
+    let mut errors = vec![None; width as usize * height as usize];
+    let rows: Vec<ErrorStats> = errors
+        .par_chunks_mut(width.max(1) as usize)
+        .enumerate()
+        .map(|(y, row)| {
+            let y = y as u32;
+            let mut st = ErrorStats::default();
+            let mut sum = 0.0;
+            for (x, e) in row.iter_mut().enumerate() {
+                let x = x as u32;
+                let got = positions[(y * width + x) as usize];
+                st.count += 1;
+                match (exact_uv(&cam, p, w, h, x, y), got) {
+                    (Some(ex), Some(g)) => {
+                        let phi = cam.pixel_lat_long(x, y).map_or(0.0, |d| d.1);
+                        let err = position_error(p, w, h, phi, ex, g);
+                        sum += err;
+                        if err > st.max || !err.is_finite() {
+                            st.max = if err.is_finite() { err } else { f64::INFINITY };
+                            st.worst_pixel = (x, y);
+                        }
+                        st.max_raw = st.max_raw.max(raw_error(p, w, phi, ex, g));
+                        *e = Some(err);
                     }
-                    st.max_raw = st.max_raw.max(raw);
-                }
-                (None, None) => st.count += 1,
-                (Some(e), None) | (None, Some(e)) => {
-                    // Only a mismatch if the covered side is not right at the edge.
-                    let edge = e.1 < 0.5 || e.1 > h - 0.5;
-                    if !edge {
-                        st.coverage_mismatch += 1;
+                    (None, None) => {}
+                    (Some(c), None) | (None, Some(c)) => {
+                        // Only a mismatch if the covered side is not right at the edge.
+                        if !(c.1 < 0.5 || c.1 > h - 0.5) {
+                            st.coverage_mismatch += 1;
+                            *e = Some(f64::INFINITY);
+                        }
                     }
-                    st.count += 1;
                 }
             }
-        }
+            if st.count > 0 {
+                st.mean = sum / st.count as f64;
+            }
+            st
+        })
+        .collect();
+    let mut st = ErrorStats::default();
+    for r in &rows {
+        st.merge(r);
     }
-    if st.count > 0 {
-        st.mean = sum / st.count as f64;
-    }
-    st
+    (errors, st)
 }

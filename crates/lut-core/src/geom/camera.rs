@@ -1,41 +1,73 @@
-//! The camera of `docs/conventions.md`: yaw/pitch/hfov → rays through output pixel centers.
+//! The camera of `docs/conventions.md`: yaw/pitch/hfov and an output projection → rays
+//! through output pixel centers.
 
 use crate::error::ViewError;
 use crate::geom::limits::MAX_OUTPUT_SIDE;
+use crate::geom::view_projection::ViewProjection;
 use glam::DVec3;
 
-/// A validated view: angles in degrees as the user gives them, normalized.
+/// A validated view: angles in degrees as the user gives them, normalized, and the
+/// output projection.
 ///
 /// * yaw is reduced to (−180, 180] (any finite value is legal),
 /// * pitch is clamped to [−90, 90],
-/// * hfov must lie in the open interval (0, 180).
+/// * hfov must lie in the projection's range: the open interval (0, 180) for the
+///   rectilinear camera ([`View::new`]), up to 360 for the others
+///   ([`View::with_projection`], see [`ViewProjection`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct View {
     yaw: f64,
     pitch: f64,
     hfov: f64,
+    projection: ViewProjection,
 }
 
 impl View {
-    /// Validate and normalize a view.
+    /// Validate and normalize a rectilinear view.
     ///
     /// # Errors
     /// [`ViewError::NonFinite`] for NaN/infinite angles, [`ViewError::HfovOutOfRange`]
     /// for an hfov outside (0, 180).
     pub fn new(yaw_deg: f64, pitch_deg: f64, hfov_deg: f64) -> Result<View, ViewError> {
+        View::with_projection(yaw_deg, pitch_deg, hfov_deg, ViewProjection::Rectilinear)
+    }
+
+    /// Validate and normalize a view in output projection `projection`.
+    ///
+    /// # Errors
+    /// [`ViewError::NonFinite`] for NaN/infinite angles; as [`ViewProjection::check`] for
+    /// an hfov outside the projection's range or a bad Pannini parameter.
+    pub fn with_projection(
+        yaw_deg: f64,
+        pitch_deg: f64,
+        hfov_deg: f64,
+        projection: ViewProjection,
+    ) -> Result<View, ViewError> {
         for (name, value) in [("yaw", yaw_deg), ("pitch", pitch_deg), ("hfov", hfov_deg)] {
             if !value.is_finite() {
                 return Err(ViewError::NonFinite { name, value });
             }
         }
-        if !(hfov_deg > 0.0 && hfov_deg < 180.0) {
-            return Err(ViewError::HfovOutOfRange(hfov_deg));
-        }
+        projection.check(hfov_deg)?;
         Ok(View {
             yaw: wrap_deg(yaw_deg),
             pitch: pitch_deg.clamp(-90.0, 90.0),
             hfov: hfov_deg,
+            projection,
         })
+    }
+
+    /// This view in another output projection (same yaw, pitch and hfov).
+    ///
+    /// # Errors
+    /// As [`View::with_projection`].
+    pub fn projected(self, projection: ViewProjection) -> Result<View, ViewError> {
+        View::with_projection(self.yaw, self.pitch, self.hfov, projection)
+    }
+
+    /// The output projection.
+    pub fn projection(&self) -> ViewProjection {
+        self.projection
     }
 
     /// Yaw in degrees, (−180, 180].
@@ -46,7 +78,7 @@ impl View {
     pub fn pitch_deg(&self) -> f64 {
         self.pitch
     }
-    /// Horizontal field of view in degrees, (0, 180).
+    /// Horizontal field of view in degrees (in the projection's range).
     pub fn hfov_deg(&self) -> f64 {
         self.hfov
     }
@@ -70,6 +102,7 @@ impl Default for View {
             yaw: 0.0,
             pitch: 0.0,
             hfov: 90.0,
+            projection: ViewProjection::Rectilinear,
         }
     }
 }
@@ -109,8 +142,10 @@ pub struct Camera {
     pub width: u32,
     /// Output height in pixels.
     pub height: u32,
-    /// Focal length in pixels: (W/2) / tan(hfov/2).
+    /// Focal length in pixels of the view's projection ([`ViewProjection::focal`];
+    /// (W/2) / tan(hfov/2) for the rectilinear camera).
     pub focal: f64,
+    projection: ViewProjection,
     /// sin and cos of pitch.
     sp: f64,
     cp: f64,
@@ -123,13 +158,15 @@ pub struct Camera {
 impl Camera {
     /// A camera for `view` rendering a `width × height` image.
     pub fn new(view: View, width: u32, height: u32) -> Camera {
-        let focal = (width as f64 / 2.0) / (view.hfov() / 2.0).tan();
+        let projection = view.projection();
+        let focal = projection.focal(width, view.hfov());
         let (sp, cp) = view.pitch().sin_cos();
         let (sy, cy) = view.yaw().sin_cos();
         Camera {
             width,
             height,
             focal,
+            projection,
             sp,
             cp,
             sy,
@@ -143,10 +180,21 @@ impl Camera {
         self.view
     }
 
-    /// Camera-space ray through a point of the image plane (pixel coordinates, pixel
-    /// centers at +0.5): X right, Y up, Z forward.
+    /// The output projection.
+    pub fn projection(&self) -> ViewProjection {
+        self.projection
+    }
+
+    /// Camera-space ray through a point of the rectilinear image plane (pixel
+    /// coordinates, pixel centers at +0.5): X right, Y up, Z forward. For a rectilinear
+    /// view only (the scanline renderers' model); [`Camera::ray`] handles every projection.
     #[inline]
     pub fn camera_ray(&self, px: f64, py: f64) -> DVec3 {
+        debug_assert!(
+            self.projection.is_rectilinear(),
+            "camera_ray of a {} view",
+            self.projection
+        );
         DVec3::new(
             px - self.width as f64 / 2.0,
             self.height as f64 / 2.0 - py,
@@ -154,11 +202,33 @@ impl Camera {
         )
     }
 
-    /// World direction (not normalized) of the ray through image point (px, py): rotated
-    /// by pitch about X (Z toward +Y), then by yaw about Y (Z toward +X).
+    /// World direction (not normalized) of the rectilinear ray through image point
+    /// (px, py): rotated by pitch about X (Z toward +Y), then by yaw about Y (Z toward
+    /// +X). For a rectilinear view only (the LUT's and the cube renderers' model);
+    /// [`Camera::ray`] handles every projection.
     #[inline]
     pub fn world_ray(&self, px: f64, py: f64) -> DVec3 {
-        let d = self.camera_ray(px, py);
+        self.rotate(self.camera_ray(px, py))
+    }
+
+    /// World direction (not normalized) of image point (px, py) (pixel coordinates,
+    /// centers at +0.5) in the view's projection, or `None` where the projection has no
+    /// direction (outside a fisheye's disc). Equal to [`Camera::world_ray`] for a
+    /// rectilinear view.
+    #[inline]
+    pub fn ray(&self, px: f64, py: f64) -> Option<DVec3> {
+        if self.projection == ViewProjection::Rectilinear {
+            return Some(self.world_ray(px, py));
+        }
+        let (cx, cy) = (px - self.width as f64 / 2.0, self.height as f64 / 2.0 - py);
+        self.projection
+            .direction(self.focal, cx, cy)
+            .map(|d| self.rotate(d))
+    }
+
+    /// A camera-space direction turned into the world: by pitch about X, then yaw about Y.
+    #[inline]
+    pub fn rotate(&self, d: DVec3) -> DVec3 {
         // pitch about X
         let y1 = d.y * self.cp + d.z * self.sp;
         let z1 = d.z * self.cp - d.y * self.sp;
@@ -168,14 +238,16 @@ impl Camera {
         DVec3::new(x2, y1, z2)
     }
 
-    /// (λ, φ) of the ray through the center of output pixel (x, y).
+    /// (λ, φ) of the ray through the center of output pixel (x, y), or `None` where the
+    /// projection has no direction.
     #[inline]
-    pub fn pixel_lat_long(&self, x: u32, y: u32) -> (f64, f64) {
-        dir_to_lat_long(self.world_ray(x as f64 + 0.5, y as f64 + 0.5))
+    pub fn pixel_lat_long(&self, x: u32, y: u32) -> Option<(f64, f64)> {
+        self.ray(x as f64 + 0.5, y as f64 + 0.5)
+            .map(dir_to_lat_long)
     }
 
-    /// The inverse of [`Camera::world_ray`]: image-plane position (pixel coordinates) of
-    /// a world direction, or `None` when it is behind the camera.
+    /// The inverse of [`Camera::ray`]: image position (pixel coordinates) of a world
+    /// direction, or `None` when the view does not show it (behind a rectilinear camera).
     pub fn project(&self, d: DVec3) -> Option<(f64, f64)> {
         // undo yaw
         let x1 = d.x * self.cy - d.z * self.sy;
@@ -183,14 +255,10 @@ impl Camera {
         // undo pitch
         let y0 = d.y * self.cp - z1 * self.sp;
         let z0 = z1 * self.cp + d.y * self.sp;
-        if z0 <= 0.0 {
-            return None;
-        }
-        let s = self.focal / z0;
-        Some((
-            x1 * s + self.width as f64 / 2.0,
-            self.height as f64 / 2.0 - y0 * s,
-        ))
+        let (px, py) = self
+            .projection
+            .image_point(self.focal, DVec3::new(x1, y0, z0))?;
+        Some((px + self.width as f64 / 2.0, self.height as f64 / 2.0 - py))
     }
 }
 

@@ -21,7 +21,7 @@
 //!   highest latitude seen is nondecreasing in θ, and so is the lowest: the pitches that
 //!   fit form an interval, found by bisection (always keeping the side that fits).
 
-use crate::geom::camera::{wrap_deg, View};
+use crate::geom::camera::{dir_to_lat_long, wrap_deg, Camera, View};
 use crate::geom::coverage::Coverage;
 
 /// How far the frame reaches, for one pitch: latitude extremes and the half-width in
@@ -90,7 +90,14 @@ fn tans(hfov_deg: f64, width: u32, height: u32) -> (f64, f64) {
 }
 
 /// True when the whole frame of `view` on a `width × height` output lies in `cov`.
+///
+/// Exact for rectilinear views (the analysis of the module docs); for other output
+/// projections the directions of a 65 × 65 lattice of image points spanning the frame
+/// (borders included) are checked, since their frames have no such closed form.
 pub fn view_inside(view: View, width: u32, height: u32, cov: &Coverage) -> bool {
+    if !view.projection().is_rectilinear() {
+        return sampled_inside(view, width, height, cov);
+    }
     let (a, b) = tans(view.hfov_deg(), width, height);
     let e = frame_extent(view.pitch_deg(), a, b);
     let (lo, hi) = cov.lat_range();
@@ -98,6 +105,22 @@ pub fn view_inside(view: View, width: u32, height: u32, cov: &Coverage) -> bool 
         return false;
     }
     cov.full_width() || wrap_deg(view.yaw_deg() - cov.yaw()).abs() + e.half_lon <= cov.hfov() / 2.0
+}
+
+/// [`view_inside`] for a non-rectilinear view: the directions of a lattice of image points.
+fn sampled_inside(view: View, width: u32, height: u32, cov: &Coverage) -> bool {
+    const N: u32 = 64;
+    let cam = Camera::new(view, width, height);
+    (0..=N).all(|i| {
+        (0..=N).all(|j| {
+            let px = width as f64 * i as f64 / N as f64;
+            let py = height as f64 * j as f64 / N as f64;
+            cam.ray(px, py).is_none_or(|d| {
+                let (l, p) = dir_to_lat_long(d);
+                cov.contains(l, p, 1e-4)
+            })
+        })
+    })
 }
 
 /// The interval of pitches at which a frame with tangents (a, b) fits `cov` vertically
@@ -150,7 +173,13 @@ fn bisect_first(lo: f64, hi: f64, ok: impl Fn(f64) -> bool) -> Option<f64> {
 /// The view nearest `view` whose whole frame on a `width × height` output lies inside
 /// `cov` (see the module docs). A view that already fits is returned unchanged; a
 /// coverage so small that no view fits returns `view` unchanged.
+///
+/// Rectilinear views only: a view in another output projection is returned unchanged
+/// (its frame has no closed form here; outside the coverage it shows the background).
 pub fn limit_view(view: View, width: u32, height: u32, cov: &Coverage) -> View {
+    if !view.projection().is_rectilinear() {
+        return view;
+    }
     if view_inside(view, width, height, cov) {
         return view;
     }

@@ -1,4 +1,4 @@
-//! The scanline-coherent look-up table (US 5,748,194, FIGS. 5-8A).
+//! The scanline-coherent look-up table (US 5,748,194, FIGS. 5-8B).
 //!
 //! ## Surface and coordinates
 //! The table lives on a surface of extrusion concentric with the sphere whose axis is
@@ -12,6 +12,12 @@
 //! * [`Surface::Plane`] (FIG. 8A): the plane `z = 1`; a point is `(x, y, 1)`, rows are
 //!   `y = tan a`, columns `x = t / cos a`. It cannot show a scanline at |a| ≥ 90°; such
 //!   scanlines (and everything beyond the table) fall back to exact evaluation.
+//! * [`Surface::Diamond`] (FIG. 8B): an extruded diamond `|y| + |z| = 1`, four planar
+//!   faces; in the stored face `y + z = 1` a point is `(x, r, 1 − r)`. The scanline of
+//!   angle a meets it at the row `r = sin a / (sin a + cos a)` and its pixels are at
+//!   `x = t / (sin a + cos a)`: again one row and one scale per scanline, and a full
+//!   360° of pitch with planar faces. Its grid step is 1/√2 of the cylinder's (so its
+//!   columns are nowhere coarser in t; see `DIAMOND_STEP`).
 //!
 //! Each entry holds the environment-map indices of its surface point for the map's
 //! projection, `Λ = λ · W / 2π` and `V = profile(φ)` (see [`crate::Projection`]), as
@@ -21,6 +27,8 @@
 //! Only `a ∈ [0, π/2]`, `t ≥ 0` is stored. The other seven regions follow by sign and
 //! reflection: `t → −t` negates Λ; `a → −a` negates V; `a → π − a` (behind the viewer)
 //! maps Λ to `W/2 − Λ`. For the plane only the first two apply (a quarter is stored).
+//! The diamond's point for a is the cylinder's direction scaled, so the same eighth
+//! (`r ∈ [0, 1]`, `x ≥ 0`) and the same three rules hold.
 //!
 //! ## Accuracy bookkeeping
 //! At build time every table cell is checked against the exact map. Cells whose bilinear
@@ -36,10 +44,17 @@
 //! map's top edge — are measured against the exact map at five points. The zones are the
 //! same as measuring everything (a unit test compares both for every projection, surface
 //! and table kind); for an 8192-wide map 1.4 % of the wide table's cells and 0.6 % of the
-//! high table's are measured.
+//! high table's are measured. The bounds are derived for the cylinder and the plane (in
+//! `bounds.rs`); the diamond's faces have none yet, so every diamond cell is measured
+//! (its build takes about ten times the cylinder's).
+
+mod bounds;
 
 use crate::geom::projection::Projection;
 use crate::named::Named;
+use bounds::{CellBounds, PROOF_BLOCK};
+#[cfg(test)]
+use bounds::{CellGeom, PROVEN_LIMIT};
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -55,6 +70,8 @@ pub enum Surface {
     Cylinder,
     /// The planar table of FIG. 8A.
     Plane,
+    /// The extruded diamond of FIG. 8B: four planar faces, a full 360° of pitch.
+    Diamond,
 }
 
 impl Surface {
@@ -65,17 +82,19 @@ impl Surface {
 }
 
 impl Named for Surface {
-    const ALL: &'static [Self] = &[Surface::Cylinder, Surface::Plane];
+    const ALL: &'static [Self] = &[Surface::Cylinder, Surface::Plane, Surface::Diamond];
     fn name(self) -> &'static str {
         match self {
             Surface::Cylinder => "cylinder",
             Surface::Plane => "plane",
+            Surface::Diamond => "diamond",
         }
     }
     fn help(self) -> &'static str {
         match self {
             Surface::Cylinder => "Cylinder (FIGS. 5-7)",
             Surface::Plane => "Plane (FIG. 8A)",
+            Surface::Diamond => "Extruded diamond (FIG. 8B): planar faces, full pitch",
         }
     }
 }
@@ -123,6 +142,13 @@ impl TableSpec {
                 surface,
                 step,
                 row_max: FRAC_PI_2,
+                col_max: t_max,
+            },
+            Surface::Diamond => TableSpec {
+                surface,
+                step: step * DIAMOND_STEP,
+                row_max: 1.0,
+                // x = t / (sin a + cos a) ≤ t.
                 col_max: t_max,
             },
             Surface::Plane => {
@@ -179,14 +205,25 @@ impl std::fmt::Debug for LutTable {
 const V_CLAMP: f64 = 32000.0;
 
 /// The `(y, z)` direction components shared by a whole table row (the column coordinate
-/// is the `x` component): `(sin a, cos a)` on the cylinder, `(row, 1)` on the plane.
+/// is the `x` component): `(sin a, cos a)` on the cylinder, `(row, 1)` on the plane,
+/// `(row, 1 − row)` on the diamond's face `y + z = 1`.
 #[inline]
 fn row_yz(surface: Surface, row: f64) -> (f64, f64) {
     match surface {
         Surface::Cylinder => row.sin_cos(),
         Surface::Plane => (row, 1.0),
+        Surface::Diamond => (row, 1.0 - row),
     }
 }
+
+/// The diamond's grid step relative to the cylinder's: a step of the diamond's column
+/// coordinate `x = t/(sin a + cos a)` is up to √2 steps of `t` (at a = 45°), and one of
+/// its row coordinate `r = sin a/(sin a + cos a)` up to two of the angle a; at 1/√2 of
+/// the cylinder's step the columns are nowhere coarser than the cylinder's. Measured on
+/// an 8k map (wide table, hfov 90 views): at the cylinder's step the table is 1.6 MB but
+/// 4.2 % of pixels fall in exact zones, at 1/√2 3.2 MB and 0.5 %, at ½ 6.4 MB and 0.1 %
+/// (the cylinder: 2.5 MB, 1.3 %).
+const DIAMOND_STEP: f64 = std::f64::consts::FRAC_1_SQRT_2;
 
 /// Exact (Λ, V, φ) of the direction `(x, y, z)`, in map pixels, before fixed-point rounding.
 #[inline]
@@ -409,6 +446,8 @@ impl LutTable {
         let rows = match self.spec.surface {
             Surface::Cylinder => 2 * (PI / step).ceil() as usize + 1,
             Surface::Plane => 2 * (self.rows - 1) + 1,
+            // Four faces, each r ∈ [0, 1].
+            Surface::Diamond => 4 * (1.0 / step).ceil() as usize + 1,
         };
         let cols = 2 * (self.cols - 1) + 1;
         rows * cols * std::mem::size_of::<[i32; 2]>() + (rows - 1) * 4
@@ -491,229 +530,6 @@ const MEASURE_POINTS: [(f64, f64); 5] = [
     (0.75, 0.25),
 ];
 
-/// Cells proven together first (one bound over the block; a block that fails is checked
-/// cell by cell).
-const PROOF_BLOCK: usize = 16;
-
-/// A cell whose analytic error bound is at most this is not measured: 10 % under
-/// [`TABLE_ERROR_BUDGET`] (the margin covers the floating-point evaluation of the bound
-/// many times over).
-const PROVEN_LIMIT: f64 = 0.9 * TABLE_ERROR_BUDGET;
-
-/// Largest Q15.16 rounding of a node, map pixels.
-const Q_ROUND: f64 = 0.5 / 65536.0;
-
-/// Bounds, over one cell `[r0, r1] × [t0, t1]`, of the derivatives of λ and φ (radians)
-/// with respect to the table's row (r) and column (t) coordinates, and of tan φ and cos φ.
-#[derive(Debug, Clone, Copy)]
-struct CellGeom {
-    /// sup |λ_rr|, sup |λ_tt| (λ_rr ≥ 0 ≥ λ_tt: they never share a sign).
-    lam_rr: f64,
-    lam_tt: f64,
-    /// sup |φ_r|, sup |φ_t|, sup |φ_rr|, sup |φ_tt|.
-    phi_r: f64,
-    phi_t: f64,
-    phi_rr: f64,
-    phi_tt: f64,
-    /// Bounds tan φ_min ≥ `tan_min` and tan φ_max ≤ `tan_max` (φ ≥ 0 in the stored region).
-    tan_min: f64,
-    tan_max: f64,
-    /// sup cos φ.
-    cos_max: f64,
-}
-
-/// Peak of `2x/(1+x²)²` over x ≥ 0 (at x = 1/√3, 0.64952), rounded up.
-const ATAN_TT_PEAK: f64 = 0.6496;
-
-impl CellGeom {
-    /// The cylinder cell `a ∈ [a0, a1] ⊂ [0, π/2)` given as `s = sin a`, `c = cos a` at both
-    /// ends, `t ∈ [t0, t1]`, `t0 ≥ 0`. The direction is `(t, s, c)`, so with
-    /// `q = √(t² + c²)`:
-    /// `λ = atan2(t, c)`, `λ_tt = −2tc/(c²+t²)²`, `λ_aa = tc(c²+t²+2s²)/(c²+t²)²`;
-    /// `φ = atan2(s, q)`, `φ_a = c/q`, `φ_t = −st/(q(1+t²))`, `φ_aa = −st²/q³`,
-    /// `φ_tt = −s/((1+t²)q) · (c²/q² − 2t²/(1+t²))`; `tan φ = s/q`, `cos φ = q/√(1+t²)`.
-    /// Every factor is monotone in a (s rises, c falls) and in t ≥ 0, so each bound takes
-    /// numerators at their largest and denominators at their smallest corner value (and
-    /// ratios known to be ≤ 1, such as c/q and t/q, at most 1). `None` unless `c1 > 0`.
-    fn cylinder(s0: f64, c0: f64, s1: f64, c1: f64, t0: f64, t1: f64) -> Option<CellGeom> {
-        if !(c1 > 0.0 && s0 >= 0.0 && t0 >= 0.0) {
-            return None;
-        }
-        let q2_min = t0 * t0 + c1 * c1;
-        let q_min = q2_min.sqrt();
-        let q_max = (t1 * t1 + c0 * c0).sqrt();
-        let d_min = q2_min * q2_min;
-        let one_t0 = 1.0 + t0 * t0;
-        Some(CellGeom {
-            lam_rr: t1 * c0 * (c0 * c0 + t1 * t1 + 2.0 * s1 * s1) / d_min,
-            lam_tt: (2.0 * t1 * c0 / d_min).min(ATAN_TT_PEAK / (c1 * c1)),
-            phi_r: (c0 / q_min).min(1.0),
-            phi_t: s1 / one_t0 * (t1 / q_min).min(1.0),
-            phi_rr: s1 / q_min * (t1 * t1 / q2_min).min(1.0),
-            phi_tt: s1 / (one_t0 * q_min)
-                * (c0 * c0 / q2_min)
-                    .min(1.0)
-                    .max(2.0 * t1 * t1 / (1.0 + t1 * t1)),
-            tan_min: s0 / q_max,
-            tan_max: s1 / q_min,
-            cos_max: (q_max / one_t0.sqrt()).min(1.0),
-        })
-    }
-
-    /// The plane cell `y ∈ [y0, y1]`, `x ∈ [x0, x1]`, both ≥ 0. The direction is
-    /// `(x, y, 1)`, so with `m = √(1+x²)`, `D = 1 + x² + y²`:
-    /// `λ = atan(x)`, `λ_xx = −2x/m⁴`, `λ_yy = 0`; `φ = atan2(y, m)`, `φ_y = m/D`,
-    /// `φ_x = −xy/(mD)`, `φ_yy = −2ym/D²`, `φ_xx = −y/(mD) · (1/m² − 2x²/D)`;
-    /// `tan φ = y/m`, `cos φ = m/√D`.
-    fn plane(y0: f64, y1: f64, x0: f64, x1: f64) -> Option<CellGeom> {
-        if !(y0 >= 0.0 && x0 >= 0.0) {
-            return None;
-        }
-        let m0 = (1.0 + x0 * x0).sqrt();
-        let m1 = (1.0 + x1 * x1).sqrt();
-        let d_min = 1.0 + x0 * x0 + y0 * y0;
-        Some(CellGeom {
-            lam_rr: 0.0,
-            lam_tt: (2.0 * x1 / (m0 * m0 * m0 * m0)).min(ATAN_TT_PEAK),
-            phi_r: (m1 / d_min).min(1.0 / m0),
-            phi_t: x1 * y1 / (m0 * d_min),
-            phi_rr: 2.0 * y1 * m1 / (d_min * d_min),
-            phi_tt: y1 / (m0 * d_min) * (1.0 / (m0 * m0)).max(2.0 * x1 * x1 / d_min),
-            tan_min: y0 / m1,
-            tan_max: y1 / m0,
-            cos_max: (m1 / d_min.sqrt()).min(1.0),
-        })
-    }
-}
-
-/// The analytic per-cell error bound of the table's bilinear interpolation.
-///
-/// Bilinear interpolation of a C² function `f` over a cell of side `h` errs by
-/// `e = E_t + E_r`: linear interpolation along t errs by `E_t = −x(h−x)/2 · f_tt(ξ)`, and
-/// the interpolation along r of the rows' errors `−y(h−y)/2 · f_rr(η)` (weights in [0, 1])
-/// adds `E_r`; so `|e| ≤ h²/8 · (sup|f_rr| + sup|f_tt|)`. When `f_tt` and `f_rr` have
-/// opposite signs over the whole cell, so do `E_t` and `E_r`, and `|e| ≤ h²/8 ·
-/// max(sup|f_rr|, sup|f_tt|)`: that holds for λ everywhere in the stored region (cylinder:
-/// `λ_tt = −2tc/q⁴ ≤ 0 ≤ λ_aa`; plane: `λ_yy = 0`), and halves the bound near the poles,
-/// where λ is nearly harmonic. For Λ = λ·W/2π and V = P(φ) (`V_rr = P''φ_r² + P'φ_rr`,
-/// no sign used), plus the nodes' Q15.16 rounding, this bounds |ΔΛ| and |ΔV|;
-/// [`entry_error`] then is at most
-/// `cos φ·|ΔΛ| + (1 + 2·coupling)·|ΔV|` (the u error is scaled by at most cos φ, and for
-/// scaled rows the row scale moves by at most `coupling·|ΔV|` in u, scaled by at most 2).
-struct CellBounds {
-    surface: Surface,
-    p: Projection,
-    h: f64,
-    step: f64,
-    /// `step²/8`.
-    hh8: f64,
-    /// W/2π (Λ pixels per radian).
-    lam_px: f64,
-    /// `1 + 2·coupling` (1 for rectangular rows).
-    v_factor: f64,
-    /// False: measure every cell.
-    enabled: bool,
-}
-
-/// The bound for one row band: its row ends' direction components.
-struct BandBounds<'a> {
-    c: &'a CellBounds,
-    /// Cylinder: (sin a, cos a) at both ends; plane: (y, 1).
-    y0: f64,
-    z0: f64,
-    y1: f64,
-    z1: f64,
-}
-
-impl CellBounds {
-    fn new(surface: Surface, p: Projection, w: f64, h: f64, step: f64, check: ZoneCheck) -> Self {
-        // The proof needs unsaturated entries: |V| ≤ H/2 below the clamp, Λ ≤ W/4 in Q15.16.
-        let fits = h * 0.5 + 1.0 < V_CLAMP && w * 0.25 + 1.0 < i32::MAX as f64 / 65536.0;
-        CellBounds {
-            surface,
-            p,
-            h,
-            step,
-            hh8: step * step / 8.0,
-            lam_px: w / TAU,
-            v_factor: 1.0 + 2.0 * p.row_scale_coupling(w, h),
-            enabled: check == ZoneCheck::Bounded && fits && step > 0.0,
-        }
-    }
-
-    /// The bounds of band `b`, or `None` when its cells must all be measured.
-    fn band(&self, b: usize) -> Option<BandBounds<'_>> {
-        if !self.enabled {
-            return None;
-        }
-        let (y0, z0) = row_yz(self.surface, b as f64 * self.step);
-        let (y1, z1) = row_yz(self.surface, (b + 1) as f64 * self.step);
-        Some(BandBounds {
-            c: self,
-            y0,
-            z0,
-            y1,
-            z1,
-        })
-    }
-
-    /// The error bound of a cell with geometry `g`: `Some(bound)` when it proves the cell
-    /// within [`PROVEN_LIMIT`] (`Some(0)`: the whole cell is above a cylinder map's top, so
-    /// both exact and interpolated positions are background), else `None` (measure it).
-    fn bound(&self, g: &CellGeom) -> Option<f64> {
-        let (w, h) = (self.lam_px * TAU, self.h);
-        // λ_rr and λ_tt never share a sign (see the type's doc): the larger one bounds.
-        let e_lam = self.hh8 * self.lam_px * g.lam_rr.max(g.lam_tt) + Q_ROUND;
-        let (p1, p2) = match self.p {
-            Projection::Equirect | Projection::Elliptical | Projection::Diamond => (h / PI, 0.0),
-            Projection::Sine => (h * 0.5, h * 0.5),
-            Projection::Cylinder => {
-                // P = r tan φ: P' = r sec²φ, P'' = 2r sec²φ tan φ; sec²φ = 1 + tan²φ.
-                let r = w / TAU;
-                let sec2 = 1.0 + g.tan_max * g.tan_max;
-                (r * sec2, 2.0 * r * sec2 * g.tan_max)
-            }
-        };
-        let v_rr = p2 * g.phi_r * g.phi_r + p1 * g.phi_rr;
-        let v_tt = p2 * g.phi_t * g.phi_t + p1 * g.phi_tt;
-        let e_v = self.hh8 * (v_rr + v_tt) + Q_ROUND;
-        if self.p == Projection::Cylinder {
-            // Coverage is |V| ≤ H/2, V = r tan φ ≥ 0 here.
-            let r = w / TAU;
-            if r * g.tan_min > h * 0.5 + 1e-3 {
-                // Every exact V, and so every node and every blend of nodes, is above the
-                // map (H/2 + 1 < the clamp, see `new`).
-                return Some(0.0);
-            }
-            if r * g.tan_max + e_v + 1e-3 > h * 0.5 {
-                return None; // the cell may straddle the map's edge: measure
-            }
-            // (A NaN anywhere makes `bound` NaN, which proves nothing below.)
-        }
-        let bound = g.cos_max * e_lam + self.v_factor * e_v;
-        (bound <= PROVEN_LIMIT).then_some(bound)
-    }
-}
-
-impl BandBounds<'_> {
-    /// The geometry bounds over cells `k0..k1` of this band.
-    fn geom(&self, k0: usize, k1: usize) -> Option<CellGeom> {
-        let step = self.c.step;
-        let (t0, t1) = (k0 as f64 * step, k1 as f64 * step);
-        match self.c.surface {
-            Surface::Cylinder => CellGeom::cylinder(self.y0, self.z0, self.y1, self.z1, t0, t1),
-            Surface::Plane => CellGeom::plane(self.y0, self.y1, t0, t1),
-        }
-    }
-
-    /// An error bound proven for each of cells `k0..k1` (one bound over their union), or
-    /// `None` (check them one by one).
-    #[inline]
-    fn cells(&self, k0: usize, k1: usize) -> Option<f64> {
-        self.geom(k0, k1).and_then(|g| self.c.bound(&g))
-    }
-}
-
 /// Sampling-position error between an exact (Λ, V, φ) and an interpolated (Λ, V), in the
 /// angular metric of [`crate::position_error`], after turning both into map (u, v).
 fn entry_error(p: Projection, w: f64, h: f64, exact: (f64, f64, f64), got: (f64, f64)) -> f64 {
@@ -788,11 +604,11 @@ mod tests {
         assert!(t.max_cell_error() <= TABLE_ERROR_BUDGET);
     }
 
-    /// Every projection, both surfaces, both kinds, on a small map (and the cylinder
+    /// Every projection, every surface, both kinds, on a small map (and the cylinder
     /// projection on a tall and a wide one: its coverage edge is where cells straddle).
     fn configs() -> Vec<(Surface, TableKind, Projection, u32, u32)> {
         let mut v = Vec::new();
-        for surface in [Surface::Cylinder, Surface::Plane] {
+        for surface in [Surface::Cylinder, Surface::Plane, Surface::Diamond] {
             for kind in [TableKind::Wide, TableKind::High] {
                 for p in Projection::ALL {
                     v.push((surface, kind, p, 2048, 1024));
@@ -922,6 +738,7 @@ mod tests {
             let r_top = match surface {
                 Surface::Cylinder => FRAC_PI_2 - 1e-3,
                 Surface::Plane => 1.8,
+                Surface::Diamond => unreachable!("no closed-form bounds for the diamond"),
             };
             for (ri, r0) in (0..60).map(|i| (i, r_top * (1.0 - (i as f64 / 60.0).powi(3)))) {
                 for t0 in [0.0, 1e-3, 0.01, 0.05, 0.2, 0.7, 1.5, 3.7] {
@@ -934,6 +751,7 @@ mod tests {
                             CellGeom::cylinder(s0, c0, s1, c1, t0, t1)
                         }
                         Surface::Plane => CellGeom::plane(r0, r1, t0, t1),
+                        Surface::Diamond => unreachable!(),
                     }
                     .expect("cell below the pole");
                     for i in 0..=4 {
@@ -990,7 +808,14 @@ mod tests {
     fn folded_table_is_an_eighth_of_the_unfolded_one() {
         for w in [2048u32, 4096, 8192, 16384, 65536] {
             for kind in [TableKind::Wide, TableKind::High] {
-                for (surface, fold) in [(Surface::Cylinder, 8.0), (Surface::Plane, 4.0)] {
+                for (surface, fold) in [
+                    (Surface::Cylinder, 8.0),
+                    (Surface::Plane, 4.0),
+                    (Surface::Diamond, 8.0),
+                ] {
+                    if surface == Surface::Diamond && w > 16384 {
+                        continue; // every cell measured: slow to build, nothing new
+                    }
                     let spec = TableSpec::default_for(surface, kind, w);
                     let t = LutTable::build(spec, Projection::Equirect, w, w / 2);
                     let ratio = t.unfolded_bytes() as f64 / t.bytes() as f64;
@@ -1000,6 +825,67 @@ mod tests {
                         "{surface:?} {kind:?} {w}: unfolded/folded = {ratio}"
                     );
                 }
+            }
+        }
+    }
+
+    /// The diamond (FIG. 8B): its surface points are the cylinder's directions (the
+    /// face y + z = 1 meets the plane of angle a at r = sin a/(sin a + cos a), a column x
+    /// there is t = x (sin a + cos a)), and outside the exact zones every cell is within
+    /// the table budget at a 5×5 grid of points (edges included), not only at the five
+    /// measured ones, for every full-sphere projection (a cylindrical map's coverage edge
+    /// is where a point between the measured ones can fall on the other side: the render
+    /// property tests count those pixels).
+    #[test]
+    fn diamond_cells_within_budget_outside_the_zones() {
+        for p in Projection::ALL.into_iter().filter(|p| p.full_sphere()) {
+            let (w, h) = (2048, 1024);
+            let kinds: &[TableKind] = match p {
+                Projection::Equirect => &[TableKind::Wide, TableKind::High],
+                _ => &[TableKind::Wide],
+            };
+            for &kind in kinds {
+                let spec = TableSpec::default_for(Surface::Diamond, kind, w);
+                let t = LutTable::build(spec, p, w, h);
+                let (wf, hf) = (w as f64, h as f64);
+                let step = spec.step;
+                let mut worst = 0.0f64;
+                for b in 0..t.rows - 1 {
+                    for k in 0..t.cols - 1 {
+                        if t.zone(b) >= 0.0 && (k as f64 * step) < t.zone(b) {
+                            continue;
+                        }
+                        let e = |rr: usize, kk: usize| {
+                            let e = t.entries[rr * t.cols + kk];
+                            (e[0] as f64 / 65536.0, e[1] as f64 / 65536.0)
+                        };
+                        let (e00, e01, e10, e11) =
+                            (e(b, k), e(b, k + 1), e(b + 1, k), e(b + 1, k + 1));
+                        for i in 0..5 {
+                            for j in 0..5 {
+                                let (fr, fc) = (i as f64 / 4.0, j as f64 / 4.0);
+                                let (r, x) = ((b as f64 + fr) * step, (k as f64 + fc) * step);
+                                // The same direction on the cylinder.
+                                let a = r.atan2(1.0 - r);
+                                let tc = x * (a.sin() + a.cos());
+                                let ex = exact_entry(Surface::Cylinder, p, wf, hf, a, tc);
+                                let ed = exact_entry(Surface::Diamond, p, wf, hf, r, x);
+                                assert!((ex.0 - ed.0).abs() < 1e-6 && (ex.1 - ed.1).abs() < 1e-6);
+                                let bl = |a: f64, bb: f64, c: f64, d: f64| {
+                                    let top = a + (bb - a) * fc;
+                                    top + (c + (d - c) * fc - top) * fr
+                                };
+                                let got = (
+                                    bl(e00.0, e01.0, e10.0, e11.0),
+                                    bl(e00.1, e01.1, e10.1, e11.1),
+                                );
+                                worst = worst.max(entry_error(p, wf, hf, ed, got));
+                            }
+                        }
+                    }
+                }
+                assert!(worst <= TABLE_ERROR_BUDGET * 1.1, "{p} {kind:?}: {worst}");
+                assert!(t.max_cell_error() <= TABLE_ERROR_BUDGET, "{p} {kind:?}");
             }
         }
     }

@@ -104,6 +104,7 @@ impl EnvMap {
         // Bilinear only wraps for column −1 / W; a non-360° crop never asks for those
         // (see `bilinear_cropped`), so the projection can say equirect in both cases.
         m.projection = Projection::Equirect;
+        m.row_extent.clear();
         m.crop = if crop.is_full() { None } else { Some(crop) };
         Ok(m)
     }

@@ -33,6 +33,9 @@ pub struct EnvMap {
     pub(crate) start_view: Option<crate::geom::coverage::StartView>,
     /// Minification pyramid levels 1.. (see `map/pyramid.rs`), built on first use.
     pub(crate) levels: std::sync::OnceLock<Vec<EnvMap>>,
+    /// Elliptical and diamond maps: per row, the first and last pixel whose centre lies
+    /// in the row's extent (the samplers wrap within it, see `map/sample.rs`).
+    pub(crate) row_extent: Vec<(i64, i64)>,
 }
 
 impl std::fmt::Debug for EnvMap {
@@ -134,6 +137,7 @@ impl EnvMap {
             pose_heading: None,
             start_view: None,
             levels: std::sync::OnceLock::new(),
+            row_extent: row_extents(width, height, projection),
         }
     }
 
@@ -183,4 +187,28 @@ impl EnvMap {
     pub fn covers(&self, v: Fx) -> bool {
         v >= 0 && v <= (self.height as i64) << FX_BITS
     }
+}
+
+/// The pixels of each row of an elliptical or diamond map that lie on the sphere: those
+/// whose centre is within the row's extent `|u − W/2| ≤ s(φ)·W/2` (φ at the row's
+/// centre), as [`Projection::direction`] has it. A row narrower than a pixel keeps its
+/// centre pixel. Empty for the other projections.
+fn row_extents(w: u32, h: u32, p: Projection) -> Vec<(i64, i64)> {
+    if !p.scaled_rows() {
+        return Vec::new();
+    }
+    let (wf, hf) = (w as f64, h as f64);
+    (0..h)
+        .map(|j| {
+            let e = p.row_scale_at_v(j as f64 + 0.5, hf) * wf * 0.5;
+            let lo = (wf * 0.5 - e - 0.5 - 1e-9).ceil().max(0.0) as i64;
+            let hi = (wf * 0.5 + e - 0.5 + 1e-9).floor().min(wf - 1.0) as i64;
+            if lo <= hi {
+                (lo, hi)
+            } else {
+                let c = (w as i64 / 2).min(w as i64 - 1);
+                (c, c)
+            }
+        })
+        .collect()
 }

@@ -139,11 +139,12 @@ fn build_levels(map: &EnvMap) -> Vec<EnvMap> {
             for (i, p) in row.iter_mut().enumerate() {
                 let (x, y) = (2 * i as u32, 2 * j as u32);
                 let (x1, y1) = (right(x), below(y));
+                // (Elliptical and diamond maps: pixels on the sphere only.)
                 *p = average4(
-                    prev.pixel(x, y),
-                    prev.pixel(x1, y),
-                    prev.pixel(x, y1),
-                    prev.pixel(x1, y1),
+                    prev.pixel_on_sphere(x, y),
+                    prev.pixel_on_sphere(x1, y),
+                    prev.pixel_on_sphere(x, y1),
+                    prev.pixel_on_sphere(x1, y1),
                 );
             }
         });

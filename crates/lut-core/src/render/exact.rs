@@ -48,30 +48,57 @@ pub fn sample_at_lod(map: &EnvMap, uv: Option<(f64, f64)>, lod: i32) -> u32 {
     }
 }
 
-/// Exact pixel footprint at (x, y): the larger of the map-pixel distances to the exact
-/// positions of the next pixel to the right and below (u differences taken the short way
-/// round the seam). `None` where the map does not cover the pixel.
-fn exact_footprint(
-    cam: &Camera,
-    proj: Projection,
-    mw: f64,
-    mh: f64,
-    x: f64,
-    y: f64,
-    at: (f64, f64),
-) -> f64 {
-    let (u0, v0) = at;
-    let mut f: f64 = 0.0;
-    for (dx, dy) in [(1.0, 0.0), (0.0, 1.0)] {
-        if let Some((u, v)) = exact_uv_at(cam, proj, mw, mh, x + dx, y + dy) {
-            let mut du = (u - u0).abs();
-            if proj.wraps() && du > mw * 0.5 {
-                du = mw - du;
-            }
-            f = f.max(du).max((v - v0).abs());
+/// The exact level of detail of single pixels: the camera and map geometry of a frame.
+/// The exact renderer's trilinear pixels, and the pixels the LUT and grid renderers
+/// evaluate exactly (pole zones, beyond a table, cells at a disc's edge), take their level
+/// of detail from it, so such a pixel is the exact renderer's pixel.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ExactFootprint {
+    pub(crate) cam: Camera,
+    pub(crate) proj: Projection,
+    pub(crate) mw: f64,
+    pub(crate) mh: f64,
+}
+
+impl ExactFootprint {
+    /// For `view` of a `map_w × map_h` map in `proj` on a `width × height` output.
+    pub(crate) fn new(view: View, width: u32, height: u32, map: (u32, u32, Projection)) -> Self {
+        ExactFootprint {
+            cam: Camera::new(view, width, height),
+            proj: map.2,
+            mw: map.0 as f64,
+            mh: map.1 as f64,
         }
     }
-    f
+
+    /// Exact pixel footprint at image point (x, y) with exact position `at`: the larger
+    /// of the map-pixel distances to the exact positions of the points one pixel to the
+    /// right and one below (u differences taken the short way round the seam).
+    pub(crate) fn footprint(&self, x: f64, y: f64, at: (f64, f64)) -> f64 {
+        let (u0, v0) = at;
+        let mut f: f64 = 0.0;
+        for (dx, dy) in [(1.0, 0.0), (0.0, 1.0)] {
+            if let Some((u, v)) =
+                exact_uv_at(&self.cam, self.proj, self.mw, self.mh, x + dx, y + dy)
+            {
+                let mut du = (u - u0).abs();
+                if self.proj.wraps() && du > self.mw * 0.5 {
+                    du = self.mw - du;
+                }
+                f = f.max(du).max((v - v0).abs());
+            }
+        }
+        f
+    }
+
+    /// The level of detail (Q.8) of pixel (x, y) whose exact position is `uv` (0 where the
+    /// map does not cover it).
+    #[inline]
+    pub(crate) fn lod(&self, x: usize, y: usize, uv: Option<(f64, f64)>) -> i32 {
+        uv.map_or(0, |at| {
+            lod_q8(self.footprint(x as f64 + 0.5, y as f64 + 0.5, at))
+        })
+    }
 }
 
 /// Render `view` of `map` into `frame`, exactly (also reached through
@@ -94,14 +121,11 @@ pub fn render_exact(
     let proj = map.projection();
     if sampler == Sampler::Trilinear && map.crop().is_none() {
         map.pyramid();
+        let fp = ExactFootprint { cam, proj, mw, mh };
         for_each_row(out, width as usize, threads, |y, line| {
             for (x, px) in line.iter_mut().enumerate() {
-                let (xf, yf) = (x as f64 + 0.5, y as f64 + 0.5);
-                let uv = exact_uv_at(&cam, proj, mw, mh, xf, yf);
-                let lod = uv.map_or(0, |at| {
-                    lod_q8(exact_footprint(&cam, proj, mw, mh, xf, yf, at))
-                });
-                *px = sample_at_lod(map, uv, lod);
+                let uv = exact_uv_at(&cam, proj, mw, mh, x as f64 + 0.5, y as f64 + 0.5);
+                *px = sample_at_lod(map, uv, fp.lod(x, y, uv));
             }
         });
         return;

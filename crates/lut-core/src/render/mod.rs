@@ -12,12 +12,22 @@
 //! * per pixel, `kernel/`: the span kernels, with the rules they keep;
 //! * `sink.rs`: where a scanline writes (pixels per sampler, or positions).
 //!
-//! `exact.rs` is the per-pixel reference renderer, `cube.rs` the cube renderers.
+//! `exact.rs` is the per-pixel reference renderer, `cube.rs` the cube renderers,
+//! `heat.rs` the error heat map (per-pixel sampling-position error of a renderer),
+//! `grid.rs` the per-view adaptive grid (every output projection, with the same span
+//! kernels), `projected.rs` cube maps in the other output projections.
+//!
+//! Which draws a frame: [`RendererKind::Exact`] the exact renderer; [`RendererKind::Grid`]
+//! the grid; [`RendererKind::Lut`] the table for rectilinear views and the grid for the
+//! other output projections (they are not scanline-coherent, so no table applies).
 
 pub(crate) mod cube;
 pub(crate) mod exact;
 pub(crate) mod frame;
+pub(crate) mod grid;
+pub(crate) mod heat;
 pub(crate) mod kernel;
+pub(crate) mod projected;
 pub(crate) mod rows;
 pub(crate) mod scanline;
 pub(crate) mod setup;
@@ -26,7 +36,8 @@ pub(crate) mod steps;
 
 use crate::cube::CubeMap;
 use crate::error::ViewError;
-use crate::geom::camera::{check_size, View};
+use crate::geom::camera::{check_size, Camera, View};
+use crate::geom::mapping::exact_uv;
 use crate::geom::projection::Projection;
 use crate::lut::{LutTable, Surface, TableKind, TableSpec};
 use crate::map::envmap::EnvMap;
@@ -34,13 +45,14 @@ use crate::map::pyramid::lod_q8;
 use crate::map::sample::Sampler;
 use crate::named::Named;
 use cube::{render_cube, CubeRenderer};
-use exact::render_exact;
+use exact::{render_exact, ExactFootprint};
 use frame::Frame;
+use grid::{Grid, GridStats};
 use kernel::level_texels;
 use rows::for_each_row;
 use scanline::{render_row, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
-use sink::{Batch, PixelSink, PosSink, Sink, TriSink};
+use sink::{Batch, PixelRows, PixelSink, PosRows, PosSink, RowSinks, Sink, TriRows, TriSink};
 use std::f64::consts::TAU;
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
@@ -70,8 +82,11 @@ impl<'a> From<&'a CubeMap> for Scene<'a> {
 /// Which renderer draws the frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum RendererKind {
-    /// The scanline-coherent LUT renderer.
+    /// The scanline-coherent LUT renderer (rectilinear views; the grid draws the other
+    /// output projections).
     Lut,
+    /// The per-view adaptive grid of exact positions (every output projection).
+    Grid,
     /// The exact per-pixel renderer.
     Exact,
 }
@@ -132,16 +147,20 @@ impl Default for RenderOptions {
 }
 
 impl Named for RendererKind {
-    const ALL: &'static [Self] = &[RendererKind::Lut, RendererKind::Exact];
+    const ALL: &'static [Self] = &[RendererKind::Lut, RendererKind::Grid, RendererKind::Exact];
     fn name(self) -> &'static str {
         match self {
             RendererKind::Lut => "lut",
+            RendererKind::Grid => "grid",
             RendererKind::Exact => "exact",
         }
     }
     fn help(self) -> &'static str {
         match self {
-            RendererKind::Lut => "The scanline-coherent LUT renderer",
+            RendererKind::Lut => {
+                "The scanline-coherent LUT renderer (the grid draws non-rectilinear views)"
+            }
+            RendererKind::Grid => "A per-view adaptive grid of exact positions, any projection",
             RendererKind::Exact => "The exact per-pixel renderer",
         }
     }
@@ -207,10 +226,14 @@ pub enum RenderPath {
     LutWide,
     /// The high-resolution table (plus exact pixels where it cannot be trusted).
     LutHigh,
+    /// The per-view grid (plus exact pixels where no cell can be trusted).
+    Grid,
     /// The exact renderer.
     Exact,
-    /// A cube map, with the given renderer.
+    /// A cube map, with the given renderer (rectilinear views).
     Cube(CubeRenderer),
+    /// A cube map in another output projection, per pixel.
+    CubeProjected,
 }
 
 impl RenderPath {
@@ -219,9 +242,11 @@ impl RenderPath {
         match self {
             RenderPath::LutWide => "lut-wide",
             RenderPath::LutHigh => "lut-high",
+            RenderPath::Grid => "grid",
             RenderPath::Exact => "exact",
             RenderPath::Cube(CubeRenderer::Basic) => "cube-basic",
             RenderPath::Cube(CubeRenderer::Accelerated) => "cube-accelerated",
+            RenderPath::CubeProjected => "cube-per-pixel",
         }
     }
 }
@@ -231,17 +256,33 @@ impl RenderPath {
 pub struct RenderReport {
     /// The path.
     pub path: RenderPath,
-    /// Pixels the LUT path evaluated exactly (pole zones, beyond the table). Equal to
-    /// `pixels` for the exact path, 0 for a cube map.
+    /// Pixels the LUT path evaluated exactly (pole zones, beyond the table), or the grid
+    /// (cells that failed their budget at the smallest size, the edge of a fisheye's
+    /// disc). Equal to `pixels` for the exact path, 0 for a cube map.
     pub exact_pixels: u64,
     /// Pixels in the frame.
     pub pixels: u64,
-    /// Bytes of the table used (0 for exact; the texels for a cube map).
+    /// Bytes of the table used (0 for exact and the grid; the texels for a cube map).
     pub table_bytes: usize,
-    /// Largest index step used on any scanline.
+    /// Largest index step used on any scanline (the grid: the largest interpolated cell
+    /// side, 0 when every pixel was exact or background).
     pub max_step: u32,
-    /// Smallest index step used on any scanline.
+    /// Smallest index step used on any scanline (the grid: the smallest cell side).
     pub min_step: u32,
+}
+
+impl RenderReport {
+    /// The report of the exact renderer: every one of `pixels` evaluated exactly.
+    fn exact(pixels: u64) -> RenderReport {
+        RenderReport {
+            path: RenderPath::Exact,
+            exact_pixels: pixels,
+            pixels,
+            table_bytes: 0,
+            max_step: 1,
+            min_step: 1,
+        }
+    }
 }
 
 /// Sampling positions of a frame, row-major; `None` where the background shows.
@@ -389,6 +430,17 @@ impl Renderer {
         let pixels = width as u64 * height as u64;
         let map = match scene {
             Scene::Map(map) => map,
+            Scene::Cube(cube) if !view.projection().is_rectilinear() => {
+                projected::render_cube(cube, view, opts.sampler, frame, opts.threads);
+                return Ok(RenderReport {
+                    path: RenderPath::CubeProjected,
+                    exact_pixels: 0,
+                    pixels,
+                    table_bytes: cube.bytes(),
+                    max_step: 1,
+                    min_step: 1,
+                });
+            }
             Scene::Cube(cube) => {
                 render_cube(cube, view, opts.sampler, opts.cube, frame, opts.threads);
                 return Ok(RenderReport {
@@ -403,16 +455,12 @@ impl Renderer {
         };
         if opts.renderer == RendererKind::Exact {
             render_exact(map, view, opts.sampler, frame, opts.threads);
-            return Ok(RenderReport {
-                path: RenderPath::Exact,
-                exact_pixels: pixels,
-                pixels,
-                table_bytes: 0,
-                max_step: 1,
-                min_step: 1,
-            });
+            return Ok(RenderReport::exact(pixels));
         }
         self.set_geometry(map.width(), map.height(), map.projection());
+        if uses_grid(view, opts) {
+            return Ok(self.render_grid(map, view, opts, frame));
+        }
         let (setup, report) = self.prepare_frame(view, opts, width, height);
         let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
         let scans = &self.scans;
@@ -431,6 +479,7 @@ impl Renderer {
             // The pyramid is built here once, before the rows run in parallel.
             let (levels, n) = level_texels(map);
             let levels = &levels[..n];
+            let fp = ExactFootprint::new(view, width, height, geometry_of(map));
             for_each_row(out, w, opts.threads, |y, row| {
                 let scan = &scans[y];
                 let mut s = TriSink {
@@ -439,6 +488,7 @@ impl Renderer {
                     levels,
                     fy: scan.fy,
                     lod: 0,
+                    exact: (&fp, y),
                     whole_levels: level_bilinear,
                     batch: Batch::new(),
                 };
@@ -477,9 +527,73 @@ impl Renderer {
         Ok(report)
     }
 
-    /// The map positions the LUT renderer samples for `view` (row-major, `None` =
-    /// background): the same kernel as [`Renderer::render`], writing positions instead of
-    /// pixels. Used to measure the sampling-position error against the exact map.
+    /// The grid renderer's frame (see `grid.rs`): pixels through the sinks of the
+    /// sampler (and partial map), as the LUT path.
+    fn render_grid(
+        &self,
+        map: &EnvMap,
+        view: View,
+        opts: &RenderOptions,
+        frame: &mut Frame<'_>,
+    ) -> RenderReport {
+        let (width, height) = (frame.width(), frame.height());
+        let geometry = geometry_of(map);
+        let setup = Setup::new(width, geometry, 0.0);
+        let grid = Grid::new(view, width, height, &setup, &self.row_scale);
+        let out = frame.pixels_mut();
+        let t = opts.threads;
+        fn px<R: RowSinks<Px = u32>>(g: &Grid, out: &mut [u32], r: &R, t: bool) -> GridStats {
+            g.render(out, r, t, false)
+        }
+        let stats = if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
+            let (levels, n) = level_texels(map); // builds the pyramid
+            let exact = ExactFootprint::new(view, width, height, geometry);
+            let rows = TriRows {
+                map,
+                levels: &levels[..n],
+                exact: &exact,
+            };
+            grid.render(out, &rows, t, true)
+        } else {
+            match (opts.sampler != Sampler::Nearest, map.crop().is_some()) {
+                (true, false) => px(&grid, out, &PixelRows::<true, false> { map }, t),
+                (false, false) => px(&grid, out, &PixelRows::<false, false> { map }, t),
+                (true, true) => px(&grid, out, &PixelRows::<true, true> { map }, t),
+                (false, true) => px(&grid, out, &PixelRows::<false, true> { map }, t),
+            }
+        };
+        grid_report(stats, width, height)
+    }
+
+    /// Build the grid renderer's cells for `view` of a `map_w × map_h` map in
+    /// `projection` on a `width × height` output without drawing them: the per-view part
+    /// of a grid frame alone (its cost is inside every grid frame; `viewer bench` times
+    /// it). The report counts the exact pixels and the cell sizes as a grid frame's does.
+    ///
+    /// # Errors
+    /// [`ViewError::BadSize`] for a bad output size.
+    #[allow(clippy::too_many_arguments)]
+    pub fn build_grid(
+        &mut self,
+        map_w: u32,
+        map_h: u32,
+        projection: Projection,
+        view: View,
+        width: u32,
+        height: u32,
+        threads: bool,
+    ) -> Result<RenderReport, ViewError> {
+        check_size(width, height)?;
+        self.set_geometry(map_w, map_h, projection);
+        let setup = Setup::new(width, (map_w, map_h, projection), 0.0);
+        let grid = Grid::new(view, width, height, &setup, &self.row_scale);
+        Ok(grid_report(grid.build(threads), width, height))
+    }
+
+    /// The map positions the renderer `opts` selects samples for `view` (row-major,
+    /// `None` = background): the same kernels as [`Renderer::render`] (the LUT's or the
+    /// grid's), writing positions instead of pixels; the exact positions for the exact
+    /// renderer. Used to measure the sampling-position error against the exact map.
     ///
     /// # Errors
     /// As [`Renderer::render`].
@@ -497,15 +611,55 @@ impl Renderer {
         check_size(width, height)?;
         check_step(opts.index_step)?;
         self.set_geometry(map_w, map_h, projection);
+        let pixels = width as u64 * height as u64;
+        let mut out = vec![None; pixels as usize];
+        if opts.renderer == RendererKind::Exact {
+            let cam = Camera::new(view, width, height);
+            let (mw, mh) = (map_w as f64, map_h as f64);
+            for_each_row(&mut out, width as usize, opts.threads, |y, row| {
+                for (x, p) in row.iter_mut().enumerate() {
+                    *p = exact_uv(&cam, projection, mw, mh, x as u32, y as u32);
+                }
+            });
+            return Ok((out, RenderReport::exact(pixels)));
+        }
+        if uses_grid(view, opts) {
+            let setup = Setup::new(width, (map_w, map_h, projection), 0.0);
+            let grid = Grid::new(view, width, height, &setup, &self.row_scale);
+            let stats = grid.render(&mut out, &PosRows, opts.threads, false);
+            return Ok((out, grid_report(stats, width, height)));
+        }
         let (setup, report) = self.prepare_frame(view, opts, width, height);
         let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
-        let mut out = vec![None; width as usize * height as usize];
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
-        for_each_row(&mut out, width as usize, true, |y, row| {
+        for_each_row(&mut out, width as usize, opts.threads, |y, row| {
             let mut s = PosSink { row };
             render_row(&scans[y], table, &setup, row_scale, &mut s);
         });
         Ok((out, report))
+    }
+}
+
+/// The map geometry the renderers use: (width, height, projection) of the full panorama.
+fn geometry_of(map: &EnvMap) -> (u32, u32, Projection) {
+    (map.width(), map.height(), map.projection())
+}
+
+/// True when the grid draws a map frame: asked for, or a view the table cannot draw.
+fn uses_grid(view: View, opts: &RenderOptions) -> bool {
+    opts.renderer == RendererKind::Grid
+        || (opts.renderer == RendererKind::Lut && !view.projection().is_rectilinear())
+}
+
+/// The report of a grid frame.
+fn grid_report(stats: GridStats, width: u32, height: u32) -> RenderReport {
+    RenderReport {
+        path: RenderPath::Grid,
+        exact_pixels: stats.exact_pixels,
+        pixels: width as u64 * height as u64,
+        table_bytes: 0,
+        max_step: stats.max_cell,
+        min_step: stats.min_cell,
     }
 }

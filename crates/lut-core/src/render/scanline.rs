@@ -123,9 +123,10 @@ fn lut_run<S: Sink>(
     }
 }
 
-/// Emit `m` pixels from `x` on, starting at (Λ, V) and stepping by (dΛ, dV).
+/// Emit `m` pixels from `x` on, starting at (Λ, V) and stepping by (dΛ, dV) (also the
+/// grid renderer's spans).
 #[inline(always)]
-fn emit<S: Sink>(
+pub(crate) fn emit<S: Sink>(
     fr: &Setup,
     row_scale: &[i64],
     x: i64,

@@ -67,6 +67,30 @@ pub(crate) struct Setup {
     pub(crate) scaled: bool,
 }
 
+impl Setup {
+    /// The constants of a frame `w_out` pixels wide of a `mw × mh` map in `proj`, turned
+    /// by `yaw` radians (0 for renderers whose positions already include the yaw).
+    pub(crate) fn new(w_out: u32, (mw, mh, proj): (u32, u32, Projection), yaw: f64) -> Setup {
+        let (mwf, mhf) = (mw as f64, mh as f64);
+        let yaw_px = yaw / TAU * mwf;
+        Setup {
+            w_out: w_out as usize,
+            proj,
+            mw: mwf,
+            mh: mhf,
+            map_w_fx: (mw as i64) << FX_BITS,
+            half_map_w_fx: (mw as i64) << (FX_BITS - 1),
+            map_h_fx: (mh as i64) << FX_BITS,
+            half_map_h_fx: to_fx(mhf * 0.5),
+            off_fx: to_fx(mwf * 0.5 + yaw_px),
+            yaw_fx: to_fx(yaw_px),
+            yaw,
+            coverage: !proj.full_sphere(),
+            scaled: proj.scaled_rows(),
+        }
+    }
+}
+
 /// Per-frame setup: one [`Scan`] per output row.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn prepare(
@@ -82,23 +106,7 @@ pub(crate) fn prepare(
     let cam = Camera::new(view, width, height);
     let f = cam.focal;
     let (mwf, mhf) = (mw as f64, mh as f64);
-    let yaw = view.yaw();
-    let yaw_px = yaw / TAU * mwf;
-    let frame = Setup {
-        w_out: width as usize,
-        proj,
-        mw: mwf,
-        mh: mhf,
-        map_w_fx: (mw as i64) << FX_BITS,
-        half_map_w_fx: (mw as i64) << (FX_BITS - 1),
-        map_h_fx: (mh as i64) << FX_BITS,
-        half_map_h_fx: to_fx(mhf * 0.5),
-        off_fx: to_fx(mwf * 0.5 + yaw_px),
-        yaw_fx: to_fx(yaw_px),
-        yaw,
-        coverage: !proj.full_sphere(),
-        scaled: proj.scaled_rows(),
-    };
+    let frame = Setup::new(width, (mw, mh, proj), view.yaw());
     let nominal = match opts.index_step {
         IndexStep::Fixed(n) => n,
         IndexStep::Adaptive => ADAPTIVE_MAX_STEP,
@@ -145,6 +153,13 @@ pub(crate) fn prepare(
             Surface::Cylinder => {
                 scan.col_per_x = 1.0 / rho;
                 Some(a)
+            }
+            Surface::Diamond => {
+                // The scanline's plane meets the face y + z = 1 (folded a ∈ [0, π/2]) at
+                // r = sin a/(sin a + cos a); its pixels at x = t/(sin a + cos a).
+                let (s, c) = a.sin_cos();
+                scan.col_per_x = 1.0 / (rho * (s + c));
+                Some(s / (s + c))
             }
             Surface::Plane => {
                 if back || a >= table.row_max() {

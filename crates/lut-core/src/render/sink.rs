@@ -3,7 +3,7 @@
 //! never per pixel; a trilinear sink that sets its level of detail once per span; and a
 //! sink of sampling positions, for measuring them against the exact mapping.
 
-use super::exact::{sample_at, sample_at_lod};
+use super::exact::{sample_at, sample_at_lod, ExactFootprint};
 use super::kernel::{
     sample_span_cropped, sample_spans, trilinear_spans, SpanJob, Texels, MAX_JOBS,
 };
@@ -30,6 +30,10 @@ pub(crate) trait Sink {
     /// footprint): the trilinear sink picks its pyramid level from it.
     #[inline(always)]
     fn footprint(&mut self, _dl: Fx, _dv: Fx, _region: usize) {}
+    /// The pixel footprint (level-0 map pixels) of the spans that follow, known as a whole
+    /// (the grid renderer's cells): the trilinear sink picks its pyramid level from it.
+    #[inline(always)]
+    fn set_footprint(&mut self, _footprint: f64) {}
     /// Write what the sink still holds (called at the end of each row).
     #[inline(always)]
     fn flush(&mut self) {}
@@ -164,7 +168,8 @@ impl<const BILINEAR: bool, const CROP: bool> Drop for PixelSink<'_, BILINEAR, CR
 }
 
 /// Trilinear sampling (see `map/pyramid.rs`): the level of detail is set per span from
-/// the span's step and the scanline's vertical footprint.
+/// the span's step and the scanline's vertical footprint; pixels evaluated exactly get
+/// the exact renderer's level of detail, from their own exact footprint.
 pub(crate) struct TriSink<'a> {
     pub(crate) row: &'a mut [u32],
     pub(crate) map: &'a EnvMap,
@@ -173,6 +178,8 @@ pub(crate) struct TriSink<'a> {
     /// Vertical footprint per region of this scanline, in level-0 map pixels.
     pub(crate) fy: [f32; STEP_REGIONS],
     pub(crate) lod: i32,
+    /// The frame's exact footprints and this row's index.
+    pub(crate) exact: (&'a ExactFootprint, usize),
     /// Whole levels only (bilinear on the level matching the footprint, see
     /// `Renderer::set_bilinear_level`): the level of detail is rounded down to a level.
     pub(crate) whole_levels: bool,
@@ -214,14 +221,26 @@ impl Sink for TriSink<'_> {
     }
     #[inline]
     fn exact(&mut self, x: usize, uv: Option<(f64, f64)>) {
-        // Pole zones and pixels beyond the table: the footprint of the nearest span (or
-        // of the scanline, before the first span).
-        self.row[x] = sample_at_lod(self.map, uv, self.lod);
+        // Pole zones, pixels beyond the table: their own exact footprint, as the exact
+        // renderer (a span's or the scanline's footprint can be far off there: at hfov
+        // 170 the edge columns beyond the wide table see a fraction of the centre's).
+        let (fp, y) = self.exact;
+        let lod = fp.lod(x, y, uv);
+        let lod = if self.whole_levels {
+            (lod + 128) & !0xFF
+        } else {
+            lod
+        };
+        self.row[x] = sample_at_lod(self.map, uv, lod);
     }
     #[inline(always)]
     fn footprint(&mut self, dl: Fx, dv: Fx, region: usize) {
         let fx = dl.unsigned_abs().max(dv.unsigned_abs()) as f64 / FX_ONE as f64;
         self.set_lod(lod_q8(fx.max(self.fy[region] as f64)));
+    }
+    #[inline(always)]
+    fn set_footprint(&mut self, footprint: f64) {
+        self.set_lod(lod_q8(footprint));
     }
 }
 
@@ -246,5 +265,80 @@ impl Sink for PosSink<'_> {
     }
     fn exact(&mut self, x: usize, uv: Option<(f64, f64)>) {
         self.row[x] = uv;
+    }
+}
+
+/// The sinks of a frame, one per output row, for renderers that draw across rows (the
+/// grid renderer's cells).
+pub(crate) trait RowSinks: Sync {
+    /// The output element: a pixel or a position.
+    type Px: Send;
+    /// The sink of one row.
+    type S<'r>: Sink
+    where
+        Self: 'r;
+    /// The sink writing `row`, output row `y`.
+    fn sink<'r>(&'r self, row: &'r mut [Self::Px], y: usize) -> Self::S<'r>;
+}
+
+/// [`PixelSink`]s of a map.
+pub(crate) struct PixelRows<'a, const BILINEAR: bool, const CROP: bool> {
+    pub(crate) map: &'a EnvMap,
+}
+
+impl<const BILINEAR: bool, const CROP: bool> RowSinks for PixelRows<'_, BILINEAR, CROP> {
+    type Px = u32;
+    type S<'r>
+        = PixelSink<'r, BILINEAR, CROP>
+    where
+        Self: 'r;
+    #[inline]
+    fn sink<'r>(&'r self, row: &'r mut [u32], _y: usize) -> Self::S<'r> {
+        PixelSink {
+            row,
+            map: self.map,
+            batch: Batch::new(),
+        }
+    }
+}
+
+/// [`TriSink`]s of a map, their level of detail set per cell ([`Sink::set_footprint`]).
+pub(crate) struct TriRows<'a> {
+    pub(crate) map: &'a EnvMap,
+    /// The map's levels as the span kernels read them (`kernel::level_texels`).
+    pub(crate) levels: &'a [Texels<'a>],
+    pub(crate) exact: &'a ExactFootprint,
+}
+
+impl RowSinks for TriRows<'_> {
+    type Px = u32;
+    type S<'r>
+        = TriSink<'r>
+    where
+        Self: 'r;
+    #[inline]
+    fn sink<'r>(&'r self, row: &'r mut [u32], y: usize) -> Self::S<'r> {
+        TriSink {
+            row,
+            map: self.map,
+            levels: self.levels,
+            fy: [0.0; STEP_REGIONS],
+            lod: 0,
+            exact: (self.exact, y),
+            whole_levels: false,
+            batch: Batch::new(),
+        }
+    }
+}
+
+/// [`PosSink`]s.
+pub(crate) struct PosRows;
+
+impl RowSinks for PosRows {
+    type Px = Option<(f64, f64)>;
+    type S<'r> = PosSink<'r>;
+    #[inline]
+    fn sink<'r>(&'r self, row: &'r mut [Option<(f64, f64)>], _y: usize) -> Self::S<'r> {
+        PosSink { row }
     }
 }

@@ -1,14 +1,18 @@
 //! `viewer render`: one view of a panorama to a PNG, headless.
 
-use crate::args::{named, parse_angle, parse_size, parse_stops, InputArgs, MaxPixelsArg};
-use crate::lighting::{apply_lights, LightArgs};
+use crate::args::{
+    named, named_or_parse, parse_angle, parse_size, parse_stops, InputArgs, MaxPixelsArg,
+};
+use crate::heatmap::{summary, write_error_map};
+use crate::lighting::LightArgs;
 use crate::output::write_png_atomic;
 use crate::panorama::{coverage_text, heading_text, load_cube, load_panorama_partial};
-use crate::scene::{render_scene, Scene};
+use crate::scene::{measure_errors, render_scene, Scene};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use lut_core::{
     IndexStep, LutChoice, RenderOptions, RenderReport, RendererKind, Sampler, Surface, View,
+    ViewProjection, PANNINI_D_DEFAULT,
 };
 use std::path::PathBuf;
 
@@ -16,20 +20,33 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// Panorama image (JPEG, PNG, ...), or a cube map: a folder, six face files, or one
-    /// layout image with --projection cube. The bundled sample when omitted.
+    /// layout image with --projection cube. When omitted, the --scene file's panorama,
+    /// else the bundled sample.
     pub panorama: Vec<PathBuf>,
     /// Output PNG, written atomically.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Yaw in degrees (any value, taken modulo 360; positive turns right).
-    #[arg(long, default_value = "0", value_parser = parse_angle, allow_hyphen_values = true)]
-    pub yaw: f64,
-    /// Pitch in degrees (positive looks up; clamped to [-90, 90]).
-    #[arg(long, default_value = "0", value_parser = parse_angle, allow_hyphen_values = true)]
-    pub pitch: f64,
-    /// Horizontal field of view in degrees, in (0, 180).
-    #[arg(long, default_value = "90", value_parser = parse_angle, allow_hyphen_values = true)]
-    pub hfov: f64,
+    /// Yaw in degrees (any value, taken modulo 360; positive turns right). Default 0, or
+    /// the --scene file's view.
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub yaw: Option<f64>,
+    /// Pitch in degrees (positive looks up; clamped to [-90, 90]). Default 0, or the
+    /// --scene file's view.
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub pitch: Option<f64>,
+    /// Horizontal field of view in degrees: in (0, 180) for the rectilinear view
+    /// projection, up to 360 for the others (see --view-projection). Default 90, or the
+    /// --scene file's view.
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub hfov: Option<f64>,
+    /// How output pixels map to directions. Stereographic at --pitch -90 and a wide
+    /// --hfov (e.g. 300) is the little planet.
+    #[arg(long, default_value = "rectilinear", value_parser = named_or_parse::<ViewProjection>())]
+    pub view_projection: ViewProjection,
+    /// Pannini's parameter d >= 0 (0: rectilinear, 1: classic; default 1), with
+    /// --view-projection pannini.
+    #[arg(long, value_parser = parse_pannini_d, allow_hyphen_values = true)]
+    pub pannini_d: Option<f64>,
     /// Output size WIDTHxHEIGHT (each side 1..=16384).
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -65,15 +82,74 @@ pub struct RenderArgs {
     /// The pixel limit.
     #[command(flatten)]
     pub limit: MaxPixelsArg,
-    /// Print which path rendered and the table size.
+    /// Draw the false colours' legend (a bar with its lux scale) at the right edge; needs
+    /// --false-color (or a scene file with false colours on).
+    #[arg(long)]
+    pub legend: bool,
+    /// Print which path rendered, the table size and the sampling-position error against
+    /// the exact map (max and mean, source pixels).
     #[arg(long, short)]
     pub verbose: bool,
+    /// Also write the error heat map of this view to this PNG: per pixel the
+    /// sampling-position error of the renderer in use against the exact map, on a log
+    /// scale from 0.001 to 1 source pixel, with a legend.
+    #[arg(long, value_name = "OUT.png")]
+    pub error_map: Option<PathBuf>,
     /// Luminaires lighting the scene.
     #[command(flatten)]
     pub lights: LightArgs,
 }
 
+/// Pannini's d: a finite number (the range is checked with the view).
+fn parse_pannini_d(s: &str) -> Result<f64, String> {
+    crate::args::values::finite(s).ok_or_else(|| format!("'{s}' is not a finite number"))
+}
+
 impl RenderArgs {
+    /// Yaw, pitch and hfov: the options given, else the scene file's view, else 0, 0, 90.
+    pub fn angles(&self, scene: Option<crate::lighting::SceneView>) -> (f64, f64, f64) {
+        (
+            self.yaw.or(scene.map(|v| v.yaw)).unwrap_or(0.0),
+            self.pitch.or(scene.map(|v| v.pitch)).unwrap_or(0.0),
+            self.hfov.or(scene.map(|v| v.hfov)).unwrap_or(90.0),
+        )
+    }
+
+    /// The output projection these arguments select (Pannini with its d).
+    ///
+    /// # Errors
+    /// `--pannini-d` with another projection.
+    pub fn view_projection(&self) -> Result<ViewProjection> {
+        match (self.view_projection, self.pannini_d) {
+            (ViewProjection::Pannini(_), d) => {
+                Ok(ViewProjection::Pannini(d.unwrap_or(PANNINI_D_DEFAULT)))
+            }
+            (p, Some(_)) => bail!(
+                "--pannini-d applies to --view-projection pannini, not {}",
+                p.name()
+            ),
+            (p, None) => Ok(p),
+        }
+    }
+
+    /// The view these arguments select (angles not given: the scene file's view's).
+    ///
+    /// # Errors
+    /// Bad angles, an hfov outside the projection's range, a bad Pannini d.
+    pub fn view(&self, scene: Option<crate::lighting::SceneView>) -> Result<View> {
+        let p = self.view_projection()?;
+        let (yaw, pitch, hfov) = self.angles(scene);
+        View::with_projection(yaw, pitch, hfov, p).map_err(|e| {
+            let hint = match e {
+                lut_core::ViewError::HfovOutOfRange(h) if h >= 180.0 => {
+                    " (wider views: --view-projection stereographic, fisheye, equisolid or pannini)"
+                }
+                _ => "",
+            };
+            anyhow::anyhow!("invalid view: {e}{hint}")
+        })
+    }
+
     /// The render options these arguments select.
     pub fn options(&self) -> RenderOptions {
         RenderOptions {
@@ -89,25 +165,31 @@ impl RenderArgs {
 
     /// The panorama these arguments name: a cube map, or a map placed by `--coverage` or
     /// its GPano XMP.
-    fn load(&self) -> Result<Scene> {
+    fn load(&self, from_scene: Option<PathBuf>) -> Result<Scene> {
         let input = &self.input;
-        if input.projection.value.reads_cube(&self.panorama) {
+        let scene_pano: Vec<PathBuf> = from_scene.into_iter().collect();
+        let panorama = if self.panorama.is_empty() {
+            &scene_pano
+        } else {
+            &self.panorama
+        };
+        if input.projection.value.reads_cube(panorama) {
             if input.coverage.is_some() {
                 bail!("--coverage applies to equirectangular panoramas, not cube maps");
             }
-            return Ok(Scene::Cube(load_cube(&self.panorama, input.cube)?));
+            return Ok(Scene::Cube(load_cube(panorama, input.cube)?));
         }
-        if self.panorama.len() > 1 {
+        if panorama.len() > 1 {
             bail!(
                 "{} files given: a single panorama takes one file (use --projection cube for six faces)",
-                self.panorama.len()
+                panorama.len()
             );
         }
         let tone = lut_core::Tone {
             exposure_ev: self.exposure,
         };
         let (map, _) = load_panorama_partial(
-            self.panorama.first().map(|p| p.as_path()),
+            panorama.first().map(|p| p.as_path()),
             &self.limit.options(input.projection.value.map(), tone),
             input.coverage,
             &mut |_| {},
@@ -118,18 +200,65 @@ impl RenderArgs {
 
 /// Run `viewer render`.
 pub fn run(a: RenderArgs) -> Result<()> {
-    let mut view = View::new(a.yaw, a.pitch, a.hfov).context("invalid view")?;
+    let (scene_pano, scene_view) = a.lights.room.scene_panorama()?;
+    let mut view = a.view(scene_view)?;
+    if a.view_limit && !view.projection().is_rectilinear() {
+        bail!(
+            "--view-limit applies to rectilinear views, not --view-projection {}",
+            view.projection().name()
+        );
+    }
     let (w, h) = a.size;
-    let mut scene = a.load()?;
+    // The lights first: a bad luminaire or room is reported before the panorama loads.
+    let mut lights = a.lights.state()?;
+    if a.legend && !lights.false_color {
+        bail!("--legend draws the false colours' scale: give --false-color too");
+    }
+    let mut scene = a.load(scene_pano)?;
     if let (true, Some(map)) = (a.view_limit, scene.env_map()) {
         view = lut_core::limit_view(view, w, h, &map.coverage());
     }
     let mut out = vec![0u32; w as usize * h as usize];
     let report = render_scene(scene.as_mut(), view, &a.options(), &mut out, w, h)?;
+    let error_map = if a.verbose || a.error_map.is_some() {
+        Some(
+            measure_errors(scene.as_mut(), view, &a.options(), w, h)
+                .context("cannot measure the sampling-position error")?,
+        )
+    } else {
+        None
+    };
     if a.verbose {
         print_report(&a, &scene, &report, view);
+        if let Some(em) = &error_map {
+            eprintln!("{}", summary(em));
+        }
     }
-    apply_lights(&a.lights, view, &mut out, w, h)?;
+    if let (Some(path), Some(em)) = (&a.error_map, &error_map) {
+        write_error_map(path, em)?;
+    }
+    let mut lit = crate::lighting::LitCache::default();
+    let t0 = std::time::Instant::now();
+    lights
+        .light_frame_with(&mut lit, false, view, &mut out, w, h)
+        .map_err(anyhow::Error::msg)?;
+    if a.verbose && !lights.lights.is_empty() {
+        eprintln!(
+            "lit from an illuminance map of {:.1} KiB ({} luminaires, map and shading {:.0} ms, exposure {:.0} lx)",
+            lit.bytes() as f64 / 1024.0,
+            lights.lights.len(),
+            t0.elapsed().as_secs_f64() * 1e3,
+            lights.exposure_lux
+        );
+    }
+    if lights.show_room {
+        crate::lighting::overlay::draw_room_and_lights(&lights, view, &mut out, w, h)
+            .map_err(anyhow::Error::msg)?;
+    }
+    if a.legend {
+        crate::lighting::legend::draw_legend(&mut out, w, h, lights.false_color_max)
+            .map_err(anyhow::Error::msg)?;
+    }
     write_png_atomic(&a.output, &out, w, h)?;
     Ok(())
 }
@@ -139,8 +268,13 @@ fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View
     let (w, h) = a.size;
     match scene {
         Scene::Map { map, .. } => {
+            let steps = if report.path == lut_core::RenderPath::Grid {
+                format!("grid cells {}..{} px", report.min_step, report.max_step)
+            } else {
+                format!("index step {}..{}", report.min_step, report.max_step)
+            };
             eprintln!(
-                "rendered {}x{} from {}x{} {} map: path {}, table {} bytes, {} of {} pixels exact, index step {}..{}",
+                "rendered {}x{} from {}x{} {} map: path {}, table {} bytes, {} of {} pixels exact, {steps}",
                 w,
                 h,
                 map.width(),
@@ -150,9 +284,14 @@ fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View
                 report.table_bytes,
                 report.exact_pixels,
                 report.pixels,
-                report.min_step,
-                report.max_step
             );
+            if !view.projection().is_rectilinear() {
+                eprintln!(
+                    "view projection {} (hfov {} degrees)",
+                    view.projection(),
+                    view.hfov_deg()
+                );
+            }
             if let Some(c) = coverage_text(map) {
                 eprintln!("partial panorama: {c}");
             }
@@ -196,7 +335,13 @@ mod tests {
         assert_eq!(a.options(), lut_core::RenderOptions::default());
         assert_eq!(a.options().cube, CubeRenderer::Accelerated);
         assert_eq!(a.size, (1280, 720));
-        assert_eq!((a.yaw, a.pitch, a.hfov), (0.0, 0.0, 90.0));
+        assert_eq!(a.angles(None), (0.0, 0.0, 90.0));
+        let saved = crate::lighting::SceneView {
+            yaw: 10.0,
+            pitch: -20.0,
+            hfov: 70.0,
+        };
+        assert_eq!(a.angles(Some(saved)), (10.0, -20.0, 70.0));
         assert_eq!(a.input.cube_renderer, CubeRenderer::Accelerated);
         assert_eq!(a.input.projection.value, crate::args::ProjectionArg::Auto);
     }
@@ -241,7 +386,45 @@ mod tests {
             a.input.projection.value.map(),
             Some(lut_core::Projection::Elliptical)
         );
-        assert_eq!(a.yaw, -30.0);
+        assert_eq!(a.yaw, Some(-30.0));
+    }
+
+    #[test]
+    fn view_projections_and_their_parameter() {
+        use lut_core::ViewProjection;
+        let a = render_args(&[]).unwrap();
+        assert_eq!(
+            a.view(None).unwrap(),
+            lut_core::View::new(0.0, 0.0, 90.0).unwrap()
+        );
+        assert!(a.error_map.is_none());
+        let a = render_args(&["--view-projection", "pannini", "--hfov", "200"]).unwrap();
+        assert_eq!(
+            a.view(None).unwrap().projection(),
+            ViewProjection::Pannini(1.0)
+        );
+        let a = render_args(&["--view-projection", "pannini", "--pannini-d", "0.25"]).unwrap();
+        assert_eq!(a.view_projection().unwrap(), ViewProjection::Pannini(0.25));
+        let a = render_args(&["--view-projection", "little-planet", "--hfov", "330"]).unwrap();
+        assert_eq!(
+            a.view(None).unwrap().projection(),
+            ViewProjection::Stereographic
+        );
+        let a = render_args(&["--renderer", "grid", "--lut-surface", "diamond"]).unwrap();
+        assert_eq!(a.options().renderer, RendererKind::Grid);
+        assert_eq!(a.options().surface, Surface::Diamond);
+        let a = render_args(&["--view-projection", "fisheye", "--pannini-d", "1"]).unwrap();
+        assert!(a
+            .view(None)
+            .unwrap_err()
+            .to_string()
+            .contains("--pannini-d applies"));
+        let a = render_args(&["--hfov", "250"]).unwrap();
+        let e = a.view(None).unwrap_err().to_string();
+        assert!(
+            e.contains("got 250") && e.contains("--view-projection"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -256,6 +439,9 @@ mod tests {
             ("--projection", "mercator"),
             ("--size", "0x10"),
             ("--yaw", "nan"),
+            ("--view-projection", "mercator"),
+            ("--pannini-d", "inf"),
+            ("--renderer", "table"),
         ] {
             let e = render_args(&[flag, bad]).unwrap_err().to_string();
             assert!(e.contains(bad), "{flag} {bad}: {e}");

@@ -26,11 +26,17 @@
 use super::keys::KeyAction;
 use super::quality::Settings;
 use glam::DVec3;
-use lut_core::{dir_to_lat_long, wrap_deg, Camera, Named, View};
+use lut_core::{wrap_deg, Named, View, ViewProjection};
+
+mod grab;
+mod projection;
+pub use grab::{dir_at, resolution_hfov, solve_grab, solve_grab_in};
+pub use projection::{widest_hfov, PLANET_HFOV, PLANET_S, WIDE_HFOV_MAX};
 
 /// Narrowest horizontal field of view the wheel and keys reach, degrees.
 pub const HFOV_MIN: f64 = 1.0;
-/// Widest horizontal field of view, degrees (rectilinear views stretch badly beyond).
+/// Widest horizontal field of view of a rectilinear view, degrees (they stretch badly
+/// beyond); the wide projections go further ([`widest_hfov`]).
 pub const HFOV_MAX: f64 = 170.0;
 /// hfov of the default start view.
 pub const HFOV_HOME: f64 = 90.0;
@@ -81,24 +87,37 @@ pub struct Look {
     pub yaw: f64,
     /// Pitch in [−90, 90].
     pub pitch: f64,
-    /// Horizontal field of view in [`HFOV_MIN`], [`HFOV_MAX`].
+    /// Horizontal field of view in [`HFOV_MIN`], [`widest_hfov`] of the projection.
     pub hfov: f64,
+    /// The output projection (issue 12): rectilinear unless the user picks another.
+    pub projection: ViewProjection,
 }
 
 impl Look {
-    /// A look with its angles normalized and clamped.
+    /// A rectilinear look with its angles normalized and clamped.
     pub fn new(yaw: f64, pitch: f64, hfov: f64) -> Look {
+        Look::in_projection(yaw, pitch, hfov, ViewProjection::Rectilinear)
+    }
+
+    /// A look in `projection`, hfov clamped to its [`widest_hfov`].
+    pub fn in_projection(yaw: f64, pitch: f64, hfov: f64, projection: ViewProjection) -> Look {
         Look {
             yaw: wrap_deg(yaw),
             pitch: pitch.clamp(-90.0, 90.0),
-            hfov: hfov.clamp(HFOV_MIN, HFOV_MAX),
+            hfov: hfov.clamp(HFOV_MIN, widest_hfov(projection)),
+            projection,
         }
+    }
+
+    /// This look's projection at another yaw, pitch and hfov (normalized and clamped).
+    pub fn moved(&self, yaw: f64, pitch: f64, hfov: f64) -> Look {
+        Look::in_projection(yaw, pitch, hfov, self.projection)
     }
 
     /// The lut-core view. A `Look` always holds finite, in-range angles, so this cannot
     /// fail; the fallback keeps it total anyway.
     pub fn view(&self) -> View {
-        View::new(self.yaw, self.pitch, self.hfov).unwrap_or_default()
+        View::with_projection(self.yaw, self.pitch, self.hfov, self.projection).unwrap_or_default()
     }
 }
 
@@ -216,76 +235,6 @@ pub fn wheel_notches(unit: egui::MouseWheelUnit, delta_y: f32) -> f64 {
     }
 }
 
-/// The narrowest hfov at which one map pixel covers `screen_px_per_map_px` screen pixels
-/// at the center of a `scene_width`-pixel view, for a map whose pixels span
-/// `map_px_deg` degrees (360 / width for a map, 90 / face size for a cube map). With
-/// focal length f (pixels), a center pixel spans 1/f radians; f = ratio / map pixel.
-pub fn resolution_hfov(map_px_deg: f64, scene_width: u32, screen_px_per_map_px: f64) -> f64 {
-    let map_px = map_px_deg.to_radians();
-    if !(map_px > 0.0 && screen_px_per_map_px > 0.0) || scene_width == 0 {
-        return HFOV_MIN;
-    }
-    let f = screen_px_per_map_px / map_px;
-    (2.0 * (f64::from(scene_width) / 2.0 / f).atan())
-        .to_degrees()
-        .clamp(HFOV_MIN, HFOV_MAX)
-}
-
-/// World direction (unit) through image-plane point `pos` of a `size` scene for `look`.
-pub fn dir_at(look: &Look, pos: (f64, f64), size: (u32, u32)) -> DVec3 {
-    Camera::new(look.view(), size.0.max(1), size.1.max(1))
-        .world_ray(pos.0, pos.1)
-        .normalize_or_zero()
-}
-
-/// Yaw and pitch (degrees) that put world direction `dir` at image-plane point `pos` of a
-/// `size` scene with field of view `hfov`, pitch clamped to ±90°. Of the two exact
-/// solutions the one nearer `prev_pitch` wins; when no pitch within ±90° reaches (a
-/// direction near a pole under a cursor near the edge), the nearest one is taken.
-pub fn solve_grab(
-    dir: DVec3,
-    pos: (f64, f64),
-    size: (u32, u32),
-    hfov: f64,
-    prev_pitch: f64,
-) -> (f64, f64) {
-    let base = Look::new(0.0, 0.0, hfov);
-    let cam = Camera::new(base.view(), size.0.max(1), size.1.max(1));
-    let c = cam.camera_ray(pos.0, pos.1).normalize_or_zero();
-    let d = dir.normalize_or_zero();
-    // Pitching the camera ray c by p gives height c.y cos p + c.z sin p = R sin(α + p);
-    // it must equal the target's height d.y (yaw does not change heights).
-    let r = (c.y * c.y + c.z * c.z).sqrt();
-    let alpha = c.y.atan2(c.z);
-    let half_pi = std::f64::consts::FRAC_PI_2;
-    let pitch = if r <= 1e-12 {
-        prev_pitch.to_radians()
-    } else if (d.y / r).abs() >= 1.0 {
-        (half_pi.copysign(d.y) - alpha).clamp(-half_pi, half_pi)
-    } else {
-        let a = (d.y / r).asin();
-        let cands = [a - alpha, std::f64::consts::PI - a - alpha].map(|p| {
-            // Into (−π, π], then nearest legal pitch.
-            let p = wrap_deg(p.to_degrees()).to_radians();
-            (p, p.clamp(-half_pi, half_pi))
-        });
-        let prev = prev_pitch.to_radians();
-        // Prefer exact solutions (p == clamped) and, among them, the one nearest `prev`.
-        let score = |(p, q): (f64, f64)| (p - q).abs() * 1e3 + (q - prev).abs();
-        if score(cands[0]) <= score(cands[1]) {
-            cands[0].1
-        } else {
-            cands[1].1
-        }
-    };
-    let (sp, cp) = pitch.sin_cos();
-    let z1 = c.z * cp - c.y * sp;
-    let (lambda_d, _) = dir_to_lat_long(d);
-    let lambda_c = c.x.atan2(z1);
-    let yaw = wrap_deg((lambda_d - lambda_c).to_degrees());
-    (yaw, pitch.to_degrees())
-}
-
 /// A drag in progress.
 #[derive(Debug, Clone, Copy)]
 enum Drag {
@@ -353,6 +302,8 @@ pub struct Controller {
     last_input: f64,
     /// Auto-rotation is turning the view now.
     rotating: bool,
+    /// The little planet (`projection.rs`): the look to return to and the transition.
+    planet: Option<projection::Planet>,
 }
 
 impl Controller {
@@ -378,6 +329,7 @@ impl Controller {
             frame_s: DEFAULT_FRAME_S,
             last_input: f64::NEG_INFINITY,
             rotating: false,
+            planet: None,
         }
     }
 
@@ -389,7 +341,11 @@ impl Controller {
         self.zoom_anim = None;
         // A jump to another panorama is not motion: no speed is measured across it.
         self.prev_frame = None;
-        self.look = Look::new(home.yaw, home.pitch, self.clamp_hfov(home.hfov));
+        // The projection the user picked stays (a little planet's return view goes).
+        self.planet = None;
+        self.look = self
+            .look
+            .moved(home.yaw, home.pitch, self.clamp_hfov(home.hfov));
         self.apply_limit();
     }
 
@@ -406,20 +362,21 @@ impl Controller {
     }
 
     /// Keep hfov within `min`..=`max` from now on (the map's resolution limit and the
-    /// widest view), and pull the current view in at once.
+    /// widest view; the projection's [`widest_hfov`] holds too), and pull the current
+    /// view in at once.
     pub fn set_zoom_range(&mut self, min: f64, max: f64) {
-        let max = max.clamp(HFOV_MIN, HFOV_MAX);
+        let max = max.clamp(HFOV_MIN, WIDE_HFOV_MAX);
         let min = min.clamp(HFOV_MIN, max);
         self.zoom_range = (min, max);
         let h = self.clamp_hfov(self.look.hfov);
         if h != self.look.hfov {
-            self.look = Look::new(self.look.yaw, self.look.pitch, h);
+            self.look = self.look.moved(self.look.yaw, self.look.pitch, h);
         }
     }
 
     /// The hfov range in force.
     pub fn zoom_range(&self) -> (f64, f64) {
-        self.zoom_range
+        (self.zoom_range.0.min(self.widest()), self.widest())
     }
 
     /// True (once) when a zoom out was stopped at the widest view since the last call:
@@ -429,7 +386,13 @@ impl Controller {
     }
 
     fn clamp_hfov(&self, hfov: f64) -> f64 {
-        hfov.clamp(self.zoom_range.0, self.zoom_range.1)
+        let widest = self.widest();
+        hfov.clamp(self.zoom_range.0.min(widest), widest)
+    }
+
+    /// The widest hfov now: the zoom range's, at most the projection's [`widest_hfov`].
+    fn widest(&self) -> f64 {
+        self.zoom_range.1.min(widest_hfov(self.look.projection))
     }
 
     /// Keep every edge of a `size` scene inside `coverage` from now on (`None`: no
@@ -445,11 +408,12 @@ impl Controller {
         let Some((cov, (w, h))) = self.limit else {
             return;
         };
-        if w == 0 || h == 0 {
+        // The limit is a rectilinear frame's (wide projections show the background).
+        if w == 0 || h == 0 || !self.look.projection.is_rectilinear() {
             return;
         }
         let v = lut_core::limit_view(self.look.view(), w, h, &cov);
-        let l = Look::new(v.yaw_deg(), v.pitch_deg(), v.hfov_deg());
+        let l = self.look.moved(v.yaw_deg(), v.pitch_deg(), v.hfov_deg());
         if l != self.look {
             if l.yaw != self.look.yaw {
                 self.velocity.0 = 0.0;
@@ -480,6 +444,7 @@ impl Controller {
         self.last_input = t;
         self.rotating = false;
         self.zoom_anim = None;
+        self.finish_planet_transition();
     }
 
     /// The mouse button went down at `pos` in a `size` scene.
@@ -510,10 +475,13 @@ impl Controller {
         self.last_input = t;
         match &mut self.drag {
             Some(Drag::Grab { dir }) => {
-                let (yaw, pitch) = solve_grab(*dir, pos, size, self.look.hfov, self.look.pitch);
+                let Some((yaw, pitch)) = solve_grab_in(*dir, pos, size, self.look, self.look.pitch)
+                else {
+                    return;
+                };
                 let prev_yaw = self.samples.last().map_or(self.look.yaw, |s| s.1);
                 let unwrapped = prev_yaw + wrap_deg(yaw - wrap_deg(prev_yaw));
-                self.look = Look::new(yaw, pitch, self.look.hfov);
+                self.look = self.look.moved(yaw, pitch, self.look.hfov);
                 self.samples.push((t, unwrapped, pitch));
                 // Only the last 100 ms matter for the release velocity.
                 let keep_from = self.samples.iter().position(|s| s.0 >= t - 0.1);
@@ -578,7 +546,7 @@ impl Controller {
     /// Set hfov (clamped to the zoom range), keeping the direction under `cursor` where
     /// it is.
     pub fn zoom_to(&mut self, hfov: f64, cursor: Option<(f64, f64)>, size: (u32, u32)) {
-        if hfov > self.zoom_range.1 && self.look.hfov >= self.zoom_range.1 {
+        if hfov > self.widest() && self.look.hfov >= self.widest() {
             self.zoomed_past_widest = true;
         }
         let hfov = self.clamp_hfov(hfov);
@@ -588,11 +556,15 @@ impl Controller {
         match cursor {
             Some(pos) => {
                 let dir = dir_at(&self.look, pos, size);
-                let (yaw, pitch) = solve_grab(dir, pos, size, hfov, self.look.pitch);
-                self.look = Look::new(yaw, pitch, hfov);
+                let to = self.look.moved(self.look.yaw, self.look.pitch, hfov);
+                self.look = match solve_grab_in(dir, pos, size, to, self.look.pitch) {
+                    Some((yaw, pitch)) => to.moved(yaw, pitch, hfov),
+                    // No direction under the cursor: zoom about the centre.
+                    None => to,
+                };
                 // A grab in progress keeps its point under the cursor at the new zoom.
             }
-            None => self.look = Look::new(self.look.yaw, self.look.pitch, hfov),
+            None => self.look = self.look.moved(self.look.yaw, self.look.pitch, hfov),
         }
     }
 
@@ -603,8 +575,10 @@ impl Controller {
             KeyAction::ZoomIn => self.zoom_to(self.look.hfov / ZOOM_PER_NOTCH, None, size),
             KeyAction::ZoomOut => self.zoom_to(self.look.hfov * ZOOM_PER_NOTCH, None, size),
             KeyAction::Reset => {
+                // The start view in the projection in use.
                 let h = self.home;
-                self.look = Look::new(h.yaw, h.pitch, self.clamp_hfov(h.hfov));
+                self.planet = None;
+                self.look = self.look.moved(h.yaw, h.pitch, self.clamp_hfov(h.hfov));
                 self.velocity = (0.0, 0.0);
                 self.zoom_anim = None;
             }
@@ -631,6 +605,7 @@ impl Controller {
             || self.velocity != (0.0, 0.0)
             || self.zoom_anim.is_some()
             || self.rotating
+            || self.planet_moving()
     }
 
     /// QTVR turning rate (deg/s yaw, pitch) when the cursor is off the press point.
@@ -679,13 +654,15 @@ impl Controller {
         };
         self.last_tick = Some(t);
         let before = self.look;
+        self.step_planet(t);
         if let Some(z) = self.zoom_anim {
             // Ease in and out, geometric in hfov, the grabbed point fixed under the cursor.
             let p = ((t - z.t0) / DOUBLE_CLICK_S).clamp(0.0, 1.0);
             let e = p * p * (3.0 - 2.0 * p);
             let hfov = z.from * (z.to / z.from).powf(e);
-            let (yaw, pitch) = solve_grab(z.dir, z.pos, z.size, hfov, self.look.pitch);
-            self.look = Look::new(yaw, pitch, hfov);
+            let to = self.look.moved(self.look.yaw, self.look.pitch, hfov);
+            self.look = solve_grab_in(z.dir, z.pos, z.size, to, self.look.pitch)
+                .map_or(to, |(yaw, pitch)| to.moved(yaw, pitch, hfov));
             if p >= 1.0 {
                 self.zoom_anim = None;
             }
@@ -718,7 +695,7 @@ impl Controller {
         }
         let zoom = f64::from(u8::from(h.zoom_out)) - f64::from(u8::from(h.zoom_in));
         let hfov = self.look.hfov * (zoom * dt * std::f64::consts::LN_2 / ZOOM_HALVING_S).exp();
-        if hfov > self.zoom_range.1 && h.zoom_out {
+        if hfov > self.widest() && h.zoom_out {
             self.zoomed_past_widest = true;
         }
         let pitch = self.look.pitch + pitch_rate * dt;
@@ -726,7 +703,9 @@ impl Controller {
             // At the pole, throwing further up does nothing: drop the vertical inertia.
             self.velocity.1 = 0.0;
         }
-        self.look = Look::new(self.look.yaw + yaw_rate * dt, pitch, self.clamp_hfov(hfov));
+        self.look = self
+            .look
+            .moved(self.look.yaw + yaw_rate * dt, pitch, self.clamp_hfov(hfov));
         self.look != before
     }
 
@@ -787,6 +766,7 @@ impl Default for Controller {
 mod tests {
     use super::*;
     use crate::window::quality::{frame_level, AaMode, FrameTimes, Level, FRAME_BUDGET_MS};
+    use lut_core::Camera;
     use lut_core::Sampler;
 
     const SIZE: (u32, u32) = (800, 500);

@@ -47,6 +47,12 @@ pub enum KeyAction {
     ExposureUp,
     /// Auto-rotate on or off.
     AutoRotate,
+    /// The next output projection (rectilinear, stereographic, fisheye, ...).
+    CycleProjection,
+    /// Into the little planet, or back to the view it left.
+    LittlePlanet,
+    /// The error heat map on or off.
+    HeatMap,
     /// Close the window.
     Quit,
 }
@@ -174,6 +180,21 @@ pub const BINDINGS: &[Binding] = &[
         help: "auto-rotate on/off (starts after the idle delay)",
     },
     Binding {
+        chords: &[plain(Key::V)],
+        action: KeyAction::CycleProjection,
+        help: "next projection: rectilinear, stereographic, fisheye, equisolid, Pannini",
+    },
+    Binding {
+        chords: &[plain(Key::L)],
+        action: KeyAction::LittlePlanet,
+        help: "little planet on/off (animated; back to the view it left)",
+    },
+    Binding {
+        chords: &[plain(Key::E)],
+        action: KeyAction::HeatMap,
+        help: "error heat map on/off (sampling error against the exact map)",
+    },
+    Binding {
         chords: &[ctrl(Key::O)],
         action: KeyAction::Open,
         help: "open a panorama (file dialog)",
@@ -238,7 +259,14 @@ pub const MOUSE_HELP: &[(&str, &str)] = &[
     ("double-click", "zoom in toward the point"),
     ("drop an image", "open it"),
     ("drop a folder", "open it as a cube map (or six faces)"),
-    ("drop .ies / .ldt", "add a light"),
+    ("drop .ies / .ldt", "add a light (recognized by content)"),
+    ("drop a scene file", "open its panorama, room and lights"),
+    ("click a light", "select it (Show room on)"),
+    ("drag a light", "move it along the ceiling or its wall"),
+    (
+        "drag a room edge",
+        "move its walls to fit the photo (Show room on)",
+    ),
     ("Tab, Enter", "focus and press the buttons"),
 ];
 
@@ -384,6 +412,9 @@ mod tests {
             (K::PageUp, KeyAction::OpenPrevious),
             (K::PageDown, KeyAction::OpenNext),
             (K::Space, KeyAction::AutoRotate),
+            (K::V, KeyAction::CycleProjection),
+            (K::L, KeyAction::LittlePlanet),
+            (K::E, KeyAction::HeatMap),
         ];
         let none = Modifiers::NONE;
         for (k, a) in cases {

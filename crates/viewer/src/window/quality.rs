@@ -237,6 +237,11 @@ pub struct Settings {
     pub export_scale: u32,
     /// Partial panoramas: keep the view's edges inside the covered area.
     pub view_limit: bool,
+    /// Pannini's parameter d when the Pannini projection is chosen (0: rectilinear).
+    pub pannini_d: f64,
+    /// Show the error heat map instead of the panorama (the renderer's sampling-position
+    /// error against the exact map, `lut_core::ErrorMap`).
+    pub heat_map: bool,
 }
 
 impl Default for Settings {
@@ -256,6 +261,8 @@ impl Default for Settings {
             exposure_ev: 0.0,
             export_scale: 1,
             view_limit: true,
+            pannini_d: lut_core::PANNINI_D_DEFAULT,
+            heat_map: false,
         }
     }
 }

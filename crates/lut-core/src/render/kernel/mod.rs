@@ -238,6 +238,10 @@ pub(crate) fn sample_span<const BILINEAR: bool>(
     du: Fx,
     dv: Fx,
 ) {
+    if map.projection.scaled_rows() {
+        // Rows wrap within their own length (`EnvMap::bilinear`): per pixel.
+        return sample_span_slow::<BILINEAR>(map, out, u, v, du, dv);
+    }
     let t = texels(map);
     let done = if BILINEAR {
         jobs::bilinear_span(&t, out, u, v, du, dv)
@@ -253,7 +257,10 @@ pub(crate) fn sample_span<const BILINEAR: bool>(
 /// kernel call for them all; spans leaving the map are sampled per pixel.
 pub(crate) fn sample_spans<const BILINEAR: bool>(map: &EnvMap, row: &mut [u32], spans: &[SpanJob]) {
     let t = texels(map);
-    let mut refused = if BILINEAR {
+    // Maps whose rows wrap within their own length (scaled rows): every span per pixel.
+    let mut refused = if map.projection.scaled_rows() {
+        (1u64 << spans.len()) - 1
+    } else if BILINEAR {
         jobs::bilinear_spans(&t, row, spans)
     } else {
         jobs::nearest_spans(&t, row, spans)
@@ -349,7 +356,11 @@ pub(crate) fn trilinear_spans(
     spans: &[SpanJob],
     lods: &[i32],
 ) {
-    let mut refused = jobs::trilinear_spans(levels, row, spans, lods);
+    let mut refused = if map.projection.scaled_rows() {
+        (1u64 << spans.len()) - 1 // per pixel, as `sample_spans`
+    } else {
+        jobs::trilinear_spans(levels, row, spans, lods)
+    };
     while refused != 0 {
         let i = refused.trailing_zeros() as usize;
         refused &= refused - 1;

@@ -97,8 +97,12 @@ pub fn view_sets(which: ViewsArg) -> Result<Vec<ViewSet>> {
 pub enum Config {
     /// The exact renderer.
     Exact(Sampler),
-    /// The LUT renderer with an index step (the set's table).
+    /// The LUT renderer with an index step (the set's table, on the cylinder).
     Lut(Sampler, IndexStep),
+    /// The LUT renderer on another table surface (plane, diamond), adaptive step.
+    LutSurface(Sampler, Surface),
+    /// The per-view adaptive grid (`--renderer grid`).
+    Grid(Sampler),
     /// A cube renderer on the map converted to a cube.
     Cube(Sampler, CubeRenderer),
     /// A plain gather along precomputed (exact, nearest) indices: the floor for any
@@ -119,14 +123,26 @@ pub const STEPS: [IndexStep; 6] = [
 /// The samplers measured (also the exact images each view is compared with).
 pub const SAMPLERS: [Sampler; 2] = [Sampler::Nearest, Sampler::Bilinear];
 
-/// Every configuration, in report order: exact, LUT (sampler × step), the cube
-/// renderers (when `cube`), the gather.
+/// The table surfaces measured beside the cylinder (adaptive step).
+pub const OTHER_SURFACES: [Surface; 2] = [Surface::Plane, Surface::Diamond];
+
+/// Every configuration, in report order: exact, LUT (sampler × step), LUT on the other
+/// surfaces (sampler × surface), the grid (per sampler), the cube renderers (when
+/// `cube`), the gather.
 pub fn configs(cube: bool) -> Vec<Config> {
     let mut v: Vec<Config> = SAMPLERS.iter().map(|&s| Config::Exact(s)).collect();
     for s in SAMPLERS {
         for st in STEPS {
             v.push(Config::Lut(s, st));
         }
+    }
+    for s in SAMPLERS {
+        for surface in OTHER_SURFACES {
+            v.push(Config::LutSurface(s, surface));
+        }
+    }
+    for s in SAMPLERS {
+        v.push(Config::Grid(s));
     }
     if cube {
         for s in SAMPLERS {
@@ -147,6 +163,24 @@ pub fn lut_choice(table: TableKind) -> LutChoice {
     }
 }
 
+/// Render options of a configuration whose sampling positions are measured (LUT, LUT
+/// on another surface, grid), on the set's table; `None` for the others.
+pub fn position_opts(cfg: Config, table: TableKind) -> Option<RenderOptions> {
+    match cfg {
+        Config::Lut(s, st) => Some(lut_opts(s, st, table)),
+        Config::LutSurface(s, surface) => Some(RenderOptions {
+            surface,
+            ..lut_opts(s, IndexStep::Adaptive, table)
+        }),
+        Config::Grid(s) => Some(RenderOptions {
+            renderer: RendererKind::Grid,
+            sampler: s,
+            ..RenderOptions::default()
+        }),
+        _ => None,
+    }
+}
+
 /// Render options of a LUT configuration on the set's table.
 pub fn lut_opts(sampler: Sampler, step: IndexStep, table: TableKind) -> RenderOptions {
     RenderOptions {
@@ -164,8 +198,32 @@ impl Config {
     /// The sampler; the gather samples the nearest pixel.
     pub fn sampler(self) -> Sampler {
         match self {
-            Config::Exact(s) | Config::Lut(s, _) | Config::Cube(s, _) => s,
+            Config::Exact(s)
+            | Config::Lut(s, _)
+            | Config::LutSurface(s, _)
+            | Config::Grid(s)
+            | Config::Cube(s, _) => s,
             Config::Gather => Sampler::Nearest,
+        }
+    }
+
+    /// The same configuration with the nearest sampler (positions do not depend on the
+    /// sampler: they are measured once, on the nearest twin).
+    pub fn nearest_twin(self) -> Config {
+        match self {
+            Config::Lut(_, st) => Config::Lut(Sampler::Nearest, st),
+            Config::LutSurface(_, surface) => Config::LutSurface(Sampler::Nearest, surface),
+            Config::Grid(_) => Config::Grid(Sampler::Nearest),
+            c => c,
+        }
+    }
+
+    /// The report's `surface` field: the table surface of LUT configurations.
+    pub fn surface(self) -> Option<&'static str> {
+        match self {
+            Config::Lut(..) => Some(Surface::Cylinder.name()),
+            Config::LutSurface(_, surface) => Some(surface.name()),
+            _ => None,
         }
     }
 
@@ -173,7 +231,8 @@ impl Config {
     pub fn renderer_name(self) -> &'static str {
         match self {
             Config::Exact(_) => RendererKind::Exact.name(),
-            Config::Lut(..) => RendererKind::Lut.name(),
+            Config::Lut(..) | Config::LutSurface(..) => RendererKind::Lut.name(),
+            Config::Grid(_) => RendererKind::Grid.name(),
             Config::Cube(_, CubeRenderer::Basic) => "cube-basic",
             Config::Cube(_, CubeRenderer::Accelerated) => "cube-scanline",
             Config::Gather => "gather",
@@ -185,6 +244,10 @@ impl Config {
     pub fn lut_fields(self, table: TableKind) -> (serde_json::Value, Option<&'static str>) {
         match self {
             Config::Lut(_, st) => (step_json(st), Some(lut_choice(table).name())),
+            Config::LutSurface(..) => (
+                step_json(IndexStep::Adaptive),
+                Some(lut_choice(table).name()),
+            ),
             _ => (serde_json::Value::Null, None),
         }
     }
@@ -260,18 +323,45 @@ mod tests {
     fn configurations_in_report_order() {
         let with = configs(true);
         let without = configs(false);
-        assert_eq!(with.len(), 2 + 2 * 6 + 2 * 2 + 1);
-        assert_eq!(without.len(), 2 + 2 * 6 + 1);
+        assert_eq!(with.len(), 2 + 2 * 6 + 2 * 2 + 2 + 2 * 2 + 1);
+        assert_eq!(without.len(), 2 + 2 * 6 + 2 * 2 + 2 + 1);
         assert_eq!(with[0], Config::Exact(Sampler::Nearest));
         assert_eq!(with[2], Config::Lut(Sampler::Nearest, IndexStep::Fixed(1)));
         assert_eq!(with[7], Config::Lut(Sampler::Nearest, IndexStep::Adaptive));
+        assert_eq!(
+            with[14..20],
+            [
+                Config::LutSurface(Sampler::Nearest, Surface::Plane),
+                Config::LutSurface(Sampler::Nearest, Surface::Diamond),
+                Config::LutSurface(Sampler::Bilinear, Surface::Plane),
+                Config::LutSurface(Sampler::Bilinear, Surface::Diamond),
+                Config::Grid(Sampler::Nearest),
+                Config::Grid(Sampler::Bilinear),
+            ]
+        );
         assert_eq!(*with.last().unwrap(), Config::Gather);
         assert!(!without.iter().any(|c| matches!(c, Config::Cube(..))));
-        let names: Vec<&str> = with[14..18].iter().map(|c| c.renderer_name()).collect();
+        let names: Vec<&str> = with[20..24].iter().map(|c| c.renderer_name()).collect();
         assert_eq!(
             names,
             ["cube-basic", "cube-scanline", "cube-basic", "cube-scanline"]
         );
+        assert_eq!(with[18].renderer_name(), "grid");
+        assert_eq!(with[17].renderer_name(), "lut");
+        assert_eq!(with[17].surface(), Some("diamond"));
+        assert_eq!(with[7].surface(), Some("cylinder"));
+        assert_eq!(with[19].surface(), None);
+        assert_eq!(with[19].nearest_twin(), Config::Grid(Sampler::Nearest));
+        let o = position_opts(with[17], TableKind::High).unwrap();
+        assert_eq!(
+            (o.surface, o.lut, o.index_step),
+            (Surface::Diamond, LutChoice::High, IndexStep::Adaptive)
+        );
+        assert_eq!(
+            position_opts(with[18], TableKind::Wide).unwrap().renderer,
+            RendererKind::Grid
+        );
+        assert_eq!(position_opts(with[0], TableKind::Wide), None);
     }
 
     #[test]

@@ -2,8 +2,8 @@
 //! exact mapping, PSNR against the exact images, and frame times.
 
 use super::configs::{
-    lut_opts, minify_opts, minify_size, minify_views, Config, ViewSet, MINIFY_CONFIGS, MINIFY_HFOV,
-    SAMPLERS,
+    minify_opts, minify_size, minify_views, position_opts, Config, ViewSet, MINIFY_CONFIGS,
+    MINIFY_HFOV, SAMPLERS,
 };
 use super::export::Export;
 use super::progress;
@@ -134,13 +134,18 @@ fn render_config(
             gather(ctx.src, idx, out, w as usize, ctx.map.background());
             return Ok(());
         }
-        Config::Lut(s, st) => (
-            SceneRef::Map {
-                map: ctx.map,
-                renderer,
-            },
-            lut_opts(s, st, ctx.set.table),
-        ),
+        Config::Lut(..) | Config::LutSurface(..) | Config::Grid(_) => {
+            let Some(opts) = position_opts(cfg, ctx.set.table) else {
+                bail!("internal: no options for {cfg:?}");
+            };
+            (
+                SceneRef::Map {
+                    map: ctx.map,
+                    renderer,
+                },
+                opts,
+            )
+        }
         Config::Cube(s, r) => {
             let Some(cube) = ctx.cube else {
                 bail!("internal: a cube configuration without a cube");
@@ -186,7 +191,8 @@ pub fn measure_errors(
             .for_each(|(y, row)| {
                 for (x, e) in row.iter_mut().enumerate() {
                     let uv = exact_uv(&cam, proj, mw as f64, mh as f64, x as u32, y as u32);
-                    *e = (uv, cam.pixel_lat_long(x as u32, y as u32).1);
+                    let phi = cam.pixel_lat_long(x as u32, y as u32).map_or(0.0, |d| d.1);
+                    *e = (uv, phi);
                 }
             });
         for (si, s) in SAMPLERS.iter().enumerate() {
@@ -216,8 +222,9 @@ pub fn measure_errors(
             let e = &mut acc[ci];
             // Positions do not depend on the sampler: measured once (nearest), shared
             // with the bilinear rows below.
-            if let Config::Lut(Sampler::Nearest, st) = *cfg {
-                let opts = lut_opts(Sampler::Nearest, st, ctx.set.table);
+            if let (Sampler::Nearest, Some(opts)) =
+                (cfg.sampler(), position_opts(*cfg, ctx.set.table))
+            {
                 let (pos, rep) = renderer.positions(mw, mh, proj, view, &opts, w, h)?;
                 let (max, sum, cnt) = compare(&pos, &exact, proj, mw, mh);
                 e.max = e.max.max(max);
@@ -240,13 +247,11 @@ pub fn measure_errors(
             }];
             e.sse += sse(&img, reference);
         }
-        // Share the sampler-independent position stats with the bilinear LUT rows.
+        // Share the sampler-independent position stats with the bilinear rows.
         for ci in 0..cfgs.len() {
-            if let Config::Lut(Sampler::Bilinear, st) = cfgs[ci] {
-                if let Some(nj) = cfgs
-                    .iter()
-                    .position(|c| *c == Config::Lut(Sampler::Nearest, st))
-                {
+            let twin = cfgs[ci].nearest_twin();
+            if cfgs[ci].sampler() == Sampler::Bilinear && twin != cfgs[ci] {
+                if let Some(nj) = cfgs.iter().position(|c| *c == twin) {
                     let src = acc[nj];
                     let e = &mut acc[ci];
                     e.pos_count = src.pos_count;
@@ -360,6 +365,24 @@ pub fn time_config(
             render_config(ctx, renderer, cfg, view, &gather_idx[vi], &mut out)?;
             std::hint::black_box(&out);
             if pass >= warm {
+                times.push(t.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+    }
+    Ok(times)
+}
+
+/// Milliseconds of the grid's per-view build alone (`Renderer::build_grid`, no drawing)
+/// for each frame of the set: one warm-up pass, then `passes` timed passes.
+pub fn time_grid_build(ctx: &Ctx, renderer: &mut Renderer, passes: u32) -> Result<Vec<f64>> {
+    let (mw, mh, p) = (ctx.map.width(), ctx.map.height(), ctx.map.projection());
+    let mut times = Vec::new();
+    for pass in 0..=passes {
+        for &view in &ctx.set.views {
+            let t = Instant::now();
+            let rep = renderer.build_grid(mw, mh, p, view, ctx.w, ctx.h, true)?;
+            std::hint::black_box(rep);
+            if pass > 0 {
                 times.push(t.elapsed().as_secs_f64() * 1e3);
             }
         }
@@ -527,17 +550,14 @@ mod tests {
             match cfg {
                 Config::Exact(_) => assert_eq!((e.sse, e.max), (0, 0.0)),
                 Config::Gather => assert_eq!(e.sse, 0, "the gather is the exact nearest image"),
-                Config::Lut(s, st) => {
+                Config::Lut(..) | Config::LutSurface(..) | Config::Grid(_) => {
                     assert!(
                         e.pos_count.unwrap() > 0 && e.max < 0.05,
                         "{cfg:?} {}",
                         e.max
                     );
-                    let twin = cfgs
-                        .iter()
-                        .position(|c| *c == Config::Lut(Sampler::Nearest, *st))
-                        .unwrap();
-                    assert_eq!(e.max, errs.per_config[twin].max, "{s:?}");
+                    let twin = cfgs.iter().position(|c| *c == cfg.nearest_twin()).unwrap();
+                    assert_eq!(e.max, errs.per_config[twin].max, "{cfg:?}");
                     assert!(e.px > 0 && e.sse < e.samples * 16, "{cfg:?}");
                 }
                 Config::Cube(..) => assert!(e.pos_count.is_none()),

@@ -2,8 +2,9 @@
 //!
 //! Two phases over the same fixed view sets (see [`configs::view_sets`]):
 //! 1. **error**: per view, the exact map positions and the exact images (nearest and
-//!    bilinear) are computed once; every LUT configuration's sampling positions
-//!    (`Renderer::positions`, the same kernel as `render`) are compared with them
+//!    bilinear) are computed once; every LUT (cylinder by step, plane and diamond
+//!    adaptive) and grid configuration's sampling positions (`Renderer::positions`, the
+//!    same kernels as `render`) are compared with them
 //!    (`accuracy::position_error`, the angular metric), and every renderer's image is
 //!    compared with the exact image of the same sampler (PSNR over R, G, B, pooled over
 //!    the set's frames).
@@ -11,7 +12,9 @@
 //!    then `--passes` timed passes); the median milliseconds per frame is reported.
 //!
 //! Tables are built before timing (their build time is reported separately), so a frame's
-//! time is all the per-view work: per-scanline setup plus the kernels. A third set, the
+//! time is all the per-view work: per-scanline setup plus the kernels. The grid renderer
+//! has no table: its per-view build is inside every frame, and is also timed alone
+//! (`Renderer::build_grid`; the grid rows' `table_build_ms`). A third set, the
 //! minification set, compares samplers zoomed out with a supersampled truth.
 //!
 //! * [`mod@configs`]: the view sets and the renderer configurations;
@@ -165,15 +168,24 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
     let sets = view_sets(a.views)?;
     let mut renderer = Renderer::new(&map);
 
-    // Tables: built once, timed, before any frame.
-    let mut tables = Tables::default();
-    for (i, kind) in [TableKind::Wide, TableKind::High].into_iter().enumerate() {
-        let t = Instant::now();
-        let table = renderer.table(Surface::Cylinder, kind);
-        tables.build_ms[i] = t.elapsed().as_secs_f64() * 1e3;
-        tables.bytes[i] = table.bytes();
-        tables.unfolded[i] = table.unfolded_bytes();
-    }
+    // Tables: built once, timed, before any frame (the cylinder's, then the other
+    // surfaces').
+    let mut build = |surface: Surface| {
+        let mut tables = Tables::default();
+        for (i, kind) in [TableKind::Wide, TableKind::High].into_iter().enumerate() {
+            let t = Instant::now();
+            let table = renderer.table(surface, kind);
+            tables.build_ms[i] = t.elapsed().as_secs_f64() * 1e3;
+            tables.bytes[i] = table.bytes();
+            tables.unfolded[i] = table.unfolded_bytes();
+        }
+        tables
+    };
+    let tables = build(Surface::Cylinder);
+    let others: Vec<(&str, Tables)> = configs::OTHER_SURFACES
+        .iter()
+        .map(|&sf| (sf.name(), build(sf)))
+        .collect();
 
     let cube_map = if a.no_cube {
         None
@@ -223,10 +235,29 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
                 )
             };
             e.fill(&mut row);
-            if let configs::Config::Lut(..) = cfg {
-                row.exact_fraction = Some(e.exact_fraction());
-                row.table_bytes = Some(tables.bytes[ti]);
-                row.table_build_ms = Some(tables.build_ms[ti]);
+            row.surface = cfg.surface();
+            match cfg {
+                configs::Config::Lut(..) => {
+                    row.exact_fraction = Some(e.exact_fraction());
+                    row.table_bytes = Some(tables.bytes[ti]);
+                    row.table_build_ms = Some(tables.build_ms[ti]);
+                }
+                configs::Config::LutSurface(_, sf) => {
+                    let t = &others
+                        .iter()
+                        .find(|(n, _)| *n == sf.name())
+                        .ok_or_else(|| anyhow!("internal: no {} tables", sf.name()))?
+                        .1;
+                    row.exact_fraction = Some(e.exact_fraction());
+                    row.table_bytes = Some(t.bytes[ti]);
+                    row.table_build_ms = Some(t.build_ms[ti]);
+                }
+                configs::Config::Grid(_) => {
+                    row.exact_fraction = Some(e.exact_fraction());
+                    let build = measure::time_grid_build(&ctx, &mut renderer, a.passes)?;
+                    row.table_build_ms = Some(measure::median(&build));
+                }
+                _ => {}
             }
             progress(&row_line(&row));
             rows.push(row);
@@ -250,6 +281,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
             &mut std::io::stdout().lock(),
             &rows,
             &tables,
+            &others,
             &kernel.to_string(),
         )?;
         if let Some(n) = minify_note {

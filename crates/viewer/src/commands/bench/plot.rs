@@ -55,9 +55,17 @@ fn series(rows: &[Row]) -> Vec<Series<'_>> {
         if !r.max_err_px.is_some_and(|e| e > 0.0) || r.ms_median <= 0.0 {
             continue;
         }
+        // The table's surface when it is not the default cylinder (e.g. diamond).
+        let surface = r
+            .surface
+            .filter(|s| *s != "cylinder")
+            .map_or(String::new(), |s| format!(" {s}"));
         let label = match r.lut {
-            Some(lut) => format!("{} {lut} (hfov {}), {}", r.renderer, r.hfov, r.sampler),
-            None => format!("{} (hfov {}), {}", r.renderer, r.hfov, r.sampler),
+            Some(lut) => format!(
+                "{}{surface} {lut} (hfov {}), {}",
+                r.renderer, r.hfov, r.sampler
+            ),
+            None => format!("{}{surface} (hfov {}), {}", r.renderer, r.hfov, r.sampler),
         };
         match out.iter_mut().find(|s| s.label == label) {
             Some(s) => s.rows.push(r),
@@ -426,6 +434,7 @@ mod tests {
         Row {
             index_step: serde_json::json!(step),
             lut: Some(table),
+            surface: Some("cylinder"),
             max_err_px: Some(err),
             mean_err_px: Some(err / 4.0),
             ..Row::timed(&run(), "lut", Sampler::Bilinear, 90.0, 1, &[ms])

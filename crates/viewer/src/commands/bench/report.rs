@@ -28,7 +28,7 @@ pub struct RunInfo {
 /// One line of the report (one element of the `--json` array).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Row {
-    /// "exact", "lut", "cube-basic", "cube-scanline" or "gather".
+    /// "exact", "lut", "grid", "cube-basic", "cube-scanline" or "gather".
     pub renderer: &'static str,
     /// The sampler's name.
     pub sampler: &'static str,
@@ -61,12 +61,16 @@ pub struct Row {
     /// PSNR against the exact render supersampled 8×8 per pixel (the minification set).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub psnr_ss_db: Option<f64>,
-    /// Fraction of pixels the LUT renderer evaluated exactly (pole zones, beyond a table).
+    /// Fraction of pixels the LUT or grid renderer evaluated exactly (pole zones, beyond
+    /// a table; grid cells that failed their budget at the smallest size).
     pub exact_fraction: Option<f64>,
     /// Bytes of the table (LUT rows).
     pub table_bytes: Option<usize>,
-    /// Milliseconds the table took to build (LUT rows).
+    /// Milliseconds the table took to build (LUT rows, once per map); grid rows: the
+    /// median milliseconds of the grid's per-view build alone (part of every frame).
     pub table_build_ms: Option<f64>,
+    /// The table surface: "cylinder", "plane" or "diamond" (LUT rows), else null.
+    pub surface: Option<&'static str>,
 }
 
 impl Row {
@@ -101,11 +105,13 @@ impl Row {
             exact_fraction: None,
             table_bytes: None,
             table_build_ms: None,
+            surface: None,
         }
     }
 }
 
-/// The two tables (wide, high): build milliseconds, bytes, bytes unfolded.
+/// The two tables (wide, high) of one surface: build milliseconds, bytes, bytes
+/// unfolded.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Tables {
     /// Build time in milliseconds.
@@ -114,6 +120,21 @@ pub struct Tables {
     pub bytes: [usize; 2],
     /// Bytes of the same table unfolded.
     pub unfolded: [usize; 2],
+}
+
+/// One line of the tables' summary: a surface's two tables.
+fn tables_line(name: &str, t: &Tables) -> String {
+    format!(
+        "{name}: wide {:.1} ms, {} KiB (unfolded {} KiB, 1/{:.2}); high {:.1} ms, {} KiB (unfolded {} KiB, 1/{:.2})",
+        t.build_ms[0],
+        t.bytes[0] / 1024,
+        t.unfolded[0] / 1024,
+        t.unfolded[0] as f64 / t.bytes[0].max(1) as f64,
+        t.build_ms[1],
+        t.bytes[1] / 1024,
+        t.unfolded[1] / 1024,
+        t.unfolded[1] as f64 / t.bytes[1].max(1) as f64
+    )
 }
 
 fn fmt_opt(v: Option<f64>, prec: usize) -> String {
@@ -131,9 +152,13 @@ pub fn step_str(v: &serde_json::Value) -> String {
 
 /// One row as a line of the text table (also the progress line).
 pub fn row_line(r: &Row) -> String {
+    let renderer = match r.surface {
+        Some(sf) if sf != "cylinder" => format!("{}/{sf}", r.renderer),
+        _ => r.renderer.to_string(),
+    };
     format!(
         "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9.2} {:>9.2} {:>7.0} {:>10} {:>10} {:>7} {:>7}",
-        r.renderer,
+        renderer,
         r.sampler,
         step_str(&r.index_step),
         r.lut.unwrap_or("-"),
@@ -149,11 +174,18 @@ pub fn row_line(r: &Row) -> String {
     )
 }
 
-/// The text table: what was measured, the tables, one line per row, the units.
+/// The text table: what was measured, the kernel, the tables (the cylinder's, then the
+/// other surfaces' in `others`), one line per row, the units.
 ///
 /// `cpu`: the kernel line (`lut_core::kernel_info()`: the kernel, how it was chosen, the
 /// CPU features detected).
-pub fn write_table(o: &mut impl Write, rows: &[Row], t: &Tables, cpu: &str) -> std::io::Result<()> {
+pub fn write_table(
+    o: &mut impl Write,
+    rows: &[Row],
+    t: &Tables,
+    others: &[(&str, Tables)],
+    cpu: &str,
+) -> std::io::Result<()> {
     if let Some(r) = rows.first() {
         let run = &r.run;
         writeln!(
@@ -169,18 +201,10 @@ pub fn write_table(o: &mut impl Write, rows: &[Row], t: &Tables, cpu: &str) -> s
         )?;
     }
     writeln!(o, "{cpu}")?;
-    writeln!(
-        o,
-        "tables: wide {:.1} ms, {} KiB (unfolded {} KiB, 1/{:.2}); high {:.1} ms, {} KiB (unfolded {} KiB, 1/{:.2})",
-        t.build_ms[0],
-        t.bytes[0] / 1024,
-        t.unfolded[0] / 1024,
-        t.unfolded[0] as f64 / t.bytes[0].max(1) as f64,
-        t.build_ms[1],
-        t.bytes[1] / 1024,
-        t.unfolded[1] / 1024,
-        t.unfolded[1] as f64 / t.bytes[1].max(1) as f64
-    )?;
+    writeln!(o, "{}", tables_line("tables", t))?;
+    for (name, t) in others {
+        writeln!(o, "{}", tables_line(&format!("{name} tables"), t))?;
+    }
     writeln!(
         o,
         "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9} {:>9} {:>7} {:>10} {:>10} {:>7} {:>7}",
@@ -202,7 +226,11 @@ pub fn write_table(o: &mut impl Write, rows: &[Row], t: &Tables, cpu: &str) -> s
     }
     writeln!(
         o,
-        "Mpx/s: output megapixels per second at the median; errors in source pixels (angular metric); PSNR in dB against the exact render with the same sampler ('-' = identical)"
+        "Mpx/s: output megapixels per second at the median; errors in source pixels (angular metric); PSNR in dB against the exact render with the same sampler ('-' = identical); grid rows: per-view grid build {} ms median (inside each frame)",
+        rows.iter()
+            .find(|r| r.renderer == "grid")
+            .and_then(|r| r.table_build_ms)
+            .map_or("-".into(), |ms| format!("{ms:.2}"))
     )
 }
 
@@ -295,6 +323,7 @@ mod tests {
             "exact_fraction",
             "table_bytes",
             "table_build_ms",
+            "surface",
         ];
         let mut got = keys.clone();
         got.sort_unstable();
@@ -354,12 +383,13 @@ mod tests {
             &mut out,
             &[lut_row()],
             &tables,
+            &[("diamond", tables)],
             "kernel avx2 (auto; CPU: avx2)",
         )
         .unwrap();
         let text = String::from_utf8(out).unwrap();
         let mut lines: Vec<&str> = text.lines().collect();
-        assert_eq!(lines.len(), 6, "{text}");
+        assert_eq!(lines.len(), 7, "{text}");
         assert_eq!(
             lines[0],
             "map 8192x4096 equirect, output 1920x1080, 2 threads, 3 frames per set"
@@ -369,8 +399,17 @@ mod tests {
             lines[1],
             "tables: wide 10.0 ms, 2 KiB (unfolded 16 KiB, 1/8.00); high 20.0 ms, 4 KiB (unfolded 8 KiB, 1/2.00)"
         );
-        assert!(lines[2].starts_with("renderer      sampler"));
-        assert_eq!(lines[3], row_line(&lut_row()));
+        assert_eq!(
+            lines[2],
+            "diamond tables: wide 10.0 ms, 2 KiB (unfolded 16 KiB, 1/8.00); high 20.0 ms, 4 KiB (unfolded 8 KiB, 1/2.00)"
+        );
+        assert!(lines[3].starts_with("renderer      sampler"));
+        assert_eq!(lines[4], row_line(&lut_row()));
+        let diamond = Row {
+            surface: Some("diamond"),
+            ..lut_row()
+        };
+        assert!(row_line(&diamond).starts_with("lut/diamond   bilinear"));
     }
 
     #[test]

@@ -3,16 +3,16 @@
 //! with egui, and decide when the next frame is due.
 
 use super::{App, SceneKey};
-use crate::scene::{render_scene, SceneRef};
+use crate::scene::{measure_errors, render_scene, SceneRef};
 use crate::window::dialogs::Chosen;
-use crate::window::input::{resolution_hfov, wheel_notches, Held, Look, HFOV_MAX};
+use crate::window::input::{resolution_hfov, wheel_notches, Held, Look, WIDE_HFOV_MAX};
 use crate::window::keys::{KeyAction, Route};
 use crate::window::overlay::{self, NoticesOutput, ToolbarModel};
 use crate::window::paint::SceneRect;
 use crate::window::quality::{frame_level, FRAME_BUDGET_MS};
 use crate::window::ui::{self, PanelModel, PanelOutput};
 use anyhow::{anyhow, Result};
-use lut_core::{CubeRenderer, RenderPath, Sampler};
+use lut_core::{CubeRenderer, RenderOptions, RenderPath, Sampler};
 use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -31,13 +31,6 @@ pub(super) struct FrameRequests {
     pub scene_rect: Option<SceneRect>,
     /// The pointer over the scene, in scene pixels.
     pub cursor: Option<(f64, f64)>,
-}
-
-/// The widest hfov of the output view. Wide output projections (issue 12) hand over
-/// here: when they land, this returns the chosen projection's widest view, and
-/// `Controller::take_zoomed_past_widest` says when the user zoomed out past it.
-fn widest_hfov() -> f64 {
-    HFOV_MAX
 }
 
 impl App {
@@ -98,7 +91,21 @@ impl App {
                 .input(|i| i.pointer.press_origin())
                 .or(resp.interact_pointer_pos());
             if let Some(o) = origin {
-                self.ctl.press(to_px(o), size, t);
+                // On a luminaire's marker the drag moves the luminaire.
+                if !self.press_light(to_px(o), size) {
+                    self.ctl.press(to_px(o), size, t);
+                }
+            }
+        }
+        if self.light_drag.is_some() || self.edge_drag.is_some() {
+            match resp.interact_pointer_pos() {
+                Some(p) if resp.dragged_by(primary) => self.drag_light(to_px(p), size),
+                _ => self.end_light_drag(),
+            }
+        }
+        if resp.clicked_by(primary) {
+            if let Some(p) = resp.interact_pointer_pos() {
+                self.click_scene(to_px(p), size);
             }
         }
         if self.ctl.dragging() {
@@ -189,7 +196,7 @@ impl App {
             (Some(ratio), Some(deg)) => resolution_hfov(deg, self.scene_width, ratio),
             _ => 0.0,
         };
-        self.ctl.set_zoom_range(min, widest_hfov());
+        self.ctl.set_zoom_range(min, WIDE_HFOV_MAX);
     }
 
     pub(super) fn redraw(&mut self, el: &ActiveEventLoop) -> Result<()> {
@@ -236,6 +243,12 @@ impl App {
         };
         self.ctl.set_limit(limit);
         let frame = self.ctl.frame(t);
+        if self.ctl.take_zoomed_past_widest() && frame.look.projection.is_rectilinear() {
+            self.notices.info(
+                "widest rectilinear view: V for a wide projection, L for a little planet",
+                t,
+            );
+        }
         let mut ui_ms = ui_t0.elapsed().as_secs_f64() * 1e3;
         if let Some(r) = scene_rect {
             self.render_scene(r, frame.look, frame.fast);
@@ -315,6 +328,10 @@ impl App {
         if self.notices.expire(t) {
             want(now);
         }
+        if self.lit.refining() {
+            // The coarse illuminance map shown: the full one next.
+            want(now);
+        }
         if let Some(n) = next {
             // At most one frame per display refresh, whoever asks.
             let n = n.max(now + self.frame_interval);
@@ -360,14 +377,15 @@ impl App {
         let pixels = u64::from(rect.w) * u64::from(rect.h);
         let s = self.ctl.settings;
         let (level, degraded) = frame_level(s.aa, fast, &self.times, pixels, FRAME_BUDGET_MS);
-        let Some(cur) = self.doc.current_mut() else {
+        if self.doc.current().is_none() {
             return;
-        };
+        }
         let opts = s.render_options(level);
         // While the view moves, bilinear frames read the pyramid level that matches the
         // screen (`Renderer::set_bilinear_level`): a huge map then pans at the cost of the
         // level it shows. The still frame reads the map itself.
         let bilinear_level = fast && opts.sampler == Sampler::Bilinear;
+        let lit = self.update_lit();
         let key = SceneKey {
             look,
             size: (rect.w, rect.h),
@@ -378,12 +396,21 @@ impl App {
             lut: opts.lut,
             cube_renderer: opts.cube,
             bilinear_level,
+            heat_map: s.heat_map,
             map_generation: generation,
             lights: self.lights.key(),
+            lit: (
+                self.lit.generation(),
+                self.lights.show_room,
+                self.lights.selected,
+            ),
         };
         if self.scene_key.as_ref() == Some(&key) {
             return;
         }
+        let Some(cur) = self.doc.current_mut() else {
+            return;
+        };
         if let SceneRef::Map { renderer, .. } = cur.scene.as_mut() {
             renderer.set_bilinear_level(bilinear_level);
         }
@@ -422,7 +449,12 @@ impl App {
                 return;
             }
         };
-        self.light_scene(view, rect);
+        self.doc.readouts.heat = None;
+        if s.heat_map {
+            self.show_heat_map(view, &opts, rect, k);
+        } else {
+            self.light_scene(lit.as_deref(), view, rect);
+        }
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         self.times.record(level, ms, pixels);
         // A frame read from a pyramid level is not the still frame: one is due.
@@ -454,7 +486,7 @@ impl App {
         if self.print_view {
             println!(
                 "view yaw={:.4} pitch={:.4} hfov={:.4} path={path} sampler={} level={} fast={} \
-                 ms={ms:.2} size={}x{} lights={}",
+                 ms={ms:.2} size={}x{} lights={} proj={}",
                 look.yaw,
                 look.pitch,
                 look.hfov,
@@ -463,19 +495,45 @@ impl App {
                 fast,
                 rect.w,
                 rect.h,
-                self.lights.lights.len()
+                self.lights.lights.len(),
+                look.projection.name()
             );
         }
     }
 
-    /// Light the freshly rendered scene (as `viewer render --light ...` does); a scene
-    /// that cannot be built (a light outside the room) is reported in the panel and the
-    /// frame is left unlit.
-    fn light_scene(&mut self, view: lut_core::View, rect: SceneRect) {
-        let result = self
-            .lights
-            .light_frame(view, &mut self.scene, rect.w, rect.h);
-        self.lights.scene_error = result.err();
+    /// Replace the scene by the heat map of `view` with `opts` (measured at the frame's
+    /// size, `rect` divided by `k`, as the frame was rendered) and put its max and mean in
+    /// the readouts.
+    fn show_heat_map(
+        &mut self,
+        view: lut_core::View,
+        opts: &RenderOptions,
+        rect: SceneRect,
+        k: u32,
+    ) {
+        let Some(cur) = self.doc.current_mut() else {
+            return;
+        };
+        let (sw, sh) = (rect.w.div_ceil(k), rect.h.div_ceil(k));
+        match measure_errors(cur.scene.as_mut(), view, opts, sw, sh) {
+            Ok(em) => {
+                let colors = em.colors();
+                if k == 1 {
+                    self.scene.copy_from_slice(&colors);
+                } else {
+                    crate::window::paint::upscale_bilinear(
+                        &colors,
+                        sw,
+                        sh,
+                        &mut self.scene,
+                        rect.w,
+                        rect.h,
+                    );
+                }
+                self.doc.readouts.heat = Some((em.stats.max, em.stats.mean));
+            }
+            Err(e) => self.doc.set_error(format!("heat map failed: {e}")),
+        }
     }
 
     /// The illuminance at the pointer for the readout; true when it changed.
