@@ -256,7 +256,8 @@ mod tests {
             assert_eq!(sides, [(15, 8), (8, 4), (4, 2)], "{proj}");
             let l1 = &m.pyramid()[0];
             let l2 = &m.pyramid()[1];
-            let p = |x: u32, y: u32| m.pixel(x, y);
+            // (Elliptical maps average the pixels on the sphere: `pixel_on_sphere`.)
+            let p = |x: u32, y: u32| m.pixel_on_sphere(x, y);
             // Level 1: 30 is even, 15 rows are odd: the last row repeats row 14.
             assert_eq!(l1.pixel(3, 2), average4(p(6, 4), p(7, 4), p(6, 5), p(7, 5)));
             assert_eq!(
@@ -264,7 +265,7 @@ mod tests {
                 average4(p(6, 14), p(7, 14), p(6, 14), p(7, 14))
             );
             // Level 2: 15 columns are odd: the last column wraps (360°) or repeats.
-            let q = |x: u32, y: u32| l1.pixel(x, y);
+            let q = |x: u32, y: u32| l1.pixel_on_sphere(x, y);
             let beyond = if proj.wraps() { 0 } else { 14 };
             assert_eq!(
                 l2.pixel(7, 1),
