@@ -125,6 +125,11 @@ pub use render::grid::{GRID_CELL, GRID_CELL_BUDGET, GRID_MIN_CELL};
 pub use render::heat::{
     heat_color, heat_scale, ErrorMap, HEAT_BACKGROUND, HEAT_MAX, HEAT_MIN, HEAT_MISMATCH,
 };
+pub use render::kernel::{
+    active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
+    KernelError, KernelInfo, KernelSource, SpanJob, Texels, Window, KERNEL_ENV, MAX_JOBS,
+    MAX_LEVELS, TRILINEAR_CHUNK,
+};
 pub use render::steps::{ADAPTIVE_MAX_STEP, SPAN_ERROR_BUDGET};
 pub use render::{
     IndexStep, LutChoice, Positions, RenderOptions, RenderPath, RenderReport, Renderer,

@@ -8,6 +8,11 @@ use viewer::commands::{bench, bench_load, convert, ies, lux, render};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // A bad LUTPANO_KERNEL (the span kernel override) is refused up front.
+    if let Err(e) = lut_core::kernel_from_env() {
+        eprintln!("viewer: {e}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Some(Command::Render(a)) => render::run(*a),
         Some(Command::Convert(a)) => convert::run(a),

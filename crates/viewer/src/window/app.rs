@@ -52,6 +52,8 @@ struct SceneKey {
     lut: LutChoice,
     cube_renderer: CubeRenderer,
     heat_map: bool,
+    /// Bilinear read from the pyramid level matching the footprint (while moving).
+    bilinear_level: bool,
     map_generation: u64,
     lights: LightsKey,
     /// The illuminance map's generation, the room shown, the selected light.

@@ -3,7 +3,7 @@
 //! with egui, and decide when the next frame is due.
 
 use super::{App, SceneKey};
-use crate::scene::{measure_errors, render_scene};
+use crate::scene::{measure_errors, render_scene, SceneRef};
 use crate::window::dialogs::Chosen;
 use crate::window::input::{resolution_hfov, wheel_notches, Held, Look, WIDE_HFOV_MAX};
 use crate::window::keys::{KeyAction, Route};
@@ -12,7 +12,7 @@ use crate::window::paint::SceneRect;
 use crate::window::quality::{frame_level, FRAME_BUDGET_MS};
 use crate::window::ui::{self, PanelModel, PanelOutput};
 use anyhow::{anyhow, Result};
-use lut_core::{CubeRenderer, RenderOptions, RenderPath};
+use lut_core::{CubeRenderer, RenderOptions, RenderPath, Sampler};
 use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -381,6 +381,10 @@ impl App {
             return;
         }
         let opts = s.render_options(level);
+        // While the view moves, bilinear frames read the pyramid level that matches the
+        // screen (`Renderer::set_bilinear_level`): a huge map then pans at the cost of the
+        // level it shows. The still frame reads the map itself.
+        let bilinear_level = fast && opts.sampler == Sampler::Bilinear;
         let lit = self.update_lit();
         let key = SceneKey {
             look,
@@ -391,6 +395,7 @@ impl App {
             index_step: opts.index_step,
             lut: opts.lut,
             cube_renderer: opts.cube,
+            bilinear_level,
             heat_map: s.heat_map,
             map_generation: generation,
             lights: self.lights.key(),
@@ -406,6 +411,9 @@ impl App {
         let Some(cur) = self.doc.current_mut() else {
             return;
         };
+        if let SceneRef::Map { renderer, .. } = cur.scene.as_mut() {
+            renderer.set_bilinear_level(bilinear_level);
+        }
         self.scene.resize(rect.w as usize * rect.h as usize, 0);
         let t0 = Instant::now();
         let view = look.view();
@@ -449,7 +457,8 @@ impl App {
         }
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         self.times.record(level, ms, pixels);
-        self.ctl.rendered(degraded);
+        // A frame read from a pyramid level is not the still frame: one is due.
+        self.ctl.rendered(degraded || bilinear_level);
         self.renders.push_back(Instant::now());
         let r = &mut self.doc.readouts;
         r.table_bytes = report.table_bytes;
