@@ -37,6 +37,9 @@ echo "== cargo clippy"
 cargo clippy --workspace --all-targets --profile ci -- -D warnings
 echo "== cargo test (profile ci: optimized, overflow checks on)"
 cargo test --workspace --profile ci
+echo "== cargo test again with the scalar span kernel forced (LUTPANO_KERNEL=scalar)"
+# Same binaries (the kernel is chosen at run time): SIMD and scalar must render the same.
+LUTPANO_KERNEL=scalar cargo test --workspace --profile ci
 if [ -f scripts/window-smoke.sh ]; then
   echo "== window smoke test under Xvfb"
   # the binary the test run just built (optimized, overflow checks on): no second build

@@ -14,6 +14,9 @@
 # Run 2 (the settings written by run 1, panel hidden, default zoom limit): the panel
 #   stays hidden, the zoom stops where a map pixel covers two screen pixels, Ctrl+S
 #   saves the view where the settings say; docs/screenshot.png is taken here.
+# Run 3 (panel hidden): a scene file with --show-room opens its panorama at its view with
+#   its five luminaires; a click on a marker selects that light, dragging it moves it
+#   along the ceiling without turning the view; dragging a room edge resizes the room.
 #
 # Screenshots and logs: target/window-smoke/ (kept as CI artifacts). The settings live
 # in a temporary config folder (LUTPANO_CONFIG_DIR), never the real home.
@@ -401,5 +404,61 @@ sleep 0.5
 press Return
 wait_for "^saved $SAVES/view-1.png (${SW}×${SH})" "$N" 20
 [ "$($IDENTIFY -format '%wx%h' "$SAVES/view-1.png")" = "${SW}x${SH}" ] || fail "view-1.png is not ${SW}x${SH}"
+quit_viewer
+
+########## Run 3: a scene file, its room shown, a luminaire picked and dragged ##########
+log "run 3: the viewer on assets/interior_lit.json with --show-room"
+start_viewer --scene "$ROOT/assets/interior_lit.json" --show-room --pitch 70
+wait_for '^loaded .*interior.jpg' 0 60
+wait_for '^markers ' 0 60
+settle
+find_window
+SCENE=$(field size); SW=${SCENE%x*}; SH=${SCENE#*x}
+CX=$((X + SW / 2)); CY=$((Y + SH / 2))
+[ "$(field yaw)" = -40.0000 ] || fail "the scene's view yaw -40 should be kept, got $(field yaw)"
+[ "$(field lights)" = 5 ] || fail "the scene's five lights should be loaded, got $(field lights)"
+# A marker well inside the scene (clear of the toolbar): "N=X,Y".
+MARK=$(grep '^markers ' "$VIEWLOG" | tail -n 1 | tr ' ' '\n' | grep '=' |
+  awk -F'[=,]' -v w="$SW" -v h="$SH" '$2 > 60 && $2 < w - 60 && $3 > 80 && $3 < h - 60 { print; exit }')
+[ -n "$MARK" ] || fail "no luminaire marker inside the view: $(grep '^markers ' "$VIEWLOG" | tail -n 1)"
+LN=${MARK%%=*}; MXY=${MARK#*=}; MX=$((X + ${MXY%,*})); MY=$((Y + ${MXY#*,}))
+log "light $LN's marker at $MX,$MY"
+N=$(lines)
+xdotool mousemove "$MX" "$MY"; sleep 0.2; xdotool click 1
+wait_for "^light $LN selected" "$N" 5
+settle
+YAW0=$(field yaw); PITCH0=$(field pitch)
+# Drag the marker: the light moves along the ceiling, the view does not turn.
+N=$(lines)
+xdotool mousemove "$MX" "$MY"; sleep 0.2; xdotool mousedown 1; sleep 0.1
+for i in 1 2 3 4 5 6 7 8; do xdotool mousemove $((MX + 8 * i)) $((MY + 5 * i)); sleep 0.05; done
+sleep 0.2; xdotool mouseup 1
+wait_for "^light $LN moved to " "$N" 5
+settle
+MOVED=$(grep "^light $LN moved to " "$VIEWLOG" | tail -n 1)
+log "$MOVED"
+[ "$(echo "$MOVED" | sed 's/.* to //' | cut -d, -f2)" = 2.680 ] ||
+  fail "a ceiling light should stay 2.680 m up: $MOVED"
+[ "$(field yaw)" = "$YAW0" ] && [ "$(field pitch)" = "$PITCH0" ] ||
+  fail "dragging a light turned the view: yaw $YAW0 -> $(field yaw), pitch $PITCH0 -> $(field pitch)"
+# Drag a room edge (its middle, clear of the toolbar): the room changes, the view does not.
+EDGE=$(grep '^edges ' "$VIEWLOG" | tail -n 1 | tr ' ' '\n' | grep '=' |
+  awk -F'[=,]' -v w="$SW" -v h="$SH" '$2 > 60 && $2 < w - 60 && $3 > 80 && $3 < h - 60 { print; exit }')
+[ -n "$EDGE" ] || fail "no room edge inside the view: $(grep '^edges ' "$VIEWLOG" | tail -n 1)"
+EXY=${EDGE#*=}; EX=$((X + ${EXY%,*})); EY=$((Y + ${EXY#*,}))
+log "room edge ${EDGE%%=*} at $EX,$EY"
+N=$(lines)
+xdotool mousemove "$EX" "$EY"; sleep 0.2; xdotool mousedown 1; sleep 0.1
+for i in 1 2 3 4 5 6; do xdotool mousemove $((EX - 4 * i)) $((EY + 6 * i)); sleep 0.05; done
+sleep 0.2; xdotool mouseup 1
+wait_for "^room " "$N" 5
+settle
+log "$(grep '^room ' "$VIEWLOG" | tail -n 1)"
+grep -q '^room 4.170x2.990x2.700 centre 0.485,0.045' "$VIEWLOG" &&
+  fail "dragging a room edge left the room as it was"
+[ "$(field yaw)" = "$YAW0" ] && [ "$(field pitch)" = "$PITCH0" ] ||
+  fail "dragging a room edge turned the view"
+sleep 0.3
+$IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/lights.png"
 quit_viewer
 log "PASS (screenshots in $OUT, docs/screenshot.png updated)"

@@ -4,7 +4,7 @@
 
 use lut_core::{
     detect_format, IesFile, Interpolation, LdtError, LdtFile, LdtSymmetry, LdtType, LightError,
-    LightFileFormat, LightTable, Photometry, PhotometrySource, Symmetry, TableOptions,
+    LightFileFormat, LightTable, Named, Photometry, PhotometrySource, Symmetry, TableOptions,
 };
 use std::path::PathBuf;
 

@@ -2,7 +2,7 @@
 //! (EP 0613099 claim 8) with lookups identical to the uncut table, and the interpolation
 //! between measured angles (linear or Catmull-Rom).
 
-use lut_core::{Interpolation, LdtFile, LightTable, Photometry, Symmetry, TableOptions};
+use lut_core::{Interpolation, LdtFile, LightTable, Named, Photometry, Symmetry, TableOptions};
 use std::path::PathBuf;
 use test_support::light_fixtures::{sphere, synth};
 

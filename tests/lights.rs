@@ -440,9 +440,11 @@ fn distance_series_halves_and_interpolates_by_log_distance() {
         |hh, vv| 100.0 + (vv * 0.7).sin().abs() * 900.0 + hh,
         1.0,
     );
+    // The plain series (the patent's halving, not checked against the measured table).
     let opts = TableOptions {
         reference_distance: 2.0,
         max_levels: 4,
+        series_tolerance: None,
         ..TableOptions::default()
     };
     let t = LightTable::from_ies(&f, &opts).unwrap();
@@ -484,7 +486,11 @@ fn distance_series_tends_to_the_far_field_table_for_smooth_light() {
     let v: Vec<f64> = (0..=36).map(|i| i as f64 * 5.0).collect();
     let far = |g: f64| 1000.0 + 500.0 * g.to_radians().cos();
     let f = synth(1, &v, &[0.0], |_, g| far(g), 1.0);
-    let t = table(&f);
+    let plain = TableOptions {
+        series_tolerance: None,
+        ..TableOptions::default()
+    };
+    let t = LightTable::from_ies(&f, &plain).unwrap();
     assert_eq!(t.level_count(), 4);
     let level_angles: [Vec<f64>; 4] = [
         v.clone(),
@@ -507,7 +513,8 @@ fn distance_series_tends_to_the_far_field_table_for_smooth_light() {
     // Measured every 1°, every level stays within 0.5% of the far-field values at any angle
     // (damping ≤ 0.2% plus linear interpolation ≤ 0.15% at the coarsest 8° step).
     let v1: Vec<f64> = (0..=180).map(|i| i as f64).collect();
-    let t1 = table(&synth(1, &v1, &[0.0], |_, g| far(g), 1.0));
+    let t1 = LightTable::from_ies(&synth(1, &v1, &[0.0], |_, g| far(g), 1.0), &plain).unwrap();
+    assert_eq!(t1.level_count(), 4);
     for k in 0..t1.level_count() {
         for i in 0..=360 {
             let g = i as f64 * 0.5;
@@ -522,9 +529,54 @@ fn distance_series_tends_to_the_far_field_table_for_smooth_light() {
     // A constant table is the same at every level (the filter preserves constants).
     let iso = synth(1, &v, &[0.0], |_, _| 300.0, 1.0);
     let ti = table(&iso);
+    assert_eq!(ti.level_count(), 4);
     for k in 0..ti.level_count() {
         assert_eq!(ti.level_candela(k, 77.0, 0.0), Some(300.0));
     }
+}
+
+#[test]
+fn checked_series_keeps_only_faithful_tables() {
+    // The default series stops at the first table that strays more than 0.4 % from the
+    // measured one (below 5 % of the peak, 0.4 % of 5 % of the peak).
+    let fine: Vec<f64> = (0..=180).map(|i| i as f64).collect();
+    let five: Vec<f64> = (0..=36).map(|i| i as f64 * 5.0).collect();
+    let smooth = |g: f64| 1000.0 + 500.0 * g.to_radians().cos();
+    let spot = |g: f64| 20_000.0 * g.to_radians().cos().max(0.0).powi(40);
+    let counts: Vec<usize> = [
+        (&fine, &smooth as &dyn Fn(f64) -> f64),
+        (&five, &smooth),
+        (&five, &spot),
+    ]
+    .iter()
+    .map(|(v, f)| {
+        let t = table(&synth(1, v, &[0.0], |_, g| f(g), 1.0));
+        // Whatever is kept is faithful, at any angle.
+        for k in 0..t.level_count() {
+            for i in 0..=1800 {
+                let g = i as f64 * 0.1;
+                let (a, b) = (t.level_candela(k, g, 0.0).unwrap(), t.candela(g, 0.0));
+                let peak = f(0.0).max(f(180.0));
+                assert!(
+                    (a - b).abs() <= 0.004 * b.max(0.05 * peak) + 1e-9,
+                    "level {k} γ {g}"
+                );
+            }
+        }
+        t.level_count()
+    })
+    .collect();
+    // Measured every 1°, a broad distribution keeps the whole series; every 5°, the
+    // second table (10° steps) already strays; a narrow spot keeps its measured table.
+    assert_eq!(counts[0], 4, "{counts:?}");
+    assert!(counts[1] < 4, "{counts:?}");
+    assert_eq!(counts[2], 1, "{counts:?}");
+    // A tolerance must be a finite number ≥ 0.
+    let bad = TableOptions {
+        series_tolerance: Some(f64::NAN),
+        ..TableOptions::default()
+    };
+    assert!(LightTable::from_ies(&synth(1, &five, &[0.0], |_, g| smooth(g), 1.0), &bad).is_err());
 }
 
 // ---------------------------------------------------------------- lighting
@@ -748,6 +800,7 @@ fn series_lookup_matches_the_tables_inside_and_outside_constant_ranges() {
         &TableOptions {
             reference_distance: 1.0,
             max_levels: 3,
+            series_tolerance: None,
             ..TableOptions::default()
         },
     )

@@ -36,6 +36,20 @@ fn lut(map: &EnvMap, view: View, sampler: Sampler, w: u32, h: u32) -> Vec<u32> {
     render_frame(&mut Renderer::new(map), Scene::Map(map), view, &opts, w, h).0
 }
 
+/// The exact render supersampled 8×8 per pixel (bilinear sub-samples, box filter).
+fn truth(map: &EnvMap, view: View, w: u32, h: u32) -> Vec<u32> {
+    let mut truth = vec![0u32; (w * h) as usize];
+    render_exact_supersampled(
+        map,
+        view,
+        Sampler::Bilinear,
+        8,
+        &mut Frame::new(&mut truth, w, h).unwrap(),
+        true,
+    );
+    truth
+}
+
 #[test]
 fn trilinear_is_closer_to_the_supersampled_truth_when_zoomed_out() {
     let map = fine_map(2048, 1024);
@@ -47,15 +61,7 @@ fn trilinear_is_closer_to_the_supersampled_truth_when_zoomed_out() {
         (90.0, 89.0, 100.0),
     ] {
         let view = View::new(yaw, pitch, hfov).unwrap();
-        let mut truth = vec![0u32; (w * h) as usize];
-        render_exact_supersampled(
-            &map,
-            view,
-            Sampler::Bilinear,
-            8,
-            &mut Frame::new(&mut truth, w, h).unwrap(),
-            true,
-        );
+        let truth = truth(&map, view, w, h);
         let bi = lut(&map, view, Sampler::Bilinear, w, h);
         let tri = lut(&map, view, Sampler::Trilinear, w, h);
         let mut tri_exact = vec![0u32; (w * h) as usize];
@@ -98,6 +104,80 @@ fn trilinear_is_bilinear_when_magnifying() {
         lut(&map, view, Sampler::Trilinear, w, h),
         lut(&map, view, Sampler::Bilinear, w, h)
     );
+}
+
+/// `Renderer::set_bilinear_level`: bilinear reads one pyramid level, the one whose
+/// texel matches the footprint. Magnified it is plain bilinear byte for byte; zoomed out
+/// it is closer to the supersampled truth than bilinear on the map, and it reads the
+/// level (the same frame as rendering that level as a map of its own, up to the LUT's
+/// sub-pixel position rounding).
+#[test]
+fn bilinear_level_reads_the_matching_level() {
+    let map = fine_map(2048, 1024);
+    let opts = RenderOptions {
+        sampler: Sampler::Bilinear,
+        ..RenderOptions::default()
+    };
+    let level_frame = |map: &EnvMap, view: View, w: u32, h: u32| {
+        let mut r = Renderer::new(map);
+        r.set_bilinear_level(true);
+        assert!(r.bilinear_level());
+        render_frame(&mut r, Scene::Map(map), view, &opts, w, h).0
+    };
+    // Magnified: level 0, identical bytes.
+    let view = View::new(33.0, 12.0, 20.0).unwrap();
+    assert_eq!(
+        level_frame(&map, view, 160, 120),
+        lut(&map, view, Sampler::Bilinear, 160, 120)
+    );
+    // Zoomed out: hfov 90 over 64 columns of a 2048-wide map is 8 map pixels per screen
+    // pixel at the centre (a little less towards the edges): levels 2 and 3.
+    let (w, h) = (64, 48);
+    let view = View::new(10.0, 0.0, 90.0).unwrap();
+    let got = level_frame(&map, view, w, h);
+    let bi = lut(&map, view, Sampler::Bilinear, w, h);
+    let truth = truth(&map, view, w, h);
+    let (pl, pb) = (psnr(&got, &truth), psnr(&bi, &truth));
+    assert!(pl >= pb + 3.0, "level {pl:.1} dB vs bilinear {pb:.1} dB");
+    // The middle of the centre column reads level 3 (footprints 9 to 10 map pixels;
+    // towards the top and bottom they fall below 8): the same as bilinear on that level.
+    let level3 = &map.pyramid()[2];
+    let on_level = lut(level3, view, Sampler::Bilinear, w, h);
+    let x = (w / 2) as usize;
+    let mut diff = 0u32;
+    for y in h as usize / 4..3 * h as usize / 4 {
+        let (a, b) = (got[y * w as usize + x], on_level[y * w as usize + x]);
+        for s in [0, 8, 16] {
+            diff = diff.max(((a >> s) & 0xFF).abs_diff((b >> s) & 0xFF));
+        }
+    }
+    assert!(diff <= 8, "centre column differs from level 3 by {diff}");
+}
+
+/// Maps with odd sides deeper down get every level too (1800×900: 225×113 at level 3,
+/// where the pyramid used to stop at 450×225): zoomed out far enough to need level 3 and
+/// beyond, trilinear is closer to the supersampled truth than bilinear, across the seam
+/// too.
+#[test]
+fn odd_sided_maps_minify_too() {
+    let map = fine_map(1800, 900);
+    assert_eq!(map.pyramid().len(), 9, "levels down to 4x2");
+    assert_eq!(
+        (map.pyramid()[2].width(), map.pyramid()[2].height()),
+        (225, 113)
+    );
+    let (w, h) = (48, 32);
+    for (yaw, pitch) in [(0.0, 0.0), (179.0, 20.0)] {
+        // hfov 100 over 48 columns: about 12 map pixels per screen pixel at the centre.
+        let view = View::new(yaw, pitch, 100.0).unwrap();
+        let truth = truth(&map, view, w, h);
+        let pb = psnr(&lut(&map, view, Sampler::Bilinear, w, h), &truth);
+        let pt = psnr(&lut(&map, view, Sampler::Trilinear, w, h), &truth);
+        assert!(
+            pt >= pb + 3.0,
+            "({yaw}, {pitch}): trilinear {pt:.1} dB vs bilinear {pb:.1} dB"
+        );
+    }
 }
 
 /// Columns `x0..x1` of a `w`-wide image.

@@ -1,19 +1,37 @@
-//! Per-frame cost of lighting a 1920×1080 frame with 1 and 8 goniometric luminaires
-//! (linear interpolation, the default), and with 8 using Catmull-Rom.
+//! Lighting a room panorama at 1920×1080 on 2 threads (a rayon pool of 2).
 //!
-//! Run: `cargo bench -p lut-core --bench lights`.
-//! The luminaire is a synthetic type C, bilateral (0-180) distribution with 5° steps and
-//! a cut-off at 80° (so the constant range is exercised), in a 6 × 5 × 2.8 m room.
+//! Run: `cargo bench -p lut-core --bench lights` (add a filter, e.g. `-- pan`); its
+//! output is the "Measured" table of docs/lights.md.
+//!
+//! * `lights_pan`: whole frames of a pan (yaw +7.3° per frame, pitch −15°, hfov 100°) of a
+//!   4096×2048 equirectangular grid map with the default render options (LUT, bilinear,
+//!   adaptive step): `unlit`, then lit from the illuminance map with 0, 1 and 8 lights
+//!   (`map/N`, as the window does), and lit per pixel with 1 light (`per_pixel/1`, as
+//!   `viewer render` does).
+//! * `lights_shade`: the shading pass alone on a fixed view: from the map (`map/N`; its
+//!   cost does not depend on the number of lights) and per pixel with 1 and 8 lights,
+//!   linear and Catmull-Rom.
+//! * `lights_relight`: building the illuminance map (the cost of changing a light) with
+//!   0, 1 and 8 lights, default and preview spacing.
+//!
+//! The luminaire is a synthetic type C, bilateral (0-180) distribution with 5° steps and a
+//! cut-off at 80° (so the constant range is exercised), hung 10 cm below the ceiling of a
+//! 6 × 5 × 2.8 m room, eight of them on a ring.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::DVec3;
+use lut_core::{grid_map, Frame, Projection, RenderOptions, Renderer, Scene};
 use lut_core::{
-    shade_frame, IesFile, Interpolation, LightScene, LightTable, Luminaire, Room, ShadeOptions,
-    TableOptions,
+    shade_frame, IesFile, IlluminanceMap, Interpolation, LightScene, LightTable, Luminaire,
+    MapOptions, Room, ShadeOptions, TableOptions,
 };
 use lut_core::{Camera, View};
 use std::hint::black_box;
 use std::sync::Arc;
+use std::time::Duration;
+
+const W: u32 = 1920;
+const H: u32 = 1080;
 
 fn synthetic_table(interpolation: Interpolation) -> LightTable {
     let v: Vec<f64> = (0..=36).map(|i| i as f64 * 5.0).collect();
@@ -37,7 +55,9 @@ fn synthetic_table(interpolation: Interpolation) -> LightTable {
                 if g >= 80.0 {
                     0.0
                 } else {
-                    2000.0 * g.to_radians().cos().powi(2) * (1.0 + 0.2 * hh.to_radians().cos())
+                    // The planes agree at the nadir, as a measured luminaire's do.
+                    let (sg, cg) = g.to_radians().sin_cos();
+                    2000.0 * cg * cg * (1.0 + 0.2 * hh.to_radians().cos() * sg)
                 }
             })
             .collect();
@@ -52,50 +72,176 @@ fn synthetic_table(interpolation: Interpolation) -> LightTable {
     LightTable::from_ies(&f, &opts).expect("bench table builds")
 }
 
-fn bench_lights(c: &mut Criterion) {
-    let linear = Arc::new(synthetic_table(Interpolation::Linear));
-    let cubic = Arc::new(synthetic_table(Interpolation::CatmullRom));
+fn scene(n: usize, table: &Arc<LightTable>) -> LightScene {
     let room = Room::new(6.0, 5.0, 2.8, 1.5).expect("room");
-    let (w, h) = (1920u32, 1080u32);
-    let cam = Camera::new(View::new(30.0, -15.0, 100.0).expect("view"), w, h);
-    let base: Vec<u32> = (0..w * h)
-        .map(|i| (i.wrapping_mul(2_654_435_761)) & 0xff_ffff)
+    let lights: Vec<Luminaire> = (0..n)
+        .map(|i| {
+            let a = i as f64 / n as f64 * std::f64::consts::TAU;
+            let mut l = Luminaire::new(
+                Arc::clone(table),
+                DVec3::new(2.0 * a.cos(), 2.7, 1.8 * a.sin()),
+            );
+            l.yaw_deg = i as f64 * 37.0;
+            l
+        })
         .collect();
-    let mut frame = base.clone();
-    let mut group = c.benchmark_group("lights_1920x1080");
-    group.throughput(Throughput::Elements(u64::from(w * h)));
-    group.sample_size(10);
-    // 0, 1 and 8 lights with linear interpolation (the default), 8 with Catmull-Rom.
-    let cases = [
-        ("lights", 0usize, &linear),
-        ("lights", 1, &linear),
-        ("lights", 8, &linear),
-        ("lights_catmull_rom", 8, &cubic),
-    ];
-    for (name, n, table) in cases {
-        let lights: Vec<Luminaire> = (0..n)
-            .map(|i| {
-                let a = i as f64 / n as f64 * std::f64::consts::TAU;
-                let mut l = Luminaire::new(
-                    Arc::clone(table),
-                    DVec3::new(2.0 * a.cos(), 2.7, 1.8 * a.sin()),
-                );
-                l.yaw_deg = i as f64 * 37.0;
-                l
+    LightScene::new(room, lights).expect("scene")
+}
+
+fn pool() -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .expect("thread pool")
+}
+
+fn pan_view(frame: &mut u32) -> View {
+    *frame = frame.wrapping_add(1);
+    View::new((*frame as f64 * 7.3) % 360.0, -15.0, 100.0).expect("view")
+}
+
+fn short(g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>) {
+    g.sample_size(10);
+    g.warm_up_time(Duration::from_millis(500));
+    g.measurement_time(Duration::from_secs(3));
+}
+
+/// Whole frames of a pan: render, then light.
+fn pan(c: &mut Criterion) {
+    let pool = pool();
+    let table = Arc::new(synthetic_table(Interpolation::Linear));
+    let map = grid_map(4096, 2048, Projection::Equirect).expect("map");
+    let mut renderer = Renderer::new(&map);
+    let opts = RenderOptions::default();
+    let shade = ShadeOptions::default();
+    let mut pixels = vec![0u32; (W * H) as usize];
+    let mut g = c.benchmark_group("lights_pan");
+    g.throughput(Throughput::Elements(u64::from(W * H)));
+    short(&mut g);
+    let mut k = 0u32;
+    {
+        g.bench_function("unlit", |b| {
+            pool.install(|| {
+                b.iter(|| {
+                    let view = pan_view(&mut k);
+                    let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
+                    renderer
+                        .render(Scene::Map(&map), view, &opts, &mut frame)
+                        .expect("render");
+                    black_box(&pixels);
+                })
             })
-            .collect();
-        let scene = LightScene::new(room, lights).expect("scene");
-        let opts = ShadeOptions::default();
-        group.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
-            b.iter(|| {
-                frame.copy_from_slice(&base);
-                shade_frame(black_box(&scene), &cam, &mut frame, w, h, &opts).expect("shade");
-                black_box(&frame);
+        });
+        for n in [0usize, 1, 8] {
+            let s = scene(n, &table);
+            let lmap = IlluminanceMap::build(&s, &MapOptions::default()).expect("map");
+            g.bench_with_input(BenchmarkId::new("map", n), &n, |b, _| {
+                pool.install(|| {
+                    b.iter(|| {
+                        let view = pan_view(&mut k);
+                        let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
+                        renderer
+                            .render(Scene::Map(&map), view, &opts, &mut frame)
+                            .expect("render");
+                        let cam = Camera::new(view, W, H);
+                        lmap.shade_frame(&cam, &mut pixels, W, H, &shade)
+                            .expect("shade");
+                        black_box(&pixels);
+                    })
+                })
+            });
+        }
+        let s = scene(1, &table);
+        g.bench_function(BenchmarkId::new("per_pixel", 1), |b| {
+            pool.install(|| {
+                b.iter(|| {
+                    let view = pan_view(&mut k);
+                    let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
+                    renderer
+                        .render(Scene::Map(&map), view, &opts, &mut frame)
+                        .expect("render");
+                    let cam = Camera::new(view, W, H);
+                    shade_frame(&s, &cam, &mut pixels, W, H, &shade).expect("shade");
+                    black_box(&pixels);
+                })
             })
         });
     }
-    group.finish();
+    g.finish();
 }
 
-criterion_group!(benches, bench_lights);
+/// The shading pass alone, on one view.
+fn shade_pass(c: &mut Criterion) {
+    let pool = pool();
+    let linear = Arc::new(synthetic_table(Interpolation::Linear));
+    let cubic = Arc::new(synthetic_table(Interpolation::CatmullRom));
+    let cam = Camera::new(View::new(30.0, -15.0, 100.0).expect("view"), W, H);
+    let base: Vec<u32> = (0..W * H)
+        .map(|i| (i.wrapping_mul(2_654_435_761)) & 0xff_ffff)
+        .collect();
+    let mut frame = base.clone();
+    let opts = ShadeOptions::default();
+    let mut g = c.benchmark_group("lights_shade");
+    g.throughput(Throughput::Elements(u64::from(W * H)));
+    short(&mut g);
+    {
+        for n in [0usize, 8] {
+            let lmap =
+                IlluminanceMap::build(&scene(n, &linear), &MapOptions::default()).expect("map");
+            g.bench_with_input(BenchmarkId::new("map", n), &n, |b, _| {
+                pool.install(|| {
+                    b.iter(|| {
+                        frame.copy_from_slice(&base);
+                        lmap.shade_frame(&cam, &mut frame, W, H, &opts)
+                            .expect("shade");
+                        black_box(&frame);
+                    })
+                })
+            });
+        }
+        for (name, n, table) in [
+            ("per_pixel", 0usize, &linear),
+            ("per_pixel", 1, &linear),
+            ("per_pixel", 8, &linear),
+            ("per_pixel_catmull_rom", 8, &cubic),
+        ] {
+            let s = scene(n, table);
+            g.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
+                pool.install(|| {
+                    b.iter(|| {
+                        frame.copy_from_slice(&base);
+                        shade_frame(black_box(&s), &cam, &mut frame, W, H, &opts).expect("shade");
+                        black_box(&frame);
+                    })
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
+/// Building the illuminance map: what changing a light costs.
+fn relight(c: &mut Criterion) {
+    let pool = pool();
+    let table = Arc::new(synthetic_table(Interpolation::Linear));
+    let mut g = c.benchmark_group("lights_relight");
+    short(&mut g);
+    {
+        for n in [0usize, 1, 8] {
+            let s = scene(n, &table);
+            g.bench_with_input(BenchmarkId::new("map", n), &n, |b, _| {
+                pool.install(|| {
+                    b.iter(|| black_box(IlluminanceMap::build(&s, &MapOptions::default())))
+                })
+            });
+        }
+        let s = scene(8, &table);
+        g.bench_function(BenchmarkId::new("preview", 8), |b| {
+            pool.install(|| b.iter(|| black_box(IlluminanceMap::build(&s, &MapOptions::preview()))))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, pan, shade_pass, relight);
 criterion_main!(benches);

@@ -10,7 +10,7 @@
 //! `valgrind --tool=callgrind target/release/examples/light_interpolation lookups linear 1000000`.
 
 use glam::DVec3;
-use lut_core::{Interpolation, LightTable, Photometry, TableOptions};
+use lut_core::{Interpolation, LightTable, Named, Photometry, TableOptions};
 use std::path::PathBuf;
 
 const FILES: &[&str] = &[

@@ -126,6 +126,11 @@ pub use render::grid::{GRID_CELL, GRID_CELL_BUDGET, GRID_MIN_CELL};
 pub use render::heat::{
     heat_color, heat_scale, ErrorMap, HEAT_BACKGROUND, HEAT_MAX, HEAT_MIN, HEAT_MISMATCH,
 };
+pub use render::kernel::{
+    active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
+    KernelError, KernelInfo, KernelSource, SpanJob, Texels, Window, KERNEL_ENV, MAX_JOBS,
+    MAX_LEVELS, TRILINEAR_CHUNK,
+};
 pub use render::steps::{ADAPTIVE_MAX_STEP, SPAN_ERROR_BUDGET};
 pub use render::{
     IndexStep, LutChoice, Positions, RenderOptions, RenderPath, RenderReport, Renderer,
@@ -154,10 +159,11 @@ pub use cube::{
 
 // Lights.
 pub use light::{
-    detect_format, lux_at, shade_frame, IesError, IesFile, IesFormat, Interpolation, LampSet,
-    LdtError, LdtFile, LdtSymmetry, LdtType, LightError, LightFileFormat, LightScene, LightTable,
-    Luminaire, PhotometricType, Photometry, PhotometrySource, Room, ShadeOptions, Symmetry,
-    TableOptions, Tilt, TiltData, MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES,
+    detect_format, false_color, false_color_position, lux_at, shade_frame, IesError, IesFile,
+    IesFormat, IlluminanceMap, Interpolation, LampSet, LdtError, LdtFile, LdtSymmetry, LdtType,
+    LightError, LightFileFormat, LightScene, LightTable, Luminaire, MapOptions, PhotometricType,
+    Photometry, PhotometrySource, Room, RoomFace, ShadeOptions, Symmetry, TableOptions, Tilt,
+    TiltData, MAP_SHADE_BLOCK, MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES,
 };
 
 /// The module layout's rules, checked from the source: dependencies between the stages
@@ -178,7 +184,7 @@ mod layout {
         ("cube", &["geom", "map", "error", "named"]),
         ("render", &["geom", "map", "lut", "cube", "error", "named"]),
         ("file", &[]),
-        ("light", &["geom", "render", "error", "file"]),
+        ("light", &["geom", "render", "error", "named", "file"]),
         (
             "io",
             &["geom", "map", "lut", "cube", "render", "error", "file"],

@@ -42,7 +42,7 @@ pub(crate) fn unknown_name<T: Named>(what: &str, s: &str) -> String {
 mod tests {
     use super::*;
     use crate::{CubeRenderer, IndexStep, Layout, LutChoice, Naming, Projection, RendererKind};
-    use crate::{Sampler, Surface};
+    use crate::{Kernel, Sampler, Surface};
 
     /// Every value's name is unique and parses back to it; names are what scripts type.
     fn round_trip<T: Named + PartialEq + std::fmt::Debug>() {
@@ -67,6 +67,8 @@ mod tests {
         round_trip::<Layout>();
         round_trip::<Naming>();
         round_trip::<CubeRenderer>();
+        round_trip::<Kernel>();
+        round_trip::<crate::Interpolation>();
         round_trip::<crate::ViewProjection>();
     }
 

@@ -1,7 +1,7 @@
 //! The command line: `viewer [PANORAMA]` opens the window; the subcommands render,
 //! convert, summarize IES files and measure.
 
-use crate::commands::{bench, bench_load, convert, ies, render};
+use crate::commands::{bench, bench_load, convert, ies, lux, render};
 use clap::{Parser, Subcommand};
 
 /// CPU panorama viewer: scanline-coherent LUT rendering (US 5,748,194).
@@ -30,6 +30,8 @@ pub enum Command {
     Convert(convert::ConvertArgs),
     /// Summarize an IES LM-63 file and sample its candela distribution.
     Ies(ies::IesArgs),
+    /// Illuminance in lux at points of the room from its luminaires.
+    Lux(lux::LuxArgs),
     /// Measure speed against error for every renderer configuration.
     Bench(bench::BenchArgs),
     /// Huge panoramas: load time, table build, frame time and peak memory for generated

@@ -5,15 +5,21 @@
 use clap::Parser;
 use std::process::ExitCode;
 use viewer::cli::{Cli, Command};
-use viewer::commands::{bench, bench_load, convert, ies, render};
+use viewer::commands::{bench, bench_load, convert, ies, lux, render};
 
 fn main() -> ExitCode {
     viewer::signals::install();
     let cli = Cli::parse();
+    // A bad LUTPANO_KERNEL (the span kernel override) is refused up front.
+    if let Err(e) = lut_core::kernel_from_env() {
+        viewer::errln!("viewer: {e}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Some(Command::Render(a)) => render::run(*a),
         Some(Command::Convert(a)) => convert::run(a),
         Some(Command::Ies(a)) => ies::run(a),
+        Some(Command::Lux(a)) => lux::run(a),
         Some(Command::Bench(a)) => bench::run(a),
         Some(Command::BenchLoad(a)) => bench_load::run(a),
         None => viewer::window::run(cli.open),

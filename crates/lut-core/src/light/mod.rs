@@ -11,25 +11,38 @@
 //!   out and substituted at lookup, and a series of pre-filtered tables by distance, each
 //!   about half the size of the previous, normalized to a reference distance and scaled by
 //!   the inverse square.
-//! * [`shade`]: a room box around the camera, luminaires placed in it, and per-pixel
-//!   shading of a rendered frame: scene point = ray ∩ room, E = I(direction)·cos(incidence)/d²,
-//!   colour = albedo · (ambient + exposure · ΣE), with a false-colour illuminance overlay.
+//! * [`room`]: the room box around the camera, turned and shifted to fit the photograph;
+//!   room coordinates.
+//! * [`shade`]: luminaires placed in the room, and per-pixel shading of a rendered frame:
+//!   scene point = ray ∩ room, E = I(direction)·cos(incidence)/d², colour = albedo ·
+//!   (ambient + exposure · ΣE), with a false-colour illuminance overlay. The exact path.
+//! * [`illum`]: the illuminance map, E computed once per lighting change over the room's
+//!   faces, which frames sample (`map_shade`): the interactive path.
 //!
 //! World frame (docs/conventions.md): X right, Y up, Z forward at yaw 0; metres. The origin is
 //! the floor point below the camera, so the camera sits at (0, camera height, 0).
 //! See `docs/lights.md` for the design.
 
 pub mod ies;
+pub mod illum;
 pub mod ldt;
 mod level;
+mod map_shade;
 pub mod photometry;
+pub mod room;
 pub mod shade;
+mod shade_table;
 pub mod table;
 
 pub use ies::{IesError, IesFile, IesFormat, PhotometricType, Tilt, TiltData};
+pub use illum::{IlluminanceMap, MapOptions};
 pub use ldt::{LampSet, LdtError, LdtFile, LdtSymmetry, LdtType};
+pub use map_shade::BLOCK as MAP_SHADE_BLOCK;
 pub use photometry::{detect_format, LightFileFormat, Photometry, PhotometrySource};
-pub use shade::{lux_at, shade_frame, LightScene, Luminaire, Room, ShadeOptions};
+pub use room::{Room, RoomFace};
+pub use shade::{
+    false_color, false_color_position, lux_at, shade_frame, LightScene, Luminaire, ShadeOptions,
+};
 pub use table::{Interpolation, LightTable, Symmetry, TableOptions};
 
 /// Largest photometric file read, in bytes. Real IES and EULUMDAT files are well under
@@ -139,24 +152,57 @@ pub enum LightError {
     },
     /// A luminaire lies outside the room box (the walls would shadow it entirely).
     #[error(
-        "light {index} at ({x}, {y}, {z}) m is outside the room \
-         (x in ±{half_width}, y in 0..{height}, z in ±{half_depth})"
+        "light {} at ({}, {}, {}) m is outside the room \
+         (x in {}..{}, y in {}..{}, z in {}..{})",
+        index + 1, position[0], position[1], position[2],
+        low[0], high[0], low[1], high[1], low[2], high[2]
     )]
     LightOutsideRoom {
-        /// Index of the luminaire in the scene.
+        /// Index of the luminaire in the scene (0-based; the message counts from 1).
         index: usize,
-        /// Position X.
-        x: f64,
-        /// Position Y.
-        y: f64,
-        /// Position Z.
-        z: f64,
-        /// Half the room width.
-        half_width: f64,
-        /// Room height.
-        height: f64,
-        /// Half the room depth.
-        half_depth: f64,
+        /// Its position in room coordinates.
+        position: [f64; 3],
+        /// The room's low corner.
+        low: [f64; 3],
+        /// The room's high corner.
+        high: [f64; 3],
+    },
+    /// A point (for a lux reading) lies outside the room box.
+    #[error(
+        "point ({}, {}, {}) m is outside the room (x in {}..{}, y in {}..{}, z in {}..{})",
+        point[0], point[1], point[2], low[0], high[0], low[1], high[1], low[2], high[2]
+    )]
+    PointOutsideRoom {
+        /// The point, room coordinates.
+        point: [f64; 3],
+        /// The room's low corner.
+        low: [f64; 3],
+        /// The room's high corner.
+        high: [f64; 3],
+    },
+    /// A point lies on no face of the room, so the surface normal is not known.
+    #[error(
+        "point ({}, {}, {}) m is not on a wall, the floor or the ceiling (none within {} m): \
+         the surface's normal is needed",
+        point[0], point[1], point[2], tol
+    )]
+    PointOffSurface {
+        /// The point, room coordinates.
+        point: [f64; 3],
+        /// How close to a face it had to be, in metres.
+        tol: f64,
+    },
+    /// A point lies on an edge or corner of the room, where faces with different normals
+    /// meet.
+    #[error(
+        "point ({}, {}, {}) m lies where the {} and the {} meet: the surface's normal is needed",
+        point[0], point[1], point[2], faces.0, faces.1
+    )]
+    PointOnEdge {
+        /// The point, room coordinates.
+        point: [f64; 3],
+        /// Two of the faces meeting there.
+        faces: (&'static str, &'static str),
     },
     /// The frame buffer does not hold width × height pixels.
     #[error("frame holds {len} pixels but {width}x{height} needs {needed}")]

@@ -7,148 +7,21 @@
 //! the shaded colour is albedo · (ambient + exposure · ΣE), computed on linear light
 //! (sRGB decoded, multiplied, encoded again).
 //!
-//! World frame (docs/conventions.md): X right, Y up, Z forward at yaw 0, in metres, with the
-//! origin on the floor below the camera: the room spans x ∈ [−W/2, W/2], y ∈ [0, H],
-//! z ∈ [−D/2, D/2] and the camera sits at (0, camera height, 0). The walls are convex
-//! around every light inside, so there are no shadows to trace.
+//! Positions are in room coordinates ([`Room`]): metres along the box's edges, origin on
+//! the floor below the camera; camera rays are turned from the panorama's frame into the
+//! room's by the room's yaw. The walls are convex around every light inside, so there are
+//! no shadows to trace.
+//!
+//! This is the per-pixel path: exact, and the reference the illuminance map
+//! ([`super::lumamap`]) is measured against; the window lights frames from that map.
 
+use super::room::Room;
 use super::table::LightTable;
 use super::{LightError, PhotometricType};
 use crate::geom::camera::Camera;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::{Arc, OnceLock};
-
-/// A box-shaped room around the camera, in metres.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Room {
-    width: f64,
-    depth: f64,
-    height: f64,
-    camera_height: f64,
-}
-
-impl Room {
-    /// A room `width` (along X) × `depth` (along Z) × `height` (along Y), with the camera
-    /// at the horizontal centre, `camera_height` above the floor.
-    ///
-    /// # Errors
-    /// [`LightError::BadOption`] when a size is not a positive finite number or the camera
-    /// is not strictly between floor and ceiling.
-    pub fn new(
-        width: f64,
-        depth: f64,
-        height: f64,
-        camera_height: f64,
-    ) -> Result<Room, LightError> {
-        for (name, value) in [
-            ("room width", width),
-            ("room depth", depth),
-            ("room height", height),
-        ] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(LightError::BadOption {
-                    name,
-                    expected: "a positive number of metres",
-                    value,
-                });
-            }
-        }
-        if !(camera_height > 0.0 && camera_height < height) {
-            return Err(LightError::BadOption {
-                name: "camera height",
-                expected: "strictly between the floor (0) and the ceiling",
-                value: camera_height,
-            });
-        }
-        Ok(Room {
-            width,
-            depth,
-            height,
-            camera_height,
-        })
-    }
-
-    /// A cube room of side `size` (a cube panorama's room), camera at `camera_height`.
-    ///
-    /// # Errors
-    /// As [`Room::new`].
-    pub fn cube(size: f64, camera_height: f64) -> Result<Room, LightError> {
-        Room::new(size, size, size, camera_height)
-    }
-
-    /// Width along X in metres.
-    pub fn width(&self) -> f64 {
-        self.width
-    }
-    /// Depth along Z in metres.
-    pub fn depth(&self) -> f64 {
-        self.depth
-    }
-    /// Height along Y in metres.
-    pub fn height(&self) -> f64 {
-        self.height
-    }
-    /// Camera height above the floor in metres.
-    pub fn camera_height(&self) -> f64 {
-        self.camera_height
-    }
-
-    /// The camera's position in the world frame.
-    pub fn camera_position(&self) -> DVec3 {
-        DVec3::new(0.0, self.camera_height, 0.0)
-    }
-
-    /// Whether a point lies in the closed box (with a 1 µm tolerance).
-    pub fn contains(&self, p: DVec3) -> bool {
-        let e = 1e-6;
-        p.x.abs() <= self.width / 2.0 + e
-            && p.z.abs() <= self.depth / 2.0 + e
-            && p.y >= -e
-            && p.y <= self.height + e
-    }
-
-    /// Where the ray from `origin` (inside the box) along `dir` (any length, not zero)
-    /// leaves the box, and the inward unit normal of the face it hits.
-    #[inline]
-    pub fn hit(&self, origin: DVec3, dir: DVec3) -> (DVec3, DVec3) {
-        let lo = DVec3::new(-self.width / 2.0, 0.0, -self.depth / 2.0);
-        let hi = DVec3::new(self.width / 2.0, self.height, self.depth / 2.0);
-        let mut t = f64::INFINITY;
-        let mut n = DVec3::ZERO;
-        for axis in 0..3 {
-            let d = dir[axis];
-            if d == 0.0 {
-                continue;
-            }
-            let (plane, normal) = if d > 0.0 {
-                (hi[axis], -1.0)
-            } else {
-                (lo[axis], 1.0)
-            };
-            let ta = (plane - origin[axis]) / d;
-            if ta < t {
-                t = ta;
-                n = DVec3::ZERO;
-                n[axis] = normal;
-            }
-        }
-        if !t.is_finite() {
-            return (origin, DVec3::Y);
-        }
-        let mut p = origin + dir * t.max(0.0);
-        // Put the hit exactly on its face (no drift off the wall from rounding).
-        let axis = if n.x != 0.0 {
-            0
-        } else if n.y != 0.0 {
-            1
-        } else {
-            2
-        };
-        p[axis] = if n[axis] < 0.0 { hi[axis] } else { lo[axis] };
-        (p, n)
-    }
-}
 
 /// One luminaire placed in the room.
 #[derive(Debug, Clone)]
@@ -253,14 +126,12 @@ impl LightScene {
                 });
             }
             if !room.contains(l.position) {
+                let (lo, hi) = room.bounds();
                 return Err(LightError::LightOutsideRoom {
                     index,
-                    x: l.position.x,
-                    y: l.position.y,
-                    z: l.position.z,
-                    half_width: room.width / 2.0,
-                    height: room.height,
-                    half_depth: room.depth / 2.0,
+                    position: l.position.to_array(),
+                    low: lo.to_array(),
+                    high: hi.to_array(),
                 });
             }
             let (right, up, aim) = l.frame();
@@ -315,9 +186,11 @@ impl LightScene {
         e
     }
 
-    /// The scene point and inward normal seen along world direction `dir` from the camera.
+    /// The scene point and inward normal (room coordinates) seen along direction `dir`
+    /// of the panorama (the camera's world frame) from the camera.
     pub fn scene_point(&self, dir: DVec3) -> (DVec3, DVec3) {
-        self.room.hit(self.room.camera_position(), dir)
+        self.room
+            .hit(self.room.camera_position(), self.room.to_room(dir))
     }
 }
 
@@ -346,8 +219,52 @@ impl Default for ShadeOptions {
     }
 }
 
+impl ShadeOptions {
+    /// Check the options.
+    ///
+    /// # Errors
+    /// [`LightError::BadOption`] for non-finite or negative ambient/exposure or a
+    /// non-positive false-colour maximum.
+    pub fn check(&self) -> Result<(), LightError> {
+        for (name, value) in [("ambient", self.ambient), ("exposure", self.exposure)] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(LightError::BadOption {
+                    name,
+                    expected: "a finite number ≥ 0",
+                    value,
+                });
+            }
+        }
+        if self.false_color
+            && !(self.false_color_max_lux.is_finite() && self.false_color_max_lux > 0.0)
+        {
+            return Err(LightError::BadOption {
+                name: "false-colour maximum",
+                expected: "a positive number of lux",
+                value: self.false_color_max_lux,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// [`LightError::BufferSize`] unless `frame` holds `w × h` pixels and `cam` was made for
+/// that size.
+pub(crate) fn check_frame(cam: &Camera, frame: &[u32], w: u32, h: u32) -> Result<(), LightError> {
+    let needed = w as usize * h as usize;
+    if frame.len() != needed || cam.width != w || cam.height != h {
+        return Err(LightError::BufferSize {
+            len: frame.len(),
+            width: w,
+            height: h,
+            needed,
+        });
+    }
+    Ok(())
+}
+
 /// sRGB 8-bit → linear.
-fn decode_lut() -> &'static [f32; 256] {
+pub(crate) fn decode_lut() -> &'static [f32; 256] {
     static LUT: OnceLock<[f32; 256]> = OnceLock::new();
     LUT.get_or_init(|| {
         let mut t = [0.0f32; 256];
@@ -363,10 +280,10 @@ fn decode_lut() -> &'static [f32; 256] {
     })
 }
 
-const ENC_N: usize = 4096;
+pub(crate) const ENC_N: usize = 4096;
 
 /// Linear [0, 1] in 4096 steps → sRGB 8-bit.
-fn encode_lut() -> &'static [u8; ENC_N] {
+pub(crate) fn encode_lut() -> &'static [u8; ENC_N] {
     static LUT: OnceLock<[u8; ENC_N]> = OnceLock::new();
     LUT.get_or_init(|| {
         let mut t = [0u8; ENC_N];
@@ -384,7 +301,7 @@ fn encode_lut() -> &'static [u8; ENC_N] {
 }
 
 #[inline]
-fn encode(l: f32, enc: &[u8; ENC_N]) -> u32 {
+pub(crate) fn encode(l: f32, enc: &[u8; ENC_N]) -> u32 {
     let i = (l.clamp(0.0, 1.0) * (ENC_N - 1) as f32 + 0.5) as usize;
     enc[i.min(ENC_N - 1)] as u32
 }
@@ -407,8 +324,10 @@ pub fn false_color(t: f64) -> u32 {
     (ch(0) << 16) | (ch(1) << 8) | ch(2)
 }
 
-/// Position on the false-colour scale of `lux` for a scale topping at `max_lux`.
-fn scale_pos(lux: f64, max_lux: f64) -> f64 {
+/// Position in [0, 1] on the false-colour scale (the argument of [`false_color`]) of
+/// `lux` for a scale topping at `max_lux`: logarithmic over three decades, 0 at
+/// `max_lux / 1000` and below, 1 at `max_lux` and above.
+pub fn false_color_position(lux: f64, max_lux: f64) -> f64 {
     if lux.is_nan() || lux <= 0.0 {
         return 0.0;
     }
@@ -417,7 +336,7 @@ fn scale_pos(lux: f64, max_lux: f64) -> f64 {
 
 /// Shade one pixel of albedo `p` with light factor `k`.
 #[inline]
-fn shade_pixel(p: u32, k: f32, dec: &[f32; 256], enc: &[u8; ENC_N]) -> u32 {
+pub(crate) fn shade_pixel(p: u32, k: f32, dec: &[f32; 256], enc: &[u8; ENC_N]) -> u32 {
     let r = encode(dec[((p >> 16) & 0xff) as usize] * k, enc);
     let g = encode(dec[((p >> 8) & 0xff) as usize] * k, enc);
     let b = encode(dec[(p & 0xff) as usize] * k, enc);
@@ -440,33 +359,9 @@ pub fn shade_frame(
     h: u32,
     opts: &ShadeOptions,
 ) -> Result<(), LightError> {
-    let needed = w as usize * h as usize;
-    if frame.len() != needed || cam.width != w || cam.height != h {
-        return Err(LightError::BufferSize {
-            len: frame.len(),
-            width: w,
-            height: h,
-            needed,
-        });
-    }
-    for (name, value) in [("ambient", opts.ambient), ("exposure", opts.exposure)] {
-        if !(value.is_finite() && value >= 0.0) {
-            return Err(LightError::BadOption {
-                name,
-                expected: "a finite number ≥ 0",
-                value,
-            });
-        }
-    }
-    if opts.false_color && !(opts.false_color_max_lux.is_finite() && opts.false_color_max_lux > 0.0)
-    {
-        return Err(LightError::BadOption {
-            name: "false-colour maximum",
-            expected: "a positive number of lux",
-            value: opts.false_color_max_lux,
-        });
-    }
-    if needed == 0 {
+    check_frame(cam, frame, w, h)?;
+    opts.check()?;
+    if frame.is_empty() {
         return Ok(());
     }
     let dec = decode_lut();
@@ -479,16 +374,17 @@ pub fn shade_frame(
             let py = y as f64 + 0.5;
             for (x, px) in row.iter_mut().enumerate() {
                 // Pixels with no direction (outside a fisheye's disc) stay as rendered.
-                let Some(dir) = cam.ray(x as f64 + 0.5, py) else {
+                let Some(ray) = cam.ray(x as f64 + 0.5, py) else {
                     continue;
                 };
+                let dir = scene.room.to_room(ray);
                 let (p, n) = scene.room.hit(origin, dir);
                 let e = scene.illuminance(p, n);
                 let k = (opts.ambient + opts.exposure * e) as f32;
                 let shaded = shade_pixel(*px, k, dec, enc);
                 *px = if opts.false_color {
                     blend(
-                        false_color(scale_pos(e, opts.false_color_max_lux)),
+                        false_color(false_color_position(e, opts.false_color_max_lux)),
                         shaded,
                         0.65,
                     )
@@ -501,7 +397,7 @@ pub fn shade_frame(
 }
 
 /// a · t + b · (1 − t) per channel.
-fn blend(a: u32, b: u32, t: f32) -> u32 {
+pub(crate) fn blend(a: u32, b: u32, t: f32) -> u32 {
     let ch = |s: u32| {
         let x = ((a >> s) & 0xff) as f32;
         let y = ((b >> s) & 0xff) as f32;
@@ -524,19 +420,6 @@ pub fn lux_at(scene: &LightScene, cam: &Camera, px: f64, py: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn hit_faces_and_normals() {
-        let r = Room::new(4.0, 6.0, 3.0, 1.5).unwrap();
-        let o = r.camera_position();
-        let (p, n) = r.hit(o, DVec3::new(0.0, -1.0, 0.0));
-        assert_eq!((p, n), (DVec3::new(0.0, 0.0, 0.0), DVec3::Y));
-        let (p, n) = r.hit(o, DVec3::new(1.0, 0.0, 0.0));
-        assert_eq!((p, n), (DVec3::new(2.0, 1.5, 0.0), -DVec3::X));
-        let (p, n) = r.hit(o, DVec3::new(0.0, 1.0, -1.0));
-        assert_eq!(n, DVec3::NEG_Y);
-        assert!((p - DVec3::new(0.0, 3.0, -1.5)).length() < 1e-12);
-    }
 
     #[test]
     fn light_frame_down_has_up_along_z() {
@@ -568,7 +451,7 @@ mod tests {
     fn false_color_ends() {
         assert_eq!(false_color(0.0), 0x000060);
         assert_eq!(false_color(1.0), 0xff2000);
-        assert_eq!(scale_pos(1000.0, 1000.0), 1.0);
-        assert_eq!(scale_pos(1.0, 1000.0), 0.0);
+        assert_eq!(false_color_position(1000.0, 1000.0), 1.0);
+        assert_eq!(false_color_position(1.0, 1000.0), 0.0);
     }
 }

@@ -40,6 +40,7 @@ use super::level::{Edge, Edges, Grid, Level, LevelSpec};
 use super::photometry::Photometry;
 pub use super::photometry::Symmetry;
 use super::LightError;
+use crate::named::Named;
 use glam::DVec3;
 
 /// How a table value is filtered between measured angles (claim 3).
@@ -54,24 +55,36 @@ pub enum Interpolation {
     CatmullRom,
 }
 
-impl Interpolation {
-    /// Every value, in the order menus list them.
-    pub const ALL: &'static [Interpolation] = &[Interpolation::Linear, Interpolation::CatmullRom];
+impl Named for Interpolation {
+    const ALL: &'static [Interpolation] = &[Interpolation::Linear, Interpolation::CatmullRom];
 
-    /// The name used by the command line and messages.
-    pub fn name(self) -> &'static str {
+    fn name(self) -> &'static str {
         match self {
             Interpolation::Linear => "linear",
             Interpolation::CatmullRom => "catmull-rom",
         }
     }
 
-    /// One-line help.
-    pub fn help(self) -> &'static str {
+    fn help(self) -> &'static str {
         match self {
             Interpolation::Linear => "bilinear between measured angles (default)",
             Interpolation::CatmullRom => "bicubic Catmull-Rom (as Blender Cycles), clamped at 0",
         }
+    }
+}
+
+impl std::fmt::Display for Interpolation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Interpolation {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        crate::named::parse_name(s)
+            .ok_or_else(|| crate::named::unknown_name::<Interpolation>("light interpolation", s))
     }
 }
 
@@ -88,6 +101,15 @@ pub struct TableOptions {
     /// Leave constant ranges out of the stored tables (claim 8). Default true; the
     /// lookups are the same either way, only the memory differs.
     pub cut_constant_ranges: bool,
+    /// Keep a table of the distance series only while it reproduces the measured table
+    /// within this fraction: at every measured angle (and between them),
+    /// |I_k − I_0| ≤ tolerance · max(I_0, 5 % of the peak). The series stops at the first
+    /// table that does not (a smooth distribution measured finely keeps several tables;
+    /// a peaked one, or one measured coarsely, keeps its measured table at every
+    /// distance, so lux readings are never blurred by the pre-filter). Default
+    /// `Some(0.004)`; `None` builds the plain series (every table halves, whatever it
+    /// costs in accuracy; see docs/lights.md for what that costs a narrow beam).
+    pub series_tolerance: Option<f64>,
 }
 
 impl Default for TableOptions {
@@ -97,6 +119,7 @@ impl Default for TableOptions {
             max_levels: 4,
             interpolation: Interpolation::Linear,
             cut_constant_ranges: true,
+            series_tolerance: Some(0.004),
         }
     }
 }
@@ -111,6 +134,11 @@ pub struct LightTable {
     d_ref: f64,
     d_ref2: f64,
     tilt: Option<TiltData>,
+    /// The smallest step between measured angles, degrees (either axis).
+    finest_step: f64,
+    /// Type C: the γ beyond which every value is 0 (the lit cone's half-angle); 180
+    /// otherwise.
+    lit_cone: f64,
 }
 
 impl LightTable {
@@ -151,6 +179,15 @@ impl LightTable {
                 expected: "at least 1",
                 value: 0.0,
             });
+        }
+        if let Some(t) = opts.series_tolerance {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(LightError::BadOption {
+                    name: "series tolerance",
+                    expected: "a finite number ≥ 0",
+                    value: t,
+                });
+            }
         }
         p.check()?;
         let is_c = p.photometric_type == PhotometricType::C;
@@ -203,16 +240,60 @@ impl LightTable {
             h_bounded: !is_c,
         };
         let mut levels = vec![grid.to_level(&spec)];
+        // Where the series is checked: every measured angle and the midpoints between
+        // (folded horizontal angles of the stored subset, as lookups pass them).
+        let probes = |a: &[f64]| -> Vec<f64> {
+            let mut out = a.to_vec();
+            out.extend(a.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+            out
+        };
+        let (hs, vs) = (probes(&grid.h), probes(&grid.v));
+        let peak = grid.vals.iter().cloned().fold(0.0, f64::max) * spec.scale;
         while levels.len() < opts.max_levels {
-            match grid.halve(h_edges) {
-                Some(g) => {
-                    levels.push(g.to_level(&spec));
-                    grid = g;
+            let Some(g) = grid.halve(h_edges) else {
+                break;
+            };
+            let level = g.to_level(&spec);
+            if let Some(tol) = opts.series_tolerance {
+                let faithful = hs.iter().all(|&h| {
+                    vs.iter().all(|&v| {
+                        let want = levels[0].sample(h, v);
+                        (level.sample(h, v) - want).abs() <= tol * want.max(0.05 * peak)
+                    })
+                });
+                if !faithful {
+                    break;
                 }
-                None => break,
             }
+            levels.push(level);
+            grid = g;
         }
+        let steps = |a: &[f64]| {
+            a.windows(2)
+                .map(|w| w[1] - w[0])
+                .fold(f64::INFINITY, f64::min)
+        };
+        let finest_step = steps(&p.vertical_angles)
+            .min(steps(&p.horizontal_angles))
+            .min(180.0);
+        let nv = p.vertical_angles.len();
+        let lit_cone = if is_c {
+            // The last γ with light in any plane; past the next measured angle (where the
+            // interpolation has come down to 0) and past the measured range all is dark.
+            let last = (0..nv)
+                .rev()
+                .find(|&v| p.candela.iter().skip(v).step_by(nv).any(|&c| c > 0.0));
+            match last {
+                Some(v) if v + 1 < nv => p.vertical_angles[v + 1],
+                Some(v) => p.vertical_angles[v],
+                None => 0.0,
+            }
+        } else {
+            180.0
+        };
         Ok(LightTable {
+            finest_step,
+            lit_cone,
             photometric_type: p.photometric_type,
             symmetry,
             interpolation: opts.interpolation,
@@ -250,6 +331,22 @@ impl LightTable {
     /// The reference distance in metres.
     pub fn reference_distance(&self) -> f64 {
         self.d_ref
+    }
+
+    /// The smallest step between the file's measured angles in degrees (either axis;
+    /// 180 for a file with one angle on each): light varies on this angular scale, so the
+    /// illuminance map samples surfaces finely enough to resolve it.
+    pub fn finest_step_deg(&self) -> f64 {
+        self.finest_step
+    }
+
+    /// For type C, the angle γ from the aim beyond which the luminaire gives no light in
+    /// any plane (180 when it lights the whole sphere); 180 for types A and B. The
+    /// pre-filtered tables of the distance series may spread light one step further (each
+    /// level a step of its own); the illuminance map uses this only to choose its node
+    /// spacing, never to leave light out.
+    pub fn lit_cone_deg(&self) -> f64 {
+        self.lit_cone
     }
 
     /// Tilt data of a `TILT=INCLUDE` file.

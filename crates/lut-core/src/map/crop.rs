@@ -74,13 +74,20 @@ impl EnvMap {
         }
         // The padding column must repeat column 0 only when the crop spans 360°.
         let wrap = crop.width() == crop.full_width();
-        let mut m = if self.projection.wraps() == wrap {
+        // A crop that is the whole panorama becomes a plain map: its stored column 0 is
+        // panorama column `left`, so the columns are turned to put panorama column 0
+        // first (e.g. `360x180+30+0`: the stored image starts 30° east).
+        let turn = crop.is_full() && crop.left() != 0;
+        let mut m = if self.projection.wraps() == wrap && !turn {
             self
         } else {
             let (w, h) = (self.width, self.height);
+            // Panorama column x is stored column (x − left) mod W (left is 0 unless
+            // `turn`).
+            let shift = if turn { w - crop.left() % w } else { 0 };
             let px: Vec<u32> = (0..h)
                 .flat_map(|y| (0..w).map(move |x| (x, y)))
-                .map(|(x, y)| self.pixel(x, y))
+                .map(|(x, y)| self.pixel((x + shift) % w, y))
                 .collect();
             // (elliptical maps pad by repeating the last column)
             let pad_as = if wrap {
@@ -224,6 +231,50 @@ mod tests {
         assert_eq!(m.coverage(), Coverage::FULL);
         let b = m.bilinear(to_fx(0.0), to_fx(2.5));
         assert_eq!(b, lerp_px(m.pixel(15, 2), m.pixel(0, 2), 128));
+    }
+
+    /// Regression: a crop covering the whole panorama from column `left` (e.g.
+    /// `--coverage 360x180+30+0`) used to become a plain map with the offset dropped.
+    #[test]
+    fn whole_crop_with_an_offset_is_turned() {
+        let crop = Crop::new(16, 8, 3, 0, 16, 8).unwrap();
+        let stored = partial_source(16, 8);
+        let m = EnvMap::from_pixels(16, 8, &stored, Projection::Elliptical)
+            .unwrap()
+            .into_partial(crop)
+            .unwrap();
+        assert!(m.crop().is_none());
+        for y in 0..8 {
+            for x in 0..16 {
+                // Panorama column x is stored column (x − 3) mod 16.
+                let want = stored[(y * 16 + (x + 13) % 16) as usize];
+                assert_eq!(m.pixel(x, y), want, "({x}, {y})");
+            }
+        }
+        // The padding column wraps to the new column 0 (a plain 360° map).
+        let b = m.bilinear(to_fx(0.0), to_fx(2.5));
+        assert_eq!(b, lerp_px(m.pixel(15, 2), m.pixel(0, 2), 128));
+        // The same stored image with the offset given as a full-width crop of part of
+        // the rows (kept as a crop) samples the same panorama column.
+        let band = Crop::new(16, 10, 3, 1, 16, 8).unwrap();
+        let p = EnvMap::from_pixels(16, 8, &stored, Projection::Equirect)
+            .unwrap()
+            .into_partial(band)
+            .unwrap();
+        for x in 0..16 {
+            let u = to_fx(x as f64 + 0.5);
+            assert_eq!(
+                p.nearest_cropped(u, to_fx(3.5)),
+                m.pixel(x, 2),
+                "column {x}"
+            );
+        }
+    }
+
+    fn partial_source(w: u32, h: u32) -> Vec<u32> {
+        (0..w * h)
+            .map(|i| 0x010000 * (i % w) + 0x100 * (i / w) + 7)
+            .collect()
     }
 
     #[test]

@@ -9,9 +9,15 @@
 //!
 //! Geometry: level k pixel j covers level-0 pixels [j·2^k, (j+1)·2^k), so a level-0
 //! position u (pixel i spans [i, i + 1)) is u / 2^k on level k — a shift of the Q.16
-//! coordinate. Levels are built only while both sides stay even (so that relation is exact
-//! and the ±180° seam stays at a level column boundary); a 6000×3000 map gets
-//! 3000×1500, 1500×750 and 750×375.
+//! coordinate. Every map gets levels down to a side of 2, odd sides included: a level of
+//! an odd side has ⌈side / 2⌉ pixels, its last pixel averaging the previous level's last
+//! column (or row) with the one beyond it — column 0 for a 360° map (the seam), the last
+//! column again otherwise, the last row again at the bottom — so the relation above stays
+//! exact for every position inside the map. A 6000×3000 map gets 3000×1500, 1500×750,
+//! 750×375, 375×188, … 6×3, 3×2. (Where a level's width is not W / 2^k, a 360° map's seam
+//! falls inside its last column instead of on a column boundary: within a level texel of
+//! the seam the level blends the two sides a little early, which a minifying filter
+//! tolerates; levels of maps whose sides stay even are unchanged by this.)
 //!
 //! The level of detail is `log2(footprint) − ½` in Q.8 ([`lod_q8`]), where the footprint is
 //! the larger side of the pixel's extent in level-0 map pixels. The LUT renderer takes the
@@ -50,7 +56,8 @@ pub fn lod_q8(footprint: f64) -> i32 {
 
 impl EnvMap {
     /// The pyramid levels 1, 2, ... (level 0 is the map itself), built on first use
-    /// (rayon) and kept. Empty for partial maps and maps with an odd side.
+    /// (rayon) and kept, down to a side of 2 (odd sides included). Empty for partial
+    /// maps.
     pub fn pyramid(&self) -> &[EnvMap] {
         self.levels.get_or_init(|| build_levels(self))
     }
@@ -113,20 +120,31 @@ fn build_levels(map: &EnvMap) -> Vec<EnvMap> {
     loop {
         let prev = levels.last().unwrap_or(map);
         let (w, h) = (prev.width, prev.height);
-        if w % 2 != 0 || h % 2 != 0 || w / 2 < MIN_LEVEL_SIDE || h / 2 < MIN_LEVEL_SIDE {
+        let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
+        if nw < MIN_LEVEL_SIDE || nh < MIN_LEVEL_SIDE {
             return levels;
         }
-        let (nw, nh) = ((w / 2) as usize, (h / 2) as usize);
+        // The column right of the last one (odd widths): column 0 across a 360° seam,
+        // else the last column again; the row below the last: the last row again.
+        let wraps = prev.projection.wraps();
+        let right = |x: u32| match (x + 1 < w, wraps) {
+            (true, _) => x + 1,
+            (false, true) => 0,
+            (false, false) => x,
+        };
+        let below = |y: u32| (y + 1).min(h - 1);
+        let (nw, nh) = (nw as usize, nh as usize);
         let mut px = vec![0u32; nw * nh];
         px.par_chunks_mut(nw).enumerate().for_each(|(j, row)| {
             for (i, p) in row.iter_mut().enumerate() {
                 let (x, y) = (2 * i as u32, 2 * j as u32);
+                let (x1, y1) = (right(x), below(y));
                 // (Elliptical and diamond maps: pixels on the sphere only.)
                 *p = average4(
                     prev.pixel_on_sphere(x, y),
-                    prev.pixel_on_sphere(x + 1, y),
-                    prev.pixel_on_sphere(x, y + 1),
-                    prev.pixel_on_sphere(x + 1, y + 1),
+                    prev.pixel_on_sphere(x1, y),
+                    prev.pixel_on_sphere(x, y1),
+                    prev.pixel_on_sphere(x1, y1),
                 );
             }
         });
@@ -171,11 +189,11 @@ mod tests {
     }
 
     #[test]
-    fn levels_halve_while_even_and_average() {
+    fn levels_halve_and_average() {
         let m = checker(48, 24);
         let l = m.pyramid();
         let sides: Vec<_> = l.iter().map(|m| (m.width(), m.height())).collect();
-        assert_eq!(sides, vec![(24, 12), (12, 6), (6, 3)]);
+        assert_eq!(sides, vec![(24, 12), (12, 6), (6, 3), (3, 2)]);
         // A one-pixel checker averages to mid grey on every level.
         for lv in l {
             for y in 0..lv.height() {
@@ -218,6 +236,72 @@ mod tests {
         // (6..8, 4..6): both give the average of those four.
         let (u, v) = (to_fx(7.0), to_fx(5.0));
         assert_eq!(m.trilinear(u, v, 256), m.pyramid()[0].pixel(3, 2));
+    }
+
+    /// Odd sides get levels too (⌈side / 2⌉): the last column of a 360° map's level
+    /// averages across the seam, the last row repeats; a clamped map repeats its last
+    /// column. Even levels are the plain 2×2 averages.
+    #[test]
+    fn odd_sides_get_levels() {
+        let px: Vec<u32> = (0..30 * 15)
+            .map(|i: u32| i.wrapping_mul(2654435761) & 0xFFFFFF)
+            .collect();
+        for proj in [Projection::Equirect, Projection::Elliptical] {
+            let m = EnvMap::from_pixels(30, 15, &px, proj).unwrap();
+            let sides: Vec<_> = m
+                .pyramid()
+                .iter()
+                .map(|l| (l.width(), l.height()))
+                .collect();
+            assert_eq!(sides, [(15, 8), (8, 4), (4, 2)], "{proj}");
+            let l1 = &m.pyramid()[0];
+            let l2 = &m.pyramid()[1];
+            // (Elliptical maps average the pixels on the sphere: `pixel_on_sphere`.)
+            let p = |x: u32, y: u32| m.pixel_on_sphere(x, y);
+            // Level 1: 30 is even, 15 rows are odd: the last row repeats row 14.
+            assert_eq!(l1.pixel(3, 2), average4(p(6, 4), p(7, 4), p(6, 5), p(7, 5)));
+            assert_eq!(
+                l1.pixel(3, 7),
+                average4(p(6, 14), p(7, 14), p(6, 14), p(7, 14))
+            );
+            // Level 2: 15 columns are odd: the last column wraps (360°) or repeats.
+            let q = |x: u32, y: u32| l1.pixel_on_sphere(x, y);
+            let beyond = if proj.wraps() { 0 } else { 14 };
+            assert_eq!(
+                l2.pixel(7, 1),
+                average4(q(14, 2), q(beyond, 2), q(14, 3), q(beyond, 3)),
+                "{proj}"
+            );
+            // Level-0 positions inside the map are inside every level (u >> k).
+            let (u, v) = (to_fx(29.9), to_fx(14.9));
+            for (k, l) in m.pyramid().iter().enumerate() {
+                let k = k as u32 + 1;
+                assert!(to_level(u, k) < (l.width() as i64) << 16);
+                assert!(to_level(v, k) < (l.height() as i64) << 16);
+            }
+        }
+        // The map of the module doc.
+        let m = EnvMap::from_pixels(
+            6000,
+            3000,
+            &vec![0x123456; 6000 * 3000],
+            Projection::Equirect,
+        )
+        .unwrap();
+        let sides: Vec<_> = m
+            .pyramid()
+            .iter()
+            .map(|l| (l.width(), l.height()))
+            .collect();
+        assert_eq!(
+            sides[..4],
+            [(3000, 1500), (1500, 750), (750, 375), (375, 188)]
+        );
+        assert_eq!(sides.last(), Some(&(3, 2)));
+        assert!(m
+            .pyramid()
+            .iter()
+            .all(|l| l.pixel(l.width() - 1, 0) == 0x123456));
     }
 
     #[test]

@@ -48,10 +48,12 @@ use cube::{render_cube, CubeRenderer};
 use exact::{render_exact, ExactFootprint};
 use frame::Frame;
 use grid::{Grid, GridStats};
+use kernel::level_texels;
 use rows::for_each_row;
 use scanline::{render_row, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
-use sink::{PixelRows, PixelSink, PosRows, PosSink, RowSinks, TriRows, TriSink};
+use sink::{Batch, PixelRows, PixelSink, PosRows, PosSink, RowSinks, Sink, TriRows, TriSink};
+use std::f64::consts::TAU;
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
 pub const LUT_SWITCH_HFOV: f64 = 60.0;
@@ -295,6 +297,9 @@ pub struct Renderer {
     /// Row scale per map row (Q.30: multiplied by Λ up to W/2, so Q.16 would lose up to
     /// 0.06 px), for elliptical and diamond maps.
     row_scale: Vec<i64>,
+    /// Bilinear reads the pyramid level matching the footprint
+    /// ([`Renderer::set_bilinear_level`]).
+    bilinear_level: bool,
 }
 
 /// The table of `surface` and `kind` among `tables` (built by [`Renderer::table`]).
@@ -312,6 +317,29 @@ impl Renderer {
         let mut r = Renderer::default();
         r.set_geometry(map.width(), map.height(), map.projection());
         r
+    }
+
+    /// Bilinear frames of the LUT renderer read the pyramid level whose texel matches
+    /// the pixel footprint (`on`), or the map itself (`false`, the default).
+    ///
+    /// Zoomed out on a big map, a bilinear frame reads texels far apart: each sample a
+    /// cache miss, so the frame costs more the bigger the map. With this on, the frame
+    /// reads level k of the pyramid (one level, no blend: bilinear's cost), where 2^k
+    /// map pixels ≤ the footprint < 2^(k+1), the same footprint the trilinear sampler
+    /// uses: a 32768-wide map then pans at the cost of the level that matches the screen
+    /// (about an 8k map at 1080p, hfov 90), with less aliasing than the map itself. At
+    /// footprints below 2 map pixels it is plain bilinear, byte for byte, and a frame
+    /// whose view centre shows fewer than 2 map pixels per screen pixel is rendered as
+    /// plain bilinear outright (at plain bilinear's cost). Meant for a window while the
+    /// view moves; partial maps (no pyramid) are unaffected. The pyramid is built on the
+    /// first such frame if it was not (`EnvMap::pyramid`).
+    pub fn set_bilinear_level(&mut self, on: bool) {
+        self.bilinear_level = on;
+    }
+
+    /// Whether bilinear reads the pyramid level ([`Renderer::set_bilinear_level`]).
+    pub fn bilinear_level(&self) -> bool {
+        self.bilinear_level
     }
 
     fn set_geometry(&mut self, w: u32, h: u32, p: Projection) {
@@ -440,19 +468,33 @@ impl Renderer {
         let w = width as usize;
         let out = frame.pixels_mut();
         let bilinear = opts.sampler != Sampler::Nearest;
-        if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
-            map.pyramid(); // built once, before the rows run in parallel
+        // Bilinear on the pyramid level only where the view is minified: at the view's
+        // centre 2 map pixels or more per screen pixel (below that the frame would read
+        // level 0 nearly everywhere, at the level sink's cost).
+        let centre_footprint =
+            2.0 * (view.hfov() * 0.5).tan() / width as f64 * map.width() as f64 / TAU;
+        let level_bilinear =
+            opts.sampler == Sampler::Bilinear && self.bilinear_level && centre_footprint >= 2.0;
+        if (opts.sampler == Sampler::Trilinear || level_bilinear) && map.crop().is_none() {
+            // The pyramid is built here once, before the rows run in parallel.
+            let (levels, n) = level_texels(map);
+            let levels = &levels[..n];
             let fp = ExactFootprint::new(view, width, height, geometry_of(map));
             for_each_row(out, w, opts.threads, |y, row| {
                 let scan = &scans[y];
                 let mut s = TriSink {
                     row,
                     map,
+                    levels,
                     fy: scan.fy,
-                    lod: lod_q8(scan.fy[0] as f64),
+                    lod: 0,
                     exact: (&fp, y),
+                    whole_levels: level_bilinear,
+                    batch: Batch::new(),
                 };
+                s.set_lod(lod_q8(scan.fy[0] as f64));
                 render_row(scan, table, &setup, row_scale, &mut s);
+                s.flush();
             });
             return Ok(report);
         }
@@ -466,8 +508,13 @@ impl Renderer {
         ) {
             let (scans, table, setup, row_scale) = k;
             for_each_row(out, w, threads, |y, row| {
-                let mut s = PixelSink::<BILINEAR, CROP> { row, map };
+                let mut s = PixelSink::<BILINEAR, CROP> {
+                    row,
+                    map,
+                    batch: Batch::new(),
+                };
                 render_row(&scans[y], table, setup, row_scale, &mut s);
+                s.flush();
             });
         }
         let k = (&scans[..], table, &setup, row_scale);
@@ -499,9 +546,14 @@ impl Renderer {
             g.render(out, r, t, false)
         }
         let stats = if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
-            map.pyramid();
+            let (levels, n) = level_texels(map); // builds the pyramid
             let exact = ExactFootprint::new(view, width, height, geometry);
-            grid.render(out, &TriRows { map, exact: &exact }, t, true)
+            let rows = TriRows {
+                map,
+                levels: &levels[..n],
+                exact: &exact,
+            };
+            grid.render(out, &rows, t, true)
         } else {
             match (opts.sampler != Sampler::Nearest, map.crop().is_some()) {
                 (true, false) => px(&grid, out, &PixelRows::<true, false> { map }, t),

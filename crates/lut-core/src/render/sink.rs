@@ -4,7 +4,9 @@
 //! sink of sampling positions, for measuring them against the exact mapping.
 
 use super::exact::{sample_at, sample_at_lod, ExactFootprint};
-use super::kernel::{sample_span, trilinear_span};
+use super::kernel::{
+    sample_span_cropped, sample_spans, trilinear_spans, SpanJob, Texels, MAX_JOBS,
+};
 use super::scanline::wrap_u;
 use super::steps::STEP_REGIONS;
 use crate::geom::fixed::{from_fx, Fx, FX_ONE};
@@ -32,6 +34,64 @@ pub(crate) trait Sink {
     /// (the grid renderer's cells): the trilinear sink picks its pyramid level from it.
     #[inline(always)]
     fn set_footprint(&mut self, _footprint: f64) {}
+    /// Write what the sink still holds (called at the end of each row).
+    #[inline(always)]
+    fn flush(&mut self) {}
+}
+
+/// Spans of one row waiting for a batch kernel (`kernel::sample_spans`): one kernel call
+/// per [`MAX_JOBS`] spans instead of one per span.
+pub(crate) struct Batch {
+    jobs: [SpanJob; MAX_JOBS],
+    /// Level of detail per span (trilinear only).
+    lods: [i32; MAX_JOBS],
+    n: usize,
+}
+
+impl Batch {
+    pub(crate) fn new() -> Batch {
+        Batch {
+            jobs: [SpanJob::default(); MAX_JOBS],
+            lods: [0; MAX_JOBS],
+            n: 0,
+        }
+    }
+
+    /// Queue a span; `true` when the batch is full (flush it).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn push(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, lod: i32) -> bool {
+        self.jobs[self.n] = SpanJob {
+            x: x as u32,
+            len: m as u32,
+            u,
+            v,
+            du,
+            dv,
+        };
+        self.lods[self.n] = lod;
+        self.n += 1;
+        self.n == MAX_JOBS
+    }
+
+    /// Sample the queued spans into `row` (nearest or bilinear).
+    #[inline]
+    fn flush<const BILINEAR: bool>(&mut self, map: &EnvMap, row: &mut [u32]) {
+        if self.n > 0 {
+            sample_spans::<BILINEAR>(map, row, &self.jobs[..self.n]);
+            self.n = 0;
+        }
+    }
+
+    /// Sample the queued spans into `row`, trilinear with their levels of detail
+    /// (`levels`: `kernel::level_texels`).
+    #[inline]
+    fn flush_trilinear(&mut self, map: &EnvMap, levels: &[Texels], row: &mut [u32]) {
+        if self.n > 0 {
+            trilinear_spans(map, levels, row, &self.jobs[..self.n], &self.lods[..self.n]);
+            self.n = 0;
+        }
+    }
 }
 
 /// [`Sink::span`] pixel by pixel through [`Sink::put`].
@@ -58,6 +118,8 @@ pub(crate) fn put_run<S: Sink + ?Sized>(
 pub(crate) struct PixelSink<'a, const BILINEAR: bool, const CROP: bool> {
     pub(crate) row: &'a mut [u32],
     pub(crate) map: &'a EnvMap,
+    /// Spans waiting for the batch kernel (full maps).
+    pub(crate) batch: Batch,
 }
 
 impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CROP> {
@@ -71,12 +133,16 @@ impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CR
         };
     }
     #[inline(always)]
-    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, w_fx: Fx) {
+    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
         if CROP {
-            put_run(self, x, m, (u, v), (du, dv), w_fx); // per pixel: the crop test
-        } else {
-            sample_span::<BILINEAR>(self.map, &mut self.row[x..x + m], u, v, du, dv);
+            sample_span_cropped::<BILINEAR>(self.map, &mut self.row[x..x + m], u, v, du, dv);
+        } else if self.batch.push(x, m, u, v, du, dv, 0) {
+            self.batch.flush::<BILINEAR>(self.map, self.row);
         }
+    }
+    #[inline(always)]
+    fn flush(&mut self) {
+        self.batch.flush::<BILINEAR>(self.map, self.row);
     }
     #[inline(always)]
     fn background(&mut self, x: usize) {
@@ -93,17 +159,45 @@ impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CR
     }
 }
 
+/// A sink dropped with spans still queued writes them (the renderers call
+/// [`Sink::flush`] at the end of each row; this keeps a sink used without it correct).
+impl<const BILINEAR: bool, const CROP: bool> Drop for PixelSink<'_, BILINEAR, CROP> {
+    fn drop(&mut self) {
+        self.batch.flush::<BILINEAR>(self.map, self.row);
+    }
+}
+
 /// Trilinear sampling (see `map/pyramid.rs`): the level of detail is set per span from
 /// the span's step and the scanline's vertical footprint; pixels evaluated exactly get
 /// the exact renderer's level of detail, from their own exact footprint.
 pub(crate) struct TriSink<'a> {
     pub(crate) row: &'a mut [u32],
     pub(crate) map: &'a EnvMap,
+    /// The map's levels as the span kernels read them.
+    pub(crate) levels: &'a [Texels<'a>],
     /// Vertical footprint per region of this scanline, in level-0 map pixels.
     pub(crate) fy: [f32; STEP_REGIONS],
     pub(crate) lod: i32,
     /// The frame's exact footprints and this row's index.
     pub(crate) exact: (&'a ExactFootprint, usize),
+    /// Whole levels only (bilinear on the level matching the footprint, see
+    /// `Renderer::set_bilinear_level`): the level of detail is rounded down to a level.
+    pub(crate) whole_levels: bool,
+    /// Spans waiting for the batch kernel, with their levels of detail.
+    pub(crate) batch: Batch,
+}
+
+impl TriSink<'_> {
+    /// Set the level of detail (Q.8); with `whole_levels`, level k for footprints in
+    /// [2^k, 2^(k+1)) map pixels (the −½ bias of `lod_q8` undone, the blend weight 0).
+    #[inline(always)]
+    pub(crate) fn set_lod(&mut self, lod: i32) {
+        self.lod = if self.whole_levels {
+            (lod + 128) & !0xFF
+        } else {
+            lod
+        };
+    }
 }
 
 impl Sink for TriSink<'_> {
@@ -113,7 +207,13 @@ impl Sink for TriSink<'_> {
     }
     #[inline(always)]
     fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
-        trilinear_span(self.map, &mut self.row[x..x + m], u, v, du, dv, self.lod);
+        if self.batch.push(x, m, u, v, du, dv, self.lod) {
+            self.batch.flush_trilinear(self.map, self.levels, self.row);
+        }
+    }
+    #[inline(always)]
+    fn flush(&mut self) {
+        self.batch.flush_trilinear(self.map, self.levels, self.row);
     }
     #[inline(always)]
     fn background(&mut self, x: usize) {
@@ -125,16 +225,29 @@ impl Sink for TriSink<'_> {
         // renderer (a span's or the scanline's footprint can be far off there: at hfov
         // 170 the edge columns beyond the wide table see a fraction of the centre's).
         let (fp, y) = self.exact;
-        self.row[x] = sample_at_lod(self.map, uv, fp.lod(x, y, uv));
+        let lod = fp.lod(x, y, uv);
+        let lod = if self.whole_levels {
+            (lod + 128) & !0xFF
+        } else {
+            lod
+        };
+        self.row[x] = sample_at_lod(self.map, uv, lod);
     }
     #[inline(always)]
     fn footprint(&mut self, dl: Fx, dv: Fx, region: usize) {
         let fx = dl.unsigned_abs().max(dv.unsigned_abs()) as f64 / FX_ONE as f64;
-        self.lod = lod_q8(fx.max(self.fy[region] as f64));
+        self.set_lod(lod_q8(fx.max(self.fy[region] as f64)));
     }
     #[inline(always)]
     fn set_footprint(&mut self, footprint: f64) {
-        self.lod = lod_q8(footprint);
+        self.set_lod(lod_q8(footprint));
+    }
+}
+
+/// See the [`PixelSink`] drop: queued spans are written.
+impl Drop for TriSink<'_> {
+    fn drop(&mut self) {
+        self.batch.flush_trilinear(self.map, self.levels, self.row);
     }
 }
 
@@ -181,13 +294,19 @@ impl<const BILINEAR: bool, const CROP: bool> RowSinks for PixelRows<'_, BILINEAR
         Self: 'r;
     #[inline]
     fn sink<'r>(&'r self, row: &'r mut [u32], _y: usize) -> Self::S<'r> {
-        PixelSink { row, map: self.map }
+        PixelSink {
+            row,
+            map: self.map,
+            batch: Batch::new(),
+        }
     }
 }
 
 /// [`TriSink`]s of a map, their level of detail set per cell ([`Sink::set_footprint`]).
 pub(crate) struct TriRows<'a> {
     pub(crate) map: &'a EnvMap,
+    /// The map's levels as the span kernels read them (`kernel::level_texels`).
+    pub(crate) levels: &'a [Texels<'a>],
     pub(crate) exact: &'a ExactFootprint,
 }
 
@@ -202,9 +321,12 @@ impl RowSinks for TriRows<'_> {
         TriSink {
             row,
             map: self.map,
+            levels: self.levels,
             fy: [0.0; STEP_REGIONS],
             lod: 0,
             exact: (self.exact, y),
+            whole_levels: false,
+            batch: Batch::new(),
         }
     }
 }

@@ -34,9 +34,12 @@ pub struct BenchLoadArgs {
     /// Output size of the pan.
     #[arg(long, default_value = "1920x1080", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Frames per pan (yaw steps over a full turn, pitch 10°, hfov 90°).
+    /// Frames per pan (yaw steps over a full turn, pitch 10°, hfov --hfov).
     #[arg(long, default_value_t = 36)]
     pub frames: u32,
+    /// Horizontal field of view of the pan, degrees.
+    #[arg(long, default_value_t = 90.0)]
+    pub hfov: f64,
     /// Print one JSON array instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -96,6 +99,13 @@ pub struct Sample {
     pub frame_ms_nearest: f64,
     /// Median frame of the pan, trilinear (the pyramid built before the pan).
     pub frame_ms_trilinear: f64,
+    /// Median frame of the pan, bilinear on the pyramid level matching the footprint
+    /// (`Renderer::set_bilinear_level`, what the window uses while moving).
+    #[serde(default)]
+    pub frame_ms_bilinear_level: f64,
+    /// The pan's horizontal field of view.
+    #[serde(default)]
+    pub hfov: f64,
     /// Time to build the pyramid (trilinear's levels).
     pub pyramid_s: f64,
     /// Bytes of the pyramid.
@@ -136,6 +146,7 @@ pub fn run(a: BenchLoadArgs) -> Result<()> {
             .arg(&path)
             .args(["--size", &format!("{}x{}", a.size.0, a.size.1)])
             .args(["--frames", &a.frames.to_string()])
+            .args(["--hfov", &a.hfov.to_string()])
             .args(["--max-pixels", &a.limit.max_pixels.to_string()])
             .stderr(std::process::Stdio::inherit())
             .output()
@@ -161,20 +172,23 @@ fn gib(b: u64) -> f64 {
 }
 
 fn print_table(rows: &[Sample], a: &BenchLoadArgs) -> Result<()> {
+    // The children inherit LUTPANO_KERNEL, so they run the kernel named here.
+    crate::outln!("{}", lut_core::kernel_info())?;
     crate::outln!(
-        "{} threads; pan {}x{}, {} frames, LUT renderer (pitch 10°, hfov 90°)",
+        "{} threads; pan {}x{}, {} frames, LUT renderer (pitch 10°, hfov {}°)",
         rayon::current_num_threads(),
         a.size.0,
         a.size.1,
-        a.frames
+        a.frames,
+        a.hfov
     )?;
     crate::outln!(
-        "| map | JPEG | load s (read + decode + convert) | tables s | frame ms bilinear | frame ms nearest | pyramid s | frame ms trilinear | map GiB | pyramid GiB | peak RSS after load GiB | peak RSS GiB |"
+        "| map | JPEG | load s (read + decode + convert) | tables s | frame ms bilinear | frame ms nearest | pyramid s | frame ms trilinear | frame ms bilinear on the level | map GiB | pyramid GiB | peak RSS after load GiB | peak RSS GiB |"
     )?;
-    crate::outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
+    crate::outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
     for s in rows {
         crate::outln!(
-            "| {}x{} | {:.1} MB | {:.2} ({:.2} + {:.2} + {:.2}) | {:.3} | {:.1} | {:.1} | {:.2} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} |",
+            "| {}x{} | {:.1} MB | {:.2} ({:.2} + {:.2} + {:.2}) | {:.3} | {:.1} | {:.1} | {:.2} | {:.1} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} |",
             s.width,
             s.height,
             s.file_bytes as f64 / 1e6,
@@ -187,6 +201,7 @@ fn print_table(rows: &[Sample], a: &BenchLoadArgs) -> Result<()> {
             s.frame_ms_nearest,
             s.pyramid_s,
             s.frame_ms_trilinear,
+            s.frame_ms_bilinear_level,
             gib(s.map_bytes),
             gib(s.pyramid_bytes),
             gib(s.peak_after_load_bytes),
@@ -272,7 +287,8 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
 
     let (w, h) = a.size;
     let mut out = vec![0u32; w as usize * h as usize];
-    let mut pan = |sampler: Sampler| -> Result<f64> {
+    let mut pan = |sampler: Sampler, level: bool| -> Result<f64> {
+        renderer.set_bilinear_level(level);
         let o = RenderOptions {
             sampler,
             ..RenderOptions::default()
@@ -280,7 +296,7 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
         let n = a.frames.max(1);
         let mut ms = Vec::with_capacity(n as usize);
         for i in 0..=n {
-            let view = View::new(f64::from(i) * 360.0 / f64::from(n), 10.0, 90.0)?;
+            let view = View::new(f64::from(i) * 360.0 / f64::from(n), 10.0, a.hfov)?;
             let t = Instant::now();
             renderer.render(Scene::Map(&map), view, &o, &mut Frame::new(&mut out, w, h)?)?;
             if i > 0 {
@@ -290,12 +306,13 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
         }
         Ok(median(&ms))
     };
-    let frame_ms_bilinear = pan(Sampler::Bilinear)?;
-    let frame_ms_nearest = pan(Sampler::Nearest)?;
+    let frame_ms_bilinear = pan(Sampler::Bilinear, false)?;
+    let frame_ms_nearest = pan(Sampler::Nearest, false)?;
     let t = Instant::now();
     map.pyramid();
     let pyramid_s = t.elapsed().as_secs_f64();
-    let frame_ms_trilinear = pan(Sampler::Trilinear)?;
+    let frame_ms_trilinear = pan(Sampler::Trilinear, false)?;
+    let frame_ms_bilinear_level = pan(Sampler::Bilinear, true)?;
     Ok(Sample {
         width: map.width(),
         height: map.height(),
@@ -310,6 +327,8 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
         frame_ms_bilinear,
         frame_ms_nearest,
         frame_ms_trilinear,
+        frame_ms_bilinear_level,
+        hfov: a.hfov,
         pyramid_s,
         pyramid_bytes: map.pyramid_bytes() as u64,
         peak_after_load_bytes: peak_after_load,

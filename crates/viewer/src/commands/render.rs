@@ -4,7 +4,7 @@ use crate::args::{
     named, named_or_parse, parse_angle, parse_size, parse_stops, InputArgs, MaxPixelsArg,
 };
 use crate::heatmap::{summary, write_error_map};
-use crate::lighting::{apply_lights, LightArgs};
+use crate::lighting::LightArgs;
 use crate::output::{check_not_input, output_kind, write_image};
 use crate::panorama::{coverage_text, heading_text, load_cube, load_panorama_partial};
 use crate::scene::{measure_errors, render_scene, Scene};
@@ -21,22 +21,26 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// Panorama image (JPEG, PNG, ...), or a cube map: a folder, six face files, or one
-    /// layout image with --projection cube. The bundled sample when omitted.
+    /// layout image with --projection cube. When omitted, the --scene file's panorama,
+    /// else the bundled sample.
     pub panorama: Vec<PathBuf>,
     /// Output image: .png or .jpg/.jpeg (by the name), written atomically; a device or
     /// FIFO (e.g. /dev/stdout) is written into as PNG.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Yaw in degrees (any value, taken modulo 360; positive turns right).
-    #[arg(long, default_value = "0", value_parser = parse_angle, allow_hyphen_values = true)]
-    pub yaw: f64,
-    /// Pitch in degrees (positive looks up; clamped to [-90, 90]).
-    #[arg(long, default_value = "0", value_parser = parse_angle, allow_hyphen_values = true)]
-    pub pitch: f64,
+    /// Yaw in degrees (any value, taken modulo 360; positive turns right). Default 0, or
+    /// the --scene file's view.
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub yaw: Option<f64>,
+    /// Pitch in degrees (positive looks up; clamped to [-90, 90]). Default 0, or the
+    /// --scene file's view.
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub pitch: Option<f64>,
     /// Horizontal field of view in degrees: in (0, 180) for the rectilinear view
-    /// projection, up to 360 for the others (see --view-projection).
-    #[arg(long, default_value = "90", value_parser = parse_angle, allow_hyphen_values = true)]
-    pub hfov: f64,
+    /// projection, up to 360 for the others (see --view-projection). Default 90, or the
+    /// --scene file's view.
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub hfov: Option<f64>,
     /// How output pixels map to directions. Stereographic at --pitch -90 and a wide
     /// --hfov (e.g. 300) is the little planet.
     #[arg(long, default_value = "rectilinear", value_parser = named_or_parse::<ViewProjection>())]
@@ -80,6 +84,10 @@ pub struct RenderArgs {
     /// The pixel limit.
     #[command(flatten)]
     pub limit: MaxPixelsArg,
+    /// Draw the false colours' legend (a bar with its lux scale) at the right edge; needs
+    /// --false-color (or a scene file with false colours on).
+    #[arg(long)]
+    pub legend: bool,
     /// Print which path rendered, the table size and the sampling-position error against
     /// the exact map (max and mean, source pixels).
     #[arg(long, short)]
@@ -100,6 +108,15 @@ fn parse_pannini_d(s: &str) -> Result<f64, String> {
 }
 
 impl RenderArgs {
+    /// Yaw, pitch and hfov: the options given, else the scene file's view, else 0, 0, 90.
+    pub fn angles(&self, scene: Option<crate::lighting::SceneView>) -> (f64, f64, f64) {
+        (
+            self.yaw.or(scene.map(|v| v.yaw)).unwrap_or(0.0),
+            self.pitch.or(scene.map(|v| v.pitch)).unwrap_or(0.0),
+            self.hfov.or(scene.map(|v| v.hfov)).unwrap_or(90.0),
+        )
+    }
+
     /// The output projection these arguments select (Pannini with its d).
     ///
     /// # Errors
@@ -117,13 +134,14 @@ impl RenderArgs {
         }
     }
 
-    /// The view these arguments select.
+    /// The view these arguments select (angles not given: the scene file's view's).
     ///
     /// # Errors
     /// Bad angles, an hfov outside the projection's range, a bad Pannini d.
-    pub fn view(&self) -> Result<View> {
+    pub fn view(&self, scene: Option<crate::lighting::SceneView>) -> Result<View> {
         let p = self.view_projection()?;
-        View::with_projection(self.yaw, self.pitch, self.hfov, p).map_err(|e| {
+        let (yaw, pitch, hfov) = self.angles(scene);
+        View::with_projection(yaw, pitch, hfov, p).map_err(|e| {
             let hint = match e {
                 lut_core::ViewError::HfovOutOfRange(h) if h >= 180.0 => {
                     " (wider views: --view-projection stereographic, fisheye, equisolid or pannini)"
@@ -149,27 +167,33 @@ impl RenderArgs {
 
     /// The panorama these arguments name: a cube map, or a map placed by `--coverage` or
     /// its GPano XMP.
-    fn load(&self) -> Result<Scene> {
+    fn load(&self, from_scene: Option<PathBuf>) -> Result<Scene> {
         let input = &self.input;
-        if input.projection.value.reads_cube(&self.panorama) {
+        let scene_pano: Vec<PathBuf> = from_scene.into_iter().collect();
+        let panorama = if self.panorama.is_empty() {
+            &scene_pano
+        } else {
+            &self.panorama
+        };
+        if input.projection.value.reads_cube(panorama) {
             if input.coverage.is_some() {
                 return Err(usage!(
                     "--coverage applies to equirectangular panoramas, not cube maps"
                 ));
             }
-            return Ok(Scene::Cube(load_cube(&self.panorama, input.cube)?));
+            return Ok(Scene::Cube(load_cube(panorama, input.cube)?));
         }
-        if self.panorama.len() > 1 {
+        if panorama.len() > 1 {
             return Err(usage!(
                 "{} files given: a single panorama takes one file (use --projection cube for six faces)",
-                self.panorama.len()
+                panorama.len()
             ));
         }
         let tone = lut_core::Tone {
             exposure_ev: self.exposure,
         };
         let (map, _) = load_panorama_partial(
-            self.panorama.first().map(|p| p.as_path()),
+            panorama.first().map(|p| p.as_path()),
             &self.limit.options(input.projection.value.map(), tone),
             input.coverage,
             &mut |_| {},
@@ -180,7 +204,8 @@ impl RenderArgs {
 
 /// Run `viewer render`.
 pub fn run(a: RenderArgs) -> Result<()> {
-    let mut view = a.view()?;
+    let (scene_pano, scene_view) = a.lights.room.scene_panorama()?;
+    let mut view = a.view(scene_view)?;
     if a.view_limit && !view.projection().is_rectilinear() {
         return Err(usage!(
             "--view-limit applies to rectilinear views, not --view-projection {}",
@@ -196,9 +221,18 @@ pub fn run(a: RenderArgs) -> Result<()> {
         output_kind(o)?;
     }
     let mut inputs = a.panorama.clone();
-    inputs.extend(a.lights.lights.iter().map(|l| l.file.clone()));
+    inputs.extend(scene_pano.iter().cloned());
+    inputs.extend(a.lights.room.scene.iter().cloned());
+    inputs.extend(a.lights.room.lights.iter().map(|l| l.file.clone()));
     check_not_input(&outputs, &inputs)?;
-    let mut scene = a.load()?;
+    // The lights first: a bad luminaire or room is reported before the panorama loads.
+    let mut lights = a.lights.state()?;
+    if a.legend && !lights.false_color {
+        return Err(usage!(
+            "--legend draws the false colours' scale: give --false-color too"
+        ));
+    }
+    let mut scene = a.load(scene_pano)?;
     if let (true, Some(map)) = (a.view_limit, scene.env_map()) {
         view = lut_core::limit_view(view, w, h, &map.coverage());
     }
@@ -221,7 +255,28 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if let (Some(path), Some(em)) = (&a.error_map, &error_map) {
         write_error_map(path, em)?;
     }
-    apply_lights(&a.lights, view, &mut out, w, h)?;
+    let mut lit = crate::lighting::LitCache::default();
+    let t0 = std::time::Instant::now();
+    lights
+        .light_frame_with(&mut lit, false, view, &mut out, w, h)
+        .map_err(anyhow::Error::msg)?;
+    if a.verbose && !lights.lights.is_empty() {
+        crate::errln!(
+            "lit from an illuminance map of {:.1} KiB ({} luminaires, map and shading {:.0} ms, exposure {:.0} lx)",
+            lit.bytes() as f64 / 1024.0,
+            lights.lights.len(),
+            t0.elapsed().as_secs_f64() * 1e3,
+            lights.exposure_lux
+        );
+    }
+    if lights.show_room {
+        crate::lighting::overlay::draw_room_and_lights(&lights, view, &mut out, w, h)
+            .map_err(anyhow::Error::msg)?;
+    }
+    if a.legend {
+        crate::lighting::legend::draw_legend(&mut out, w, h, lights.false_color_max)
+            .map_err(anyhow::Error::msg)?;
+    }
     write_image(&a.output, &out, w, h)?;
     Ok(())
 }
@@ -298,7 +353,13 @@ mod tests {
         assert_eq!(a.options(), lut_core::RenderOptions::default());
         assert_eq!(a.options().cube, CubeRenderer::Accelerated);
         assert_eq!(a.size, (1280, 720));
-        assert_eq!((a.yaw, a.pitch, a.hfov), (0.0, 0.0, 90.0));
+        assert_eq!(a.angles(None), (0.0, 0.0, 90.0));
+        let saved = crate::lighting::SceneView {
+            yaw: 10.0,
+            pitch: -20.0,
+            hfov: 70.0,
+        };
+        assert_eq!(a.angles(Some(saved)), (10.0, -20.0, 70.0));
         assert_eq!(a.input.cube_renderer, CubeRenderer::Accelerated);
         assert_eq!(a.input.projection.value, crate::args::ProjectionArg::Auto);
     }
@@ -343,7 +404,7 @@ mod tests {
             a.input.projection.value.map(),
             Some(lut_core::Projection::Elliptical)
         );
-        assert_eq!(a.yaw, -30.0);
+        assert_eq!(a.yaw, Some(-30.0));
     }
 
     #[test]
@@ -351,17 +412,20 @@ mod tests {
         use lut_core::ViewProjection;
         let a = render_args(&[]).unwrap();
         assert_eq!(
-            a.view().unwrap(),
+            a.view(None).unwrap(),
             lut_core::View::new(0.0, 0.0, 90.0).unwrap()
         );
         assert!(a.error_map.is_none());
         let a = render_args(&["--view-projection", "pannini", "--hfov", "200"]).unwrap();
-        assert_eq!(a.view().unwrap().projection(), ViewProjection::Pannini(1.0));
+        assert_eq!(
+            a.view(None).unwrap().projection(),
+            ViewProjection::Pannini(1.0)
+        );
         let a = render_args(&["--view-projection", "pannini", "--pannini-d", "0.25"]).unwrap();
         assert_eq!(a.view_projection().unwrap(), ViewProjection::Pannini(0.25));
         let a = render_args(&["--view-projection", "little-planet", "--hfov", "330"]).unwrap();
         assert_eq!(
-            a.view().unwrap().projection(),
+            a.view(None).unwrap().projection(),
             ViewProjection::Stereographic
         );
         let a = render_args(&["--renderer", "grid", "--lut-surface", "diamond"]).unwrap();
@@ -369,12 +433,12 @@ mod tests {
         assert_eq!(a.options().surface, Surface::Diamond);
         let a = render_args(&["--view-projection", "fisheye", "--pannini-d", "1"]).unwrap();
         assert!(a
-            .view()
+            .view(None)
             .unwrap_err()
             .to_string()
             .contains("--pannini-d applies"));
         let a = render_args(&["--hfov", "250"]).unwrap();
-        let e = a.view().unwrap_err().to_string();
+        let e = a.view(None).unwrap_err().to_string();
         assert!(
             e.contains("got 250") && e.contains("--view-projection"),
             "{e}"

@@ -1,57 +1,97 @@
-//! Luminaires lighting a rendered room panorama: the `--light ...` options `viewer render`
-//! and the window share, and the light state ([`LightsState`]) they become, which the
-//! window's panel edits.
+//! Luminaires lighting a rendered room panorama: the options `viewer render`, `viewer
+//! lux` and the window share, the light state ([`LightsState`]) they become, which the
+//! window's panel edits, and scene files ([`SceneFile`]) that save and reopen it.
 
+mod files;
+pub mod legend;
+mod lit;
+pub mod overlay;
+mod scene_file;
 mod state;
 
+pub use files::{file_kind, FileKind};
+pub use lit::LitCache;
+pub use scene_file::{
+    is_scene, is_scene_file, SceneFile, SceneLight, SceneRoom, SceneView, FORMAT as SCENE_FORMAT,
+    VERSION as SCENE_VERSION,
+};
 pub use state::{
-    format_lux, LightEntry, LightsKey, LightsState, DEFAULT_CAMERA_HEIGHT, DEFAULT_EXPOSURE_LUX,
-    DEFAULT_ROOM,
+    format_lux, load_table, LightEntry, LightsKey, LightsState, AUTO_EXPOSURE_QUANTILE,
+    DEFAULT_CAMERA_HEIGHT, DEFAULT_EXPOSURE_LUX, DEFAULT_ROOM,
 };
 
+use crate::args::named;
 use crate::args::values::finite;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Args;
-use lut_core::View;
-use lut_core::{LightTable, Room, ShadeOptions};
-use std::collections::HashMap;
+use lut_core::{Interpolation, View};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
-/// Options that light a rendered room panorama (flattened into `viewer render` and the
-/// window).
+/// The room and its luminaires: the options `viewer render`, the window and `viewer lux`
+/// share (one definition each).
 // The field docs are the command-line help: `[:YAW,PITCH]` there is not a link.
 #[allow(rustdoc::broken_intra_doc_links)]
 #[derive(Args, Debug, Default, Clone)]
-pub struct LightArgs {
+pub struct RoomArgs {
+    /// A scene file (saved by the window): its room, luminaires and exposure, and for
+    /// `render` and the window its panorama and view; the options below override it and
+    /// --light adds to its luminaires.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
     /// Place a luminaire: FILE@X,Y,Z[:YAW,PITCH] in metres and degrees (repeatable); FILE is
     /// an IES or EULUMDAT (.ldt) file, recognized by content.
-    /// World frame: X right, Y up from the floor, Z forward at yaw 0; the camera is at
-    /// (0, camera height, 0). Aim defaults to straight down (yaw 0, pitch -90).
+    /// Room coordinates: X right, Y up from the floor, Z forward along the room's edges,
+    /// origin on the floor below the camera. Aim defaults to straight down (yaw 0,
+    /// pitch -90).
     #[arg(long = "light", value_parser = parse_light, allow_hyphen_values = true)]
     pub lights: Vec<LightSpec>,
-    /// Room size WIDTHxDEPTHxHEIGHT in metres, centred on the camera (default 5x5x2.7).
-    /// For a cube panorama give a cube.
+    /// Room size WIDTHxDEPTHxHEIGHT in metres (default 5x5x2.7). For a cube panorama give
+    /// a cube.
     #[arg(long, value_parser = parse_room)]
     pub room: Option<(f64, f64, f64)>,
     /// Camera height above the floor in metres (default 1.6).
     #[arg(long)]
     pub camera_height: Option<f64>,
+    /// The room's turn about the vertical axis in degrees: its front wall faces this yaw
+    /// of the panorama (default 0).
+    #[arg(long, allow_hyphen_values = true)]
+    pub room_yaw: Option<f64>,
+    /// The room's centre X,Z in metres from the point below the camera, when the camera
+    /// is not in the middle of the room (default 0,0).
+    #[arg(long, value_parser = parse_center, allow_hyphen_values = true)]
+    pub room_center: Option<(f64, f64)>,
+    /// Multiply every luminaire's intensity (default 1).
+    #[arg(long)]
+    pub light_multiplier: Option<f64>,
+    /// How luminaire tables interpolate between measured angles (default linear).
+    #[arg(long, value_parser = named::<Interpolation>())]
+    pub light_interpolation: Option<Interpolation>,
+}
+
+/// Options that light a rendered room panorama (flattened into `viewer render` and the
+/// window).
+#[derive(Args, Debug, Default, Clone)]
+pub struct LightArgs {
+    /// The room and its luminaires.
+    #[command(flatten)]
+    pub room: RoomArgs,
     /// Illuminance in lux that reproduces the panorama's own brightness (default 300).
     #[arg(long)]
     pub exposure_lux: Option<f64>,
     /// Light factor with no luminaire (0 = black, 1 = as photographed; default 0.15).
     #[arg(long)]
     pub ambient: Option<f64>,
-    /// Multiply every luminaire's intensity (default 1).
-    #[arg(long)]
-    pub light_multiplier: Option<f64>,
     /// Overlay a false-colour illuminance map (log scale, 3 decades).
     #[arg(long)]
     pub false_color: bool,
     /// Illuminance at the top (red) of the false-colour scale in lux (default 1000).
     #[arg(long)]
     pub false_color_max: Option<f64>,
+    /// Draw the room box as a wireframe and the luminaires as markers over the view, to
+    /// fit the room to the photograph's walls, floor and ceiling (the window's "Show
+    /// room").
+    #[arg(long)]
+    pub show_room: bool,
 }
 
 /// One `--light FILE.ies@X,Y,Z[:YAW,PITCH]`.
@@ -118,6 +158,109 @@ fn parse_room(s: &str) -> Result<(f64, f64, f64), String> {
     }
 }
 
+fn parse_center(s: &str) -> Result<(f64, f64), String> {
+    match s
+        .split(',')
+        .map(finite)
+        .collect::<Option<Vec<f64>>>()
+        .as_deref()
+    {
+        Some(&[x, z]) => Ok((x, z)),
+        _ => Err(format!(
+            "room centre '{s}' must be X,Z in metres, e.g. 0.4,-0.6"
+        )),
+    }
+}
+
+impl RoomArgs {
+    /// The scene file's light state (paths against its folder), or the defaults.
+    ///
+    /// # Errors
+    /// As [`SceneFile::load`] and [`SceneFile::to_state`].
+    fn base(&self) -> Result<LightsState> {
+        match &self.scene {
+            Some(path) => {
+                let scene = SceneFile::load(path)?;
+                let dir = path.parent().unwrap_or(Path::new(""));
+                scene
+                    .to_state(dir)
+                    .with_context(|| format!("{}", path.display()))
+            }
+            None => Ok(LightsState::default()),
+        }
+    }
+
+    /// Apply these options over `st` (the scene's or the defaults): room numbers replace,
+    /// `--light`s are loaded and added.
+    ///
+    /// # Errors
+    /// An unreadable or malformed luminaire file.
+    fn apply(&self, st: &mut LightsState) -> Result<()> {
+        if let Some(r) = self.room {
+            st.room = r;
+        }
+        if let Some(h) = self.camera_height {
+            st.camera_height = h;
+        }
+        if let Some(y) = self.room_yaw {
+            st.room_yaw = y;
+        }
+        if let Some(c) = self.room_center {
+            st.room_center = c;
+        }
+        if let Some(m) = self.light_multiplier {
+            st.multiplier = m;
+        }
+        if let Some(i) = self.light_interpolation {
+            st.set_interpolation(i)?;
+        }
+        for spec in &self.lights {
+            let table = st.table_for(&spec.file)?;
+            st.lights.push(LightEntry {
+                path: spec.file.clone(),
+                table,
+                position: spec.position,
+                yaw: spec.aim.0,
+                pitch: spec.aim.1,
+                multiplier: 1.0,
+                enabled: true,
+            });
+        }
+        Ok(())
+    }
+
+    /// The room and luminaires these options describe, without the shading (for
+    /// `viewer lux`), checked.
+    ///
+    /// # Errors
+    /// As [`LightArgs::state`].
+    pub fn state(&self) -> Result<LightsState> {
+        let mut st = self.base()?;
+        self.apply(&mut st)?;
+        st.room_box()
+            .map_err(anyhow::Error::msg)
+            .context("--room/--camera-height/--room-yaw/--room-center")?;
+        st.scene().map_err(anyhow::Error::msg)?;
+        Ok(st)
+    }
+
+    /// The scene file's panorama (resolved against its folder) and view, when a scene
+    /// file is given and names them.
+    ///
+    /// # Errors
+    /// As [`SceneFile::load`].
+    pub fn scene_panorama(&self) -> Result<(Option<PathBuf>, Option<SceneView>)> {
+        match &self.scene {
+            Some(path) => {
+                let scene = SceneFile::load(path)?;
+                let dir = path.parent().unwrap_or(Path::new(""));
+                Ok((scene.panorama_path(dir), scene.view))
+            }
+            None => Ok((None, None)),
+        }
+    }
+}
+
 impl LightArgs {
     /// The light state these options describe: every IES file loaded (once per file),
     /// the room and shading checked, so a bad option is reported before anything renders.
@@ -126,59 +269,45 @@ impl LightArgs {
     /// An unreadable or malformed IES file, a bad room size or camera height, a light
     /// outside the room, a non-positive `--exposure-lux`.
     pub fn state(&self) -> Result<LightsState> {
-        let lux = self.exposure_lux.unwrap_or(DEFAULT_EXPOSURE_LUX);
-        if !(lux.is_finite() && lux > 0.0) {
-            return Err(crate::usage!(
-                "--exposure-lux must be a positive number of lux, got {lux}"
-            ));
+        let mut st = self.room.base()?;
+        self.room.apply(&mut st)?;
+        if let Some(lux) = self.exposure_lux {
+            if !(lux.is_finite() && lux > 0.0) {
+                return Err(crate::usage!(
+                    "--exposure-lux must be a positive number of lux, got {lux}"
+                ));
+            }
+            st.exposure_lux = lux;
+            st.auto_exposure = false;
         }
-        let d = ShadeOptions::default();
-        let mut st = LightsState {
-            room: self.room.unwrap_or(DEFAULT_ROOM),
-            camera_height: self.camera_height.unwrap_or(DEFAULT_CAMERA_HEIGHT),
-            multiplier: self.light_multiplier.unwrap_or(1.0),
-            exposure_lux: lux,
-            ambient: self.ambient.unwrap_or(d.ambient),
-            false_color: self.false_color,
-            false_color_max: self.false_color_max.unwrap_or(d.false_color_max_lux),
-            ..LightsState::default()
-        };
-        if self.lights.is_empty() {
+        if let Some(a) = self.ambient {
+            st.ambient = a;
+        }
+        st.show_room = self.show_room;
+        if self.false_color {
+            st.false_color = true;
+        }
+        if let Some(m) = self.false_color_max {
+            st.false_color_max = m;
+        }
+        if st.lights.is_empty() {
             return Ok(st);
         }
-        let (w, d, h) = st.room;
-        Room::new(w, d, h, st.camera_height)
-            .map_err(|e| crate::usage!("--room/--camera-height: {e}"))?;
-        let mut tables: HashMap<&Path, Arc<LightTable>> = HashMap::new();
-        for spec in &self.lights {
-            let table = match tables.get(spec.file.as_path()) {
-                Some(t) => t.clone(),
-                None => {
-                    let t = Arc::new(LightTable::load(&spec.file)?);
-                    tables.insert(spec.file.as_path(), t.clone());
-                    t
-                }
-            };
-            st.lights.push(LightEntry {
-                path: spec.file.clone(),
-                table,
-                position: spec.position,
-                yaw: spec.aim.0,
-                pitch: spec.aim.1,
-            });
-        }
-        // What is left to go wrong is where the lights are: command-line values.
-        st.scene().map_err(|e| crate::usage!("{e}"))?;
+        // What is left to go wrong are values (the files are read): usage errors.
+        st.room_box()
+            .map_err(|e| crate::usage!("--room/--camera-height/--room-yaw/--room-center: {e}"))?;
+        st.check().map_err(|e| crate::usage!("{e:#}"))?;
         Ok(st)
     }
 }
 
-/// Light a rendered frame of `view` in place; a no-op when no `--light` is given.
+/// Light a rendered frame of `view` in place; a no-op when no `--light` or `--scene`
+/// is given (or the scene has no luminaire).
 ///
 /// # Errors
 /// As [`LightArgs::state`], or a frame that is not `w × h`.
 pub fn apply_lights(args: &LightArgs, view: View, frame: &mut [u32], w: u32, h: u32) -> Result<()> {
-    if args.lights.is_empty() {
+    if args.room.lights.is_empty() && args.room.scene.is_none() {
         return Ok(());
     }
     args.state()?
@@ -195,6 +324,7 @@ fn sample_path() -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::Arc;
 
     #[test]
     fn light_spec_parses() {
@@ -235,8 +365,11 @@ mod tests {
             aim: (30.0, -60.0),
         };
         let a = LightArgs {
-            lights: vec![spec([0.0, 2.6, 0.0]), spec([1.0, 2.6, -1.0])],
-            room: Some((6.0, 4.0, 2.7)),
+            room: RoomArgs {
+                lights: vec![spec([0.0, 2.6, 0.0]), spec([1.0, 2.6, -1.0])],
+                room: Some((6.0, 4.0, 2.7)),
+                ..RoomArgs::default()
+            },
             ambient: Some(0.3),
             exposure_lux: Some(150.0),
             ..LightArgs::default()
@@ -249,20 +382,16 @@ mod tests {
         let o = st.shade_options();
         assert_eq!(o.ambient, 0.3);
         assert!((o.exposure - 1.0 / 150.0).abs() < 1e-15);
-        let outside = LightArgs {
-            lights: vec![spec([0.0, 9.0, 0.0])],
-            ..a.clone()
-        };
+        let mut outside = a.clone();
+        outside.room.lights = vec![spec([0.0, 9.0, 0.0])];
         assert!(outside.state().is_err());
         let dark = LightArgs {
             exposure_lux: Some(0.0),
             ..a.clone()
         };
         assert!(format!("{:#}", dark.state().unwrap_err()).contains("--exposure-lux"));
-        let high = LightArgs {
-            camera_height: Some(5.0),
-            ..a
-        };
+        let mut high = a;
+        high.room.camera_height = Some(5.0);
         assert!(format!("{:#}", high.state().unwrap_err()).contains("--camera-height"));
     }
 }

@@ -2,8 +2,8 @@
 //! `viewer render --light ...` builds from its options, turned into the `lut_core::light`
 //! scene and shading options. Pure data (no window), so the conversions are unit-tested.
 
-use lut_core::{shade_frame, LightScene, LightTable, Luminaire, Room, ShadeOptions};
-use lut_core::{Camera, View};
+use lut_core::{Interpolation, LightScene, LightTable, Luminaire, Room, ShadeOptions};
+use lut_core::{Photometry, TableOptions};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -13,6 +13,9 @@ pub const DEFAULT_ROOM: (f64, f64, f64) = (5.0, 5.0, 2.7);
 pub const DEFAULT_CAMERA_HEIGHT: f64 = 1.6;
 /// Default exposure: the illuminance that reproduces the photograph's brightness.
 pub const DEFAULT_EXPOSURE_LUX: f64 = 300.0;
+/// The automatic exposure's quantile of the room's illuminance (see
+/// [`LightsState::apply_auto_exposure`]).
+pub const AUTO_EXPOSURE_QUANTILE: f64 = 0.95;
 
 /// One luminaire in the panel.
 #[derive(Debug, Clone)]
@@ -27,6 +30,10 @@ pub struct LightEntry {
     pub yaw: f64,
     /// Aim pitch in degrees (−90 = straight down).
     pub pitch: f64,
+    /// This luminaire's own multiplier (times [`LightsState::multiplier`]).
+    pub multiplier: f64,
+    /// Switched on.
+    pub enabled: bool,
 }
 
 impl LightEntry {
@@ -50,10 +57,19 @@ pub struct LightsState {
     pub room: (f64, f64, f64),
     /// Camera height above the floor in metres.
     pub camera_height: f64,
+    /// The room's turn about the vertical axis in degrees (its front wall faces this
+    /// panorama yaw).
+    pub room_yaw: f64,
+    /// The room's centre (x, z) from the point below the camera, metres.
+    pub room_center: (f64, f64),
     /// Multiplies every luminaire's intensity.
     pub multiplier: f64,
+    /// How the luminaires' tables interpolate between measured angles.
+    pub interpolation: Interpolation,
     /// Illuminance in lux that reproduces the panorama's own brightness.
     pub exposure_lux: f64,
+    /// The exposure follows the lights (set from the illuminance map after each change).
+    pub auto_exposure: bool,
     /// Light factor with no luminaire.
     pub ambient: f64,
     /// Overlay the false-colour illuminance map.
@@ -66,6 +82,10 @@ pub struct LightsState {
     pub scene_error: Option<String>,
     /// Illuminance at the pointer (lights only), when the pointer is over the scene.
     pub lux_at_cursor: Option<f64>,
+    /// Draw the room box and the luminaires over the view (the window's "Show room").
+    pub show_room: bool,
+    /// The luminaire selected in the view or the panel.
+    pub selected: Option<usize>,
 }
 
 impl Default for LightsState {
@@ -76,14 +96,20 @@ impl Default for LightsState {
             path_input: String::new(),
             room: DEFAULT_ROOM,
             camera_height: DEFAULT_CAMERA_HEIGHT,
+            room_yaw: 0.0,
+            room_center: (0.0, 0.0),
             multiplier: 1.0,
+            interpolation: Interpolation::Linear,
             exposure_lux: DEFAULT_EXPOSURE_LUX,
+            auto_exposure: false,
             ambient: d.ambient,
             false_color: false,
             false_color_max: d.false_color_max_lux,
             error: None,
             scene_error: None,
             lux_at_cursor: None,
+            show_room: false,
+            selected: None,
         }
     }
 }
@@ -91,9 +117,11 @@ impl Default for LightsState {
 /// What a lit frame depends on: when it is unchanged, the cached scene stays valid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightsKey {
-    lights: Vec<(usize, [f64; 3], f64, f64)>,
+    lights: Vec<(usize, [f64; 3], f64, f64, f64, bool)>,
     room: (f64, f64, f64),
     camera_height: f64,
+    room_yaw: f64,
+    room_center: (f64, f64),
     multiplier: f64,
     shade: Option<ShadeOptions>,
 }
@@ -116,10 +144,96 @@ impl LightsState {
         self.lights.push(LightEntry {
             path,
             table,
-            position: [x.clamp(-half, half), y, 0.0],
+            position: [
+                (self.room_center.0 + x)
+                    .clamp(self.room_center.0 - half, self.room_center.0 + half),
+                y,
+                self.room_center.1,
+            ],
             yaw: 0.0,
             pitch: -90.0,
+            multiplier: 1.0,
+            enabled: true,
         });
+    }
+
+    /// The table of the luminaire file `path` with this state's interpolation: shared
+    /// with a light of the same file, else loaded (IES or EULUMDAT, by content).
+    ///
+    /// # Errors
+    /// An unreadable or malformed file (named, with the line).
+    pub fn table_for(&self, path: &Path) -> anyhow::Result<Arc<LightTable>> {
+        if let Some(l) = self.lights.iter().find(|l| l.path == path) {
+            return Ok(l.table.clone());
+        }
+        Ok(Arc::new(load_table(path, self.interpolation)?))
+    }
+
+    /// Use `interpolation` from now on: every luminaire's table is rebuilt from its file.
+    ///
+    /// # Errors
+    /// A file that no longer loads (the state is left as it was).
+    pub fn set_interpolation(&mut self, interpolation: Interpolation) -> anyhow::Result<()> {
+        if interpolation == self.interpolation {
+            return Ok(());
+        }
+        let mut tables: Vec<(PathBuf, Arc<LightTable>)> = Vec::new();
+        for l in &self.lights {
+            if !tables.iter().any(|(p, _)| *p == l.path) {
+                tables.push((
+                    l.path.clone(),
+                    Arc::new(load_table(&l.path, interpolation)?),
+                ));
+            }
+        }
+        for l in &mut self.lights {
+            if let Some((_, t)) = tables.iter().find(|(p, _)| *p == l.path) {
+                l.table = t.clone();
+            }
+        }
+        self.interpolation = interpolation;
+        Ok(())
+    }
+
+    /// The room box these numbers describe.
+    ///
+    /// # Errors
+    /// A size, camera height, yaw or centre out of range (named).
+    pub fn room_box(&self) -> Result<Room, String> {
+        let (w, d, h) = self.room;
+        Room::new(w, d, h, self.camera_height)
+            .and_then(|r| r.with_yaw(self.room_yaw))
+            .and_then(|r| r.with_center(self.room_center.0, self.room_center.1))
+            .map_err(|e| e.to_string())
+    }
+
+    /// Check everything a render needs: the room, every light inside it, the exposure,
+    /// the multipliers.
+    ///
+    /// # Errors
+    /// The first problem found, named.
+    pub fn check(&self) -> anyhow::Result<()> {
+        let lux = self.exposure_lux;
+        if !(lux.is_finite() && lux > 0.0) {
+            anyhow::bail!("the exposure must be a positive number of lux, got {lux}");
+        }
+        for (name, v) in [
+            ("ambient", self.ambient),
+            ("light multiplier", self.multiplier),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                anyhow::bail!("the {name} must be a finite number ≥ 0, got {v}");
+            }
+        }
+        if !(self.false_color_max.is_finite() && self.false_color_max > 0.0) {
+            anyhow::bail!(
+                "the false-colour maximum must be a positive number of lux, got {}",
+                self.false_color_max
+            );
+        }
+        self.room_box().map_err(anyhow::Error::msg)?;
+        self.scene().map_err(anyhow::Error::msg)?;
+        Ok(())
     }
 
     /// Load `path` (an IES file) and add a luminaire with it; the table is shared with
@@ -136,10 +250,10 @@ impl LightsState {
             .map(|l| l.table.clone());
         let table = match existing {
             Some(t) => t,
-            None => match LightTable::load(path) {
+            None => match load_table(path, self.interpolation) {
                 Ok(t) => Arc::new(t),
                 Err(e) => {
-                    let msg = format!("{}: {e}", path.display());
+                    let msg = format!("{e:#}");
                     self.error = Some(msg.clone());
                     return Err(msg);
                 }
@@ -158,8 +272,9 @@ impl LightsState {
         if self.lights.is_empty() {
             return Ok(None);
         }
-        let (w, d, h) = self.room;
-        let room = Room::new(w, d, h, self.camera_height).map_err(|e| e.to_string())?;
+        let room = self.room_box()?;
+        // Every light is placed (so one outside the room is reported with its number);
+        // switched-off ones with no light.
         let lights = self
             .lights
             .iter()
@@ -167,13 +282,32 @@ impl LightsState {
                 let mut lum = Luminaire::new(l.table.clone(), l.position.into());
                 lum.yaw_deg = l.yaw;
                 lum.pitch_deg = l.pitch;
-                lum.multiplier = self.multiplier;
+                lum.multiplier = if l.enabled {
+                    self.multiplier * l.multiplier
+                } else {
+                    0.0
+                };
                 lum
             })
             .collect();
         LightScene::new(room, lights)
             .map(Some)
             .map_err(|e| e.to_string())
+    }
+
+    /// Set the exposure from the illuminance map of these lights (when
+    /// [`LightsState::auto_exposure`] is on): the lux that [`AUTO_EXPOSURE_QUANTILE`] of
+    /// the room's surface stays below (area-weighted, over walls, floor and ceiling)
+    /// looks like the photograph, so a light just added brightens the room without
+    /// blowing it out. With no light on (all dark) the exposure is left alone.
+    pub fn apply_auto_exposure(&mut self, map: &lut_core::IlluminanceMap) {
+        if !self.auto_exposure {
+            return;
+        }
+        let lux = map.quantile(AUTO_EXPOSURE_QUANTILE);
+        if lux.is_finite() && lux > 0.0 {
+            self.exposure_lux = lux.max(1.0);
+        }
     }
 
     /// How the lit frame is shaded.
@@ -190,24 +324,13 @@ impl LightsState {
         }
     }
 
-    /// Light a rendered `width × height` frame of `view` in place; a no-op with no
-    /// luminaire.
-    ///
-    /// # Errors
-    /// As [`LightsState::scene`], or a frame that is not `width × height`.
-    pub fn light_frame(
-        &self,
-        view: View,
-        frame: &mut [u32],
-        width: u32,
-        height: u32,
-    ) -> Result<(), String> {
-        let Some(scene) = self.scene()? else {
-            return Ok(());
-        };
-        let cam = Camera::new(view, width, height);
-        shade_frame(&scene, &cam, frame, width, height, &self.shade_options())
-            .map_err(|e| e.to_string())
+    /// What the illuminance map depends on: the luminaires and the room, not the
+    /// shading.
+    pub fn geometry_key(&self) -> LightsKey {
+        LightsKey {
+            shade: None,
+            ..self.key()
+        }
     }
 
     /// What the lit frame depends on.
@@ -216,14 +339,40 @@ impl LightsState {
             lights: self
                 .lights
                 .iter()
-                .map(|l| (Arc::as_ptr(&l.table) as usize, l.position, l.yaw, l.pitch))
+                .map(|l| {
+                    (
+                        Arc::as_ptr(&l.table) as usize,
+                        l.position,
+                        l.yaw,
+                        l.pitch,
+                        l.multiplier,
+                        l.enabled,
+                    )
+                })
                 .collect(),
             room: self.room,
             camera_height: self.camera_height,
+            room_yaw: self.room_yaw,
+            room_center: self.room_center,
             multiplier: self.multiplier,
             shade: (!self.lights.is_empty()).then(|| self.shade_options()),
         }
     }
+}
+
+/// Load a luminaire file (IES or EULUMDAT, by content) as a table with `interpolation`.
+///
+/// # Errors
+/// An unreadable or malformed file (named, with the line).
+pub fn load_table(path: &Path, interpolation: Interpolation) -> anyhow::Result<LightTable> {
+    let opts = TableOptions {
+        interpolation,
+        ..TableOptions::default()
+    };
+    Ok(LightTable::from_photometry(
+        &Photometry::load(path)?,
+        &opts,
+    )?)
 }
 
 /// The "lux at cursor" readout: `—` off the scene or with no light, else the value with
@@ -247,6 +396,7 @@ pub fn format_lux(lux: Option<f64>) -> String {
 mod tests {
     use super::*;
     use crate::lighting::sample_path;
+    use lut_core::{Camera, View};
 
     #[test]
     fn no_light_no_scene() {
@@ -357,6 +507,22 @@ mod tests {
         assert!((s.shade_options().exposure - 1.0 / 250.0).abs() < 1e-15);
         s.exposure_lux = 0.0;
         assert_eq!(s.shade_options().exposure, 0.0);
+    }
+
+    #[test]
+    fn added_lights_stay_in_an_off_centre_room() {
+        let mut s = LightsState {
+            room: (2.0, 3.0, 2.7),
+            room_center: (0.8, -0.5),
+            camera_height: 1.2,
+            ..LightsState::default()
+        };
+        for _ in 0..6 {
+            s.load_and_add(&sample_path()).unwrap();
+        }
+        let room = s.room_box().unwrap();
+        assert!(s.lights.iter().all(|l| room.contains(l.position.into())));
+        assert!(s.scene().is_ok());
     }
 
     #[test]

@@ -9,9 +9,12 @@
 //! * `frame.rs`: one frame: routing keys, the UI pass, the scene render at the chosen
 //!   quality, composing, and when the next frame is due.
 //! * `actions.rs`: what keys, buttons and dialogs do; settings kept between runs.
+//! * `lights.rs`: the lit scene from the illuminance map, the room and luminaires over
+//!   it, luminaires picked and dragged in the view, scene files opened and saved.
 
 mod actions;
 mod frame;
+mod lights;
 
 use super::dialogs::Dialogs;
 use super::document::{Document, LoadEvent, StartArgs};
@@ -23,7 +26,7 @@ use super::paint::Compositor;
 use super::prefs::Prefs;
 use super::quality::{FrameTimes, Level};
 use super::OpenArgs;
-use crate::lighting::{LightsKey, LightsState};
+use crate::lighting::{LightsKey, LightsState, LitCache};
 use anyhow::{anyhow, Result};
 use lut_core::{CubeRenderer, IndexStep, LutChoice, RendererKind, Sampler};
 use std::collections::VecDeque;
@@ -49,8 +52,12 @@ struct SceneKey {
     lut: LutChoice,
     cube_renderer: CubeRenderer,
     heat_map: bool,
+    /// Bilinear read from the pyramid level matching the footprint (while moving).
+    bilinear_level: bool,
     map_generation: u64,
     lights: LightsKey,
+    /// The illuminance map's generation, the room shown, the selected light.
+    lit: (u64, bool, Option<usize>),
 }
 
 /// Window, surface and egui-winit state: they exist between `resumed` and exit.
@@ -111,6 +118,16 @@ struct App {
     fatal: Option<anyhow::Error>,
     /// The luminaires (panel state).
     lights: LightsState,
+    /// Their illuminance map, rebuilt when they change.
+    lit: LitCache,
+    /// The luminaire being dragged in the view.
+    light_drag: Option<usize>,
+    /// The room edge being dragged (an index into `lut_core::Room::EDGES`).
+    edge_drag: Option<usize>,
+    /// The scene file opened or saved last.
+    scene_file: Option<PathBuf>,
+    /// The luminaires' marker positions as last printed (`--print-view`).
+    printed_markers: String,
 }
 
 /// Open the window and run until it is closed.
@@ -170,6 +187,11 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         title: String::new(),
         fatal: None,
         lights,
+        lit: LitCache::default(),
+        light_drag: None,
+        edge_drag: None,
+        scene_file: args.lights.room.scene.clone(),
+        printed_markers: String::new(),
     };
     app.take_prefs();
     app.ctl.settings.view_limit = !args.no_view_limit;

@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 enum Purpose {
     Open,
     Save,
+    SaveScene,
 }
 
 /// What the user chose.
@@ -22,6 +23,8 @@ pub enum Chosen {
     Open(PathBuf),
     /// Save the view to this file.
     Save(PathBuf),
+    /// Save the scene (room, luminaires, exposure, panorama, view) to this file.
+    SaveScene(PathBuf),
 }
 
 /// The window's file dialogs (one at a time).
@@ -41,9 +44,12 @@ impl Dialogs {
     pub fn new() -> Dialogs {
         let dialog = FileDialog::new()
             .add_file_filter_extensions("Panoramas", PANORAMA_EXTENSIONS.to_vec())
+            .add_file_filter_extensions("Scenes", vec!["json"])
+            .add_file_filter_extensions("Luminaires", vec!["ies", "ldt"])
             .default_file_filter("Panoramas")
             .add_save_extension("PNG", "png")
             .add_save_extension("JPEG", "jpg")
+            .add_save_extension("Scene", "json")
             .default_save_extension("PNG")
             .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO);
         Dialogs {
@@ -78,7 +84,8 @@ impl Dialogs {
         self.prepare(ctx);
         let c = self.dialog.config_mut();
         c.initial_directory = dir.to_path_buf();
-        c.title = Some("Open a panorama".into());
+        c.title = Some("Open a panorama, scene or luminaire".into());
+        c.default_file_filter = Some("Panoramas".into());
         self.dialog.pick_file();
         self.purpose = Some(Purpose::Open);
     }
@@ -90,8 +97,31 @@ impl Dialogs {
         c.initial_directory = dir.to_path_buf();
         c.default_file_name = name.to_string();
         c.title = Some("Save the view".into());
+        c.default_save_extension = Some("PNG".into());
         self.dialog.save_file();
         self.purpose = Some(Purpose::Save);
+    }
+
+    /// Show the Open dialog in `dir` listing scene files (the file is judged by content
+    /// whatever the filter).
+    pub fn open_scene(&mut self, ctx: &egui::Context, dir: &Path) {
+        self.open_panorama(ctx, dir);
+        let c = self.dialog.config_mut();
+        c.title = Some("Open a scene".into());
+        c.default_file_filter = Some("Scenes".into());
+        self.dialog.pick_file();
+    }
+
+    /// Show the Save dialog for a scene file in `dir` named `name`.
+    pub fn save_scene(&mut self, ctx: &egui::Context, dir: &Path, name: &str) {
+        self.prepare(ctx);
+        let c = self.dialog.config_mut();
+        c.initial_directory = dir.to_path_buf();
+        c.default_file_name = name.to_string();
+        c.title = Some("Save the scene".into());
+        c.default_save_extension = Some("Scene".into());
+        self.dialog.save_file();
+        self.purpose = Some(Purpose::SaveScene);
     }
 
     /// Draw the open dialog (if any) and return what was chosen. `scale` is the Save
@@ -123,6 +153,7 @@ impl Dialogs {
                 Some(match purpose {
                     Purpose::Open => Chosen::Open(p),
                     Purpose::Save => Chosen::Save(p),
+                    Purpose::SaveScene => Chosen::SaveScene(p),
                 })
             }
             _ => {

@@ -19,11 +19,13 @@
 //!   loads (a slider dragged across the range decodes a few times, not once per frame).
 //! * The panel's projection choice reopens the file it applies to: the current one, or
 //!   the one that failed.
-//! * Paths dropped in one event batch open together: `.ies` files add lights, the rest is
-//!   one panorama or cube map.
+//! * Paths dropped in one event batch open together, each judged by its content:
+//!   luminaire files (IES, EULUMDAT) add lights, a scene file opens, the rest is one
+//!   panorama or cube map. A file opened from the dialog or the recent list likewise.
 
 use super::loader::{LoadRequest, Loaded, Source};
 use super::ui::{LoadStatus, LoadStep, Readouts};
+use crate::lighting::{file_kind, FileKind};
 use lut_core::{Coverage, EnvMap, LoadOptions, Naming, Projection, StartView, Tone};
 use std::path::PathBuf;
 
@@ -53,8 +55,10 @@ pub enum Effect {
     /// Run this load on a loading thread and report back through
     /// [`Document::on_event`] (or [`Document::load_not_started`]).
     Load(LoadRequest),
-    /// Add a light for each of these (dropped) IES files.
+    /// Add a light for each of these (dropped or opened) IES or EULUMDAT files.
     AddLights(Vec<PathBuf>),
+    /// Open this scene file: its room, luminaires and exposure, its panorama and view.
+    OpenScene(PathBuf),
     /// The window title.
     Title(String),
     /// A line for stdout with `--print-view`.
@@ -174,7 +178,13 @@ impl Document {
 
     /// Open a file or folder chosen in the window (the Open dialog, the recent list,
     /// PageUp/PageDown): as a drop of that one path.
+    /// Luminaire and scene files are recognized by content (as drops are).
     pub fn open_path(&mut self, path: PathBuf, exposure_ev: f64) -> Option<Effect> {
+        match file_kind(&path) {
+            FileKind::Light => return Some(Effect::AddLights(vec![path])),
+            FileKind::Scene => return Some(Effect::OpenScene(path)),
+            FileKind::Other => {}
+        }
         let source = Source::of_paths(vec![path], false, None)?;
         Some(self.start_load(source, None, exposure_ev, true))
     }
@@ -350,14 +360,25 @@ impl Document {
         !self.pending_drops.is_empty()
     }
 
-    /// Open what was dropped: `.ies` files add lights, the rest is one panorama or cube.
+    /// Open what was dropped, each file judged by its content
+    /// ([`crate::lighting::file_kind`]): luminaire files (IES, EULUMDAT) add lights, a
+    /// scene file opens (the last one dropped, before the rest), the rest is one panorama
+    /// or cube.
     pub fn open_drops(&mut self, exposure_ev: f64) -> Vec<Effect> {
-        let (ies, rest): (Vec<PathBuf>, Vec<PathBuf>) = std::mem::take(&mut self.pending_drops)
-            .into_iter()
-            .partition(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("ies")));
+        let (mut lights, mut scenes, mut rest) = (Vec::new(), Vec::new(), Vec::new());
+        for p in std::mem::take(&mut self.pending_drops) {
+            match file_kind(&p) {
+                FileKind::Light => lights.push(p),
+                FileKind::Scene => scenes.push(p),
+                FileKind::Other => rest.push(p),
+            }
+        }
         let mut fx = Vec::new();
-        if !ies.is_empty() {
-            fx.push(Effect::AddLights(ies));
+        if let Some(scene) = scenes.pop() {
+            fx.push(Effect::OpenScene(scene));
+        }
+        if !lights.is_empty() {
+            fx.push(Effect::AddLights(lights));
             fx.push(Effect::ShowPanel);
         }
         if let Some(source) = Source::of_paths(rest, false, None) {

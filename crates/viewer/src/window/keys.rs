@@ -259,7 +259,14 @@ pub const MOUSE_HELP: &[(&str, &str)] = &[
     ("double-click", "zoom in toward the point"),
     ("drop an image", "open it"),
     ("drop a folder", "open it as a cube map (or six faces)"),
-    ("drop .ies / .ldt", "add a light"),
+    ("drop .ies / .ldt", "add a light (recognized by content)"),
+    ("drop a scene file", "open its panorama, room and lights"),
+    ("click a light", "select it (Show room on)"),
+    ("drag a light", "move it along the ceiling or its wall"),
+    (
+        "drag a room edge",
+        "move its walls to fit the photo (Show room on)",
+    ),
     ("Tab, Enter", "focus and press the buttons"),
 ];
 

@@ -8,7 +8,7 @@
 //! * [`document`]: what is shown, loading, the last error, drops, start views (pure
 //!   state machine, unit-tested); [`loader`]: what is opened and the loading thread's
 //!   work; [`folder`]: the next and previous panorama in a folder.
-//! * [`ui`]: the engineering panel in sections; [`overlay`]: the viewing UI over the
+//! * [`ui`]: the engineering panel in sections ([`lights_panel`]: its "Lights" section); [`overlay`]: the viewing UI over the
 //!   scene (toolbar, compass, notices, help); [`notices`]: the messages' state;
 //!   [`dialogs`]: the Open and Save dialogs.
 //! * [`prefs`]: settings kept between runs in the user's config folder.
@@ -29,6 +29,7 @@ pub mod export;
 pub mod folder;
 pub mod input;
 pub mod keys;
+pub mod lights_panel;
 pub mod loader;
 pub mod notices;
 pub mod overlay;
@@ -95,7 +96,17 @@ fn parse_hfov(s: &str) -> Result<f64, String> {
 /// # Errors
 /// A missing panorama file, or no display to open a window on (a clear message; the
 /// process exits nonzero, it does not panic).
-pub fn run(a: OpenArgs) -> anyhow::Result<()> {
+pub fn run(mut a: OpenArgs) -> anyhow::Result<()> {
+    // A scene file names the panorama and view when the command line does not.
+    let (scene_pano, scene_view) = a.lights.room.scene_panorama()?;
+    if a.panorama.is_empty() {
+        a.panorama.extend(scene_pano);
+    }
+    if let Some(v) = scene_view {
+        a.yaw = a.yaw.or(Some(v.yaw));
+        a.pitch = a.pitch.or(Some(v.pitch));
+        a.hfov = a.hfov.or(Some(v.hfov));
+    }
     for p in &a.panorama {
         // Fail before opening a window for a path that is not there at all; a file that
         // exists but does not decode is reported in the window instead.
@@ -109,7 +120,12 @@ pub fn run(a: OpenArgs) -> anyhow::Result<()> {
     }
     // Lights given on the command line: loaded now, so a bad file or position is
     // reported before any window opens (as `viewer render` reports it).
-    let lights = a.lights.state()?;
+    let mut lights = a.lights.state()?;
+    if a.lights.exposure_lux.is_none() && a.lights.room.scene.is_none() {
+        // The window's default: the exposure follows the lights, so a light added or
+        // dropped brightens the room without blowing it out.
+        lights.auto_exposure = true;
+    }
     let has_display = ["DISPLAY", "WAYLAND_DISPLAY"]
         .iter()
         .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()));

@@ -6,7 +6,7 @@
 
 use super::input::{AutoRotate, Held, Look};
 use super::quality::{Level, Settings, FRAME_BUDGET_MS};
-use crate::lighting::{format_lux, LightsState};
+use crate::lighting::LightsState;
 use lut_core::{CubeRenderer, Named, Projection, RenderPath, Sampler};
 
 mod projection;
@@ -246,6 +246,10 @@ pub struct PanelOutput {
     pub exposure_changed: bool,
     /// "Save view…" was pressed.
     pub save_view: bool,
+    /// "Open scene…" was pressed.
+    pub open_scene: bool,
+    /// "Save scene…" was pressed.
+    pub save_scene: bool,
     /// An output projection was chosen (or Pannini's d changed).
     pub view_projection: Option<lut_core::ViewProjection>,
     /// "Little planet" was pressed.
@@ -332,7 +336,11 @@ pub fn readout_rows(look: &Look, r: &Readouts) -> Vec<(&'static str, String)> {
 }
 
 /// A combo box of every value of `T`, by name, each with its help as the tooltip.
-fn named_combo<T: Named + PartialEq>(ui: &mut egui::Ui, id: &str, value: &mut T) -> egui::Response {
+pub(super) fn named_combo<T: Named + PartialEq>(
+    ui: &mut egui::Ui,
+    id: &str,
+    value: &mut T,
+) -> egui::Response {
     egui::ComboBox::from_id_salt(id)
         .selected_text(value.name())
         .show_ui(ui, |ui| {
@@ -367,7 +375,7 @@ pub const SECTIONS: &[Section] = &[
     navigation_section,
     image_section,
     save_section,
-    lights_section,
+    super::lights_panel::lights_section,
 ];
 
 /// Draw the panel on the right of `ui`; the rest of `ui` is left for the scene.
@@ -585,123 +593,6 @@ fn save_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, out: &mut PanelOutput
 
 /// The "Lights" section: add, place, aim and remove luminaires; multiplier, exposure,
 /// false colour; the lux at the pointer.
-fn lights_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, _out: &mut PanelOutput) {
-    let l = &mut *m.lights;
-    egui::CollapsingHeader::new(format!("Lights ({})", l.lights.len()))
-        .id_salt("lights")
-        .default_open(!l.lights.is_empty())
-        .show(ui, |ui| {
-            ui.horizontal(|ui| {
-                ui.label("lux at cursor");
-                ui.monospace(format_lux(l.lux_at_cursor));
-            });
-            ui.horizontal(|ui| {
-                let field = ui.add(
-                    egui::TextEdit::singleline(&mut l.path_input)
-                        .hint_text("file.ies")
-                        .desired_width(110.0),
-                );
-                let enter = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
-                if (ui.button("Add light").clicked() || enter) && !l.path_input.trim().is_empty() {
-                    let path = std::path::PathBuf::from(l.path_input.trim());
-                    if l.load_and_add(&path).is_ok() {
-                        l.path_input.clear();
-                    }
-                }
-            });
-            for e in [&l.error, &l.scene_error].into_iter().flatten() {
-                ui.colored_label(egui::Color32::from_rgb(255, 120, 100), e);
-            }
-            let mut remove = None;
-            for (i, light) in l.lights.iter_mut().enumerate() {
-                ui.push_id(("light", i), |ui| {
-                    ui.horizontal(|ui| {
-                        ui.label(format!("{}. {}", i + 1, light.name()));
-                        if ui.small_button("✖").on_hover_text("Remove").clicked() {
-                            remove = Some(i);
-                        }
-                    });
-                    ui.horizontal(|ui| {
-                        for (axis, v) in ["X", "Y", "Z"].iter().zip(light.position.iter_mut()) {
-                            ui.label(*axis);
-                            ui.add(egui::DragValue::new(v).speed(0.02).max_decimals(2));
-                        }
-                    });
-                    ui.horizontal(|ui| {
-                        ui.label("yaw");
-                        ui.add(
-                            egui::DragValue::new(&mut light.yaw)
-                                .speed(1.0)
-                                .range(-180.0..=180.0)
-                                .suffix("°"),
-                        );
-                        ui.label("pitch");
-                        ui.add(
-                            egui::DragValue::new(&mut light.pitch)
-                                .speed(1.0)
-                                .range(-90.0..=90.0)
-                                .suffix("°"),
-                        );
-                    });
-                });
-            }
-            if let Some(i) = remove {
-                l.lights.remove(i);
-            }
-            // Sliders narrow enough that their value fields fit the fixed-width panel.
-            ui.spacing_mut().slider_width = 64.0;
-            egui::Grid::new("light_opts").num_columns(2).show(ui, |ui| {
-                ui.label("Multiplier");
-                ui.add(egui::Slider::new(&mut l.multiplier, 0.0..=10.0).logarithmic(true));
-                ui.end_row();
-                ui.label("Exposure");
-                ui.add(
-                    egui::Slider::new(&mut l.exposure_lux, 10.0..=5000.0)
-                        .logarithmic(true)
-                        .suffix(" lx"),
-                )
-                .on_hover_text("Illuminance that looks as bright as the photograph");
-                ui.end_row();
-                ui.label("Ambient");
-                ui.add(egui::Slider::new(&mut l.ambient, 0.0..=1.0));
-                ui.end_row();
-                ui.label("False colour");
-                ui.checkbox(&mut l.false_color, "illuminance");
-                ui.end_row();
-                if l.false_color {
-                    ui.label("Scale top");
-                    ui.add(
-                        egui::Slider::new(&mut l.false_color_max, 10.0..=10000.0)
-                            .logarithmic(true)
-                            .suffix(" lx"),
-                    );
-                    ui.end_row();
-                }
-            });
-            ui.horizontal(|ui| {
-                ui.label("Room");
-                for v in [&mut l.room.0, &mut l.room.1, &mut l.room.2] {
-                    ui.add(
-                        egui::DragValue::new(v)
-                            .speed(0.05)
-                            .range(0.5..=100.0)
-                            .max_decimals(2),
-                    )
-                    .on_hover_text("Width (X) × depth (Z) × height (Y), metres");
-                }
-            });
-            ui.horizontal(|ui| {
-                ui.label("Camera height");
-                ui.add(
-                    egui::DragValue::new(&mut l.camera_height)
-                        .speed(0.02)
-                        .range(0.05..=100.0)
-                        .suffix(" m"),
-                );
-            });
-        });
-}
-
 #[cfg(test)]
 mod tests {
     use super::{LoadStatus, LoadStep};

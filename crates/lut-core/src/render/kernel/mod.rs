@@ -1,12 +1,23 @@
-//! Span kernels: the LUT renderer's inner loop. A *span* is a run of output pixels between
-//! two table reads; its map positions step linearly in Q.16 fixed point, `(u + i·du,
-//! v + i·dv)`, and each pixel is one sample of the map.
+//! Span kernels: the LUT renderer's inner loops, in portable scalar code and in x86-64
+//! SIMD (SSE4.1, AVX2), chosen once per process.
+//!
+//! A *span* is a run of output pixels whose map positions step linearly in Q.16:
+//! pixel `i` samples (u + i·du, v + i·dv). The renderer reads its table every 8–64
+//! pixels; a span that stays inside the map (checked at its two ends: positions are
+//! linear, so every pixel between is inside too) is sampled with no clamps or wraps, the
+//! padding column and row of the map making x + 1 and y + 1 readable at the last column
+//! and row. A span that leaves the map is refused (nothing is written) and the caller
+//! samples it per pixel.
+//!
+//! The kernels take plain data ([`Texels`]: the padded pixel slice and its size;
+//! [`SpanJob`]: a span's place in the output row and its Q.16 start and step), so they do
+//! not depend on the rest of the crate.
 //!
 //! # The rules a kernel keeps, and why
 //! * **No per-pixel dispatch.** The sampler (nearest or bilinear), the partial-map crop
 //!   test and the trilinear level are chosen once per frame (a monomorphized sink per
 //!   combination in `render/sink.rs`) or once per span (the level of detail), never per
-//!   pixel.
+//!   pixel; the instruction set once per process.
 //! * **No division inside a span.** Longitude is wrapped once at the start of a span (one
 //!   period off at most on the renderer's path; `rem_euclid` only for a start further
 //!   off), never per pixel.
@@ -16,34 +27,208 @@
 //!   `y + 1` readable at the last column and row. A span that leaves the map falls back to
 //!   the per-pixel samplers, which wrap and clamp.
 //!
-//! The numbers that showed it (callgrind instruction counts, `docs/ARCHITECTURE.md` "What
-//! was measured and changed"): the nearest inner loop was ~10 instructions per pixel, but
-//! ~25 per pixel went to span overhead (a table read, two `i64::rem_euclid` divisions and
-//! the sampler's clamps every 4 pixels), and a plain gather along precomputed indices (the
-//! same memory accesses) was 3–4× faster than the kernel. Removing the divisions and
-//! clamps (this module) and lengthening the spans (per-region index steps) took the
-//! nearest frame from 15.4 to about 12 ms at 1080p on 2 threads.
+//! The numbers that first showed it (callgrind instruction counts, `docs/ARCHITECTURE.md`
+//! "What was measured and changed"): the nearest inner loop was ~10 instructions per
+//! pixel, but ~25 per pixel went to span overhead (a table read, two `i64::rem_euclid`
+//! divisions and the sampler's clamps every 4 pixels), and a plain gather along
+//! precomputed indices (the same memory accesses) was 3–4× faster than the kernel.
 //!
 //! # Layout
-//! [`scalar`] holds the portable kernels: functions over the map's padded pixel slice,
-//! its stride, the output slice and the span's Q.16 start and step, with every position
-//! known to be inside (the checks above are done here, once per span). SIMD twins of
-//! them go next to it (one file per instruction set), each with a test that it agrees
-//! with the scalar kernel.
+//! `mod.rs` (this file): the kernels' data types and the entries the renderer calls on an
+//! [`EnvMap`]; `jobs.rs`: the span check, batches and the dispatch; `scalar.rs`: the
+//! portable kernels (the reference); `x86.rs`: SSE4.1 and AVX2 (the only file where
+//! `unsafe` is allowed); `select.rs`: choosing the kernel; `tests.rs`: the property tests.
+//!
+//! # Batches
+//! Spans are short (8–16 pixels at hfov 90), so what a span costs besides its pixels
+//! (the range check, the lane setup, a call) matters as much as the blend. The renderer
+//! queues a row's spans and hands up to [`MAX_JOBS`] of them to one call
+//! ([`Kernel::bilinear_spans`], [`Kernel::nearest_spans`], [`Kernel::trilinear_spans`]):
+//! the kernel is chosen once per batch, and the span checks and the SIMD loop are
+//! compiled into one `#[target_feature]` function (each SIMD loop has a single caller, so
+//! it is inlined there; a non-inlined kernel taking its span setup through memory cost a
+//! failed store-to-load forward per span, and made AVX2 nearest slower than scalar).
+//! Single spans are batches of one.
+//!
+//! # Identical bytes
+//! Every SIMD kernel computes exactly what its scalar twin in `scalar.rs` computes: the
+//! same 8-bit weights, the same rounding (`(a·(256 − w) + b·w + 128) >> 8` per channel, in
+//! 16-bit lanes where it cannot overflow: at most 255·256 + 128), the same positions. The
+//! property tests in `tests.rs` compare the bytes of every available kernel with the
+//! scalar one over random spans and batches (the seam, the last column and row, the
+//! poles, partial maps, lengths 1..=64, odd output offsets, negative and huge steps, 1×1
+//! and 2×1 maps, 65536-wide maps), and the scalar one with the per-pixel samplers. The
+//! whole test suite also runs with the scalar kernel forced (`LUTPANO_KERNEL=scalar`, see
+//! `scripts/test.sh`).
+//!
+//! # Positions in 32-bit lanes
+//! Q.16 positions of a 65536-wide map reach 2³² and do not fit an `i32` lane. The SIMD
+//! kernels split the span's start into a whole pixel (x₀, y₀), folded into one base
+//! index, and a fraction f < 1; lanes hold the span-local `f + i·du`, exact in `i32` as
+//! long as `|du|·(len − 1) + 1` stays below 2³¹ (32768 map pixels of travel per span).
+//! Spans that travel further (only far zoomed out on a huge map) run the scalar kernel.
+//! Lane indices are also clamped to the slice before each load, so memory safety never
+//! rests on that arithmetic; equality with the scalar twin is what the tests prove.
+//!
+//! # Measured and chosen (see `docs/performance.md`, "Span kernels")
+//! - Loads, not gathers: each bilinear pixel reads its 2×2 block with two 64-bit loads
+//!   (top pair, bottom pair); two `shufps` separate the left and right texels of 8
+//!   pixels. On the development machine (which reports no Gather Data Sampling
+//!   mitigation) `vpgatherdq` of the pairs was 5–10 % faster, `vpgatherdd` for nearest no
+//!   faster; gathers are several times slower on CPUs with that microcode fix and on AMD
+//!   Zen 2/3, so the loads stay.
+//! - One pass, not two: writing a batch's per-pixel indices and weights first, then
+//!   gathering and blending all its pixels in one loop, took more instructions per pixel
+//!   (bilinear 67.6 against 62.8 per frame pixel, nearest 62.2 against 49.5): the fixed
+//!   cost of a span (checks, lane setup) stays, and the results must be copied back.
+//! - No AVX-512 kernel yet: at 8–16 pixels per span the per-span cost, not the blend,
+//!   dominates the kernel, and a 16-lane vector would be half empty on 8-pixel spans.
+//!
+//! # Choosing the kernel once
+//! [`active_kernel`] is decided on first use: the `LUTPANO_KERNEL` environment variable
+//! (`auto`, `scalar`, `sse41`, `avx2`; read once) or else the best kernel the CPU runs
+//! ([`Kernel::best`], from `is_x86_feature_detected!`). [`set_kernel`] changes it (the
+//! benchmarks compare kernels in one run); [`kernel_info`] tells what runs and which CPU
+//! features were detected. The choice costs one relaxed atomic load per batch, never a
+//! test per pixel.
+//!
+//! Why not a crate: `multiversion` (0.9, MIT/Apache-2.0, maintained) compiles one generic
+//! function for several targets, but these kernels are different code per instruction set
+//! (a 4-lane and an 8-lane layout, scalar index arithmetic), and its dispatcher cannot be
+//! forced to a lower level at run time, which the tests and benchmarks need. `pulp`
+//! (0.22, MIT, maintained) is a portable SIMD abstraction whose API changes between 0.x
+//! releases and does not express the paired 64-bit loads and byte shuffles these kernels
+//! are made of. The standard library's detection (itself cached in an atomic) plus one
+//! atomic byte for the choice is all the dispatch needs.
+//!
+//! aarch64 and x86 CPUs without SSE4.1 run the scalar kernel.
 
-pub(crate) mod scalar;
+mod jobs;
+mod scalar;
+mod select;
+#[cfg(test)]
+mod tests;
+#[cfg(target_arch = "x86_64")]
+mod x86;
 
-use crate::geom::fixed::{Fx, FX_BITS, FX_HALF, FX_ONE};
+pub use select::{
+    active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
+    KernelError, KernelInfo, KernelSource, KERNEL_ENV,
+};
+
+use crate::geom::fixed::{Fx, FX_BITS};
 use crate::map::envmap::EnvMap;
 use crate::map::sample::lerp_px;
+
+/// Longest span the trilinear kernel blends in one piece (the second level restarts its
+/// position every this many pixels, as the per-pixel path always has).
+pub const TRILINEAR_CHUNK: usize = 64;
+
+/// Most spans in one batch ([`Kernel::bilinear_spans`]: one bit per span in its answer).
+pub const MAX_JOBS: usize = 32;
+
+/// One span of an output row, for the batch kernels: `len` pixels from column `x` on
+/// sample (u + i·du, v + i·dv), Q.16 map coordinates.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SpanJob {
+    /// First output column.
+    pub x: u32,
+    /// Pixels.
+    pub len: u32,
+    /// Position of the first pixel.
+    pub u: Fx,
+    /// Position of the first pixel.
+    pub v: Fx,
+    /// Step per pixel.
+    pub du: Fx,
+    /// Step per pixel.
+    pub dv: Fx,
+}
+
+/// A map's pixels as the kernels read them: `(width + 1) × (height + 1)` 0RGB `u32`,
+/// row-major, the last column and row being padding (column `width` repeats column 0
+/// for maps that wrap horizontally, else column `width − 1`; row `height` repeats row
+/// `height − 1`).
+#[derive(Debug, Clone, Copy)]
+pub struct Texels<'a> {
+    px: &'a [u32],
+    width: u32,
+    height: u32,
+    wraps: bool,
+}
+
+impl<'a> Texels<'a> {
+    /// The padded pixels of a `width × height` map; `wraps`: the map is 360° wide (a
+    /// span may start one period off and is wrapped once). `None` when `px` does not
+    /// hold `(width + 1) × (height + 1)` pixels, a side is 0, or it holds 2³¹ or more.
+    pub fn new(px: &'a [u32], width: u32, height: u32, wraps: bool) -> Option<Texels<'a>> {
+        let n = (width as usize + 1).checked_mul(height as usize + 1)?;
+        (width > 0 && height > 0 && px.len() == n && n <= i32::MAX as usize).then_some(Texels {
+            px,
+            width,
+            height,
+            wraps,
+        })
+    }
+
+    /// Pixels per row, padding included.
+    #[inline(always)]
+    pub fn stride(&self) -> usize {
+        self.width as usize + 1
+    }
+}
+
+/// A partial map's place in the full panorama, for [`Kernel::cropped_span`]: the stored
+/// [`Texels`] hold columns `left..left + width` (mod `full_width`) and rows
+/// `top..top + height` of a `full_width × full_height` panorama.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Window {
+    /// Full panorama width in pixels.
+    pub full_width: u32,
+    /// Full panorama height in pixels.
+    pub full_height: u32,
+    /// First stored column, in `0..full_width`.
+    pub left: u32,
+    /// First stored row.
+    pub top: u32,
+    /// The background colour (0RGB) outside the stored pixels.
+    pub background: u32,
+}
+
+/// Most pyramid levels the trilinear kernels take (level 0, the map, included).
+pub const MAX_LEVELS: usize = 32;
+
+/// The stored pixels of `map` as the kernels read them.
+#[inline]
+pub(crate) fn texels(map: &EnvMap) -> Texels<'_> {
+    let (px, _) = map.padded();
+    // A partial map's stored pixels wrap only when the crop spans 360°.
+    let wraps = map
+        .crop
+        .map_or(map.projection.wraps(), |c| c.width() == c.full_width());
+    Texels::new(px, map.width, map.height, wraps)
+        .expect("a map holds (width + 1) x (height + 1) pixels, fewer than 2^31")
+}
+
+/// The texels of level 0 (`map`) and of each pyramid level, as the span kernels take
+/// them, and how many there are (the pyramid is built here if it was not).
+pub(crate) fn level_texels(map: &EnvMap) -> ([Texels<'_>; MAX_LEVELS], usize) {
+    let mut t = [texels(map); MAX_LEVELS];
+    let levels = map.pyramid();
+    let n = 1 + levels.len().min(MAX_LEVELS - 1);
+    for (d, l) in t[1..n].iter_mut().zip(levels) {
+        *d = texels(l);
+    }
+    (t, n)
+}
 
 /// Sample a run of positions stepping linearly: `out[i]` = the `BILINEAR` (else nearest)
 /// sample of `map` at (u + i·du, v + i·dv). Identical to calling [`EnvMap::bilinear`] /
 /// [`EnvMap::nearest`] per pixel with u wrapped into [0, W) for 360° maps.
 ///
-/// When the whole run stays inside the map (after one wrap of its start), the scalar
-/// kernel runs with no clamps and no wrap tests. Otherwise the run falls back to the
-/// per-pixel functions.
+/// When the whole run stays inside the map (after one wrap of its start), the span
+/// kernel runs ([`Kernel`]: no clamps, no wrap tests, SIMD where the CPU has it).
+/// Otherwise the run falls back to the per-pixel functions.
 #[inline]
 pub(crate) fn sample_span<const BILINEAR: bool>(
     map: &EnvMap,
@@ -53,46 +238,38 @@ pub(crate) fn sample_span<const BILINEAR: bool>(
     du: Fx,
     dv: Fx,
 ) {
-    let m = out.len() as i64;
-    if m == 0 {
-        return;
-    }
     if map.projection.scaled_rows() {
         // Rows wrap within their own length (`EnvMap::bilinear`): per pixel.
         return sample_span_slow::<BILINEAR>(map, out, u, v, du, dv);
     }
-    let wfx = (map.width as i64) << FX_BITS;
-    let hfx = (map.height as i64) << FX_BITS;
-    // Bilinear reads the pixel centres around (u − ½, v − ½).
-    let bias = if BILINEAR { FX_HALF } else { 0 };
-    let wraps = map.projection.wraps();
-    let mut uu = u - bias;
-    if wraps && !(0..wfx).contains(&uu) {
-        // One period off at most on the renderer's path; a division otherwise.
-        uu += if uu < 0 { wfx } else { -wfx };
-        if !(0..wfx).contains(&uu) {
-            uu = uu.rem_euclid(wfx);
-        }
-    }
-    let vv = v - bias;
-    let (u_end, v_end) = (uu + du * (m - 1), vv + dv * (m - 1));
-    // Nearest may read column W and row H (padding equal to the clamped pixel);
-    // bilinear needs x0, y0 ≤ W − 1, H − 1 so that x0 + 1, y0 + 1 are the padding.
-    let (u_lim, v_lim) = if BILINEAR {
-        (wfx, hfx)
+    let t = texels(map);
+    let done = if BILINEAR {
+        jobs::bilinear_span(&t, out, u, v, du, dv)
     } else {
-        (wfx + FX_ONE, hfx + FX_ONE)
+        jobs::nearest_span(&t, out, u, v, du, dv)
     };
-    let inside = |a: Fx, lim: Fx| a >= 0 && a < lim;
-    if !(inside(uu, u_lim) && inside(u_end, u_lim) && inside(vv, v_lim) && inside(v_end, v_lim)) {
+    if !done {
         sample_span_slow::<BILINEAR>(map, out, u, v, du, dv);
-        return;
     }
-    let (data, stride) = map.padded();
-    if BILINEAR {
-        scalar::bilinear_span(data, stride, out, uu, vv, du, dv);
+}
+
+/// [`sample_span`] for a batch of spans of one output row (at most [`MAX_JOBS`]): one
+/// kernel call for them all; spans leaving the map are sampled per pixel.
+pub(crate) fn sample_spans<const BILINEAR: bool>(map: &EnvMap, row: &mut [u32], spans: &[SpanJob]) {
+    let t = texels(map);
+    // Maps whose rows wrap within their own length (scaled rows): every span per pixel.
+    let mut refused = if map.projection.scaled_rows() {
+        (1u64 << spans.len()) - 1
+    } else if BILINEAR {
+        jobs::bilinear_spans(&t, row, spans)
     } else {
-        scalar::nearest_span(data, stride, out, uu, vv, du, dv);
+        jobs::nearest_spans(&t, row, spans)
+    };
+    while refused != 0 {
+        let j = &spans[refused.trailing_zeros() as usize];
+        refused &= refused - 1;
+        let (x, n) = (j.x as usize, j.len as usize);
+        sample_span_slow::<BILINEAR>(map, &mut row[x..x + n], j.u, j.v, j.du, j.dv);
     }
 }
 
@@ -122,7 +299,8 @@ fn sample_span_slow<const BILINEAR: bool>(
 
 /// [`EnvMap::trilinear`] over a run of positions stepping linearly (see [`sample_span`]),
 /// one level of detail for the run: bilinear spans on the two pyramid levels around
-/// `lod`, blended in chunks of 64 pixels.
+/// `lod`, blended (the second level restarting every [`TRILINEAR_CHUNK`] pixels).
+#[cfg(test)]
 pub(crate) fn trilinear_span(
     map: &EnvMap,
     out: &mut [u32],
@@ -135,6 +313,17 @@ pub(crate) fn trilinear_span(
     if lod <= 0 || map.crop.is_some() {
         return sample_span::<true>(map, out, u, v, du, dv);
     }
+    let (levels, n) = level_texels(map);
+    if jobs::trilinear_span(&levels[..n], lod, out, u, v, du, dv) {
+        return;
+    }
+    trilinear_span_slow(map, out, u, v, du, dv, lod);
+}
+
+/// [`trilinear_span`] where a level's span leaves its map: per level, with the per-pixel
+/// fallbacks.
+#[inline(never)]
+fn trilinear_span_slow(map: &EnvMap, out: &mut [u32], u: Fx, v: Fx, du: Fx, dv: Fx, lod: i32) {
     let k = (lod >> 8) as usize;
     let frac = (lod & 0xFF) as u32;
     let (a_map, ka) = map.level(k);
@@ -143,7 +332,7 @@ pub(crate) fn trilinear_span(
     if frac == 0 || kb == ka {
         return;
     }
-    let mut scratch = [0u32; 64];
+    let mut scratch = [0u32; TRILINEAR_CHUNK];
     let (mut u, mut v) = (u, v);
     for chunk in out.chunks_mut(scratch.len()) {
         let s = &mut scratch[..chunk.len()];
@@ -156,64 +345,65 @@ pub(crate) fn trilinear_span(
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::geom::fixed::to_fx;
-    use crate::geom::projection::Projection;
-    use crate::map::synth::grid_map;
-
-    /// The span kernels against the per-pixel samplers, inside the map, across the seam
-    /// and off its edges (the slow path), for a wrapping and a clamping projection.
-    #[test]
-    fn spans_equal_per_pixel_samples() {
-        for proj in [Projection::Equirect, Projection::Elliptical] {
-            let m = grid_map(64, 32, proj).unwrap();
-            let wfx = 64i64 << FX_BITS;
-            for &(u, v, du, dv) in &[
-                (3.3, 4.2, 0.7, 0.1),
-                (60.0, 10.0, 0.5, 0.0),
-                (-2.0, 31.5, 0.25, 0.02),
-                (10.0, 0.1, -0.3, -0.01),
-                (0.2, 16.0, 1.9, 0.4),
-            ] {
-                let (u, v, du, dv) = (to_fx(u), to_fx(v), to_fx(du), to_fx(dv));
-                let mut nb = vec![0u32; 40];
-                let mut nn = vec![0u32; 40];
-                sample_span::<true>(&m, &mut nb, u, v, du, dv);
-                sample_span::<false>(&m, &mut nn, u, v, du, dv);
-                for i in 0..40 {
-                    let uu = u + du * i as i64;
-                    let uu = if proj.wraps() { uu.rem_euclid(wfx) } else { uu };
-                    let vv = v + dv * i as i64;
-                    assert_eq!(nb[i], m.bilinear(uu, vv), "{proj} bilinear pixel {i}");
-                    assert_eq!(nn[i], m.nearest(uu, vv), "{proj} nearest pixel {i}");
-                }
-            }
-        }
+/// [`trilinear_span`] for a batch of spans of one output row (`lods[i]` the level of
+/// detail of `spans[i]`): one kernel call for them all. `levels` is [`level_texels`]
+/// (taken once per frame). For the renderer's trilinear rows; partial maps are sampled
+/// bilinearly elsewhere.
+pub(crate) fn trilinear_spans(
+    map: &EnvMap,
+    levels: &[Texels],
+    row: &mut [u32],
+    spans: &[SpanJob],
+    lods: &[i32],
+) {
+    let mut refused = if map.projection.scaled_rows() {
+        (1u64 << spans.len()) - 1 // per pixel, as `sample_spans`
+    } else {
+        jobs::trilinear_spans(levels, row, spans, lods)
+    };
+    while refused != 0 {
+        let i = refused.trailing_zeros() as usize;
+        refused &= refused - 1;
+        let j = &spans[i];
+        let o = &mut row[j.x as usize..(j.x + j.len) as usize];
+        trilinear_span_slow(map, o, j.u, j.v, j.du, j.dv, lods[i]);
     }
+}
 
-    #[test]
-    fn span_equals_per_pixel() {
-        let m = crate::map::synth::grid_map(256, 128, Projection::Equirect).unwrap();
-        for lod in [0, 100, 256, 300, 700, 5000] {
-            let (u, v, du, dv) = (to_fx(250.3), to_fx(40.2), to_fx(1.7), to_fx(-0.4));
-            let mut out = vec![0u32; 100];
-            trilinear_span(&m, &mut out, u, v, du, dv, lod);
-            for (i, o) in out.iter().enumerate() {
-                let uu = (u + du * i as i64).rem_euclid(256 << FX_BITS);
-                let vv = v + dv * i as i64;
-                // The span steps each level by du >> k (truncated): up to i/65536 px
-                // off after i pixels, which can move an 8-bit weight by one step.
-                let want = m.trilinear(uu, vv, lod);
-                for s in [0, 8, 16] {
-                    let (a, b) = ((o >> s) & 0xFF, (want >> s) & 0xFF);
-                    assert!(
-                        a.abs_diff(b) <= 2,
-                        "lod {lod} pixel {i}: {o:06x} vs {want:06x}"
-                    );
-                }
-            }
-        }
+/// A run of [`EnvMap::nearest_cropped`] (`BILINEAR` false) or
+/// [`EnvMap::bilinear_cropped`] samples at full-panorama positions (u + i·du, v + i·dv),
+/// u wrapped per pixel. Spans inside the stored pixels or wholly in the background take
+/// the span kernels ([`Kernel::cropped_span`]); spans over the crop's edge are sampled
+/// per pixel.
+pub(crate) fn sample_span_cropped<const BILINEAR: bool>(
+    map: &EnvMap,
+    out: &mut [u32],
+    u: Fx,
+    v: Fx,
+    du: Fx,
+    dv: Fx,
+) {
+    let Some(c) = map.crop else {
+        return sample_span::<BILINEAR>(map, out, u, v, du, dv);
+    };
+    let w = Window {
+        full_width: c.full_width(),
+        full_height: c.full_height(),
+        left: c.left(),
+        top: c.top(),
+        background: map.background,
+    };
+    if jobs::cropped_span(BILINEAR, &texels(map), &w, out, u, v, du, dv) {
+        return;
+    }
+    let (mut u, mut v) = (u, v);
+    for o in out.iter_mut() {
+        *o = if BILINEAR {
+            map.bilinear_cropped(u, v)
+        } else {
+            map.nearest_cropped(u, v)
+        };
+        u += du;
+        v += dv;
     }
 }

@@ -34,7 +34,7 @@ use clap::Args;
 use configs::{configs, view_sets, ViewsArg};
 use lut_core::CubeMap;
 use lut_core::TableKind;
-use lut_core::{Projection, Renderer, Sampler, Surface};
+use lut_core::{Kernel, Projection, Renderer, Sampler, Surface};
 use measure::{gather_source, in_pool, measure_errors, time_config, Ctx};
 use report::{row_line, Row, RunInfo, Tables};
 use std::path::PathBuf;
@@ -84,15 +84,43 @@ pub struct BenchArgs {
     /// render supersampled 8x8, which takes a while).
     #[arg(long)]
     pub no_minify: bool,
+    /// The span kernel: auto (the best this CPU runs), scalar, sse41 or avx2 (default:
+    /// LUTPANO_KERNEL, else auto). The kernel that ran and the CPU features detected are
+    /// printed with the results.
+    #[arg(long, value_parser = parse_kernel_choice)]
+    pub kernel: Option<KernelChoice>,
     /// The pixel limit for PANORAMA.
     #[command(flatten)]
     pub limit: MaxPixelsArg,
+}
+
+/// `--kernel`: a kernel, or `auto` (`None`: the best the CPU runs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KernelChoice(pub Option<Kernel>);
+
+/// Parse `--kernel` (`auto` or a kernel name; whether the CPU runs it is checked when
+/// the bench starts).
+fn parse_kernel_choice(s: &str) -> Result<KernelChoice, String> {
+    if s.eq_ignore_ascii_case("auto") {
+        return Ok(KernelChoice(None));
+    }
+    lut_core::parse_name::<Kernel>(s)
+        .map(|k| KernelChoice(Some(k)))
+        .ok_or_else(|| {
+            format!(
+                "unknown kernel '{s}' (expected auto, {})",
+                lut_core::name_list::<Kernel>()
+            )
+        })
 }
 
 /// Run `viewer bench`.
 pub fn run(a: BenchArgs) -> Result<()> {
     if a.passes == 0 {
         return Err(crate::usage!("--passes must be at least 1"));
+    }
+    if let Some(KernelChoice(k)) = a.kernel {
+        lut_core::set_kernel(k).map_err(|e| anyhow!("--kernel: {e}"))?;
     }
     in_pool(a.threads, |threads| run_in_pool(&a, threads))
 }
@@ -125,6 +153,8 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         t0.elapsed().as_secs_f64(),
         threads
     ));
+    let kernel = lut_core::kernel_info();
+    progress(&kernel.to_string());
     let (w, h) = a.size;
     let run = RunInfo {
         width: w,
@@ -133,6 +163,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         map_width: map.width(),
         map_height: map.height(),
         projection: map.projection().name(),
+        kernel: kernel.active.name(),
     };
     let sets = view_sets(a.views)?;
     let mut renderer = Renderer::new(&map);
@@ -246,7 +277,13 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
     if a.json {
         crate::outln!("{}", serde_json::to_string_pretty(&rows)?)?;
     } else {
-        report::write_table(&mut std::io::stdout().lock(), &rows, &tables, &others)?;
+        report::write_table(
+            &mut std::io::stdout().lock(),
+            &rows,
+            &tables,
+            &others,
+            &kernel.to_string(),
+        )?;
         if let Some(n) = minify_note {
             crate::outln!("{n}")?;
         }
@@ -298,7 +335,17 @@ mod tests {
             Some(lut_core::Projection::Sine)
         );
         assert!(a.json && a.no_cube && a.no_minify && a.threads == Some(2));
-        for (flag, bad) in [("--views", "all"), ("--map-size", "big"), ("--size", "1x0")] {
+        assert_eq!(a.kernel, None);
+        for (k, want) in [("auto", None), ("scalar", Some(lut_core::Kernel::Scalar))] {
+            let a = bench_args(&["--kernel", k]).unwrap();
+            assert_eq!(a.kernel, Some(super::KernelChoice(want)));
+        }
+        for (flag, bad) in [
+            ("--views", "all"),
+            ("--map-size", "big"),
+            ("--size", "1x0"),
+            ("--kernel", "neon9"),
+        ] {
             let e = bench_args(&[flag, bad]).unwrap_err().to_string();
             assert!(e.contains(bad), "{e}");
         }

@@ -21,6 +21,8 @@ pub struct RunInfo {
     pub map_height: u32,
     /// The map's projection name.
     pub projection: &'static str,
+    /// The span kernel that ran (`lut_core::Kernel` name: scalar, sse41, avx2).
+    pub kernel: &'static str,
 }
 
 /// One line of the report (one element of the `--json` array).
@@ -47,6 +49,8 @@ pub struct Row {
     pub ms_min: f64,
     /// Slowest frame.
     pub ms_max: f64,
+    /// Output megapixels per second at the median frame time.
+    pub mpix_s: f64,
     /// Max sampling-position error over all frames, source pixels (null: not measured,
     /// e.g. a cube renderer samples cube faces, not the map).
     pub max_err_px: Option<f64>,
@@ -80,6 +84,7 @@ impl Row {
         frames: usize,
         times: &[f64],
     ) -> Row {
+        let ms_median = super::measure::median(times);
         Row {
             renderer,
             sampler: sampler.name(),
@@ -88,9 +93,11 @@ impl Row {
             run: *run,
             hfov,
             frames,
-            ms_median: super::measure::median(times),
+            ms_median,
             ms_min: times.iter().copied().fold(f64::INFINITY, f64::min),
             ms_max: times.iter().copied().fold(0.0, f64::max),
+            mpix_s: (run.width as f64 * run.height as f64)
+                / (ms_median * 1e3).max(f64::MIN_POSITIVE),
             max_err_px: None,
             mean_err_px: None,
             psnr_db: None,
@@ -150,7 +157,7 @@ pub fn row_line(r: &Row) -> String {
         _ => r.renderer.to_string(),
     };
     format!(
-        "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9.2} {:>9.2} {:>10} {:>10} {:>7} {:>7}",
+        "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9.2} {:>9.2} {:>7.0} {:>10} {:>10} {:>7} {:>7}",
         renderer,
         r.sampler,
         step_str(&r.index_step),
@@ -158,6 +165,7 @@ pub fn row_line(r: &Row) -> String {
         r.hfov,
         r.ms_median,
         r.ms_min,
+        r.mpix_s,
         fmt_opt(r.max_err_px, 4),
         fmt_opt(r.mean_err_px, 5),
         fmt_opt(r.psnr_db, 1),
@@ -166,13 +174,17 @@ pub fn row_line(r: &Row) -> String {
     )
 }
 
-/// The text table: what was measured, the tables (the cylinder's, then the other
-/// surfaces' in `others`), one line per row, the units.
+/// The text table: what was measured, the kernel, the tables (the cylinder's, then the
+/// other surfaces' in `others`), one line per row, the units.
+///
+/// `cpu`: the kernel line (`lut_core::kernel_info()`: the kernel, how it was chosen, the
+/// CPU features detected).
 pub fn write_table(
     o: &mut impl Write,
     rows: &[Row],
     t: &Tables,
     others: &[(&str, Tables)],
+    cpu: &str,
 ) -> std::io::Result<()> {
     if let Some(r) = rows.first() {
         let run = &r.run;
@@ -188,13 +200,14 @@ pub fn write_table(
             r.frames
         )?;
     }
+    writeln!(o, "{cpu}")?;
     writeln!(o, "{}", tables_line("tables", t))?;
     for (name, t) in others {
         writeln!(o, "{}", tables_line(&format!("{name} tables"), t))?;
     }
     writeln!(
         o,
-        "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9} {:>9} {:>10} {:>10} {:>7} {:>7}",
+        "{:<13} {:<8} {:>8} {:<4} {:>5} {:>9} {:>9} {:>7} {:>10} {:>10} {:>7} {:>7}",
         "renderer",
         "sampler",
         "step",
@@ -202,6 +215,7 @@ pub fn write_table(
         "hfov",
         "ms_med",
         "ms_min",
+        "Mpx/s",
         "max_err",
         "mean_err",
         "PSNR",
@@ -212,7 +226,7 @@ pub fn write_table(
     }
     writeln!(
         o,
-        "errors in source pixels (angular metric); PSNR in dB against the exact render with the same sampler ('-' = identical); grid rows: per-view grid build {} ms median (inside each frame)",
+        "Mpx/s: output megapixels per second at the median; errors in source pixels (angular metric); PSNR in dB against the exact render with the same sampler ('-' = identical); grid rows: per-view grid build {} ms median (inside each frame)",
         rows.iter()
             .find(|r| r.renderer == "grid")
             .and_then(|r| r.table_build_ms)
@@ -262,6 +276,7 @@ mod tests {
             map_width: 8192,
             map_height: 4096,
             projection: "equirect",
+            kernel: "avx2",
         }
     }
 
@@ -295,11 +310,13 @@ mod tests {
             "map_width",
             "map_height",
             "projection",
+            "kernel",
             "hfov",
             "frames",
             "ms_median",
             "ms_min",
             "ms_max",
+            "mpix_s",
             "max_err_px",
             "mean_err_px",
             "psnr_db",
@@ -320,6 +337,9 @@ mod tests {
             "{text}"
         );
         assert_eq!(v["ms_median"], 2.0);
+        // 1920×1080 pixels in 2 ms.
+        assert_eq!(v["mpix_s"], 1920.0 * 1080.0 / 2000.0);
+        assert_eq!(v["kernel"], "avx2");
         assert_eq!(
             (v["ms_min"].as_f64(), v["ms_max"].as_f64()),
             (Some(1.0), Some(3.0))
@@ -345,12 +365,12 @@ mod tests {
     fn table_lines() {
         assert_eq!(
             row_line(&lut_row()),
-            "lut           bilinear        4 wide    90      2.00      1.00     0.0123    0.00100    48.2   1.25%"
+            "lut           bilinear        4 wide    90      2.00      1.00    1037     0.0123    0.00100    48.2   1.25%"
         );
         let gather = Row::timed(&run(), "gather", Sampler::Nearest, 90.0, 13, &[0.5]);
         assert_eq!(
             row_line(&gather),
-            "gather        nearest         - -       90      0.50      0.50          -          -       -       -"
+            "gather        nearest         - -       90      0.50      0.50    4147          -          -       -       -"
         );
         assert_eq!(step_str(&serde_json::json!("adaptive")), "adaptive");
         let mut out = Vec::new();
@@ -359,14 +379,22 @@ mod tests {
             bytes: [2048, 4096],
             unfolded: [16384, 8192],
         };
-        write_table(&mut out, &[lut_row()], &tables, &[("diamond", tables)]).unwrap();
+        write_table(
+            &mut out,
+            &[lut_row()],
+            &tables,
+            &[("diamond", tables)],
+            "kernel avx2 (auto; CPU: avx2)",
+        )
+        .unwrap();
         let text = String::from_utf8(out).unwrap();
-        let lines: Vec<&str> = text.lines().collect();
-        assert_eq!(lines.len(), 6, "{text}");
+        let mut lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 7, "{text}");
         assert_eq!(
             lines[0],
             "map 8192x4096 equirect, output 1920x1080, 2 threads, 3 frames per set"
         );
+        assert_eq!(lines.remove(1), "kernel avx2 (auto; CPU: avx2)");
         assert_eq!(
             lines[1],
             "tables: wide 10.0 ms, 2 KiB (unfolded 16 KiB, 1/8.00); high 20.0 ms, 4 KiB (unfolded 8 KiB, 1/2.00)"

@@ -31,6 +31,7 @@ impl App {
                         }
                     }
                 }
+                Effect::OpenScene(p) => self.open_scene(p),
                 Effect::Title(t) => {
                     if let Some(g) = &self.gfx {
                         g.window.set_title(&t);
@@ -111,6 +112,12 @@ impl App {
         if req.panel.save_view {
             self.do_action(KeyAction::SaveView, t, el);
         }
+        if req.panel.save_scene {
+            self.start_save_scene_dialog();
+        }
+        if req.panel.open_scene {
+            self.start_open_dialog(true);
+        }
         if let Some(p) = req.open_recent {
             if p.exists() {
                 self.open_path(p);
@@ -128,6 +135,7 @@ impl App {
                 self.open_path(p);
             }
             Some(Chosen::Save(p)) => self.save_view_to(&p, t),
+            Some(Chosen::SaveScene(p)) => self.save_scene_to(&p, t),
             None => {}
         }
         if !req.keys.is_empty() {
@@ -161,7 +169,7 @@ impl App {
                 }
             }
             KeyAction::SaveView => self.start_save_dialog(),
-            KeyAction::Open => self.start_open_dialog(),
+            KeyAction::Open => self.start_open_dialog(false),
             KeyAction::OpenNext => self.open_neighbour(Step::Next, t),
             KeyAction::OpenPrevious => self.open_neighbour(Step::Previous, t),
             KeyAction::TogglePanel => self.prefs.panel = !self.prefs.panel,
@@ -254,7 +262,7 @@ impl App {
 
     /// The Open dialog, in the current file's folder (else the last recent file's, else
     /// the working folder).
-    fn start_open_dialog(&mut self) {
+    fn start_open_dialog(&mut self, scene: bool) {
         let dir = self
             .doc
             .last_file()
@@ -262,7 +270,11 @@ impl App {
             .and_then(Path::parent)
             .filter(|d| d.is_dir())
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
-        self.dialogs.open_panorama(&self.egui_ctx, &dir);
+        if scene {
+            self.dialogs.open_scene(&self.egui_ctx, &dir);
+        } else {
+            self.dialogs.open_panorama(&self.egui_ctx, &dir);
+        }
         if self.print_view {
             let _ = crate::outln!("dialog open {}", dir.display());
         }
@@ -345,7 +357,8 @@ impl App {
         let view = self.ctl.look().view();
         let mut buf = vec![0u32; w as usize * h as usize];
         render_scene(cur.scene.as_mut(), view, &opts, &mut buf, w, h).map_err(|e| e.to_string())?;
-        self.lights.light_frame(view, &mut buf, w, h)?;
+        self.lights
+            .light_frame_with(&mut self.lit, false, view, &mut buf, w, h)?;
         Ok(buf)
     }
 }

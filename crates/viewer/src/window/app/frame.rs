@@ -3,7 +3,7 @@
 //! with egui, and decide when the next frame is due.
 
 use super::{App, SceneKey};
-use crate::scene::{measure_errors, render_scene};
+use crate::scene::{measure_errors, render_scene, SceneRef};
 use crate::window::dialogs::Chosen;
 use crate::window::input::{resolution_hfov, wheel_notches, Held, Look, WIDE_HFOV_MAX};
 use crate::window::keys::{KeyAction, Route};
@@ -12,7 +12,7 @@ use crate::window::paint::SceneRect;
 use crate::window::quality::{frame_level, FRAME_BUDGET_MS};
 use crate::window::ui::{self, PanelModel, PanelOutput};
 use anyhow::{anyhow, Result};
-use lut_core::{CubeRenderer, RenderOptions, RenderPath};
+use lut_core::{CubeRenderer, RenderOptions, RenderPath, Sampler};
 use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -91,7 +91,21 @@ impl App {
                 .input(|i| i.pointer.press_origin())
                 .or(resp.interact_pointer_pos());
             if let Some(o) = origin {
-                self.ctl.press(to_px(o), size, t);
+                // On a luminaire's marker the drag moves the luminaire.
+                if !self.press_light(to_px(o), size) {
+                    self.ctl.press(to_px(o), size, t);
+                }
+            }
+        }
+        if self.light_drag.is_some() || self.edge_drag.is_some() {
+            match resp.interact_pointer_pos() {
+                Some(p) if resp.dragged_by(primary) => self.drag_light(to_px(p), size),
+                _ => self.end_light_drag(),
+            }
+        }
+        if resp.clicked_by(primary) {
+            if let Some(p) = resp.interact_pointer_pos() {
+                self.click_scene(to_px(p), size);
             }
         }
         if self.ctl.dragging() {
@@ -314,6 +328,10 @@ impl App {
         if self.notices.expire(t) {
             want(now);
         }
+        if self.lit.refining() {
+            // The coarse illuminance map shown: the full one next.
+            want(now);
+        }
         if let Some(n) = next {
             // At most one frame per display refresh, whoever asks.
             let n = n.max(now + self.frame_interval);
@@ -359,10 +377,15 @@ impl App {
         let pixels = u64::from(rect.w) * u64::from(rect.h);
         let s = self.ctl.settings;
         let (level, degraded) = frame_level(s.aa, fast, &self.times, pixels, FRAME_BUDGET_MS);
-        let Some(cur) = self.doc.current_mut() else {
+        if self.doc.current().is_none() {
             return;
-        };
+        }
         let opts = s.render_options(level);
+        // While the view moves, bilinear frames read the pyramid level that matches the
+        // screen (`Renderer::set_bilinear_level`): a huge map then pans at the cost of the
+        // level it shows. The still frame reads the map itself.
+        let bilinear_level = fast && opts.sampler == Sampler::Bilinear;
+        let lit = self.update_lit();
         let key = SceneKey {
             look,
             size: (rect.w, rect.h),
@@ -372,12 +395,24 @@ impl App {
             index_step: opts.index_step,
             lut: opts.lut,
             cube_renderer: opts.cube,
+            bilinear_level,
             heat_map: s.heat_map,
             map_generation: generation,
             lights: self.lights.key(),
+            lit: (
+                self.lit.generation(),
+                self.lights.show_room,
+                self.lights.selected,
+            ),
         };
         if self.scene_key.as_ref() == Some(&key) {
             return;
+        }
+        let Some(cur) = self.doc.current_mut() else {
+            return;
+        };
+        if let SceneRef::Map { renderer, .. } = cur.scene.as_mut() {
+            renderer.set_bilinear_level(bilinear_level);
         }
         self.scene.resize(rect.w as usize * rect.h as usize, 0);
         let t0 = Instant::now();
@@ -418,11 +453,12 @@ impl App {
         if s.heat_map {
             self.show_heat_map(view, &opts, rect, k);
         } else {
-            self.light_scene(view, rect);
+            self.light_scene(lit.as_deref(), view, rect);
         }
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         self.times.record(level, ms, pixels);
-        self.ctl.rendered(degraded);
+        // A frame read from a pyramid level is not the still frame: one is due.
+        self.ctl.rendered(degraded || bilinear_level);
         self.renders.push_back(Instant::now());
         let r = &mut self.doc.readouts;
         r.table_bytes = report.table_bytes;
@@ -498,16 +534,6 @@ impl App {
             }
             Err(e) => self.doc.set_error(format!("heat map failed: {e}")),
         }
-    }
-
-    /// Light the freshly rendered scene (as `viewer render --light ...` does); a scene
-    /// that cannot be built (a light outside the room) is reported in the panel and the
-    /// frame is left unlit.
-    fn light_scene(&mut self, view: lut_core::View, rect: SceneRect) {
-        let result = self
-            .lights
-            .light_frame(view, &mut self.scene, rect.w, rect.h);
-        self.lights.scene_error = result.err();
     }
 
     /// The illuminance at the pointer for the readout; true when it changed.

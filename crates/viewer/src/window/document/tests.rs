@@ -235,6 +235,34 @@ fn the_next_success_clears_a_kept_error() {
 }
 
 #[test]
+fn luminaires_and_scenes_are_routed_by_content() {
+    let data = |p: &str| Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(p);
+    let dir = tempfile::tempdir().unwrap();
+    // A EULUMDAT file whose name says nothing, with a panorama and a scene file.
+    let ldt = dir.path().join("downlight");
+    std::fs::copy(data("tests/data/ldt/office_louvre_2x28w.ldt"), &ldt).unwrap();
+    let scene = data("assets/interior_lit.json");
+    let pano = data("assets/interior.jpg");
+    let mut d = doc();
+    for p in [&ldt, &pano, &scene] {
+        d.drop_path(p.clone());
+    }
+    let fx = d.open_drops(0.0);
+    assert_eq!(fx[0], Effect::OpenScene(scene.clone()));
+    assert_eq!(fx[1], Effect::AddLights(vec![ldt.clone()]));
+    assert_eq!(loads(&fx)[0].source, Source::File(pano));
+    // Opened from the dialog: the same routing.
+    assert_eq!(
+        d.open_path(ldt.clone(), 0.0),
+        Some(Effect::AddLights(vec![ldt]))
+    );
+    assert_eq!(
+        d.open_path(scene.clone(), 0.0),
+        Some(Effect::OpenScene(scene))
+    );
+}
+
+#[test]
 fn dropped_ies_files_add_lights_and_six_files_are_a_cube() {
     let mut d = doc();
     for p in ["lamp.IES", "b.ies"] {

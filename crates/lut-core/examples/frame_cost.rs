@@ -1,0 +1,219 @@
+//! The cost of whole LUT frames with one span kernel, for profilers: renders one untimed
+//! view (building tables and scratch), then `frames` views of a pan, and prints the
+//! kernel, the CPU features and the median wall time per frame.
+//!
+//! ```sh
+//! cargo build --release -p lut-core --example frame_cost
+//! target/release/examples/frame_cost sampler=bilinear kernel=avx2 frames=20 threads=2
+//! # instructions per pixel: the timed frames only, divided by frames x pixels
+//! valgrind --tool=callgrind --toggle-collect=frame_cost::timed_frames \
+//!     target/release/examples/frame_cost sampler=nearest kernel=scalar frames=2 threads=1
+//! ```
+//!
+//! Arguments (`key=value`, any order): `sampler` nearest|bilinear|trilinear (bilinear),
+//! `kernel` auto|scalar|sse41|avx2 (auto), `frames` (10), `threads` 1|2 (1), `map` WxH
+//! (8192x4096), `size` WxH (1920x1080), `hfov` (90), `pitch` (10), `yaw` (start, 30; each
+//! frame turns 7.3°), `step` adaptive|1|2|4|8|16 (adaptive), `mode` lut|gather (lut:
+//! gather = a plain gather along the frame's precomputed nearest indices, the floor the
+//! nearest kernel is compared with), `cache` PATH (keep the generated map's pixels there
+//! and read them on later runs: much faster under valgrind).
+
+use lut_core::grid_map;
+use lut_core::{Frame, IndexStep, Projection, RenderOptions, Renderer, Sampler, Scene, View};
+use std::time::Instant;
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("frame_cost: {e}");
+        std::process::exit(2);
+    }
+}
+
+fn size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once('x')
+        .ok_or_else(|| format!("'{s}' is not WxH"))?;
+    let p = |x: &str| x.parse::<u32>().map_err(|_| format!("'{s}' is not WxH"));
+    Ok((p(w)?, p(h)?))
+}
+
+/// The frames measured (callgrind: `--toggle-collect=frame_cost::timed_frames`).
+#[inline(never)]
+fn timed_frames(
+    frames: usize,
+    f: &mut dyn FnMut(usize) -> Result<(), String>,
+) -> Result<Vec<f64>, String> {
+    let mut times = Vec::with_capacity(frames);
+    for i in 0..frames {
+        let t = Instant::now();
+        f(i)?;
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(times)
+}
+
+/// One frame of a plain gather along precomputed indices, in row bands.
+fn gather_frame(src: &[u32], idx: &[u32], out: &mut [u32], w: usize) {
+    use rayon::prelude::*;
+    out.par_chunks_mut(w)
+        .zip(idx.par_chunks(w))
+        .for_each(|(o, i)| {
+            for (o, &i) in o.iter_mut().zip(i) {
+                *o = src[i as usize];
+            }
+        })
+}
+
+/// The generated grid map, or its pixels from `cache` (raw little-endian 0RGB, written
+/// there on first use): generating an 8k map costs ~20 G instructions, which under
+/// valgrind takes minutes.
+fn load_map(
+    (w, h): (u32, u32),
+    cache: Option<&std::path::Path>,
+) -> Result<lut_core::EnvMap, String> {
+    let n = w as usize * h as usize;
+    if let Some(bytes) = cache.and_then(|p| std::fs::read(p).ok()) {
+        if bytes.len() == n * 4 {
+            let px: Vec<u32> = bytes
+                .chunks_exact(4)
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect();
+            return lut_core::EnvMap::from_pixels(w, h, &px, Projection::Equirect)
+                .map_err(|e| e.to_string());
+        }
+    }
+    let map = grid_map(w, h, Projection::Equirect).map_err(|e| e.to_string())?;
+    if let Some(p) = cache {
+        let bytes: Vec<u8> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .flat_map(|(x, y)| map.pixel(x, y).to_le_bytes())
+            .collect();
+        std::fs::write(p, bytes).map_err(|e| format!("{}: {e}", p.display()))?;
+    }
+    Ok(map)
+}
+
+fn run() -> Result<(), String> {
+    let mut sampler = Sampler::Bilinear;
+    let mut kernel = None;
+    let (mut frames, mut threads) = (10usize, 1usize);
+    let (mut map_wh, mut out_wh) = ((8192, 4096), (1920, 1080));
+    let (mut hfov, mut pitch, mut yaw) = (90.0, 10.0, 30.0);
+    let mut step = IndexStep::Adaptive;
+    let mut gather = false;
+    let mut cache = None;
+    for a in std::env::args().skip(1) {
+        let (k, v) = a
+            .split_once('=')
+            .ok_or_else(|| format!("argument '{a}' is not key=value"))?;
+        let num = |v: &str| {
+            v.parse::<f64>()
+                .map_err(|_| format!("{k}={v}: not a number"))
+        };
+        match k {
+            "sampler" => sampler = v.parse()?,
+            "kernel" => kernel = lut_core::parse_kernel(v).map_err(|e| e.to_string())?,
+            "frames" => frames = num(v)? as usize,
+            "threads" => threads = num(v)? as usize,
+            "map" => map_wh = size(v)?,
+            "size" => out_wh = size(v)?,
+            "hfov" => hfov = num(v)?,
+            "pitch" => pitch = num(v)?,
+            "yaw" => yaw = num(v)?,
+            "step" => {
+                step = match v {
+                    "adaptive" => IndexStep::Adaptive,
+                    n => IndexStep::Fixed(num(n)? as u32),
+                }
+            }
+            "mode" => gather = v == "gather",
+            "cache" => cache = Some(std::path::PathBuf::from(v)),
+            _ => return Err(format!("unknown argument '{k}'")),
+        }
+    }
+    lut_core::set_kernel(kernel).map_err(|e| e.to_string())?;
+    let map = load_map(map_wh, cache.as_deref())?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.max(1))
+        .build()
+        .map_err(|e| e.to_string())?;
+    let opts = RenderOptions {
+        sampler,
+        index_step: step,
+        threads: threads > 1,
+        ..RenderOptions::default()
+    };
+    let (w, h) = out_wh;
+    let mut out = vec![0u32; w as usize * h as usize];
+    let mut r = Renderer::new(&map);
+    let view = |i: usize| View::new(yaw + 7.3 * i as f64, pitch, hfov).map_err(|e| e.to_string());
+    let mut times;
+    if gather {
+        // Indices of the padded map (stride W + 1) for the first view's nearest samples.
+        let (pos, _) = r
+            .positions(
+                map.width(),
+                map.height(),
+                Projection::Equirect,
+                view(0)?,
+                &opts,
+                w,
+                h,
+            )
+            .map_err(|e| e.to_string())?;
+        let src: Vec<u32> = (0..=map.height())
+            .flat_map(|y| (0..=map.width()).map(move |x| (x, y)))
+            .map(|(x, y)| map.pixel(x.min(map.width() - 1), y.min(map.height() - 1)))
+            .collect();
+        let stride = map.width() as usize + 1;
+        let idx: Vec<u32> = pos
+            .iter()
+            .map(|p| p.map_or(0, |(u, v)| (v as usize * stride + u as usize) as u32))
+            .collect();
+        let f = || gather_frame(&src, &idx, &mut out, w as usize);
+        pool.install(f);
+        times = pool.install(|| {
+            timed_frames(frames, &mut |_| {
+                gather_frame(&src, &idx, &mut out, w as usize);
+                Ok(())
+            })
+        })?;
+    } else {
+        // The first frame builds the tables and sizes the scratch: not counted.
+        let rep = pool.install(|| {
+            let mut f = Frame::new(&mut out, w, h).map_err(|e| e.to_string())?;
+            r.render(Scene::Map(&map), view(0)?, &opts, &mut f)
+                .map_err(|e| e.to_string())
+        })?;
+        eprintln!(
+            "first view: index steps {}..={}, {} pixels evaluated exactly",
+            rep.min_step, rep.max_step, rep.exact_pixels
+        );
+        times = pool.install(|| {
+            timed_frames(frames, &mut |i| {
+                let mut f = Frame::new(&mut out, w, h).map_err(|e| e.to_string())?;
+                r.render(Scene::Map(&map), view(i + 1)?, &opts, &mut f)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
+            })
+        })?;
+    }
+    let timed = &mut times[..];
+    timed.sort_by(f64::total_cmp);
+    let med = timed.get(timed.len() / 2).copied().unwrap_or(0.0);
+    let checksum = out
+        .iter()
+        .fold(0u64, |a, &p| a.wrapping_mul(31).wrapping_add(p as u64));
+    println!(
+        "{} | {} {} {}x{} from {}x{}, hfov {hfov}, {threads} thread(s): median {med:.2} ms over {} frame(s) (checksum {checksum:016x})",
+        lut_core::kernel_info(),
+        if gather { "gather" } else { "lut" },
+        sampler.name(),
+        w,
+        h,
+        map_wh.0,
+        map_wh.1,
+        timed.len()
+    );
+    Ok(())
+}

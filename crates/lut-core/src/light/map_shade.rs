@@ -1,0 +1,334 @@
+//! Lighting a frame from the [`IlluminanceMap`]: what the window does every frame.
+//!
+//! The camera ray is linear in the pixel coordinates, so the illuminance over the image
+//! is evaluated at the corners of blocks of [`BLOCK`] pixels (exact ray/box intersection,
+//! then the map's bilinear value) and interpolated bilinearly between them. A block is
+//! split in four (two when it is one pixel wide or high), recursively, when its corners
+//! lie on different faces (a room edge crosses it: the recursion follows the edge down
+//! to single pixels, each taking the face its own ray hits, exactly as the per-pixel path
+//! does) or further apart on the face than the map allows there (`Tile::max_len`: E
+//! curves too much for a straight line over that distance, near a light or a cut-off, or
+//! the view grazes the face). So a frame costs a few map lookups per block, whatever the
+//! number of lights, plus one table read per channel (`shade_table`: within a level of
+//! the exact path's linear-light multiply).
+
+use super::illum::IlluminanceMap;
+use super::shade::{
+    blend, check_frame, decode_lut, encode_lut, false_color, false_color_position, shade_pixel,
+    ShadeOptions,
+};
+use super::shade_table::shade_row;
+use super::LightError;
+use crate::geom::camera::Camera;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// The illuminance seen at one pixel.
+#[derive(Clone, Copy)]
+struct Probe {
+    face: usize,
+    /// The hit point relative to the camera.
+    p: DVec3,
+    e: f32,
+    /// The tile's [`super::illum::Tile::max_len`].
+    max_len: f32,
+}
+
+/// 0, 1, 2, … as f32, for filling a block (vectorizes, unlike a counter converted per
+/// pixel).
+const RAMP: [f32; BLOCK.0] = {
+    let mut r = [0f32; BLOCK.0];
+    let mut i = 0;
+    while i < BLOCK.0 {
+        r[i] = i as f32;
+        i += 1;
+    }
+    r
+};
+
+/// Block size (columns, rows) between evaluations of the map, before splitting.
+pub const BLOCK: (usize, usize) = (32, 16);
+
+/// The camera rays of one frame in the room's frame: the ray through pixel centre
+/// (x + ½, y + ½) is `a + b·(x + ½) + c·(y + ½)` (linear in both, as the camera's is).
+struct Rays {
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+}
+
+impl Rays {
+    fn new(map: &IlluminanceMap, cam: &Camera) -> Rays {
+        let room = map.room();
+        let a = room.to_room(cam.world_ray(0.0, 0.0));
+        Rays {
+            a,
+            b: room.to_room(cam.world_ray(1.0, 0.0)) - a,
+            c: room.to_room(cam.world_ray(0.0, 1.0)) - a,
+        }
+    }
+
+    /// The map's probe at pixel (x, y) (its centre; x, y may be one past the image).
+    #[inline]
+    fn probe(&self, map: &IlluminanceMap, x: usize, y: usize) -> Probe {
+        map.probe(self.a + self.b * (x as f64 + 0.5) + self.c * (y as f64 + 0.5))
+    }
+}
+
+/// [`super::RoomFace::index`] of the face on axis `a` at its low (0) or high (1) end.
+const FACE_ON_AXIS: [[usize; 2]; 3] = [[2, 3], [0, 1], [4, 5]];
+
+impl IlluminanceMap {
+    /// The map's illuminance along the camera ray `d` (room frame): the exact ray/box
+    /// intersection of [`super::Room::hit_face`] (same arithmetic, same ties), then the
+    /// face's bilinear value.
+    #[inline]
+    fn probe(&self, d: DVec3) -> Probe {
+        // Per axis, the plane ahead: the high one for a positive (or +0) component. The
+        // camera is strictly inside, so a zero component gives +∞, never NaN.
+        let pick = |c: f64, lo: f64, hi: f64| {
+            if c.is_sign_positive() {
+                (hi / c, 1)
+            } else {
+                (lo / c, 0)
+            }
+        };
+        let (tx, hx) = pick(d.x, self.rel_lo.x, self.rel_hi.x);
+        let (ty, hy) = pick(d.y, self.rel_lo.y, self.rel_hi.y);
+        let (tz, hz) = pick(d.z, self.rel_lo.z, self.rel_hi.z);
+        let (t, face) = if tx <= ty && tx <= tz {
+            (tx, FACE_ON_AXIS[0][hx])
+        } else if ty <= tz {
+            (ty, FACE_ON_AXIS[1][hy])
+        } else {
+            (tz, FACE_ON_AXIS[2][hz])
+        };
+        let f = &self.faces[face];
+        let p = d * t;
+        let (e, max_len) = f.sample(&self.values, p[f.u_axis] - f.u0_rel, p[f.v_axis] - f.v0_rel);
+        Probe {
+            face,
+            p,
+            e,
+            max_len,
+        }
+    }
+
+    /// Fill the block of columns x0 .. x1 − 1 and rows y0 .. y1 − 1 of the band `es`
+    /// (rows of `w` values, the band's first row at `band_y`) given the probes at its
+    /// corners (x1, y1 may be one past the image): bilinear between them when all four lie
+    /// on one face within the tiles' `max_len` of each other, else split in four (or two),
+    /// down to single pixels, which take their own probe.
+    #[allow(clippy::too_many_arguments)]
+    fn fill(
+        &self,
+        rays: &Rays,
+        (x0, y0, x1, y1): (usize, usize, usize, usize),
+        [tl, tr, bl, br]: [Probe; 4],
+        w: usize,
+        band_y: usize,
+        es: &mut [f32],
+    ) {
+        let (nx, ny) = (x1 - x0, y1 - y0);
+        if nx == 1 && ny == 1 {
+            es[(y0 - band_y) * w + x0] = tl.e;
+            return;
+        }
+        let len = tl.max_len.min(tr.max_len).min(bl.max_len).min(br.max_len) as f64;
+        let same = tl.face == tr.face && tl.face == bl.face && tl.face == br.face;
+        if same
+            && (tl.p - br.p).length_squared() <= len * len
+            && (tr.p - bl.p).length_squared() <= len * len
+        {
+            // Bilinear: each row linear between its two ends.
+            let (dl, dr) = ((bl.e - tl.e) / ny as f32, (br.e - tr.e) / ny as f32);
+            for (j, &fj) in RAMP[..ny].iter().enumerate() {
+                let (l, r) = (tl.e + dl * fj, tr.e + dr * fj);
+                let step = (r - l) / nx as f32;
+                let row = &mut es[(y0 + j - band_y) * w + x0..][..nx];
+                for (e, &i) in row.iter_mut().zip(RAMP.iter()) {
+                    *e = l + step * i;
+                }
+            }
+            return;
+        }
+        if nx <= 2 && ny <= 2 {
+            // Pixels of their own: one probe each (the top-left one is known).
+            for j in 0..ny {
+                for i in 0..nx {
+                    let e = match (i, j) {
+                        (0, 0) => tl.e,
+                        _ => rays.probe(self, x0 + i, y0 + j).e,
+                    };
+                    es[(y0 + j - band_y) * w + x0 + i] = e;
+                }
+            }
+            return;
+        }
+        let (xm, ym) = (x0 + nx / 2, y0 + ny / 2);
+        if ny == 1 {
+            let (t, b) = (rays.probe(self, xm, y0), rays.probe(self, xm, y1));
+            self.fill(rays, (x0, y0, xm, y1), [tl, t, bl, b], w, band_y, es);
+            self.fill(rays, (xm, y0, x1, y1), [t, tr, b, br], w, band_y, es);
+        } else if nx == 1 {
+            let (l, r) = (rays.probe(self, x0, ym), rays.probe(self, x1, ym));
+            self.fill(rays, (x0, y0, x1, ym), [tl, tr, l, r], w, band_y, es);
+            self.fill(rays, (x0, ym, x1, y1), [l, r, bl, br], w, band_y, es);
+        } else {
+            let t = rays.probe(self, xm, y0);
+            let b = rays.probe(self, xm, y1);
+            let l = rays.probe(self, x0, ym);
+            let r = rays.probe(self, x1, ym);
+            let m = rays.probe(self, xm, ym);
+            self.fill(rays, (x0, y0, xm, ym), [tl, t, l, m], w, band_y, es);
+            self.fill(rays, (xm, y0, x1, ym), [t, tr, m, r], w, band_y, es);
+            self.fill(rays, (x0, ym, xm, y1), [l, m, bl, b], w, band_y, es);
+            self.fill(rays, (xm, ym, x1, y1), [m, r, b, br], w, band_y, es);
+        }
+    }
+
+    /// The illuminance of the band of rows starting at `band_y` (`es` holds whole rows of
+    /// `w` values), block by block.
+    fn band_lux(&self, rays: &Rays, w: usize, band_y: usize, es: &mut [f32]) {
+        let rows = es.len() / w;
+        let y1 = band_y + rows;
+        let mut x0 = 0;
+        let mut l = [rays.probe(self, 0, band_y), rays.probe(self, 0, y1)];
+        while x0 < w {
+            let x1 = (x0 + BLOCK.0).min(w);
+            let r = [rays.probe(self, x1, band_y), rays.probe(self, x1, y1)];
+            self.fill(
+                rays,
+                (x0, band_y, x1, y1),
+                [l[0], r[0], l[1], r[1]],
+                w,
+                band_y,
+                es,
+            );
+            (x0, l) = (x1, r);
+        }
+    }
+
+    /// The map's illuminance at pixel (x, y) of `cam`'s image through its own ray (any
+    /// view projection); `None` where the projection has no direction.
+    #[inline]
+    fn pixel_lux(&self, cam: &Camera, x: usize, y: usize) -> Option<f32> {
+        let d = cam.ray(x as f64 + 0.5, y as f64 + 0.5)?;
+        Some(self.probe(self.room().to_room(d)).e)
+    }
+
+    /// The illuminance in lux (lights only) the map gives each pixel of `cam`'s image,
+    /// row by row, as [`IlluminanceMap::shade_frame`] uses it (for tests, and exports).
+    /// Rectilinear views interpolate it over blocks (see the module docs); the other view
+    /// projections (not linear in the pixel coordinates) probe the map at every pixel,
+    /// NaN where the projection has no direction (outside a fisheye's disc).
+    ///
+    /// # Errors
+    /// [`LightError::BufferSize`] when `out` does not hold the camera's pixels.
+    pub fn lux_frame(&self, cam: &Camera, out: &mut [f32]) -> Result<(), LightError> {
+        let (w, h) = (cam.width as usize, cam.height as usize);
+        if out.len() != w * h {
+            return Err(LightError::BufferSize {
+                len: out.len(),
+                width: cam.width,
+                height: cam.height,
+                needed: w * h,
+            });
+        }
+        if w == 0 {
+            return Ok(());
+        }
+        if !cam.projection().is_rectilinear() {
+            out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+                for (x, e) in row.iter_mut().enumerate() {
+                    *e = self.pixel_lux(cam, x, y).unwrap_or(f32::NAN);
+                }
+            });
+            return Ok(());
+        }
+        let rays = Rays::new(self, cam);
+        out.par_chunks_mut(w * BLOCK.1)
+            .enumerate()
+            .for_each(|(band, es)| self.band_lux(&rays, w, band * BLOCK.1, es));
+        Ok(())
+    }
+
+    /// Light a rendered frame in place from the map, as [`super::shade_frame`] does from
+    /// the luminaires: each pixel's colour is the albedo of the room surface its camera ray
+    /// hits, times ambient + exposure · E, in linear light. Rows run in parallel; the
+    /// result does not depend on the number of threads.
+    ///
+    /// # Errors
+    /// As [`super::shade_frame`].
+    pub fn shade_frame(
+        &self,
+        cam: &Camera,
+        frame: &mut [u32],
+        w: u32,
+        h: u32,
+        opts: &ShadeOptions,
+    ) -> Result<(), LightError> {
+        check_frame(cam, frame, w, h)?;
+        opts.check()?;
+        if frame.is_empty() {
+            return Ok(());
+        }
+        let dec = decode_lut();
+        let enc = encode_lut();
+        let (ambient, exposure) = (opts.ambient as f32, opts.exposure as f32);
+        let w = w as usize;
+        if !cam.projection().is_rectilinear() {
+            // Each pixel through its own ray; pixels with no direction stay as rendered.
+            frame.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+                for (x, px) in row.iter_mut().enumerate() {
+                    let Some(e) = self.pixel_lux(cam, x, y) else {
+                        continue;
+                    };
+                    let shaded = shade_pixel(*px, ambient + exposure * e, dec, enc);
+                    *px = if opts.false_color {
+                        let c =
+                            false_color(false_color_position(e as f64, opts.false_color_max_lux));
+                        blend(c, shaded, 0.65)
+                    } else {
+                        shaded
+                    };
+                }
+            });
+            return Ok(());
+        }
+        let rays = Rays::new(self, cam);
+        frame.par_chunks_mut(w * BLOCK.1).enumerate().for_each_init(
+            || vec![0f32; w * BLOCK.1],
+            |es, (band, pixels)| {
+                let es = &mut es[..pixels.len()];
+                self.band_lux(&rays, w, band * BLOCK.1, es);
+                if opts.false_color {
+                    let max = opts.false_color_max_lux;
+                    for (px, &e) in pixels.iter_mut().zip(es.iter()) {
+                        let shaded = shade_pixel(*px, ambient + exposure * e, dec, enc);
+                        let c = false_color(false_color_position(e as f64, max));
+                        *px = blend(c, shaded, 0.65);
+                    }
+                } else {
+                    shade_row(pixels, es, ambient, exposure);
+                }
+            },
+        );
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::RoomFace;
+
+    #[test]
+    fn face_table_matches_the_faces() {
+        for (axis, ends) in FACE_ON_AXIS.iter().enumerate() {
+            for (high, &i) in ends.iter().enumerate() {
+                assert_eq!(RoomFace::on_axis(axis, high == 1).index(), i);
+            }
+        }
+    }
+}

@@ -1,0 +1,170 @@
+//! Lighting frames from the illuminance map: the map of the current luminaires is built
+//! once per lighting change ([`LitCache`]), every frame then samples it
+//! ([`lut_core::IlluminanceMap::shade_frame`]), and the automatic exposure is set from it.
+//! In the window a change first builds a coarse map ([`lut_core::MapOptions::preview`],
+//! immediate feedback while a value is dragged), refined on the next frame.
+
+use super::state::{LightsKey, LightsState};
+use lut_core::{Camera, IlluminanceMap, MapOptions, View};
+use std::sync::Arc;
+
+/// The illuminance map of a [`LightsState`]'s luminaires, kept until they change.
+#[derive(Debug, Default)]
+pub struct LitCache {
+    /// What the map was built from (the luminaires and room, not the shading).
+    key: Option<LightsKey>,
+    map: Option<Arc<IlluminanceMap>>,
+    /// The map is the coarse preview: the next update refines it.
+    coarse: bool,
+    /// Counts the maps built (a lit frame depends on it).
+    generation: u64,
+}
+
+impl LitCache {
+    /// The map for `st`, rebuilt when its luminaires or room changed: with `progressive`
+    /// a change first gets the coarse preview map and the next call the full one. Each
+    /// new map sets the automatic exposure ([`LightsState::apply_auto_exposure`]).
+    /// `None` with no luminaire.
+    ///
+    /// # Errors
+    /// A room or luminaire the map cannot be built for (a light outside the room).
+    pub fn update(
+        &mut self,
+        st: &mut LightsState,
+        progressive: bool,
+    ) -> Result<Option<Arc<IlluminanceMap>>, String> {
+        let key = st.geometry_key();
+        let changed = self.key.as_ref() != Some(&key);
+        if !changed && !self.coarse {
+            return Ok(self.map.clone());
+        }
+        let coarse = changed && progressive;
+        self.key = Some(key);
+        self.map = None;
+        self.coarse = false;
+        self.generation += 1;
+        let Some(scene) = st.scene()? else {
+            return Ok(None);
+        };
+        let opts = if coarse {
+            MapOptions::preview()
+        } else {
+            MapOptions::default()
+        };
+        let map = Arc::new(IlluminanceMap::build(&scene, &opts).map_err(|e| e.to_string())?);
+        st.apply_auto_exposure(&map);
+        self.map = Some(map.clone());
+        self.coarse = coarse;
+        Ok(Some(map))
+    }
+
+    /// A coarse map waits to be refined (the window asks for another frame).
+    pub fn refining(&self) -> bool {
+        self.coarse && self.map.is_some()
+    }
+
+    /// Changes whenever a new map is built.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// The current map's memory in bytes (0 without one).
+    pub fn bytes(&self) -> usize {
+        self.map.as_ref().map_or(0, |m| m.bytes())
+    }
+}
+
+impl LightsState {
+    /// Light a rendered `width × height` frame of `view` in place from the illuminance
+    /// map in `cache` (updated first, see [`LitCache::update`]); a no-op with no
+    /// luminaire.
+    ///
+    /// # Errors
+    /// As [`LightsState::scene`], or a frame that is not `width × height`.
+    pub fn light_frame_with(
+        &mut self,
+        cache: &mut LitCache,
+        progressive: bool,
+        view: View,
+        frame: &mut [u32],
+        width: u32,
+        height: u32,
+    ) -> Result<(), String> {
+        let Some(map) = cache.update(self, progressive)? else {
+            return Ok(());
+        };
+        let cam = Camera::new(view, width, height);
+        map.shade_frame(&cam, frame, width, height, &self.shade_options())
+            .map_err(|e| e.to_string())
+    }
+
+    /// [`LightsState::light_frame_with`] with a map built for this one frame (the full
+    /// map: what `viewer render` does).
+    ///
+    /// # Errors
+    /// As [`LightsState::light_frame_with`].
+    pub fn light_frame(
+        &mut self,
+        view: View,
+        frame: &mut [u32],
+        width: u32,
+        height: u32,
+    ) -> Result<(), String> {
+        self.light_frame_with(&mut LitCache::default(), false, view, frame, width, height)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn lamp() -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/ies/label_lines.ies")
+    }
+
+    #[test]
+    fn built_once_per_change_coarse_then_fine() {
+        let mut st = LightsState::default();
+        st.load_and_add(&lamp()).unwrap();
+        let mut c = LitCache::default();
+        let a = c.update(&mut st, true).unwrap().unwrap();
+        assert!(c.refining());
+        let g = c.generation();
+        let b = c.update(&mut st, true).unwrap().unwrap();
+        assert!(!c.refining() && c.generation() == g + 1);
+        assert!(b.nodes() > a.nodes(), "{} {}", b.nodes(), a.nodes());
+        // Unchanged: the same map; a shading change does not rebuild it.
+        st.exposure_lux *= 2.0;
+        st.false_color = true;
+        let c2 = c.update(&mut st, true).unwrap().unwrap();
+        assert!(Arc::ptr_eq(&b, &c2) && c.generation() == g + 1);
+        // A light moved: rebuilt.
+        st.lights[0].position[0] += 0.1;
+        c.update(&mut st, false).unwrap();
+        assert!(!c.refining() && c.generation() == g + 2);
+        // No light: no map.
+        st.lights.clear();
+        assert!(c.update(&mut st, true).unwrap().is_none());
+        assert_eq!(c.bytes(), 0);
+    }
+
+    #[test]
+    fn auto_exposure_follows_the_lights() {
+        let mut st = LightsState {
+            auto_exposure: true,
+            ..LightsState::default()
+        };
+        st.load_and_add(&lamp()).unwrap();
+        let mut c = LitCache::default();
+        c.update(&mut st, false).unwrap();
+        let one = st.exposure_lux;
+        st.lights[0].multiplier = 10.0;
+        c.update(&mut st, false).unwrap();
+        assert!(
+            (st.exposure_lux / one - 10.0).abs() < 1e-6,
+            "{one} {}",
+            st.exposure_lux
+        );
+    }
+}

@@ -1,0 +1,286 @@
+//! The lights in the window: the lit scene from the illuminance map, the room and
+//! luminaires drawn over it, picking and dragging luminaires in the view, and scene files
+//! opened and saved.
+
+use super::App;
+use crate::lighting::overlay::{
+    drag_on_surface, drag_room_edge, draw_room_and_lights, pick_light, pick_room_edge,
+    project_point,
+};
+use crate::lighting::{legend::draw_legend, SceneFile, SceneView};
+use crate::window::document::StartArgs;
+use crate::window::loader::Source;
+use crate::window::paint::SceneRect;
+use lut_core::{Camera, IlluminanceMap, View};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// How near (scene pixels) a click or press must be to a luminaire's marker to take it.
+pub(super) const PICK_RADIUS: f64 = 12.0;
+/// How near (scene pixels) a press must be to a room edge to drag it.
+pub(super) const EDGE_RADIUS: f64 = 6.0;
+
+impl App {
+    /// The illuminance map for this frame (rebuilt, coarse first, when the lights
+    /// changed); a scene that cannot be lit (a light outside the room) is reported in the
+    /// panel.
+    pub(super) fn update_lit(&mut self) -> Option<Arc<IlluminanceMap>> {
+        match self.lit.update(&mut self.lights, true) {
+            Ok(map) => {
+                self.lights.scene_error = None;
+                map
+            }
+            Err(e) => {
+                self.lights.scene_error = Some(e);
+                None
+            }
+        }
+    }
+
+    /// Light the freshly rendered scene from `map` (as `viewer render` does), then draw
+    /// the room and luminaires ("Show room") and the false colours' legend over it.
+    pub(super) fn light_scene(&mut self, map: Option<&IlluminanceMap>, view: View, r: SceneRect) {
+        let (w, h) = (r.w, r.h);
+        if let Some(map) = map {
+            let cam = Camera::new(view, w, h);
+            let opts = self.lights.shade_options();
+            if let Err(e) = map.shade_frame(&cam, &mut self.scene, w, h, &opts) {
+                self.lights.scene_error = Some(e.to_string());
+            }
+        }
+        let l = &self.lights;
+        let mut result = Ok(());
+        if l.show_room {
+            result = draw_room_and_lights(l, view, &mut self.scene, w, h);
+        }
+        if l.false_color && map.is_some() {
+            result = result.and(draw_legend(&mut self.scene, w, h, l.false_color_max));
+        }
+        if let Err(e) = result {
+            self.lights.scene_error = Some(e);
+        }
+        if self.print_view && self.lights.show_room {
+            self.print_markers(view, r);
+        }
+    }
+
+    /// `--print-view`: where each luminaire's marker is in the scene (pixels), when that
+    /// changed: "markers 1=X,Y 2=X,Y" (lights behind the camera left out).
+    fn print_markers(&mut self, view: View, r: SceneRect) {
+        let Ok(room) = self.lights.room_box() else {
+            return;
+        };
+        let cam = Camera::new(view, r.w, r.h);
+        let line: Vec<String> = self
+            .lights
+            .lights
+            .iter()
+            .enumerate()
+            .filter_map(|(i, l)| {
+                let (x, y) = project_point(&room, &cam, l.position.into())?;
+                Some(format!("{}={x:.0},{y:.0}", i + 1))
+            })
+            .collect();
+        // And the middle of each room edge in view: "edges K=X,Y" (K into Room::EDGES).
+        let c = room.corners();
+        let edges: Vec<String> = lut_core::Room::EDGES
+            .iter()
+            .enumerate()
+            .filter_map(|(k, &(i, j))| {
+                let pieces = crate::lighting::overlay::edge_pieces(&room, &cam, c[i], c[j]);
+                let ((x0, y0), (x1, y1)) = *pieces.get(pieces.len() / 2)?;
+                let (x, y) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+                let inside = x >= 0.0 && y >= 0.0 && x < r.w as f64 && y < r.h as f64;
+                inside.then(|| format!("{k}={x:.0},{y:.0}"))
+            })
+            .collect();
+        let line = format!("markers {}\nedges {}", line.join(" "), edges.join(" "));
+        if line != self.printed_markers {
+            let _ = crate::outln!("{line}");
+            self.printed_markers = line;
+        }
+    }
+
+    /// `--print-view`: the selection.
+    fn print_selection(&self) {
+        if self.print_view {
+            match self.lights.selected {
+                Some(i) => {
+                    let _ = crate::outln!("light {} selected", i + 1);
+                }
+                None => {
+                    let _ = crate::outln!("no light selected");
+                }
+            }
+        }
+    }
+
+    /// A click on the scene at `at` (scene pixels): select the luminaire whose marker is
+    /// there (the room shown), or clear the selection.
+    pub(super) fn click_scene(&mut self, at: (f64, f64), size: (u32, u32)) {
+        if !self.lights.show_room {
+            return;
+        }
+        let view = self.ctl.look().view();
+        self.lights.selected = pick_light(&self.lights, view, size.0, size.1, at, PICK_RADIUS);
+        self.print_selection();
+    }
+
+    /// A drag starts at `at`: on a luminaire's marker (the room shown) it moves that
+    /// luminaire, on an edge of the room box it moves that edge's walls, instead of
+    /// turning the view. True when a luminaire or an edge was taken.
+    pub(super) fn press_light(&mut self, at: (f64, f64), size: (u32, u32)) -> bool {
+        if !self.lights.show_room {
+            return false;
+        }
+        let view = self.ctl.look().view();
+        self.light_drag = pick_light(&self.lights, view, size.0, size.1, at, PICK_RADIUS);
+        if self.light_drag.is_some() {
+            self.lights.selected = self.light_drag;
+            self.print_selection();
+            return true;
+        }
+        let cam = Camera::new(view, size.0, size.1);
+        self.edge_drag = self
+            .lights
+            .room_box()
+            .ok()
+            .and_then(|room| pick_room_edge(&room, &cam, at, EDGE_RADIUS));
+        self.edge_drag.is_some()
+    }
+
+    /// The dragged luminaire follows the cursor along the face it is nearest to; a
+    /// dragged room edge moves its walls to the cursor.
+    pub(super) fn drag_light(&mut self, at: (f64, f64), size: (u32, u32)) {
+        let Ok(room) = self.lights.room_box() else {
+            return;
+        };
+        let cam = Camera::new(self.ctl.look().view(), size.0, size.1);
+        if let Some(e) = self.edge_drag {
+            if let Some((w, d, cx, cz)) = drag_room_edge(&room, &cam, e, at) {
+                self.lights.room.0 = w;
+                self.lights.room.1 = d;
+                self.lights.room_center = (cx, cz);
+            }
+            return;
+        }
+        let Some(i) = self.light_drag else {
+            return;
+        };
+        if let Some(l) = self.lights.lights.get_mut(i) {
+            if let Some(p) = drag_on_surface(&room, &cam, l.position.into(), at) {
+                l.position = p.into();
+            }
+        }
+    }
+
+    /// The drag of a luminaire ended (`--print-view`: where it is now).
+    pub(super) fn end_light_drag(&mut self) {
+        if let (Some(_), true) = (self.edge_drag.take(), self.print_view) {
+            let (w, d, h) = self.lights.room;
+            let (cx, cz) = self.lights.room_center;
+            let _ = crate::outln!("room {w:.3}x{d:.3}x{h:.3} centre {cx:.3},{cz:.3}");
+        }
+        if let (Some(i), true) = (self.light_drag.take(), self.print_view) {
+            if let Some(l) = self.lights.lights.get(i) {
+                let [x, y, z] = l.position;
+                let _ = crate::outln!("light {} moved to {x:.3},{y:.3},{z:.3}", i + 1);
+            }
+        }
+    }
+
+    /// Open a scene file: its room, luminaires and exposure replace the panel's; its
+    /// panorama (if it names one) opens at its view. Errors are notices.
+    pub(super) fn open_scene(&mut self, path: PathBuf) {
+        let t = self.now();
+        let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+        let loaded = SceneFile::load(&path).and_then(|f| Ok((f.to_state(&dir)?, f)));
+        let (mut state, file) = match loaded {
+            Ok(x) => x,
+            Err(e) => {
+                self.notices.error(format!("{e:#}"), t);
+                return;
+            }
+        };
+        state.path_input = std::mem::take(&mut self.lights.path_input);
+        state.show_room = self.lights.show_room;
+        self.lights = state;
+        self.scene_file = Some(path.clone());
+        self.prefs.panel = true;
+        self.notices.info(format!("scene {}", path.display()), t);
+        if let Some(p) = file.panorama_path(&dir) {
+            let start = file.view.map_or_else(StartArgs::default, |v| StartArgs {
+                yaw: Some(v.yaw),
+                pitch: Some(v.pitch),
+                hfov: Some(v.hfov),
+            });
+            let source = Source::of_paths(vec![p.clone()], false, None).unwrap_or(Source::File(p));
+            let fx = self
+                .doc
+                .open(source, None, start, self.ctl.settings.exposure_ev);
+            self.apply(vec![fx]);
+        }
+    }
+
+    /// The Save dialog for a scene file, beside the scene opened last (else the
+    /// panorama's folder).
+    pub(super) fn start_save_scene_dialog(&mut self) {
+        let near = self
+            .scene_file
+            .clone()
+            .or(self.doc.last_file().map(Path::to_path_buf));
+        let dir = near
+            .as_deref()
+            .and_then(Path::parent)
+            .filter(|d| d.is_dir())
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+        let name = match (&self.scene_file, self.doc.last_file()) {
+            (Some(s), _) => s.file_name().map(|n| n.to_string_lossy().into_owned()),
+            (None, Some(p)) => p
+                .file_stem()
+                .map(|s| format!("{}.json", s.to_string_lossy())),
+            (None, None) => None,
+        };
+        let name = name.unwrap_or_else(|| "scene.json".into());
+        self.dialogs.save_scene(&self.egui_ctx, &dir, &name);
+        if self.print_view {
+            let _ = crate::outln!("dialog save-scene {}", dir.display());
+        }
+    }
+
+    /// Write the scene (the panorama shown, the view, the panel's lights) to `path`.
+    pub(super) fn save_scene_to(&mut self, path: &Path, t: f64) {
+        let panorama = self
+            .doc
+            .current()
+            .and_then(|c| c.source.single_path())
+            .map(Path::to_path_buf);
+        let look = self.ctl.look();
+        let view = SceneView {
+            yaw: look.yaw,
+            pitch: look.pitch,
+            hfov: look.hfov,
+        };
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        let file = SceneFile::from_state(&self.lights, panorama.as_deref(), Some(view), dir);
+        let status = match file.save(path) {
+            Ok(()) => {
+                self.scene_file = Some(path.to_path_buf());
+                let msg = format!("saved scene {}", path.display());
+                self.notices.info(&msg, t);
+                msg
+            }
+            Err(e) => {
+                let msg = format!("save failed: {e:#}");
+                self.notices.error(&msg, t);
+                msg
+            }
+        };
+        if self.print_view {
+            let _ = crate::outln!("{status}");
+        }
+    }
+}
