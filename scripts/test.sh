@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
-# The whole test suite: formatting, lints, unit/integration/golden/property tests, and the
-# real window under Xvfb. Works on a fresh machine with the Rust toolchain: it installs the
-# Debian packages the window test needs when they are missing (as root, via apt-get).
+# The whole test suite: formatting, lints, unit/integration/golden/property tests, the
+# real window under Xvfb (a smoke test and a one-minute soak), and every fuzz target
+# briefly on its committed seeds (FUZZ_SECONDS each, default 20). Works on a fresh
+# machine with the Rust toolchain: it installs the Debian packages the window tests need
+# when they are missing (as root, via apt-get), and the nightly toolchain and cargo-fuzz
+# for the fuzz targets.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -13,12 +16,14 @@ command -v xwininfo >/dev/null || need_pkgs+=(x11-utils)
 ldconfig -p | grep -q libxkbcommon-x11 || need_pkgs+=(libxkbcommon-x11-0)
 ldconfig -p | grep -q libXcursor || need_pkgs+=(libxcursor1)
 ldconfig -p | grep -q libXi.so || need_pkgs+=(libxi6)
+/usr/bin/python3 -c 'import Xlib' 2>/dev/null || need_pkgs+=(python3-xlib)
 if [ ${#need_pkgs[@]} -gt 0 ]; then
   if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
     echo "== installing ${need_pkgs[*]}"
     apt-get update -qq
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq xvfb xdotool x11-utils x11-apps imagemagick \
-      libx11-6 libx11-xcb1 libxcursor1 libxi6 libxkbcommon-x11-0 libxkbcommon0 libxcb1 libxcb-xkb1 >/dev/null
+      python3-xlib libx11-6 libx11-xcb1 libxcursor1 libxi6 libxkbcommon-x11-0 libxkbcommon0 libxcb1 \
+      libxcb-xkb1 >/dev/null
   else
     echo "missing packages for the window test: ${need_pkgs[*]} (install them, or run as root)" >&2
     exit 1
@@ -27,6 +32,7 @@ fi
 
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
+cargo fmt --manifest-path fuzz/Cargo.toml -- --check
 echo "== cargo clippy"
 cargo clippy --workspace --all-targets --profile ci -- -D warnings
 echo "== cargo test (profile ci: optimized, overflow checks on)"
@@ -39,4 +45,12 @@ if [ -f scripts/window-smoke.sh ]; then
   # the binary the test run just built (optimized, overflow checks on): no second build
   VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-smoke.sh
 fi
+echo "== window soak under Xvfb (one minute of random input, drops and the memory curve)"
+t0=$SECONDS
+VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-soak.sh --duration 60
+echo "== window soak took $((SECONDS - t0)) s"
+echo "== fuzz targets, ${FUZZ_SECONDS:-20} s each on the committed seeds (installs nightly and cargo-fuzz if missing)"
+t0=$SECONDS
+bash scripts/fuzz.sh --ci --time "${FUZZ_SECONDS:-20}"
+echo "== fuzzing (install, build, runs) took $((SECONDS - t0)) s"
 echo "== all tests passed"

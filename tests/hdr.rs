@@ -84,3 +84,34 @@ fn exposure_brightens() {
     };
     assert!(sum(&bright) > sum(&dark) * 2);
 }
+
+/// Every compression `exr` writes, in scan lines and tiles, half and full floats, decodes
+/// to the same map as `image`'s own EXR decoder (an independent path: its high-level
+/// reader) followed by the tone curve.
+#[test]
+fn every_exr_compression_decodes_like_image_does() {
+    use exr::prelude::{Blocks, Vec2};
+    use test_support::exr_files::{compressions, exr_file};
+    for (name, c) in compressions() {
+        for (blocks, layout) in [
+            (Blocks::ScanLines, "scan lines"),
+            (Blocks::Tiles(Vec2(16, 8)), "tiles"),
+        ] {
+            for half in [true, false] {
+                let what = format!("{name}, {layout}, half {half}");
+                let bytes = exr_file(40, 20, &["R", "G", "B", "A"], c, blocks, half);
+                let map =
+                    lut_core::decode_map(&bytes, "t.exr", &LoadOptions::default(), &mut |_| {})
+                        .unwrap_or_else(|e| panic!("{what}: {e}"));
+                let raw = image::load_from_memory(&bytes).unwrap().to_rgb32f();
+                assert_eq!((map.width(), map.height()), raw.dimensions(), "{what}");
+                for (x, y, p) in raw.enumerate_pixels() {
+                    let want = (u32::from(tone_map(p[0])) << 16)
+                        | (u32::from(tone_map(p[1])) << 8)
+                        | u32::from(tone_map(p[2]));
+                    assert_eq!(map.pixel(x, y), want, "{what}: ({x},{y})");
+                }
+            }
+        }
+    }
+}

@@ -78,6 +78,7 @@
 
 mod cube;
 mod error;
+mod file;
 mod geom;
 mod io;
 mod light;
@@ -137,8 +138,12 @@ pub use render::{
 };
 
 // Input.
-pub use io::cube::{load_cube, load_face_files, load_layout_image};
+pub use file::open_regular;
+pub use io::cube::{
+    cube_face_files, decode_layout_image, load_cube, load_face_files, load_layout_image,
+};
 pub use io::gpano::{insert_xmp, jpeg_xmp, read_gpano, xmp_packet, GPano, GPANO_NS, XMP_SIGNATURE};
+pub use io::jpeg::jpeg_max_pixels;
 pub use io::load::{
     check_pixel_limit, decode_map, load_map, map_from_image, resolve_projection, LoadOptions,
     LoadPhase, LoadProgress, DEFAULT_MAX_PIXELS,
@@ -148,7 +153,8 @@ pub use io::partial::{decode_partial, load_partial, CoverageSource};
 // Cube maps.
 pub use cube::layout::{layout_dimensions, Layout, Naming, Transform};
 pub use cube::{
-    check_face_size, face_axes, face_dir, face_of, face_uv, CubeError, CubeMap, Face, MAX_FACE_SIZE,
+    check_face_size, face_axes, face_dir, face_of, face_uv, CubeError, CubeMap, Face, FacesProblem,
+    LayoutProblem, UsageProblem, MAX_FACE_SIZE,
 };
 
 // Lights.
@@ -177,8 +183,12 @@ mod layout {
         ("lut", &["geom", "error", "named"]),
         ("cube", &["geom", "map", "error", "named"]),
         ("render", &["geom", "map", "lut", "cube", "error", "named"]),
-        ("light", &["geom", "render", "error", "named"]),
-        ("io", &["geom", "map", "lut", "cube", "render", "error"]),
+        ("file", &[]),
+        ("light", &["geom", "render", "error", "named", "file"]),
+        (
+            "io",
+            &["geom", "map", "lut", "cube", "render", "error", "file"],
+        ),
     ];
 
     /// The stage a source file belongs to: its first folder, or its stem at the root.

@@ -2,13 +2,15 @@
 //! ([`golden`]), pixel statistics ([`pixels`]: PSNR, per-channel differences), a counting
 //! global allocator ([`alloc`]), header-only decompression bombs ([`bombs`]) and frames
 //! rendered into new buffers ([`render`]), geometry computed independently of the
-//! library ([`geometry`]), and synthetic photometric files and sphere directions for the
-//! light tests ([`light_fixtures`]).
+//! library ([`geometry`]), synthetic photometric files and sphere directions for the
+//! light tests ([`light_fixtures`]), and small OpenEXR files of every compression
+//! ([`exr_files`]).
 //!
 //! A dev-dependency of `lut-core` and `viewer`; never published.
 
 pub mod alloc;
 pub mod bombs;
+pub mod exr_files;
 pub mod geometry;
 pub mod golden;
 pub mod light_fixtures;

@@ -4,7 +4,7 @@
 //! ticks, the 0.05 px budget, the max and the mean. `viewer render --error-map` writes
 //! it; the window shows the same colours (its panel draws the legend).
 
-use crate::output::write_png_atomic;
+use crate::output::write_image;
 use anyhow::{anyhow, Result};
 use lut_core::{heat_color, heat_scale, ErrorMap, HEAT_MAX, HEAT_MIN};
 use std::path::Path;
@@ -111,13 +111,13 @@ pub fn heat_image(em: &ErrorMap) -> Result<(Vec<u32>, u32, u32)> {
     Ok((px, w, h))
 }
 
-/// Write [`heat_image`] of `em` to `path` (atomically).
+/// Write [`heat_image`] of `em` to `path` (PNG or JPEG by its extension, atomically).
 ///
 /// # Errors
 /// As [`heat_image`], or when the file cannot be written.
 pub fn write_error_map(path: &Path, em: &ErrorMap) -> Result<()> {
     let (px, w, h) = heat_image(em)?;
-    write_png_atomic(path, &px, w, h)
+    write_image(path, &px, w, h)
 }
 
 #[cfg(test)]

@@ -16,7 +16,10 @@
 //!   is rendered.
 //! * [`lighting`]: luminaires lighting a rendered room (`--light`, the panel's lights).
 //! * [`heatmap`]: the error heat map as an image with its legend (`render --error-map`).
-//! * [`output`]: images written atomically.
+//! * [`output`]: images written atomically (format by extension, special files written
+//!   into, inputs never overwritten).
+//! * [`exit`]: exit statuses (0, 1 for files, 2 for usage), usage errors, standard
+//!   output without panics; [`signals`]: temporary files removed on SIGINT/SIGTERM.
 //! * [`window`]: winit + softbuffer + egui, all drawn on the CPU.
 
 #![warn(missing_docs)]
@@ -25,9 +28,11 @@ pub mod args;
 pub mod assets;
 pub mod cli;
 pub mod commands;
+pub mod exit;
 pub mod heatmap;
 pub mod lighting;
 pub mod output;
 pub mod panorama;
 pub mod scene;
+pub mod signals;
 pub mod window;

@@ -1,5 +1,6 @@
 //! `viewer`: the CPU panorama viewer (see the library's docs for what each command does).
-//! Parse the command line, run the command, print its error in one line, exit nonzero.
+//! Parse the command line, run the command, print its error in one line, exit with the
+//! status `viewer::exit` documents (0 done, 1 a file or device failed, 2 a usage error).
 
 use clap::Parser;
 use std::process::ExitCode;
@@ -7,10 +8,11 @@ use viewer::cli::{Cli, Command};
 use viewer::commands::{bench, bench_load, convert, ies, lux, render};
 
 fn main() -> ExitCode {
+    viewer::signals::install();
     let cli = Cli::parse();
     // A bad LUTPANO_KERNEL (the span kernel override) is refused up front.
     if let Err(e) = lut_core::kernel_from_env() {
-        eprintln!("viewer: {e}");
+        viewer::errln!("viewer: {e}");
         return ExitCode::FAILURE;
     }
     let result = match cli.command {
@@ -22,11 +24,15 @@ fn main() -> ExitCode {
         Some(Command::BenchLoad(a)) => bench_load::run(a),
         None => viewer::window::run(cli.open),
     };
+    // Lines still in standard output's buffer: a full disk shows here.
+    let result = result.and_then(|()| viewer::exit::flush());
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader of our output went away: nothing is wrong with the command.
+        Err(e) if viewer::exit::is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("viewer: {e:#}");
-            ExitCode::FAILURE
+            viewer::errln!("viewer: {e:#}");
+            ExitCode::from(viewer::exit::code(&e))
         }
     }
 }

@@ -126,8 +126,10 @@ pub fn load_cube(inputs: &[PathBuf], cube: CubeArgs) -> Result<CubeMap> {
 pub fn looks_like_cube(inputs: &[PathBuf]) -> bool {
     match inputs {
         [one] if one.is_dir() => true,
-        [one] => image::ImageReader::open(one)
+        // Only a regular file is looked into: opening a FIFO would block the window.
+        [one] => lut_core::open_regular(one)
             .ok()
+            .map(|f| image::ImageReader::new(std::io::BufReader::new(f)))
             .and_then(|r| r.with_guessed_format().ok())
             .and_then(|r| r.into_dimensions().ok())
             .map(|(w, h)| Layout::detect(w, h).is_some())
@@ -154,6 +156,18 @@ mod tests {
         assert!(!looks_like_cube(&[img("pano.png", 64, 32)]));
         assert!(looks_like_cube(&[tmp.path().to_path_buf()]));
         assert!(!looks_like_cube(&[tmp.path().join("missing.png")]));
+        #[cfg(unix)]
+        {
+            // A FIFO named like an image: answered at once (not a cube), never opened
+            // for reading, which would block until a writer came.
+            let fifo = tmp.path().join("pipe.png");
+            assert!(std::process::Command::new("mkfifo")
+                .arg(&fifo)
+                .status()
+                .unwrap()
+                .success());
+            assert!(!looks_like_cube(&[fifo]));
+        }
         let six: Vec<PathBuf> = (0..6).map(|i| PathBuf::from(format!("{i}.png"))).collect();
         assert!(looks_like_cube(&six));
         assert!(!looks_like_cube(&six[..2]));

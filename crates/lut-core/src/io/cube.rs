@@ -16,6 +16,10 @@ use crate::cube::{
     check_face_size, CubeError, CubeMap, Face, FacesProblem, LayoutProblem, UsageProblem,
     MAX_FACE_SIZE,
 };
+use crate::error::MapError;
+use crate::geom::projection::Projection;
+use crate::io::load::{decode_reader, LoadOptions};
+use crate::map::tone::Tone;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -69,6 +73,9 @@ fn is_image(path: &Path) -> bool {
 /// A decoded image: width, height, 0RGB pixels.
 type Decoded = (u32, u32, Vec<u32>);
 
+/// The pixel limit for cube images: a layout image of six faces of the largest size.
+const CUBE_MAX_PIXELS: u64 = 6 * (MAX_FACE_SIZE as u64) * (MAX_FACE_SIZE as u64);
+
 /// Decode an image file to 0RGB, checking its size from the header first.
 fn read_image(
     path: &Path,
@@ -78,29 +85,110 @@ fn read_image(
         path: path.to_path_buf(),
         reason,
     };
-    let reader = image::ImageReader::open(path)
-        .map_err(|e| err(e.to_string()))?
-        .with_guessed_format()
-        .map_err(|e| err(e.to_string()))?;
-    if reader.format().is_none() {
-        return Err(err("unrecognized or unsupported image format".into()));
+    let file = crate::file::open_regular(path).map_err(|e| err(e.to_string()))?;
+    let len = file.metadata().map_err(|e| err(e.to_string()))?.len();
+    decode_image(
+        std::io::BufReader::new(file),
+        len,
+        &path.display().to_string(),
+        CUBE_MAX_PIXELS,
+        check,
+    )
+}
+
+/// Decode an image from `src` (`len` bytes) to 0RGB with the map loader (the same
+/// decoders, checks and tone as a panorama), after `check` has accepted the size its
+/// header gives; `check` sees the decoded size again.
+fn decode_image<R: std::io::BufRead + std::io::Seek>(
+    mut src: R,
+    len: u64,
+    what: &str,
+    max_pixels: u64,
+    check: impl Fn(u32, u32) -> Result<(), CubeError>,
+) -> Result<Decoded, CubeError> {
+    let err = |reason: String| CubeError::Read {
+        path: what.into(),
+        reason,
+    };
+    if let Ok(size) = imagesize::reader_size(&mut src) {
+        let side = |v: usize| u32::try_from(v).unwrap_or(u32::MAX);
+        check(side(size.width), side(size.height))?;
     }
-    let (w, h) = reader.into_dimensions().map_err(|e| err(e.to_string()))?;
-    check(w, h)?;
-    let mut reader = image::ImageReader::open(path)
-        .map_err(|e| err(e.to_string()))?
-        .with_guessed_format()
+    src.seek(std::io::SeekFrom::Start(0))
         .map_err(|e| err(e.to_string()))?;
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(6 * (MAX_FACE_SIZE as u64).pow(2) * 16);
-    reader.limits(limits);
-    let img = reader.decode().map_err(|e| err(e.to_string()))?;
-    let rgb = img.to_rgb8();
-    let px = rgb
-        .pixels()
-        .map(|p| (p[0] as u32) << 16 | (p[1] as u32) << 8 | p[2] as u32)
-        .collect();
+    let opts = LoadOptions {
+        // Any aspect ratio; the padding is dropped below.
+        projection: Some(Projection::Elliptical),
+        tone: Tone::default(),
+        max_pixels,
+    };
+    let map = decode_reader(src, len, what, &opts, &mut |_| {}).map_err(|e| match e {
+        MapError::Decode { reason, .. } => err(reason),
+        other => err(other.to_string()),
+    })?;
+    let (w, h) = (map.width(), map.height());
+    check(w, h)?;
+    let (padded, stride) = map.padded();
+    let mut px = Vec::with_capacity(w as usize * h as usize);
+    for row in padded.chunks_exact(stride).take(h as usize) {
+        px.extend_from_slice(&row[..w as usize]);
+    }
     Ok((w, h, px))
+}
+
+/// The face files of a cube folder: its images whose names say which face they are
+/// (see the module docs), sorted. A face-named entry that cannot be read (a broken
+/// symbolic link or a link loop, no permission) or is not a regular file is an error
+/// naming it, never taken for a missing face.
+///
+/// # Errors
+/// [`CubeError::Read`] for the folder or such an entry, [`CubeError::Faces`] when no
+/// file is named like a face.
+pub fn cube_face_files(dir: &Path) -> Result<Vec<PathBuf>, CubeError> {
+    let read_err = |path: &Path, reason: String| CubeError::Read {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let entries = std::fs::read_dir(dir).map_err(|e| read_err(dir, e.to_string()))?;
+    let mut files = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(|e| read_err(dir, e.to_string()))?;
+        let p = entry.path();
+        if !is_image(&p) || classify(&p).is_none() {
+            continue;
+        }
+        match std::fs::metadata(&p) {
+            Ok(m) => match crate::file::special_kind(&m) {
+                None => files.push(p),
+                Some(kind) => {
+                    return Err(read_err(
+                        &p,
+                        format!("not a regular file ({kind}); only regular files are read"),
+                    ))
+                }
+            },
+            Err(e) => {
+                let link = std::fs::symlink_metadata(&p).is_ok_and(|m| m.file_type().is_symlink());
+                let reason = match (link, e.kind()) {
+                    (true, std::io::ErrorKind::NotFound) => format!(
+                        "a symbolic link to a missing file ({})",
+                        std::fs::read_link(&p)
+                            .map_or_else(|_| "?".into(), |t| t.display().to_string())
+                    ),
+                    _ => e.to_string(),
+                };
+                return Err(read_err(&p, reason));
+            }
+        }
+    }
+    files.sort();
+    if files.is_empty() {
+        return Err(CubeError::Faces {
+            what: dir.display().to_string(),
+            problem: FacesProblem::NoFaceImages,
+        });
+    }
+    Ok(files)
 }
 
 /// Load a cube map from `inputs`: one folder (six face files in it), six face files, or
@@ -125,28 +213,7 @@ pub fn load_cube(
                     layout: l,
                 }));
             }
-            let entries = std::fs::read_dir(one).map_err(|e| CubeError::Read {
-                path: one.clone(),
-                reason: e.to_string(),
-            })?;
-            let mut files = Vec::new();
-            for entry in entries {
-                let entry = entry.map_err(|e| CubeError::Read {
-                    path: one.clone(),
-                    reason: e.to_string(),
-                })?;
-                let p = entry.path();
-                if p.is_file() && is_image(&p) && classify(&p).is_some() {
-                    files.push(p);
-                }
-            }
-            files.sort();
-            if files.is_empty() {
-                return Err(CubeError::Faces {
-                    what: one.display().to_string(),
-                    problem: FacesProblem::NoFaceImages,
-                });
-            }
+            let files = cube_face_files(one)?;
             load_face_files(&one.display().to_string(), &files, naming)
         }
         [one] => match layout {
@@ -265,6 +332,39 @@ pub fn load_face_files(
 /// [`CubeError::Read`] for an unreadable file, [`CubeError::Layout`] when the image's
 /// size fits no layout (or not the one asked for).
 pub fn load_layout_image(path: &Path, layout: Option<Layout>) -> Result<CubeMap, CubeError> {
+    layout_image(path, layout, |check| read_image(path, check))
+}
+
+/// As [`load_layout_image`] for an encoded image in memory (`what` names it in errors),
+/// with a pixel limit for the whole image (`load_layout_image` allows six faces of
+/// [`MAX_FACE_SIZE`]).
+///
+/// # Errors
+/// As [`load_layout_image`].
+pub fn decode_layout_image(
+    bytes: &[u8],
+    what: &str,
+    layout: Option<Layout>,
+    max_pixels: u64,
+) -> Result<CubeMap, CubeError> {
+    let cursor = std::io::Cursor::new(bytes);
+    layout_image(Path::new(what), layout, |check| {
+        decode_image(cursor, bytes.len() as u64, what, max_pixels, check)
+    })
+}
+
+/// A cube map from one layout image read by `read` (which runs the size check it is
+/// given before decoding).
+fn layout_image(
+    path: &Path,
+    layout: Option<Layout>,
+    read: impl FnOnce(&dyn Fn(u32, u32) -> Result<(), CubeError>) -> Result<Decoded, CubeError>,
+) -> Result<CubeMap, CubeError> {
+    if layout == Some(Layout::Files) {
+        return Err(CubeError::Usage(UsageProblem::OneFileForFiles {
+            path: path.to_path_buf(),
+        }));
+    }
     let chosen = std::cell::Cell::new(None);
     let check = |w: u32, h: u32| {
         let l = match layout {
@@ -294,7 +394,7 @@ pub fn load_layout_image(path: &Path, layout: Option<Layout>) -> Result<CubeMap,
         chosen.set(Some(l));
         Ok(())
     };
-    let (w, _, px) = read_image(path, check)?;
+    let (w, _, px) = read(&check)?;
     let layout = chosen.get().unwrap_or(Layout::Cross);
     let (c, _) = layout.grid().unwrap_or((1, 1));
     let n = w / c;

@@ -27,9 +27,10 @@
 //! * the start view is a hint: a value there that does not parse, is not finite, or an
 //!   hfov outside (0, 180) is ignored, never an error;
 //! * `FullPanoHeightPixels` missing: half the full width (a 2:1 panorama);
-//! * `CroppedAreaLeftPixels` at or past the full width: taken modulo the width (longitude
-//!   wraps), and a crop running past the right edge continues at column 0 (it straddles
-//!   the ±180° seam);
+//! * `CroppedAreaLeftPixels` must be a column of the full panorama (below
+//!   `FullPanoWidthPixels`): a left edge of 4 000 000 000 on a 512-pixel panorama is an
+//!   error, not wrapped around millions of times; a crop running past the right edge
+//!   continues at column 0 (it straddles the ±180° seam);
 //! * an image whose size differs from `CroppedAreaImage{Width,Height}Pixels` (the usual
 //!   case after resizing a phone panorama): every pixel value is scaled by
 //!   `image width / CroppedAreaImageWidthPixels`, provided the height agrees within 1 %;
@@ -257,6 +258,13 @@ impl GPano {
         if fw < 1.0 || fh < 1.0 || cw < 1.0 || ch < 1.0 {
             return Err(err(GPanoError::Inconsistent(format!(
                 "sizes must be positive (full {fw}x{fh}, cropped {cw}x{ch})"
+            ))));
+        }
+        if left >= fw {
+            return Err(err(GPanoError::Inconsistent(format!(
+                "CroppedAreaLeftPixels {left} is not a column of the full panorama \
+                 (0 to {})",
+                fw - 1.0
             ))));
         }
         if cw > fw || ch > fh {
@@ -558,6 +566,12 @@ mod tests {
             (gpano([1000.0, 500.0, 0.0, 0.0, 300.0, 200.0]), (300, 100)),
             // full panorama too large at the image's scale
             (gpano([1e6, 5e5, 0.0, 0.0, 300.0, 200.0]), (300, 200)),
+            // left edge outside the full panorama (issue 15: 4e9 on 512 pixels)
+            (gpano([512.0, 256.0, 4e9, 0.0, 300.0, 200.0]), (300, 200)),
+            (
+                gpano([1000.0, 500.0, 1000.0, 0.0, 300.0, 200.0]),
+                (300, 200),
+            ),
         ];
         for (g, (w, h)) in cases {
             let e = g.crop_for_image(w, h);
@@ -569,6 +583,19 @@ mod tests {
                 "{g:?} {w}x{h}: {e:?}"
             );
         }
+        let e = gpano([512.0, 256.0, 4e9, 0.0, 300.0, 200.0])
+            .crop_for_image(300, 200)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("CroppedAreaLeftPixels") && e.contains("4000000000"),
+            "{e}"
+        );
+        // The last column is still a column: the crop straddles the seam.
+        let c = gpano([1000.0, 500.0, 999.0, 0.0, 300.0, 200.0])
+            .crop_for_image(300, 200)
+            .unwrap();
+        assert!(c.straddles_seam());
         let mut g = gpano([1000.0, 500.0, 0.0, 0.0, 300.0, 200.0]);
         g.cropped_area_top_pixels = None;
         let e = g.crop_for_image(300, 200).unwrap_err().to_string();

@@ -9,32 +9,46 @@
 //! headers, nothing more), then from the decoder's own dimensions. `image`'s [`Limits`]
 //! are set as a second line of defence (sides at most `max_pixels / 2` and
 //! [`MAX_MAP_WIDTH`], decoder allocations at most 16 bytes per
-//! allowed pixel). [`MAX_MAP_PIXELS`] stays the hard limit whatever is asked.
+//! allowed pixel). [`MAX_MAP_PIXELS`] stays the hard limit whatever is asked. A JPEG
+//! header must also fit its file: a file of `n` bytes cannot describe more than `512·n`
+//! pixels, so a tiny file claiming a huge size is refused before anything is allocated
+//! (see `io/jpeg.rs`).
+//!
+//! ## Decoders and damaged files
+//! JPEG goes to zune-jpeg directly, strictly: a truncated or corrupt file is an error,
+//! never a picture with a grey part (`io/jpeg.rs`). OpenEXR goes to the `exr` crate's
+//! block reader (`io/exr.rs`): RGB or luminance-only (Y) images, the memory a damaged
+//! DWA-compressed file can claim bounded, blocks that do not cover the image refused.
+//! PNG, Radiance `.hdr` and anything else go through `image`. Only regular files are
+//! opened (a FIFO would block; see `file.rs`).
 //!
 //! ## Memory
-//! 8-bit images (gray, gray + alpha, RGB, RGBA: every JPEG and 8-bit PNG) are decoded by
-//! `image`'s decoder straight into the first bytes of the map's padded 0RGB buffer and
-//! expanded in place, from the end, to 0RGB with the padding column and row. The peak is
-//! the map itself, 4 × (W + 1) × (H + 1) bytes, plus what the decoder holds: for JPEG the
-//! compressed file (the decoder reads it whole into memory; a progressive JPEG also
-//! holds its coefficients, about 2 bytes per pixel per colour plane). 16-bit and
-//! floating-point images (16-bit PNG, Radiance `.hdr`, OpenEXR) are first decoded to an
-//! `image::DynamicImage` (6 to 16 bytes per pixel; the EXR decoder also copies once
-//! internally) and then written into the map.
+//! 8-bit images (gray, gray + alpha, RGB, RGBA: every JPEG and 8-bit PNG) are decoded
+//! straight into the first bytes of the map's padded 0RGB buffer and expanded in place,
+//! from the end, to 0RGB with the padding column and row. The peak is the map itself,
+//! 4 × (W + 1) × (H + 1) bytes, plus what the decoder holds: for JPEG the compressed file
+//! (the decoder needs it whole in memory; a progressive JPEG also holds its coefficients,
+//! about 2 bytes per pixel per colour plane). OpenEXR blocks are decoded in parallel
+//! batches and tone-mapped straight into the map (the peak is the map plus a few
+//! blocks). 16-bit PNGs and Radiance `.hdr` are first decoded to an
+//! `image::DynamicImage` (6 to 12 bytes per pixel) and then written into the map.
 //!
 //! ## Progress
 //! A load reports [`LoadProgress`] events, in phase order [`LoadPhase::Reading`] (JPEG
 //! only: the decoder reads the whole file before decoding), [`LoadPhase::Decoding`],
 //! [`LoadPhase::Converting`]. Each phase starts with one event. A phase that can be
 //! measured reports fractions that never decrease and ends with `Some(1.0)`: reading is
-//! bytes read; decoding is bytes consumed for the streaming decoders (PNG, Radiance,
-//! OpenEXR); converting is rows written. JPEG decoding (zune-jpeg inside `image`) reports
-//! no progress: that phase starts with `fraction: None` and reports `Some(1.0)` only
-//! when it is finished. Events are throttled to steps of at least 1/200.
+//! bytes read; decoding is bytes consumed for the streaming decoders (PNG, Radiance) and
+//! blocks read for OpenEXR; converting is rows written (OpenEXR converts while it
+//! decodes: its converting phase is the padding alone). JPEG decoding (zune-jpeg)
+//! reports no progress: that phase starts with `fraction: None` and reports `Some(1.0)`
+//! only when it is finished. Events are throttled to steps of at least 1/200.
 
 use crate::error::{MapError, SizeProblem};
 use crate::geom::limits::{MAX_MAP_PIXELS, MAX_MAP_WIDTH};
 use crate::geom::projection::Projection;
+use crate::io::exr::Exr;
+use crate::io::jpeg::{check_jpeg_size, Jpeg};
 use crate::map::envmap::{check_map_size, EnvMap};
 use crate::map::tone::{tone_map, Tone};
 use image::{ColorType, DynamicImage, ImageDecoder, Limits};
@@ -217,7 +231,7 @@ pub fn load_map(
         path: path.to_path_buf(),
         reason: e.to_string(),
     };
-    let file = std::fs::File::open(path).map_err(io_err)?;
+    let file = crate::file::open_regular(path).map_err(io_err)?;
     let len = file.metadata().map_err(io_err)?.len();
     decode_reader(
         std::io::BufReader::with_capacity(1 << 20, file),
@@ -273,7 +287,7 @@ fn image_limits(max_pixels: u64) -> Limits {
     l
 }
 
-fn decode_reader<R: BufRead + Seek>(
+pub(crate) fn decode_reader<R: BufRead + Seek>(
     mut src: R,
     len: u64,
     what: &str,
@@ -285,7 +299,8 @@ fn decode_reader<R: BufRead + Seek>(
         reason,
     };
     // 1. The header alone: nothing of the image's size exists yet.
-    if let Ok(size) = imagesize::reader_size(&mut src) {
+    let header = imagesize::reader_size(&mut src).ok();
+    if let Some(size) = header {
         let (w, h) = (size.width as u64, size.height as u64);
         check_pixel_limit(what, w, h, opts.max_pixels)?;
         check_map_size(
@@ -296,69 +311,155 @@ fn decode_reader<R: BufRead + Seek>(
     }
     src.seek(SeekFrom::Start(0))
         .map_err(|e| err(e.to_string()))?;
+    let mut magic = [0u8; 16];
+    let n = read_up_to(&mut src, &mut magic).map_err(|e| err(e.to_string()))?;
+    src.seek(SeekFrom::Start(0))
+        .map_err(|e| err(e.to_string()))?;
+    let Ok(format) = image::guess_format(&magic[..n]) else {
+        return Err(err("unrecognized or unsupported image format".into()));
+    };
     let sink = Sink::new(progress, len);
+    match format {
+        image::ImageFormat::Jpeg => {
+            if let Some(size) = header {
+                check_jpeg_size(what, size.width as u64, size.height as u64, len)?;
+            }
+            decode_jpeg(src, len, what, opts, &sink)
+        }
+        image::ImageFormat::OpenExr => decode_exr(src, what, opts, &sink),
+        _ => decode_with_image(src, what, opts, &sink),
+    }
+}
+
+/// Read until `buf` is full or the source ends; the number of bytes read.
+fn read_up_to(src: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match src.read(&mut buf[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(n)
+}
+
+/// The size and projection checks every decoder's own dimensions pass (after the header
+/// check, before the map exists).
+fn check_decoded(what: &str, w: u32, h: u32, opts: &LoadOptions) -> Result<Projection, MapError> {
+    check_pixel_limit(what, w.into(), h.into(), opts.max_pixels)?;
+    check_map_size(what, w, h)?;
+    resolve_projection(what, w, h, opts.projection)
+}
+
+/// JPEG: the whole file read (the decoder needs it in memory), decoded strictly (see
+/// `io/jpeg.rs`) into the map's buffer and expanded in place.
+fn decode_jpeg<R: BufRead + Seek>(
+    src: R,
+    len: u64,
+    what: &str,
+    opts: &LoadOptions,
+    sink: &Sink,
+) -> Result<EnvMap, MapError> {
+    let err = |reason: String| MapError::Decode {
+        path: what.into(),
+        reason,
+    };
+    sink.report(LoadPhase::Reading, Some(0.0));
+    sink.bytes_phase.set(Some(LoadPhase::Reading));
+    let mut bytes = Vec::new();
+    bytes
+        .try_reserve_exact(usize::try_from(len).unwrap_or(usize::MAX))
+        .map_err(|_| err(format!("cannot hold its {len} bytes in memory")))?;
+    Counted {
+        inner: src,
+        pos: 0,
+        sink,
+    }
+    .read_to_end(&mut bytes)
+    .map_err(|e| err(e.to_string()))?;
+    sink.bytes_phase.set(None);
+    let jpeg = Jpeg::new(&bytes, what)?;
+    let (w, h) = (jpeg.width, jpeg.height);
+    let projection = check_decoded(what, w, h, opts)?;
+    check_jpeg_size(what, w.into(), h.into(), bytes.len() as u64)?;
+    sink.report(LoadPhase::Reading, Some(1.0));
+    sink.report(LoadPhase::Decoding, None);
+    let ct = jpeg.color;
+    let mut data = alloc_map(what, w, h)?;
+    let n = w as usize * h as usize * usize::from(ct.bytes_per_pixel());
+    jpeg.decode_into(&mut bytemuck::cast_slice_mut(&mut data)[..n], what)?;
+    drop(bytes);
+    Ok(finish_8bit(data, ct, w, h, projection, sink))
+}
+
+/// OpenEXR through `io/exr.rs`: blocks decoded in parallel straight into the map.
+fn decode_exr<R: BufRead + Seek>(
+    src: R,
+    what: &str,
+    opts: &LoadOptions,
+    sink: &Sink,
+) -> Result<EnvMap, MapError> {
+    sink.report(LoadPhase::Decoding, Some(0.0));
+    let exr = Exr::new(src, what)?;
+    let (w, h) = (exr.width, exr.height);
+    let projection = check_decoded(what, w, h, opts)?;
+    let mut data = alloc_map(what, w, h)?;
+    exr.decode_into(&mut data, what, opts.tone, &mut |f| {
+        sink.report(LoadPhase::Decoding, Some(f))
+    })?;
+    sink.report(LoadPhase::Decoding, Some(1.0));
+    sink.report(LoadPhase::Converting, Some(0.0));
+    let (wu, hu) = (w as usize, h as usize);
+    let wraps = projection.wraps();
+    for row in data[..hu * (wu + 1)].chunks_exact_mut(wu + 1) {
+        row[wu] = if wraps { row[0] } else { row[wu - 1] };
+    }
+    pad_last_row(&mut data, w, h);
+    sink.report(LoadPhase::Converting, Some(1.0));
+    Ok(EnvMap::from_padded(w, h, projection, data))
+}
+
+/// PNG, Radiance HDR and anything else `image` reads.
+fn decode_with_image<R: BufRead + Seek>(
+    src: R,
+    what: &str,
+    opts: &LoadOptions,
+    sink: &Sink,
+) -> Result<EnvMap, MapError> {
+    let err = |reason: String| MapError::Decode {
+        path: what.into(),
+        reason,
+    };
     let mut reader = image::ImageReader::new(Counted {
         inner: src,
         pos: 0,
-        sink: &sink,
+        sink,
     })
     .with_guessed_format()
     .map_err(|e| err(e.to_string()))?;
-    let Some(format) = reader.format() else {
+    if reader.format().is_none() {
         return Err(err("unrecognized or unsupported image format".into()));
-    };
-    // zune-jpeg (inside `image`) reads the whole file, then decodes without reporting;
-    // the other decoders stream, so bytes consumed measure decoding.
-    let streaming = format != image::ImageFormat::Jpeg;
-    let first = if streaming {
-        LoadPhase::Decoding
-    } else {
-        LoadPhase::Reading
-    };
-    sink.report(first, Some(0.0));
-    sink.bytes_phase.set(Some(first));
+    }
+    // These decoders stream, so bytes consumed measure decoding.
+    sink.report(LoadPhase::Decoding, Some(0.0));
+    sink.bytes_phase.set(Some(LoadPhase::Decoding));
     reader.limits(image_limits(opts.max_pixels));
     // 2. The decoder's own dimensions (it has read the header, no pixels).
     let decoder = reader.into_decoder().map_err(|e| err(e.to_string()))?;
     let (w, h) = decoder.dimensions();
-    check_pixel_limit(what, w.into(), h.into(), opts.max_pixels)?;
-    check_map_size(what, w, h)?;
-    let projection = resolve_projection(what, w, h, opts.projection)?;
-    if !streaming {
-        sink.bytes_phase.set(None);
-        sink.report(LoadPhase::Reading, Some(1.0));
-        sink.report(LoadPhase::Decoding, None);
-    }
+    let projection = check_decoded(what, w, h, opts)?;
     let ct = decoder.color_type();
     match ct {
         ColorType::L8 | ColorType::La8 | ColorType::Rgb8 | ColorType::Rgba8 => {
             let mut data = alloc_map(what, w, h)?;
-            {
-                let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut data);
-                let n = w as usize * h as usize * usize::from(ct.bytes_per_pixel());
-                decoder
-                    .read_image(&mut bytes[..n])
-                    .map_err(|e| err(e.to_string()))?;
-                sink.bytes_phase.set(None);
-                sink.report(LoadPhase::Decoding, Some(1.0));
-                sink.report(LoadPhase::Converting, Some(0.0));
-                let mut rows = |f: f32| sink.report(LoadPhase::Converting, Some(f));
-                match ct {
-                    ColorType::L8 => {
-                        expand_in_place::<1>(bytes, w, h, projection.wraps(), &mut rows)
-                    }
-                    ColorType::La8 => {
-                        expand_in_place::<2>(bytes, w, h, projection.wraps(), &mut rows)
-                    }
-                    ColorType::Rgb8 => {
-                        expand_in_place::<3>(bytes, w, h, projection.wraps(), &mut rows)
-                    }
-                    _ => expand_in_place::<4>(bytes, w, h, projection.wraps(), &mut rows),
-                }
-            }
-            pad_last_row(&mut data, w, h);
-            sink.report(LoadPhase::Converting, Some(1.0));
-            Ok(EnvMap::from_padded(w, h, projection, data))
+            let n = w as usize * h as usize * usize::from(ct.bytes_per_pixel());
+            decoder
+                .read_image(&mut bytemuck::cast_slice_mut(&mut data)[..n])
+                .map_err(|e| err(e.to_string()))?;
+            sink.bytes_phase.set(None);
+            Ok(finish_8bit(data, ct, w, h, projection, sink))
         }
         _ => {
             let img = DynamicImage::from_decoder(decoder).map_err(|e| err(e.to_string()))?;
@@ -372,6 +473,35 @@ fn decode_reader<R: BufRead + Seek>(
             Ok(map)
         }
     }
+}
+
+/// 8-bit pixels of colour type `ct` decoded into the first bytes of `data` (a padded map
+/// buffer): expanded in place to padded 0RGB, reporting the end of decoding and the
+/// conversion.
+fn finish_8bit(
+    mut data: Vec<u32>,
+    ct: ColorType,
+    w: u32,
+    h: u32,
+    projection: Projection,
+    sink: &Sink,
+) -> EnvMap {
+    sink.report(LoadPhase::Decoding, Some(1.0));
+    sink.report(LoadPhase::Converting, Some(0.0));
+    {
+        let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut data);
+        let mut rows = |f: f32| sink.report(LoadPhase::Converting, Some(f));
+        let wraps = projection.wraps();
+        match ct {
+            ColorType::L8 => expand_in_place::<1>(bytes, w, h, wraps, &mut rows),
+            ColorType::La8 => expand_in_place::<2>(bytes, w, h, wraps, &mut rows),
+            ColorType::Rgb8 => expand_in_place::<3>(bytes, w, h, wraps, &mut rows),
+            _ => expand_in_place::<4>(bytes, w, h, wraps, &mut rows),
+        }
+    }
+    pad_last_row(&mut data, w, h);
+    sink.report(LoadPhase::Converting, Some(1.0));
+    EnvMap::from_padded(w, h, projection, data)
 }
 
 /// A zeroed padded map buffer, `(w + 1) × (h + 1)` pixels, or an error when the memory

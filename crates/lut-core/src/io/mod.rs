@@ -4,6 +4,8 @@
 //! everything below it; nothing in the crate depends on it.
 
 pub(crate) mod cube;
+pub(crate) mod exr;
 pub(crate) mod gpano;
+pub(crate) mod jpeg;
 pub(crate) mod load;
 pub(crate) mod partial;

@@ -72,7 +72,7 @@ pub fn load_partial(
         reason: e.to_string(),
     };
     let mut head = Vec::new();
-    std::fs::File::open(path)
+    crate::file::open_regular(path)
         .map_err(io_err)?
         .take(256 * 1024)
         .read_to_end(&mut head)

@@ -56,7 +56,7 @@ pub const MAX_FILE_BYTES: u64 = 64 << 20;
 /// error type.
 pub(crate) fn read_text(path: &std::path::Path) -> Result<String, String> {
     use std::io::Read;
-    let f = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let f = crate::file::open_regular(path).map_err(|e| e.to_string())?;
     let mut bytes = Vec::new();
     f.take(MAX_FILE_BYTES + 1)
         .read_to_end(&mut bytes)

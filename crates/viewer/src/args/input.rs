@@ -3,7 +3,7 @@
 //! and the options `viewer render` and the window share.
 
 use super::named::{named, named_or_parse};
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::Args;
 use lut_core::{name_list, parse_name, Coverage, CubeRenderer, Layout, Named, Naming, Projection};
 use std::path::PathBuf;
@@ -92,7 +92,9 @@ impl ProjectionArg {
     /// `cube`, which `what` does not read.
     pub fn map_only(self, what: &str) -> Result<Option<Projection>> {
         if self == ProjectionArg::Cube {
-            bail!("--projection cube: {what} reads a map panorama, not a cube map");
+            return Err(crate::usage!(
+                "--projection cube: {what} reads a map panorama, not a cube map"
+            ));
         }
         Ok(self.map())
     }

@@ -120,7 +120,7 @@ pub struct Sample {
 pub fn run(a: BenchLoadArgs) -> Result<()> {
     if let Some(p) = &a.child {
         let s = measure(p, &a)?;
-        println!("{}", serde_json::to_string(&s)?);
+        crate::outln!("{}", serde_json::to_string(&s)?)?;
         return Ok(());
     }
     let cache = a
@@ -134,12 +134,12 @@ pub fn run(a: BenchLoadArgs) -> Result<()> {
     for &w in &a.widths {
         let path = cache.join(format!("grid_{w}x{}_q{}.jpg", w / 2, a.quality));
         if !path.exists() {
-            eprintln!("generating {} ...", path.display());
+            crate::errln!("generating {} ...", path.display());
             let t = Instant::now();
             generate_jpeg(&path, w, w / 2, a.quality)?;
-            eprintln!("  done in {:.1} s", t.elapsed().as_secs_f64());
+            crate::errln!("  done in {:.1} s", t.elapsed().as_secs_f64());
         }
-        eprintln!("measuring {}x{} in a child process ...", w, w / 2);
+        crate::errln!("measuring {}x{} in a child process ...", w, w / 2);
         let out = std::process::Command::new(&exe)
             .arg("bench-load")
             .arg("--child")
@@ -160,9 +160,9 @@ pub fn run(a: BenchLoadArgs) -> Result<()> {
         rows.push(s);
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        crate::outln!("{}", serde_json::to_string_pretty(&rows)?)?;
     } else {
-        print_table(&rows, &a);
+        print_table(&rows, &a)?;
     }
     Ok(())
 }
@@ -171,23 +171,23 @@ fn gib(b: u64) -> f64 {
     b as f64 / f64::from(1u32 << 30)
 }
 
-fn print_table(rows: &[Sample], a: &BenchLoadArgs) {
+fn print_table(rows: &[Sample], a: &BenchLoadArgs) -> Result<()> {
     // The children inherit LUTPANO_KERNEL, so they run the kernel named here.
-    println!("{}", lut_core::kernel_info());
-    println!(
+    crate::outln!("{}", lut_core::kernel_info())?;
+    crate::outln!(
         "{} threads; pan {}x{}, {} frames, LUT renderer (pitch 10°, hfov {}°)",
         rayon::current_num_threads(),
         a.size.0,
         a.size.1,
         a.frames,
         a.hfov
-    );
-    println!(
+    )?;
+    crate::outln!(
         "| map | JPEG | load s (read + decode + convert) | tables s | frame ms bilinear | frame ms nearest | pyramid s | frame ms trilinear | frame ms bilinear on the level | map GiB | pyramid GiB | peak RSS after load GiB | peak RSS GiB |"
-    );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    )?;
+    crate::outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
     for s in rows {
-        println!(
+        crate::outln!(
             "| {}x{} | {:.1} MB | {:.2} ({:.2} + {:.2} + {:.2}) | {:.3} | {:.1} | {:.1} | {:.2} | {:.1} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} |",
             s.width,
             s.height,
@@ -206,8 +206,9 @@ fn print_table(rows: &[Sample], a: &BenchLoadArgs) {
             gib(s.pyramid_bytes),
             gib(s.peak_after_load_bytes),
             gib(s.peak_bytes),
-        );
+        )?;
     }
+    Ok(())
 }
 
 /// Write the benchmark scene (`lut_core::scene_color`, a latitude/longitude grid

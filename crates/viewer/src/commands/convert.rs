@@ -2,9 +2,10 @@
 //! a folder, or one layout image) and cube → equirect. Every file is written atomically.
 
 use crate::args::{named, parse_size, CubeArgs, MaxPixelsArg, ProjectionOpt};
-use crate::output::{rgb24, write_image_atomic, write_png_atomic};
+use crate::output::{check_not_input, output_kind, write_image};
 use crate::panorama::load_cube;
-use anyhow::{anyhow, bail, Context, Result};
+use crate::usage;
+use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use lut_core::{CubeMap, Face};
 use lut_core::{Layout, Named, Sampler};
@@ -46,14 +47,14 @@ pub struct ConvertArgs {
     /// Target format.
     #[arg(long, value_parser = named::<Target>())]
     pub to: Target,
-    /// Cube face side in pixels (`--to cube`; default: input width / 4).
-    #[arg(long)]
+    /// Cube face side in pixels, 1 to 8192 (`--to cube`; default: input width / 4).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(lut_core::MAX_FACE_SIZE)))]
     pub face_size: Option<u32>,
     /// `--layout` (`--to cube`: the output layout, default files; `--to equirect`: the
     /// input's layout, overriding detection) and `--naming` (of the input's face files).
     #[command(flatten)]
     pub cube: CubeArgs,
-    /// Output size WxH (`--to equirect`; default 4N x 2N for faces of side N).
+    /// Output size WxH, 2:1 (`--to equirect`; default 4N x 2N for faces of side N).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// The input panorama's projection (`--to cube`).
@@ -81,13 +82,20 @@ pub fn run(a: ConvertArgs) -> Result<()> {
 
 fn to_cube(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()> {
     let [input] = inputs else {
-        bail!("--to cube takes one input panorama, got {}", inputs.len());
+        return Err(usage!(
+            "--to cube takes one input panorama, got {}",
+            inputs.len()
+        ));
     };
     if a.size.is_some() {
-        bail!("--size is for --to equirect; use --face-size for cube faces");
+        return Err(usage!(
+            "--size is for --to equirect; use --face-size for cube faces"
+        ));
     }
     let layout = a.cube.layout.unwrap_or(Layout::Files);
     let projection = a.projection.value.map_only("convert --to cube")?;
+    let outputs = cube_outputs(layout, output)?;
+    check_not_input(&outputs, inputs)?;
     let opts = a.limit.options(projection, lut_core::Tone::default());
     let map = lut_core::load_map(input, &opts, &mut |_| {}).map_err(crate::panorama::map_error)?;
     let face_size = a.face_size.unwrap_or((map.width() / 4).max(1));
@@ -95,66 +103,72 @@ fn to_cube(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()> {
     write_cube(&cube, layout, output)
 }
 
+/// The files `convert --to cube` writes for `layout` at `output`: six `<face>.png` in
+/// the folder for [`Layout::Files`], else the one layout image (whose name must say
+/// PNG or JPEG).
+///
+/// # Errors
+/// A usage error for an image name given to the files layout, or an image name the
+/// viewer cannot write.
+fn cube_outputs(layout: Layout, output: &Path) -> Result<Vec<PathBuf>> {
+    if layout != Layout::Files {
+        output_kind(output)?;
+        return Ok(vec![output.to_path_buf()]);
+    }
+    if output.extension().is_some() && !output.is_dir() {
+        return Err(usage!(
+            "{}: layout files writes six images into a folder; give a folder, or --layout cross|strip|3x2 for one image",
+            output.display()
+        ));
+    }
+    Ok(Face::ALL
+        .iter()
+        .map(|f| output.join(format!("{}.png", f.name())))
+        .collect())
+}
+
 /// Write a cube map: six `<face>.png` files into folder `output` (created if missing) for
 /// [`Layout::Files`], else one layout image (PNG or JPEG by extension). Atomic per file.
+///
+/// # Errors
+/// As [`cube_outputs`], or a file that cannot be written.
 pub fn write_cube(cube: &CubeMap, layout: Layout, output: &Path) -> Result<()> {
     let n = cube.face_size();
+    let outputs = cube_outputs(layout, output)?;
     if layout == Layout::Files {
-        if output
-            .extension()
-            .is_some_and(|e| image_format(e).is_some())
-            && !output.is_dir()
-        {
-            bail!(
-                "{}: layout files writes six images into a folder; give a folder, or --layout cross|strip|3x2 for one image",
-                output.display()
-            );
-        }
         std::fs::create_dir_all(output)
             .with_context(|| format!("{}: cannot create folder", output.display()))?;
-        for face in Face::ALL {
-            let path = output.join(format!("{}.png", face.name()));
-            write_png_atomic(&path, &cube.face_pixels(face), n, n)?;
+        for (face, path) in Face::ALL.into_iter().zip(&outputs) {
+            write_image(path, &cube.face_pixels(face), n, n)?;
         }
         return Ok(());
     }
     let (w, h, px) = cube.to_layout(layout)?;
-    write_any(output, &px, w, h)
+    write_image(output, &px, w, h)
 }
 
 fn to_equirect(a: &ConvertArgs, inputs: &[PathBuf], output: &Path) -> Result<()> {
     if a.face_size.is_some() {
-        bail!("--face-size is for --to cube; use --size WxH for the equirect");
+        return Err(usage!(
+            "--face-size is for --to cube; use --size WxH for the equirect"
+        ));
     }
+    if let Some((w, h)) = a.size {
+        if w != 2 * h {
+            return Err(usage!(
+                "--size {w}x{h}: an equirectangular image is 2:1 (e.g. {}x{h} or {w}x{})",
+                2 * h,
+                (w / 2).max(1)
+            ));
+        }
+    }
+    output_kind(output)?;
+    check_not_input(&[output.to_path_buf()], inputs)?;
     let cube = load_cube(inputs, a.cube)?;
     let n = cube.face_size();
     let (w, h) = a.size.unwrap_or((4 * n, 2 * n));
     let px = cube.to_equirect(w, h, a.sampler)?;
-    write_any(output, &px, w, h)
-}
-
-fn image_format(ext: &std::ffi::OsStr) -> Option<image::ImageFormat> {
-    match ext.to_str()?.to_ascii_lowercase().as_str() {
-        "png" => Some(image::ImageFormat::Png),
-        "jpg" | "jpeg" => Some(image::ImageFormat::Jpeg),
-        _ => None,
-    }
-}
-
-/// Write 0RGB pixels as PNG or JPEG (quality 95), chosen by the extension, atomically.
-fn write_any(out: &Path, px: &[u32], w: u32, h: u32) -> Result<()> {
-    match out.extension().and_then(image_format) {
-        Some(image::ImageFormat::Png) => write_png_atomic(out, px, w, h),
-        Some(_) => {
-            let rgb = rgb24(px);
-            write_image_atomic(out, |f| {
-                image::codecs::jpeg::JpegEncoder::new_with_quality(f, 95)
-                    .encode(&rgb, w, h, image::ExtendedColorType::Rgb8)
-                    .map_err(|e| anyhow!("{}: cannot encode JPEG: {e}", out.display()))
-            })
-        }
-        None => bail!("{}: output must end in .png, .jpg or .jpeg", out.display()),
-    }
+    write_image(output, &px, w, h)
 }
 
 #[cfg(test)]
@@ -202,11 +216,13 @@ mod tests {
         assert!(write_cube(&cube, Layout::Cross, &out).is_err());
         assert!(!out.exists());
         let bad = tmp.path().join("c.bmp");
-        assert!(write_cube(&cube, Layout::Cross, &bad).is_err());
+        let e = write_cube(&cube, Layout::Cross, &bad).unwrap_err();
+        assert_eq!(crate::exit::code(&e), 2, "{e:#}");
         assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 0);
         // layout files into something named like an image is refused, not a folder made
         let img = tmp.path().join("faces.png");
-        assert!(write_cube(&cube, Layout::Files, &img).is_err());
+        let e = write_cube(&cube, Layout::Files, &img).unwrap_err();
+        assert_eq!(crate::exit::code(&e), 2, "{e:#}");
         assert!(!img.exists());
     }
 }

@@ -90,31 +90,31 @@ pub fn run(a: IesArgs) -> Result<()> {
                 "lamp_sets": l.lamp_sets.len(),
             });
         }
-        println!("{obj}");
+        crate::outln!("{obj}")?;
         return Ok(());
     }
-    println!("file:               {}", a.file.display());
-    println!("format:             {}", file.format_name());
+    crate::outln!("file:               {}", a.file.display())?;
+    crate::outln!("format:             {}", file.format_name())?;
     if let Some(l) = file.luminaire() {
-        println!("luminaire:          {l}");
+        crate::outln!("luminaire:          {l}")?;
     }
-    println!("photometric type:   {}", file.photometric_type.letter());
-    println!("symmetry:           {}", table.symmetry().name());
-    println!("tilt:               {tilt}");
-    println!(
+    crate::outln!("photometric type:   {}", file.photometric_type.letter())?;
+    crate::outln!("symmetry:           {}", table.symmetry().name())?;
+    crate::outln!("tilt:               {tilt}")?;
+    crate::outln!(
         "vertical angles:    {} ({} to {})",
         v.len(),
         v[0],
         v[v.len() - 1]
-    );
-    println!(
+    )?;
+    crate::outln!(
         "horizontal angles:  {} ({} to {})",
         h.len(),
         h[0],
         h[h.len() - 1]
-    );
+    )?;
     if let Some(l) = ldt {
-        println!(
+        crate::outln!(
             "EULUMDAT:           Ityp {} ({}), Isym {}, {} lamp set(s), LORL {} %, tilt during \
              measurement {}°",
             l.type_indicator.code(),
@@ -123,24 +123,24 @@ pub fn run(a: IesArgs) -> Result<()> {
             l.lamp_sets.len(),
             l.light_output_ratio,
             l.measurement_tilt
-        );
-        println!(
+        )?;
+        crate::outln!(
             "candela scale:      {} (cd/klm × first lamp set's {} lm / 1000 × conversion factor {})",
             file.candela_scale(),
             l.lamp_flux(),
             l.conversion_factor
-        );
+        )?;
     } else {
-        println!("candela multiplier: {}", file.candela_scale());
+        crate::outln!("candela multiplier: {}", file.candela_scale())?;
     }
     match rated {
-        Some(r) => println!("rated lumens:       {r}"),
-        None => println!("rated lumens:       absolute photometry"),
+        Some(r) => crate::outln!("rated lumens:       {r}")?,
+        None => crate::outln!("rated lumens:       absolute photometry")?,
     }
-    println!("lumens:             {flux:.1} (integrated from the distribution)");
-    println!("max candela:        {}", file.max_candela());
+    crate::outln!("lumens:             {flux:.1} (integrated from the distribution)")?;
+    crate::outln!("max candela:        {}", file.max_candela())?;
     for (sv, sh, c) in samples {
-        println!("candela at vertical {sv}, horizontal {sh}: {c}");
+        crate::outln!("candela at vertical {sv}, horizontal {sh}: {c}")?;
     }
     Ok(())
 }

@@ -5,7 +5,7 @@
 
 use crate::args::values::finite;
 use crate::lighting::RoomArgs;
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 use glam::DVec3;
 use lut_core::LightError;
@@ -92,7 +92,9 @@ struct Report<'a> {
 pub fn readings(a: &LuxArgs) -> Result<Vec<Reading>> {
     let st = a.room.state()?;
     if st.lights.is_empty() {
-        bail!("no luminaire: give --light FILE@X,Y,Z[:YAW,PITCH] (or a --scene with lights)");
+        return Err(crate::usage!(
+            "no luminaire: give --light FILE@X,Y,Z[:YAW,PITCH] (or a --scene with lights)"
+        ));
     }
     let scene = st
         .scene()
@@ -113,13 +115,13 @@ pub fn readings(a: &LuxArgs) -> Result<Vec<Reading>> {
                     low: lo.to_array(),
                     high: hi.to_array(),
                 };
-                bail!("{arg}: {e}");
+                return Err(crate::usage!("{arg}: {e}"));
             }
             None => room.surface_normal(at, ON_SURFACE).map_err(|e| match e {
                 LightError::PointOffSurface { .. } | LightError::PointOnEdge { .. } => {
-                    anyhow::anyhow!("{arg}: {e} (give it: X,Y,Z:NX,NY,NZ)")
+                    crate::usage!("{arg}: {e} (give it: X,Y,Z:NX,NY,NZ)")
                 }
-                e => anyhow::anyhow!("{arg}: {e}"),
+                e => crate::usage!("{arg}: {e}"),
             })?,
         };
         out.push(Reading {
@@ -167,9 +169,9 @@ pub fn json(readings: &[Reading]) -> String {
 pub fn run(a: LuxArgs) -> Result<()> {
     let r = readings(&a)?;
     if a.json {
-        println!("{}", json(&r));
+        crate::outln!("{}", json(&r))?;
     } else {
-        print!("{}", text(&r));
+        crate::outln!("{}", text(&r).trim_end_matches('\n'))?;
     }
     Ok(())
 }

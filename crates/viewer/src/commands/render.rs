@@ -5,10 +5,11 @@ use crate::args::{
 };
 use crate::heatmap::{summary, write_error_map};
 use crate::lighting::LightArgs;
-use crate::output::write_png_atomic;
+use crate::output::{check_not_input, output_kind, write_image};
 use crate::panorama::{coverage_text, heading_text, load_cube, load_panorama_partial};
 use crate::scene::{measure_errors, render_scene, Scene};
-use anyhow::{bail, Context, Result};
+use crate::usage;
+use anyhow::{Context, Result};
 use clap::Args;
 use lut_core::{
     IndexStep, LutChoice, RenderOptions, RenderReport, RendererKind, Sampler, Surface, View,
@@ -23,7 +24,8 @@ pub struct RenderArgs {
     /// layout image with --projection cube. When omitted, the --scene file's panorama,
     /// else the bundled sample.
     pub panorama: Vec<PathBuf>,
-    /// Output PNG, written atomically.
+    /// Output image: .png or .jpg/.jpeg (by the name), written atomically; a device or
+    /// FIFO (e.g. /dev/stdout) is written into as PNG.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Yaw in degrees (any value, taken modulo 360; positive turns right). Default 0, or
@@ -124,10 +126,10 @@ impl RenderArgs {
             (ViewProjection::Pannini(_), d) => {
                 Ok(ViewProjection::Pannini(d.unwrap_or(PANNINI_D_DEFAULT)))
             }
-            (p, Some(_)) => bail!(
+            (p, Some(_)) => Err(usage!(
                 "--pannini-d applies to --view-projection pannini, not {}",
                 p.name()
-            ),
+            )),
             (p, None) => Ok(p),
         }
     }
@@ -146,7 +148,7 @@ impl RenderArgs {
                 }
                 _ => "",
             };
-            anyhow::anyhow!("invalid view: {e}{hint}")
+            usage!("invalid view: {e}{hint}")
         })
     }
 
@@ -175,15 +177,17 @@ impl RenderArgs {
         };
         if input.projection.value.reads_cube(panorama) {
             if input.coverage.is_some() {
-                bail!("--coverage applies to equirectangular panoramas, not cube maps");
+                return Err(usage!(
+                    "--coverage applies to equirectangular panoramas, not cube maps"
+                ));
             }
             return Ok(Scene::Cube(load_cube(panorama, input.cube)?));
         }
         if panorama.len() > 1 {
-            bail!(
+            return Err(usage!(
                 "{} files given: a single panorama takes one file (use --projection cube for six faces)",
                 panorama.len()
-            );
+            ));
         }
         let tone = lut_core::Tone {
             exposure_ev: self.exposure,
@@ -203,16 +207,30 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let (scene_pano, scene_view) = a.lights.room.scene_panorama()?;
     let mut view = a.view(scene_view)?;
     if a.view_limit && !view.projection().is_rectilinear() {
-        bail!(
+        return Err(usage!(
             "--view-limit applies to rectilinear views, not --view-projection {}",
             view.projection().name()
-        );
+        ));
     }
     let (w, h) = a.size;
+    // The output is checked before anything is loaded: its format, and that it is not
+    // one of the files read.
+    let mut outputs = vec![a.output.clone()];
+    outputs.extend(a.error_map.iter().cloned());
+    for o in &outputs {
+        output_kind(o)?;
+    }
+    let mut inputs = a.panorama.clone();
+    inputs.extend(scene_pano.iter().cloned());
+    inputs.extend(a.lights.room.scene.iter().cloned());
+    inputs.extend(a.lights.room.lights.iter().map(|l| l.file.clone()));
+    check_not_input(&outputs, &inputs)?;
     // The lights first: a bad luminaire or room is reported before the panorama loads.
     let mut lights = a.lights.state()?;
     if a.legend && !lights.false_color {
-        bail!("--legend draws the false colours' scale: give --false-color too");
+        return Err(usage!(
+            "--legend draws the false colours' scale: give --false-color too"
+        ));
     }
     let mut scene = a.load(scene_pano)?;
     if let (true, Some(map)) = (a.view_limit, scene.env_map()) {
@@ -231,7 +249,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if a.verbose {
         print_report(&a, &scene, &report, view);
         if let Some(em) = &error_map {
-            eprintln!("{}", summary(em));
+            crate::errln!("{}", summary(em));
         }
     }
     if let (Some(path), Some(em)) = (&a.error_map, &error_map) {
@@ -243,7 +261,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         .light_frame_with(&mut lit, false, view, &mut out, w, h)
         .map_err(anyhow::Error::msg)?;
     if a.verbose && !lights.lights.is_empty() {
-        eprintln!(
+        crate::errln!(
             "lit from an illuminance map of {:.1} KiB ({} luminaires, map and shading {:.0} ms, exposure {:.0} lx)",
             lit.bytes() as f64 / 1024.0,
             lights.lights.len(),
@@ -259,7 +277,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         crate::lighting::legend::draw_legend(&mut out, w, h, lights.false_color_max)
             .map_err(anyhow::Error::msg)?;
     }
-    write_png_atomic(&a.output, &out, w, h)?;
+    write_image(&a.output, &out, w, h)?;
     Ok(())
 }
 
@@ -273,7 +291,7 @@ fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View
             } else {
                 format!("index step {}..{}", report.min_step, report.max_step)
             };
-            eprintln!(
+            crate::errln!(
                 "rendered {}x{} from {}x{} {} map: path {}, table {} bytes, {} of {} pixels exact, {steps}",
                 w,
                 h,
@@ -286,17 +304,17 @@ fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View
                 report.pixels,
             );
             if !view.projection().is_rectilinear() {
-                eprintln!(
+                crate::errln!(
                     "view projection {} (hfov {} degrees)",
                     view.projection(),
                     view.hfov_deg()
                 );
             }
             if let Some(c) = coverage_text(map) {
-                eprintln!("partial panorama: {c}");
+                crate::errln!("partial panorama: {c}");
             }
             if a.view_limit {
-                eprintln!(
+                crate::errln!(
                     "view (limited): yaw {:.4} pitch {:.4} hfov {:.4}",
                     view.yaw_deg(),
                     view.pitch_deg(),
@@ -304,10 +322,10 @@ fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View
                 );
             }
             if let Some(hd) = heading_text(map, view.yaw_deg()) {
-                eprintln!("view centre {hd}");
+                crate::errln!("view centre {hd}");
             }
         }
-        Scene::Cube(cube) => eprintln!(
+        Scene::Cube(cube) => crate::errln!(
             "rendered {w}x{h} from a cube map of {}px faces",
             cube.face_size()
         ),

@@ -22,7 +22,7 @@ pub use state::{
 
 use crate::args::named;
 use crate::args::values::finite;
-use anyhow::{anyhow, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 use lut_core::{Interpolation, View};
 use std::path::{Path, PathBuf};
@@ -105,7 +105,11 @@ pub struct LightSpec {
     pub aim: (f64, f64),
 }
 
-fn parse_light(s: &str) -> Result<LightSpec, String> {
+/// Parse one `--light FILE@X,Y,Z[:YAW,PITCH]` (the file is not opened).
+///
+/// # Errors
+/// A message quoting `s` and saying which part is wrong.
+pub fn parse_light(s: &str) -> Result<LightSpec, String> {
     let (file, rest) = s
         .rsplit_once('@')
         .ok_or_else(|| format!("light '{s}' must look like FILE.ies@X,Y,Z[:YAW,PITCH]"))?;
@@ -269,7 +273,7 @@ impl LightArgs {
         self.room.apply(&mut st)?;
         if let Some(lux) = self.exposure_lux {
             if !(lux.is_finite() && lux > 0.0) {
-                return Err(anyhow!(
+                return Err(crate::usage!(
                     "--exposure-lux must be a positive number of lux, got {lux}"
                 ));
             }
@@ -289,10 +293,10 @@ impl LightArgs {
         if st.lights.is_empty() {
             return Ok(st);
         }
+        // What is left to go wrong are values (the files are read): usage errors.
         st.room_box()
-            .map_err(anyhow::Error::msg)
-            .context("--room/--camera-height/--room-yaw/--room-center")?;
-        st.check()?;
+            .map_err(|e| crate::usage!("--room/--camera-height/--room-yaw/--room-center: {e}"))?;
+        st.check().map_err(|e| crate::usage!("{e:#}"))?;
         Ok(st)
     }
 }

@@ -143,7 +143,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         Some(d) => {
             let (p, msg) = Prefs::load(d);
             if let Some(m) = msg {
-                eprintln!("viewer: {m}");
+                crate::errln!("viewer: {m}");
                 notices.error(m, 0.0);
             }
             p
@@ -311,7 +311,7 @@ impl App {
         self.prefs_saved = self.prefs.clone();
         if let Err(e) = self.prefs.save(dir) {
             let m = format!("settings not saved: {e:#}");
-            eprintln!("viewer: {m}");
+            crate::errln!("viewer: {m}");
             self.notices.error(m, t);
         }
     }
@@ -354,7 +354,7 @@ impl ApplicationHandler<LoadEvent> for App {
         self.frame_interval = Duration::from_secs_f64(1.0 / hz);
         self.ctl.set_frame_interval(1.0 / hz);
         if self.print_view {
-            println!("refresh {hz:.1} Hz");
+            let _ = crate::outln!("refresh {hz:.1} Hz");
         }
         let egui_winit = egui_winit::State::new(
             self.egui_ctx.clone(),

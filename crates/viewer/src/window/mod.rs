@@ -113,10 +113,10 @@ pub fn run(mut a: OpenArgs) -> anyhow::Result<()> {
         std::fs::metadata(p).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
     }
     if a.panorama.len() > 1 && matches!(a.input.projection.value, ProjectionArg::Map(_)) {
-        anyhow::bail!(
+        return Err(crate::usage!(
             "{} files given: a single panorama takes one file (six faces are a cube map)",
             a.panorama.len()
-        );
+        ));
     }
     // Lights given on the command line: loaded now, so a bad file or position is
     // reported before any window opens (as `viewer render` reports it).

@@ -134,7 +134,6 @@ impl Prefs {
             .with_context(|| format!("cannot create the config folder {}", dir.display()))?;
         let json = serde_json::to_string_pretty(self)?;
         crate::output::write_image_atomic(&dir.join(FILE_NAME), |w| {
-            use std::io::Write;
             w.write_all(json.as_bytes())?;
             Ok(())
         })

@@ -31,7 +31,7 @@ pub fn in_pool<R: Send>(
 ) -> Result<R> {
     let threads = threads.unwrap_or_else(rayon::current_num_threads);
     if threads == 0 {
-        bail!("--threads must be at least 1");
+        return Err(crate::usage!("--threads must be at least 1"));
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)

@@ -29,7 +29,7 @@ pub mod plot;
 pub mod report;
 
 use crate::args::{named, parse_map_size, parse_size, MaxPixelsArg, ProjectionOpt};
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use configs::{configs, view_sets, ViewsArg};
 use lut_core::CubeMap;
@@ -117,7 +117,7 @@ fn parse_kernel_choice(s: &str) -> Result<KernelChoice, String> {
 /// Run `viewer bench`.
 pub fn run(a: BenchArgs) -> Result<()> {
     if a.passes == 0 {
-        bail!("--passes must be at least 1");
+        return Err(crate::usage!("--passes must be at least 1"));
     }
     if let Some(KernelChoice(k)) = a.kernel {
         lut_core::set_kernel(k).map_err(|e| anyhow!("--kernel: {e}"))?;
@@ -127,7 +127,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
 
 /// Progress goes to stderr (with --json, stdout is only the JSON array).
 pub fn progress(msg: &str) {
-    eprintln!("bench: {msg}");
+    crate::errln!("bench: {msg}");
 }
 
 fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
@@ -275,7 +275,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         plot::plot(p, &rows).with_context(|| format!("{}: cannot draw the chart", p.display()))?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        crate::outln!("{}", serde_json::to_string_pretty(&rows)?)?;
     } else {
         report::write_table(
             &mut std::io::stdout().lock(),
@@ -285,7 +285,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
             &kernel.to_string(),
         )?;
         if let Some(n) = minify_note {
-            println!("{n}");
+            crate::outln!("{n}")?;
         }
     }
     Ok(())

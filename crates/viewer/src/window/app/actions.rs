@@ -10,7 +10,7 @@ use crate::window::document::Effect;
 use crate::window::folder::{self, Step};
 use crate::window::input::{Look, HFOV_HOME};
 use crate::window::keys::{KeyAction, EXPOSURE_KEY_STEP_EV};
-use crate::window::loader::LoadRequest;
+use crate::window::loader::{LoadRequest, Source};
 use crate::window::quality::Level;
 use std::path::{Path, PathBuf};
 use winit::event_loop::ActiveEventLoop;
@@ -40,10 +40,10 @@ impl App {
                 }
                 Effect::PrintView(line) => {
                     if self.print_view {
-                        println!("{line}");
+                        let _ = crate::outln!("{line}");
                     }
                 }
-                Effect::Stderr(line) => eprintln!("{line}"),
+                Effect::Stderr(line) => crate::errln!("{line}"),
                 Effect::ShowPanel => self.prefs.panel = true,
                 Effect::StartView(v) => {
                     // The new panorama's zoom range first: the old one's limit must not
@@ -130,7 +130,7 @@ impl App {
         match req.chosen {
             Some(Chosen::Open(p)) => {
                 if self.print_view {
-                    println!("dialog picked {}", p.display());
+                    let _ = crate::outln!("dialog picked {}", p.display());
                 }
                 self.open_path(p);
             }
@@ -176,7 +176,8 @@ impl App {
             KeyAction::Help => {
                 self.show_help = !self.show_help;
                 if self.print_view {
-                    println!("help {}", if self.show_help { "shown" } else { "hidden" });
+                    let _ =
+                        crate::outln!("help {}", if self.show_help { "shown" } else { "hidden" });
                 }
             }
             KeyAction::AutoRotate => {
@@ -275,7 +276,7 @@ impl App {
             self.dialogs.open_panorama(&self.egui_ctx, &dir);
         }
         if self.print_view {
-            println!("dialog open {}", dir.display());
+            let _ = crate::outln!("dialog open {}", dir.display());
         }
     }
 
@@ -299,7 +300,7 @@ impl App {
             .map_or_else(|| "view.png".into(), |n| n.to_string_lossy().into_owned());
         self.dialogs.save_view(&self.egui_ctx, &dir, &name);
         if self.print_view {
-            println!("dialog save {}", dir.display());
+            let _ = crate::outln!("dialog save {}", dir.display());
         }
     }
 
@@ -315,9 +316,18 @@ impl App {
             }),
         };
         let (w, h) = crate::window::export::export_size(scene, self.ctl.settings.export_scale);
-        let result = self.render_export(w, h).and_then(|px| {
-            crate::output::write_png_atomic(path, &px, w, h).map_err(|e| format!("{e:#}"))
-        });
+        // Never over the panorama on show (a name picked in the dialog can be its file).
+        let inputs: Vec<PathBuf> = match self.doc.current().map(|l| &l.source) {
+            Some(Source::File(p)) => vec![p.clone()],
+            Some(Source::Cube { paths, .. }) => paths.clone(),
+            _ => Vec::new(),
+        };
+        let result = crate::output::check_not_input(&[path.to_path_buf()], &inputs)
+            .map_err(|e| format!("{e:#}"))
+            .and_then(|()| self.render_export(w, h))
+            .and_then(|px| {
+                crate::output::write_image(path, &px, w, h).map_err(|e| format!("{e:#}"))
+            });
         let status = match result {
             Ok(()) => {
                 self.prefs.save_dir = path.parent().map(Path::to_path_buf);
@@ -332,7 +342,7 @@ impl App {
             }
         };
         if self.print_view {
-            println!("{status}");
+            let _ = crate::outln!("{status}");
         }
     }
 

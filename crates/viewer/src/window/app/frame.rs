@@ -365,7 +365,7 @@ impl App {
             .collect();
         let line = format!("readouts {}", line.join("; "));
         if line != self.printed_readouts {
-            println!("{line}");
+            let _ = crate::outln!("{line}");
             self.printed_readouts = line;
         }
     }
@@ -484,7 +484,7 @@ impl App {
         r.full_ms = self.times.full_ms(pixels);
         self.scene_key = Some(key);
         if self.print_view {
-            println!(
+            let _ = crate::outln!(
                 "view yaw={:.4} pitch={:.4} hfov={:.4} path={path} sampler={} level={} fast={} \
                  ms={ms:.2} size={}x{} lights={} proj={}",
                 look.yaw,

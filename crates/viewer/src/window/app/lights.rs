@@ -96,7 +96,7 @@ impl App {
             .collect();
         let line = format!("markers {}\nedges {}", line.join(" "), edges.join(" "));
         if line != self.printed_markers {
-            println!("{line}");
+            let _ = crate::outln!("{line}");
             self.printed_markers = line;
         }
     }
@@ -105,8 +105,12 @@ impl App {
     fn print_selection(&self) {
         if self.print_view {
             match self.lights.selected {
-                Some(i) => println!("light {} selected", i + 1),
-                None => println!("no light selected"),
+                Some(i) => {
+                    let _ = crate::outln!("light {} selected", i + 1);
+                }
+                None => {
+                    let _ = crate::outln!("no light selected");
+                }
             }
         }
     }
@@ -175,12 +179,12 @@ impl App {
         if let (Some(_), true) = (self.edge_drag.take(), self.print_view) {
             let (w, d, h) = self.lights.room;
             let (cx, cz) = self.lights.room_center;
-            println!("room {w:.3}x{d:.3}x{h:.3} centre {cx:.3},{cz:.3}");
+            let _ = crate::outln!("room {w:.3}x{d:.3}x{h:.3} centre {cx:.3},{cz:.3}");
         }
         if let (Some(i), true) = (self.light_drag.take(), self.print_view) {
             if let Some(l) = self.lights.lights.get(i) {
                 let [x, y, z] = l.position;
-                println!("light {} moved to {x:.3},{y:.3},{z:.3}", i + 1);
+                let _ = crate::outln!("light {} moved to {x:.3},{y:.3},{z:.3}", i + 1);
             }
         }
     }
@@ -240,7 +244,7 @@ impl App {
         let name = name.unwrap_or_else(|| "scene.json".into());
         self.dialogs.save_scene(&self.egui_ctx, &dir, &name);
         if self.print_view {
-            println!("dialog save-scene {}", dir.display());
+            let _ = crate::outln!("dialog save-scene {}", dir.display());
         }
     }
 
@@ -276,7 +280,7 @@ impl App {
             }
         };
         if self.print_view {
-            println!("{status}");
+            let _ = crate::outln!("{status}");
         }
     }
 }
