@@ -198,7 +198,13 @@ find_window
 log "window $WID at ${X},${Y} size ${WIDTH}x${HEIGHT}: $(xdotool getwindowname "$WID")"
 xdotool getwindowname "$WID" | grep -q '^viewer: a1.jpg (1024×512)$' ||
   fail "the title should name the file and its size: $(xdotool getwindowname "$WID")"
-xprop -id "$WID" _NET_WM_ICON | grep -q 'Icon (64 x 64)' || fail "no 64x64 window icon"
+# The icon property may be set a moment after the window maps: poll for up to 10 s.
+icon_ok=""
+for _ in $(seq 100); do
+  if xprop -id "$WID" _NET_WM_ICON 2>/dev/null | grep -q 'Icon (64 x 64)'; then icon_ok=1; break; fi
+  sleep 0.1
+done
+[ -n "$icon_ok" ] || fail "no 64x64 window icon"
 
 YAW0=$(field yaw); PITCH0=$(field pitch); HFOV0=$(field hfov); PATH0=$(field path)
 SCENE=$(field size); SW=${SCENE%x*}; SH=${SCENE#*x}
