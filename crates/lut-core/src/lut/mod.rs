@@ -491,17 +491,53 @@ impl LutTable {
     /// Q.16. Columns beyond the table clamp to its last node.
     #[inline(always)]
     pub fn lookup(&self, band: usize, wa: i64, col: f64) -> (i64, i64) {
-        let fc = (col * self.inv_step * 65536.0) as i64;
+        self.band(band, wa).lookup(col)
+    }
+
+    /// The two node rows of band `band` with row weight `wa` (Q.16), for reading many
+    /// columns of one scanline (see [`Band::lookup`]).
+    #[inline(always)]
+    pub fn band(&self, band: usize, wa: i64) -> Band<'_> {
+        let i0 = band * self.cols;
+        let (top, bot) = self.entries[i0..i0 + 2 * self.cols].split_at(self.cols);
+        Band {
+            top,
+            bot,
+            wa,
+            scale: self.inv_step * 65536.0,
+        }
+    }
+}
+
+/// One band of a [`LutTable`] with its row weight: the reads of one scanline.
+#[derive(Debug, Clone, Copy)]
+pub struct Band<'a> {
+    top: &'a [[i32; 2]],
+    bot: &'a [[i32; 2]],
+    wa: i64,
+    /// Q.16 column nodes per unit of column coordinate.
+    scale: f64,
+}
+
+impl Band<'_> {
+    /// [`LutTable::lookup`] in this band: folded (Λ, V) in Q.16 at column coordinate
+    /// `col ≥ 0`, two table rows blended, two columns interpolated; columns beyond the
+    /// table clamp to its last node.
+    #[inline(always)]
+    pub fn lookup(&self, col: f64) -> (i64, i64) {
+        // (col · inv_step) · 2^16 and col · (inv_step · 2^16) round alike (a power of two).
+        let fc = (col * self.scale) as i64;
+        let n = self.top.len();
         let mut k = (fc >> 16) as usize;
         let mut wk = fc & 0xFFFF;
-        if k >= self.cols - 1 {
-            k = self.cols - 2;
+        if k >= n - 1 {
+            k = n - 2;
             wk = 1 << 16;
         }
-        let i0 = band * self.cols + k;
-        let i1 = i0 + self.cols;
-        let (a, b) = (self.entries[i0], self.entries[i0 + 1]);
-        let (c, d) = (self.entries[i1], self.entries[i1 + 1]);
+        let (a, b) = (self.top[k], self.top[k + 1]);
+        let bot = &self.bot[k..k + 2];
+        let (c, d) = (bot[0], bot[1]);
+        let wa = self.wa;
         let blend = |top: i32, bot: i32| top as i64 + (((bot as i64 - top as i64) * wa) >> 16);
         let l0 = blend(a[0], c[0]);
         let l1 = blend(b[0], d[0]);

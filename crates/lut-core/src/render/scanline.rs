@@ -7,7 +7,7 @@ use super::setup::{Scan, Setup};
 use super::sink::Sink;
 use super::steps::STEP_REGIONS;
 use crate::geom::fixed::{Fx, FX_BITS};
-use crate::lut::LutTable;
+use crate::lut::{Band, LutTable};
 
 /// Render one scanline into `sink`.
 #[inline]
@@ -53,7 +53,13 @@ fn exact_run<S: Sink>(scan: &Scan, fr: &Setup, x0: i64, x1: i64, sink: &mut S) {
 #[inline(always)]
 pub(crate) fn read(scan: &Scan, table: &LutTable, fr: &Setup, x: i64) -> (Fx, Fx) {
     let big_x = x as f64 + 0.5 - fr.w_out as f64 * 0.5;
-    let (mut l, mut v) = table.lookup(scan.band, scan.wa, big_x.abs() * scan.col_per_x);
+    read_band(scan, &table.band(scan.band, scan.wa), fr, big_x)
+}
+
+/// [`read`] in the scanline's band, at X = x + ½ − W/2.
+#[inline(always)]
+fn read_band(scan: &Scan, band: &Band, fr: &Setup, big_x: f64) -> (Fx, Fx) {
+    let (mut l, mut v) = band.lookup(big_x.abs() * scan.col_per_x);
     if scan.back {
         l = fr.half_map_w_fx - l;
     }
@@ -83,11 +89,13 @@ fn lut_run<S: Sink>(
     }
     let half_w = fr.w_out as f64 * 0.5;
     let last_region = STEP_REGIONS - 1;
+    let band = table.band(scan.band, scan.wa);
     let mut xs = x0;
-    let (mut l0, mut v0) = read(scan, table, fr, xs);
+    // X of xs, carried from span to span (whole numbers plus ½: exact in f64).
+    let mut big_x = xs as f64 + 0.5 - half_w;
+    let (mut l0, mut v0) = read_band(scan, &band, fr, big_x);
     loop {
-        let big_x = (xs as f64 + 0.5 - half_w).abs();
-        let region = ((big_x * scan.region_per_x) as usize).min(last_region);
+        let region = ((big_x.abs() * scan.region_per_x) as usize).min(last_region);
         let shift = scan.shifts[region] as u32;
         let n = 1i64 << shift;
         let xe = (xs + n).min(x1);
@@ -95,7 +103,8 @@ fn lut_run<S: Sink>(
             emit(fr, row_scale, xs, 1, (l0, v0), (0, 0), sink);
             return;
         }
-        let (mut l1, v1) = read(scan, table, fr, xe);
+        let big_xe = xe as f64 + 0.5 - half_w;
+        let (mut l1, v1) = read_band(scan, &band, fr, big_xe);
         // Unwrap longitude across the span: a ±180° seam is a jump of one map width.
         let d = l1 - l0;
         if d > fr.half_map_w_fx {
@@ -118,6 +127,7 @@ fn lut_run<S: Sink>(
         }
         emit(fr, row_scale, xs, m, (l0, v0), (dl, dv), sink);
         xs = xe;
+        big_x = big_xe;
         l0 = l1;
         v0 = v1;
     }
