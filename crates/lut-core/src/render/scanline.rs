@@ -88,14 +88,15 @@ fn lut_run<S: Sink>(
         return;
     }
     let half_w = fr.w_out as f64 * 0.5;
-    let last_region = STEP_REGIONS - 1;
+    let last_region = STEP_REGIONS as i64 - 1;
     let band = table.band(scan.band, scan.wa);
     let mut xs = x0;
     // X of xs, carried from span to span (whole numbers plus ½: exact in f64).
     let mut big_x = xs as f64 + 0.5 - half_w;
     let (mut l0, mut v0) = read_band(scan, &band, fr, big_x);
     loop {
-        let region = ((big_x.abs() * scan.region_per_x) as usize).min(last_region);
+        // Through i64 (as usize: the same value, as |X| ≥ 0, but a longer conversion).
+        let region = ((big_x.abs() * scan.region_per_x) as i64).min(last_region) as usize;
         let shift = scan.shifts[region] as u32;
         let n = 1i64 << shift;
         let xe = (xs + n).min(x1);
