@@ -7,15 +7,17 @@ use super::setup::{Scan, Setup};
 use super::sink::Sink;
 use super::steps::STEP_REGIONS;
 use crate::geom::fixed::{Fx, FX_BITS};
-use crate::lut::{Band, LutTable};
+use crate::lut::{Band, Blended, LutTable};
 
-/// Render one scanline into `sink`.
+/// Render one scanline into `sink` (`scratch`: room for its blended table nodes, kept
+/// from row to row).
 #[inline]
 pub(crate) fn render_row<S: Sink>(
     scan: &Scan,
     table: &LutTable,
     fr: &Setup,
     row_scale: &[i64],
+    scratch: &mut Vec<[i32; 2]>,
     sink: &mut S,
 ) {
     let w = fr.w_out as i64;
@@ -27,11 +29,35 @@ pub(crate) fn render_row<S: Sink>(
     let zl = scan.zone_lo.max(scan.lut_lo);
     let zh = scan.zone_hi.min(scan.lut_hi);
     if zl <= zh {
-        lut_run(scan, table, fr, row_scale, scan.lut_lo, zl - 1, sink);
+        lut_run(
+            scan,
+            table,
+            fr,
+            row_scale,
+            (scan.lut_lo, zl - 1),
+            scratch,
+            sink,
+        );
         exact_run(scan, fr, zl, zh, sink);
-        lut_run(scan, table, fr, row_scale, zh + 1, scan.lut_hi, sink);
+        lut_run(
+            scan,
+            table,
+            fr,
+            row_scale,
+            (zh + 1, scan.lut_hi),
+            scratch,
+            sink,
+        );
     } else {
-        lut_run(scan, table, fr, row_scale, scan.lut_lo, scan.lut_hi, sink);
+        lut_run(
+            scan,
+            table,
+            fr,
+            row_scale,
+            (scan.lut_lo, scan.lut_hi),
+            scratch,
+            sink,
+        );
     }
     exact_run(scan, fr, scan.lut_hi + 1, w - 1, sink);
 }
@@ -56,9 +82,41 @@ pub(crate) fn read(scan: &Scan, table: &LutTable, fr: &Setup, x: i64) -> (Fx, Fx
     read_band(scan, &table.band(scan.band, scan.wa), fr, big_x)
 }
 
+/// The table reads of a scanline: straight from its band, or from its nodes blended once.
+trait Nodes {
+    fn lookup(&self, col: f64) -> (Fx, Fx);
+}
+
+impl Nodes for Band<'_> {
+    #[inline(always)]
+    fn lookup(&self, col: f64) -> (Fx, Fx) {
+        Band::lookup(self, col)
+    }
+}
+
+impl Nodes for Blended<'_> {
+    #[inline(always)]
+    fn lookup(&self, col: f64) -> (Fx, Fx) {
+        Blended::lookup(self, col)
+    }
+}
+
+/// Whether to blend a run's `nodes` once instead of two per read: when there are at
+/// most 2 nodes per read, the reads estimated from the run's length and the mean step of
+/// the regions. (Callgrind: about 20 instructions per blended node against 27 saved per
+/// read puts the break-even near 1.35; a limit of 1.25 and one of 2 measured alike on
+/// the benchmark views, docs/performance.md.) Only the cost depends on it, not the
+/// output.
+#[inline(never)]
+fn blend_pays(scan: &Scan, nodes: usize, pixels: usize) -> bool {
+    // Reads per 256 pixels, summed over the regions.
+    let per_256: usize = scan.shifts.iter().map(|&s| 256 >> s).sum();
+    nodes * 256 * STEP_REGIONS <= 2 * pixels * per_256
+}
+
 /// [`read`] in the scanline's band, at X = x + ½ − W/2.
 #[inline(always)]
-fn read_band(scan: &Scan, band: &Band, fr: &Setup, big_x: f64) -> (Fx, Fx) {
+fn read_band<N: Nodes>(scan: &Scan, band: &N, fr: &Setup, big_x: f64) -> (Fx, Fx) {
     let (mut l, mut v) = band.lookup(big_x.abs() * scan.col_per_x);
     if scan.back {
         l = fr.half_map_w_fx - l;
@@ -80,20 +138,57 @@ fn lut_run<S: Sink>(
     table: &LutTable,
     fr: &Setup,
     row_scale: &[i64],
-    x0: i64,
-    x1: i64,
+    (x0, x1): (i64, i64),
+    scratch: &mut Vec<[i32; 2]>,
     sink: &mut S,
 ) {
     if x0 > x1 {
         return;
     }
+    let band = table.band(scan.band, scan.wa);
+    // The nodes the run reads: from the smallest |X| to the largest (the column and its
+    // node are monotonic in |X|), and the next node.
+    let half_w = fr.w_out as f64 * 0.5;
+    let (xa, xb) = (x0 as f64 + 0.5 - half_w, x1 as f64 + 0.5 - half_w);
+    let x_min = if xa < 0.0 && xb > 0.0 {
+        0.0
+    } else {
+        xa.abs().min(xb.abs())
+    };
+    let k0 = band.node(x_min * scan.col_per_x).0;
+    let k1 = band.node(xa.abs().max(xb.abs()) * scan.col_per_x).0 + 1;
+    let count = k1 + 1 - k0;
+    if blend_pays(scan, count, (x1 - x0 + 1) as usize) {
+        // The scratch only grows (no clearing per run).
+        if scratch.len() < count {
+            scratch.resize(count, [0; 2]);
+        }
+        let nodes = &mut scratch[..count];
+        band.blend_nodes(k0, nodes);
+        let blended = Blended { band, k0, nodes };
+        lut_run_in(scan, &blended, fr, row_scale, x0, x1, sink);
+        return;
+    }
+    lut_run_in(scan, &band, fr, row_scale, x0, x1, sink);
+}
+
+/// [`lut_run`] with the scanline's nodes read through `band`.
+#[inline(always)]
+fn lut_run_in<S: Sink, N: Nodes>(
+    scan: &Scan,
+    band: &N,
+    fr: &Setup,
+    row_scale: &[i64],
+    x0: i64,
+    x1: i64,
+    sink: &mut S,
+) {
     let half_w = fr.w_out as f64 * 0.5;
     let last_region = STEP_REGIONS as i64 - 1;
-    let band = table.band(scan.band, scan.wa);
     let mut xs = x0;
     // X of xs, carried from span to span (whole numbers plus ½: exact in f64).
     let mut big_x = xs as f64 + 0.5 - half_w;
-    let (mut l0, mut v0) = read_band(scan, &band, fr, big_x);
+    let (mut l0, mut v0) = read_band(scan, band, fr, big_x);
     loop {
         // Through i64 (as usize: the same value, as |X| ≥ 0, but a longer conversion).
         let region = ((big_x.abs() * scan.region_per_x) as i64).min(last_region) as usize;
@@ -105,7 +200,7 @@ fn lut_run<S: Sink>(
             return;
         }
         let big_xe = xe as f64 + 0.5 - half_w;
-        let (mut l1, v1) = read_band(scan, &band, fr, big_xe);
+        let (mut l1, v1) = read_band(scan, band, fr, big_xe);
         // Unwrap longitude across the span: a ±180° seam is a jump of one map width.
         let d = l1 - l0;
         if d > fr.half_map_w_fx {
