@@ -50,7 +50,7 @@ use frame::Frame;
 use grid::{Grid, GridStats};
 use kernel::level_texels;
 use rows::{for_each_row, for_each_row_init};
-use scanline::{render_row, ROW_SCALE_ONE};
+use scanline::{render_row, Scratch, BLEND_NODES, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
 use sink::{Batch, PixelRows, PixelSink, PosRows, PosSink, RowSinks, Sink, TriRows, TriSink};
 use std::f64::consts::TAU;
@@ -480,7 +480,7 @@ impl Renderer {
             let (levels, n) = level_texels(map);
             let levels = &levels[..n];
             let fp = ExactFootprint::new(view, width, height, geometry_of(map));
-            for_each_row_init(out, w, opts.threads, Vec::new, |scratch, y, row| {
+            for_each_row_init(out, w, opts.threads, new_scratch, |scratch, y, row| {
                 let scan = &scans[y];
                 let mut s = TriSink {
                     row,
@@ -507,7 +507,7 @@ impl Renderer {
             map: &EnvMap,
         ) {
             let (scans, table, setup, row_scale) = k;
-            for_each_row_init(out, w, threads, Vec::new, |scratch, y, row| {
+            for_each_row_init(out, w, threads, new_scratch, |scratch, y, row| {
                 let mut s = PixelSink::<BILINEAR, CROP> {
                     row,
                     map,
@@ -637,7 +637,7 @@ impl Renderer {
             &mut out,
             width as usize,
             opts.threads,
-            Vec::new,
+            new_scratch,
             |scratch, y, row| {
                 let mut s = PosSink { row };
                 render_row(&scans[y], table, &setup, row_scale, scratch, &mut s);
@@ -645,6 +645,11 @@ impl Renderer {
         );
         Ok((out, report))
     }
+}
+
+/// A row task's room for blended table nodes (on the stack: no allocation per frame).
+fn new_scratch() -> Scratch {
+    [[0; 2]; BLEND_NODES]
 }
 
 /// The map geometry the renderers use: (width, height, projection) of the full panorama.

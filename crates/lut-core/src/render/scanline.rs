@@ -9,15 +9,20 @@ use super::steps::STEP_REGIONS;
 use crate::geom::fixed::{Fx, FX_BITS};
 use crate::lut::{Band, Blended, LutTable};
 
-/// Render one scanline into `sink` (`scratch`: room for its blended table nodes, kept
-/// from row to row).
+/// Room for a run's blended table nodes (a run that reads more blends per read).
+pub(crate) const BLEND_NODES: usize = 512;
+
+/// Room for a scanline's blended table nodes, kept from row to row (no allocation).
+pub(crate) type Scratch = [[i32; 2]; BLEND_NODES];
+
+/// Render one scanline into `sink` (`scratch`: room for its blended table nodes).
 #[inline]
 pub(crate) fn render_row<S: Sink>(
     scan: &Scan,
     table: &LutTable,
     fr: &Setup,
     row_scale: &[i64],
-    scratch: &mut Vec<[i32; 2]>,
+    scratch: &mut Scratch,
     sink: &mut S,
 ) {
     let w = fr.w_out as i64;
@@ -139,7 +144,7 @@ fn lut_run<S: Sink>(
     fr: &Setup,
     row_scale: &[i64],
     (x0, x1): (i64, i64),
-    scratch: &mut Vec<[i32; 2]>,
+    scratch: &mut Scratch,
     sink: &mut S,
 ) {
     if x0 > x1 {
@@ -158,11 +163,7 @@ fn lut_run<S: Sink>(
     let k0 = band.node(x_min * scan.col_per_x).0;
     let k1 = band.node(xa.abs().max(xb.abs()) * scan.col_per_x).0 + 1;
     let count = k1 + 1 - k0;
-    if blend_pays(scan, count, (x1 - x0 + 1) as usize) {
-        // The scratch only grows (no clearing per run).
-        if scratch.len() < count {
-            scratch.resize(count, [0; 2]);
-        }
+    if count <= BLEND_NODES && blend_pays(scan, count, (x1 - x0 + 1) as usize) {
         let nodes = &mut scratch[..count];
         band.blend_nodes(k0, nodes);
         let blended = Blended { band, k0, nodes };
