@@ -497,7 +497,7 @@ impl LutTable {
     /// The two node rows of band `band` with row weight `wa` (Q.16), for reading many
     /// columns of one scanline (see [`Band::lookup`]).
     #[inline(always)]
-    pub fn band(&self, band: usize, wa: i64) -> Band<'_> {
+    pub(crate) fn band(&self, band: usize, wa: i64) -> Band<'_> {
         let i0 = band * self.cols;
         let (top, bot) = self.entries[i0..i0 + 2 * self.cols].split_at(self.cols);
         Band {
@@ -511,7 +511,7 @@ impl LutTable {
 
 /// One band of a [`LutTable`] with its row weight: the reads of one scanline.
 #[derive(Debug, Clone, Copy)]
-pub struct Band<'a> {
+pub(crate) struct Band<'a> {
     top: &'a [[i32; 2]],
     bot: &'a [[i32; 2]],
     wa: i64,
@@ -524,7 +524,7 @@ impl Band<'_> {
     /// `col ≥ 0`, two table rows blended, two columns interpolated; columns beyond the
     /// table clamp to its last node.
     #[inline(always)]
-    pub fn lookup(&self, col: f64) -> (i64, i64) {
+    pub(crate) fn lookup(&self, col: f64) -> (i64, i64) {
         let (k, wk) = self.node(col);
         let (a, b) = (self.top[k], self.top[k + 1]);
         let bot = &self.bot[k..k + 2];
@@ -540,7 +540,7 @@ impl Band<'_> {
     /// The node left of column coordinate `col ≥ 0` (at most the last but one) and the
     /// Q.16 weight of the next one.
     #[inline(always)]
-    pub fn node(&self, col: f64) -> (usize, i64) {
+    pub(crate) fn node(&self, col: f64) -> (usize, i64) {
         // (col · inv_step) · 2^16 and col · (inv_step · 2^16) round alike (a power of two).
         let fc = (col * self.scale) as i64;
         let n = self.top.len();
@@ -555,7 +555,7 @@ impl Band<'_> {
     /// Nodes `k0..k0 + out.len()` with the two rows blended (what [`Band::lookup`] blends
     /// per read), for [`Blended`].
     #[inline]
-    pub fn blend_nodes(&self, k0: usize, out: &mut [[i32; 2]]) {
+    pub(crate) fn blend_nodes(&self, k0: usize, out: &mut [[i32; 2]]) {
         let k1 = k0 + out.len();
         let wa = self.wa;
         for ((o, a), c) in out.iter_mut().zip(&self.top[k0..k1]).zip(&self.bot[k0..k1]) {
@@ -574,16 +574,16 @@ fn blend(top: i32, bot: i32, wa: i64) -> i64 {
 /// A scanline's nodes blended once ([`Band::blend_nodes`] from node `k0` on): the same
 /// reads as [`Band::lookup`] for the columns whose nodes it holds, without the row blend.
 #[derive(Debug, Clone, Copy)]
-pub struct Blended<'a> {
-    pub band: Band<'a>,
-    pub k0: usize,
-    pub nodes: &'a [[i32; 2]],
+pub(crate) struct Blended<'a> {
+    pub(crate) band: Band<'a>,
+    pub(crate) k0: usize,
+    pub(crate) nodes: &'a [[i32; 2]],
 }
 
 impl Blended<'_> {
     /// [`Band::lookup`]; `col`'s node and the next must be among the blended ones.
     #[inline(always)]
-    pub fn lookup(&self, col: f64) -> (i64, i64) {
+    pub(crate) fn lookup(&self, col: f64) -> (i64, i64) {
         let (k, wk) = self.band.node(col);
         let pair = &self.nodes[k - self.k0..k - self.k0 + 2];
         let (a, b) = (pair[0], pair[1]);
