@@ -491,22 +491,104 @@ impl LutTable {
     /// Q.16. Columns beyond the table clamp to its last node.
     #[inline(always)]
     pub fn lookup(&self, band: usize, wa: i64, col: f64) -> (i64, i64) {
-        let fc = (col * self.inv_step * 65536.0) as i64;
-        let mut k = (fc >> 16) as usize;
-        let mut wk = fc & 0xFFFF;
-        if k >= self.cols - 1 {
-            k = self.cols - 2;
-            wk = 1 << 16;
+        self.band(band, wa).lookup(col)
+    }
+
+    /// The two node rows of band `band` with row weight `wa` (Q.16), for reading many
+    /// columns of one scanline (see [`Band::lookup`]).
+    #[inline(always)]
+    pub(crate) fn band(&self, band: usize, wa: i64) -> Band<'_> {
+        let i0 = band * self.cols;
+        let (top, bot) = self.entries[i0..i0 + 2 * self.cols].split_at(self.cols);
+        Band {
+            top,
+            bot,
+            wa,
+            scale: self.inv_step * 65536.0,
         }
-        let i0 = band * self.cols + k;
-        let i1 = i0 + self.cols;
-        let (a, b) = (self.entries[i0], self.entries[i0 + 1]);
-        let (c, d) = (self.entries[i1], self.entries[i1 + 1]);
-        let blend = |top: i32, bot: i32| top as i64 + (((bot as i64 - top as i64) * wa) >> 16);
-        let l0 = blend(a[0], c[0]);
-        let l1 = blend(b[0], d[0]);
-        let v0 = blend(a[1], c[1]);
-        let v1 = blend(b[1], d[1]);
+    }
+}
+
+/// One band of a [`LutTable`] with its row weight: the reads of one scanline.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Band<'a> {
+    top: &'a [[i32; 2]],
+    bot: &'a [[i32; 2]],
+    wa: i64,
+    /// Q.16 column nodes per unit of column coordinate.
+    scale: f64,
+}
+
+impl Band<'_> {
+    /// [`LutTable::lookup`] in this band: folded (Λ, V) in Q.16 at column coordinate
+    /// `col ≥ 0`, two table rows blended, two columns interpolated; columns beyond the
+    /// table clamp to its last node.
+    #[inline(always)]
+    pub(crate) fn lookup(&self, col: f64) -> (i64, i64) {
+        let (k, wk) = self.node(col);
+        let (a, b) = (self.top[k], self.top[k + 1]);
+        let bot = &self.bot[k..k + 2];
+        let (c, d) = (bot[0], bot[1]);
+        let wa = self.wa;
+        let l0 = blend(a[0], c[0], wa);
+        let l1 = blend(b[0], d[0], wa);
+        let v0 = blend(a[1], c[1], wa);
+        let v1 = blend(b[1], d[1], wa);
+        (l0 + (((l1 - l0) * wk) >> 16), v0 + (((v1 - v0) * wk) >> 16))
+    }
+
+    /// The node left of column coordinate `col ≥ 0` (at most the last but one) and the
+    /// Q.16 weight of the next one.
+    #[inline(always)]
+    pub(crate) fn node(&self, col: f64) -> (usize, i64) {
+        // (col · inv_step) · 2^16 and col · (inv_step · 2^16) round alike (a power of two).
+        let fc = (col * self.scale) as i64;
+        let n = self.top.len();
+        let k = (fc >> 16) as usize;
+        if k >= n - 1 {
+            (n - 2, 1 << 16)
+        } else {
+            (k, fc & 0xFFFF)
+        }
+    }
+
+    /// Nodes `k0..k0 + out.len()` with the two rows blended (what [`Band::lookup`] blends
+    /// per read), for [`Blended`].
+    #[inline]
+    pub(crate) fn blend_nodes(&self, k0: usize, out: &mut [[i32; 2]]) {
+        let k1 = k0 + out.len();
+        let wa = self.wa;
+        for ((o, a), c) in out.iter_mut().zip(&self.top[k0..k1]).zip(&self.bot[k0..k1]) {
+            // Between the two nodes: fits i32.
+            *o = [blend(a[0], c[0], wa) as i32, blend(a[1], c[1], wa) as i32];
+        }
+    }
+}
+
+/// Row blend of two nodes' values with the Q.16 weight `wa` of the lower one.
+#[inline(always)]
+fn blend(top: i32, bot: i32, wa: i64) -> i64 {
+    top as i64 + (((bot as i64 - top as i64) * wa) >> 16)
+}
+
+/// A scanline's nodes blended once ([`Band::blend_nodes`] from node `k0` on): the same
+/// reads as [`Band::lookup`] for the columns whose nodes it holds, without the row blend.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Blended<'a> {
+    pub(crate) band: Band<'a>,
+    pub(crate) k0: usize,
+    pub(crate) nodes: &'a [[i32; 2]],
+}
+
+impl Blended<'_> {
+    /// [`Band::lookup`]; `col`'s node and the next must be among the blended ones.
+    #[inline(always)]
+    pub(crate) fn lookup(&self, col: f64) -> (i64, i64) {
+        let (k, wk) = self.band.node(col);
+        let pair = &self.nodes[k - self.k0..k - self.k0 + 2];
+        let (a, b) = (pair[0], pair[1]);
+        let (l0, l1) = (a[0] as i64, b[0] as i64);
+        let (v0, v1) = (a[1] as i64, b[1] as i64);
         (l0 + (((l1 - l0) * wk) >> 16), v0 + (((v1 - v0) * wk) >> 16))
     }
 }
@@ -582,6 +664,37 @@ mod tests {
             );
             assert!((l as f64 / 65536.0 - el).abs() < 1e-3, "{r} {k}");
             assert!((v as f64 / 65536.0 - ev).abs() < 1e-3, "{r} {k}");
+        }
+    }
+
+    /// The nodes blended once per scanline read what the per-read blend reads, bit for
+    /// bit, at nodes, between them and beyond the last one.
+    #[test]
+    fn blended_nodes_read_as_the_band() {
+        let spec = TableSpec::default_for(Surface::Cylinder, TableKind::Wide, 2048);
+        let t = LutTable::build(spec, Projection::Equirect, 2048, 1024);
+        let step = 1.0 / t.inv_step;
+        for row in [0.0, 0.37, 1.0, 1.5, t.row_max()] {
+            let (b, wa) = t.row_position(row);
+            let band = t.band(b, wa);
+            let (k0, k1) = (5, t.cols - 1);
+            let mut nodes = vec![[0i32; 2]; k1 + 1 - k0];
+            band.blend_nodes(k0, &mut nodes);
+            let blended = Blended {
+                band,
+                k0,
+                nodes: &nodes,
+            };
+            let mut col = k0 as f64 * step;
+            while col < t.col_max() + 3.0 * step {
+                assert_eq!(blended.lookup(col), band.lookup(col), "row {row} col {col}");
+                assert_eq!(
+                    band.lookup(col),
+                    t.lookup(b, wa, col),
+                    "row {row} col {col}"
+                );
+                col += step * 0.173;
+            }
         }
     }
 

@@ -49,8 +49,8 @@ use exact::{render_exact, ExactFootprint};
 use frame::Frame;
 use grid::{Grid, GridStats};
 use kernel::level_texels;
-use rows::for_each_row;
-use scanline::{render_row, ROW_SCALE_ONE};
+use rows::{for_each_row, for_each_row_init};
+use scanline::{render_row, Scratch, BLEND_NODES, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
 use sink::{Batch, PixelRows, PixelSink, PosRows, PosSink, RowSinks, Sink, TriRows, TriSink};
 use std::f64::consts::TAU;
@@ -480,7 +480,7 @@ impl Renderer {
             let (levels, n) = level_texels(map);
             let levels = &levels[..n];
             let fp = ExactFootprint::new(view, width, height, geometry_of(map));
-            for_each_row(out, w, opts.threads, |y, row| {
+            for_each_row_init(out, w, opts.threads, new_scratch, |scratch, y, row| {
                 let scan = &scans[y];
                 let mut s = TriSink {
                     row,
@@ -493,7 +493,7 @@ impl Renderer {
                     batch: Batch::new(),
                 };
                 s.set_lod(lod_q8(scan.fy[0] as f64));
-                render_row(scan, table, &setup, row_scale, &mut s);
+                render_row(scan, table, &setup, row_scale, scratch, &mut s);
                 s.flush();
             });
             return Ok(report);
@@ -507,13 +507,13 @@ impl Renderer {
             map: &EnvMap,
         ) {
             let (scans, table, setup, row_scale) = k;
-            for_each_row(out, w, threads, |y, row| {
+            for_each_row_init(out, w, threads, new_scratch, |scratch, y, row| {
                 let mut s = PixelSink::<BILINEAR, CROP> {
                     row,
                     map,
                     batch: Batch::new(),
                 };
-                render_row(&scans[y], table, setup, row_scale, &mut s);
+                render_row(&scans[y], table, setup, row_scale, scratch, &mut s);
                 s.flush();
             });
         }
@@ -633,12 +633,23 @@ impl Renderer {
         let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
-        for_each_row(&mut out, width as usize, opts.threads, |y, row| {
-            let mut s = PosSink { row };
-            render_row(&scans[y], table, &setup, row_scale, &mut s);
-        });
+        for_each_row_init(
+            &mut out,
+            width as usize,
+            opts.threads,
+            new_scratch,
+            |scratch, y, row| {
+                let mut s = PosSink { row };
+                render_row(&scans[y], table, &setup, row_scale, scratch, &mut s);
+            },
+        );
         Ok((out, report))
     }
+}
+
+/// A row task's room for blended table nodes (on the stack: no allocation per frame).
+fn new_scratch() -> Scratch {
+    [[0; 2]; BLEND_NODES]
 }
 
 /// The map geometry the renderers use: (width, height, projection) of the full panorama.

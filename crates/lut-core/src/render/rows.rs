@@ -26,3 +26,26 @@ pub(crate) fn for_each_row<T: Send>(
             .for_each(|(y, row)| f(y, row));
     }
 }
+
+/// [`for_each_row`] with per-task state made by `init` (scratch buffers kept from row to
+/// row).
+pub(crate) fn for_each_row_init<T: Send, St>(
+    out: &mut [T],
+    width: usize,
+    threads: bool,
+    init: impl Fn() -> St + Sync + Send,
+    f: impl Fn(&mut St, usize, &mut [T]) + Sync + Send,
+) {
+    let width = width.max(1);
+    if threads && out.len() > width {
+        out.par_chunks_mut(width)
+            .enumerate()
+            .with_min_len((MIN_PIXELS_PER_TASK / width).max(1))
+            .for_each_init(init, |st, (y, row)| f(st, y, row));
+    } else {
+        let mut st = init();
+        out.chunks_mut(width)
+            .enumerate()
+            .for_each(|(y, row)| f(&mut st, y, row));
+    }
+}

@@ -7,15 +7,22 @@ use super::setup::{Scan, Setup};
 use super::sink::Sink;
 use super::steps::STEP_REGIONS;
 use crate::geom::fixed::{Fx, FX_BITS};
-use crate::lut::LutTable;
+use crate::lut::{Band, Blended, LutTable};
 
-/// Render one scanline into `sink`.
+/// Room for a run's blended table nodes (a run that reads more blends per read).
+pub(crate) const BLEND_NODES: usize = 512;
+
+/// Room for a scanline's blended table nodes, kept from row to row (no allocation).
+pub(crate) type Scratch = [[i32; 2]; BLEND_NODES];
+
+/// Render one scanline into `sink` (`scratch`: room for its blended table nodes).
 #[inline]
 pub(crate) fn render_row<S: Sink>(
     scan: &Scan,
     table: &LutTable,
     fr: &Setup,
     row_scale: &[i64],
+    scratch: &mut Scratch,
     sink: &mut S,
 ) {
     let w = fr.w_out as i64;
@@ -27,11 +34,35 @@ pub(crate) fn render_row<S: Sink>(
     let zl = scan.zone_lo.max(scan.lut_lo);
     let zh = scan.zone_hi.min(scan.lut_hi);
     if zl <= zh {
-        lut_run(scan, table, fr, row_scale, scan.lut_lo, zl - 1, sink);
+        lut_run(
+            scan,
+            table,
+            fr,
+            row_scale,
+            (scan.lut_lo, zl - 1),
+            scratch,
+            sink,
+        );
         exact_run(scan, fr, zl, zh, sink);
-        lut_run(scan, table, fr, row_scale, zh + 1, scan.lut_hi, sink);
+        lut_run(
+            scan,
+            table,
+            fr,
+            row_scale,
+            (zh + 1, scan.lut_hi),
+            scratch,
+            sink,
+        );
     } else {
-        lut_run(scan, table, fr, row_scale, scan.lut_lo, scan.lut_hi, sink);
+        lut_run(
+            scan,
+            table,
+            fr,
+            row_scale,
+            (scan.lut_lo, scan.lut_hi),
+            scratch,
+            sink,
+        );
     }
     exact_run(scan, fr, scan.lut_hi + 1, w - 1, sink);
 }
@@ -53,7 +84,45 @@ fn exact_run<S: Sink>(scan: &Scan, fr: &Setup, x0: i64, x1: i64, sink: &mut S) {
 #[inline(always)]
 pub(crate) fn read(scan: &Scan, table: &LutTable, fr: &Setup, x: i64) -> (Fx, Fx) {
     let big_x = x as f64 + 0.5 - fr.w_out as f64 * 0.5;
-    let (mut l, mut v) = table.lookup(scan.band, scan.wa, big_x.abs() * scan.col_per_x);
+    read_band(scan, &table.band(scan.band, scan.wa), fr, big_x)
+}
+
+/// The table reads of a scanline: straight from its band, or from its nodes blended once.
+trait Nodes {
+    fn lookup(&self, col: f64) -> (Fx, Fx);
+}
+
+impl Nodes for Band<'_> {
+    #[inline(always)]
+    fn lookup(&self, col: f64) -> (Fx, Fx) {
+        Band::lookup(self, col)
+    }
+}
+
+impl Nodes for Blended<'_> {
+    #[inline(always)]
+    fn lookup(&self, col: f64) -> (Fx, Fx) {
+        Blended::lookup(self, col)
+    }
+}
+
+/// Whether to blend a run's `nodes` once instead of two per read: when there are at
+/// most 2 nodes per read, the reads estimated from the run's length and the mean step of
+/// the regions. (Callgrind: about 20 instructions per blended node against 27 saved per
+/// read puts the break-even near 1.35; a limit of 1.25 and one of 2 measured alike on
+/// the benchmark views, docs/performance.md.) Only the cost depends on it, not the
+/// output.
+#[inline(never)]
+fn blend_pays(scan: &Scan, nodes: usize, pixels: usize) -> bool {
+    // Reads per 256 pixels, summed over the regions.
+    let per_256: usize = scan.shifts.iter().map(|&s| 256 >> s).sum();
+    nodes * 256 * STEP_REGIONS <= 2 * pixels * per_256
+}
+
+/// [`read`] in the scanline's band, at X = x + ½ − W/2.
+#[inline(always)]
+fn read_band<N: Nodes>(scan: &Scan, band: &N, fr: &Setup, big_x: f64) -> (Fx, Fx) {
+    let (mut l, mut v) = band.lookup(big_x.abs() * scan.col_per_x);
     if scan.back {
         l = fr.half_map_w_fx - l;
     }
@@ -74,20 +143,56 @@ fn lut_run<S: Sink>(
     table: &LutTable,
     fr: &Setup,
     row_scale: &[i64],
-    x0: i64,
-    x1: i64,
+    (x0, x1): (i64, i64),
+    scratch: &mut Scratch,
     sink: &mut S,
 ) {
     if x0 > x1 {
         return;
     }
+    let band = table.band(scan.band, scan.wa);
+    // The nodes the run reads: from the smallest |X| to the largest (the column and its
+    // node are monotonic in |X|), and the next node.
     let half_w = fr.w_out as f64 * 0.5;
-    let last_region = STEP_REGIONS - 1;
+    let (xa, xb) = (x0 as f64 + 0.5 - half_w, x1 as f64 + 0.5 - half_w);
+    let x_min = if xa < 0.0 && xb > 0.0 {
+        0.0
+    } else {
+        xa.abs().min(xb.abs())
+    };
+    let k0 = band.node(x_min * scan.col_per_x).0;
+    let k1 = band.node(xa.abs().max(xb.abs()) * scan.col_per_x).0 + 1;
+    let count = k1 + 1 - k0;
+    if count <= BLEND_NODES && blend_pays(scan, count, (x1 - x0 + 1) as usize) {
+        let nodes = &mut scratch[..count];
+        band.blend_nodes(k0, nodes);
+        let blended = Blended { band, k0, nodes };
+        lut_run_in(scan, &blended, fr, row_scale, x0, x1, sink);
+        return;
+    }
+    lut_run_in(scan, &band, fr, row_scale, x0, x1, sink);
+}
+
+/// [`lut_run`] with the scanline's nodes read through `band`.
+#[inline(always)]
+fn lut_run_in<S: Sink, N: Nodes>(
+    scan: &Scan,
+    band: &N,
+    fr: &Setup,
+    row_scale: &[i64],
+    x0: i64,
+    x1: i64,
+    sink: &mut S,
+) {
+    let half_w = fr.w_out as f64 * 0.5;
+    let last_region = STEP_REGIONS as i64 - 1;
     let mut xs = x0;
-    let (mut l0, mut v0) = read(scan, table, fr, xs);
+    // X of xs, carried from span to span (whole numbers plus ½: exact in f64).
+    let mut big_x = xs as f64 + 0.5 - half_w;
+    let (mut l0, mut v0) = read_band(scan, band, fr, big_x);
     loop {
-        let big_x = (xs as f64 + 0.5 - half_w).abs();
-        let region = ((big_x * scan.region_per_x) as usize).min(last_region);
+        // Through i64 (as usize: the same value, as |X| ≥ 0, but a longer conversion).
+        let region = ((big_x.abs() * scan.region_per_x) as i64).min(last_region) as usize;
         let shift = scan.shifts[region] as u32;
         let n = 1i64 << shift;
         let xe = (xs + n).min(x1);
@@ -95,7 +200,8 @@ fn lut_run<S: Sink>(
             emit(fr, row_scale, xs, 1, (l0, v0), (0, 0), sink);
             return;
         }
-        let (mut l1, v1) = read(scan, table, fr, xe);
+        let big_xe = xe as f64 + 0.5 - half_w;
+        let (mut l1, v1) = read_band(scan, band, fr, big_xe);
         // Unwrap longitude across the span: a ±180° seam is a jump of one map width.
         let d = l1 - l0;
         if d > fr.half_map_w_fx {
@@ -118,6 +224,7 @@ fn lut_run<S: Sink>(
         }
         emit(fr, row_scale, xs, m, (l0, v0), (dl, dv), sink);
         xs = xe;
+        big_x = big_xe;
         l0 = l1;
         v0 = v1;
     }

@@ -57,10 +57,18 @@ impl Batch {
         }
     }
 
-    /// Queue a span; `true` when the batch is full (flush it).
+    /// Queue a span with its level of detail (trilinear); `true` when the batch is full
+    /// (flush it).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn push(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, lod: i32) -> bool {
+    fn push_lod(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, lod: i32) -> bool {
+        self.lods[self.n] = lod;
+        self.push(x, m, u, v, du, dv)
+    }
+
+    /// Queue a span (nearest or bilinear: no level); `true` when the batch is full.
+    #[inline(always)]
+    fn push(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx) -> bool {
         self.jobs[self.n] = SpanJob {
             x: x as u32,
             len: m as u32,
@@ -69,7 +77,6 @@ impl Batch {
             du,
             dv,
         };
-        self.lods[self.n] = lod;
         self.n += 1;
         self.n == MAX_JOBS
     }
@@ -136,7 +143,7 @@ impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CR
     fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
         if CROP {
             sample_span_cropped::<BILINEAR>(self.map, &mut self.row[x..x + m], u, v, du, dv);
-        } else if self.batch.push(x, m, u, v, du, dv, 0) {
+        } else if self.batch.push(x, m, u, v, du, dv) {
             self.batch.flush::<BILINEAR>(self.map, self.row);
         }
     }
@@ -207,7 +214,7 @@ impl Sink for TriSink<'_> {
     }
     #[inline(always)]
     fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
-        if self.batch.push(x, m, u, v, du, dv, self.lod) {
+        if self.batch.push_lod(x, m, u, v, du, dv, self.lod) {
             self.batch.flush_trilinear(self.map, self.levels, self.row);
         }
     }
