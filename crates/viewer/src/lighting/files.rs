@@ -20,17 +20,20 @@ pub enum FileKind {
 /// How much of a file is read to judge it.
 const HEAD_BYTES: u64 = 64 << 10;
 
-/// The kind of the file at `path`: by its first 64 KiB; a file that cannot be read is
-/// judged by its extension (the loader then reports why it cannot be read).
+/// The kind of the file at `path`: by its first 64 KiB; a file that cannot be read, or is
+/// not a regular file (a FIFO would block the window on open, a device might never end),
+/// is judged by its extension (the loader then reports why it cannot be read).
 pub fn file_kind(path: &Path) -> FileKind {
     let by_name = path
         .extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("ies") || e.eq_ignore_ascii_case("ldt"));
     let mut head = Vec::new();
-    let read = std::fs::File::open(path)
-        .and_then(|f| f.take(HEAD_BYTES).read_to_end(&mut head))
-        .is_ok();
+    let regular = std::fs::metadata(path).is_ok_and(|m| m.is_file());
+    let read = regular
+        && std::fs::File::open(path)
+            .and_then(|f| f.take(HEAD_BYTES).read_to_end(&mut head))
+            .is_ok();
     if read {
         let text = String::from_utf8_lossy(&head);
         if is_scene(&text) {
@@ -53,6 +56,29 @@ mod tests {
 
     fn data(p: &str) -> std::path::PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(p)
+    }
+
+    /// A FIFO is judged by its name without being opened: opening it for reading would
+    /// block until a writer comes (the window froze on a dropped FIFO in the soak).
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_is_not_opened() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe.ies");
+        let status = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let (tx, rx) = std::sync::mpsc::channel();
+        let p = fifo.clone();
+        std::thread::spawn(move || tx.send(file_kind(&p)).unwrap());
+        let kind = rx.recv_timeout(std::time::Duration::from_secs(10));
+        assert_eq!(
+            kind,
+            Ok(FileKind::Light),
+            "file_kind blocked on a FIFO or misjudged it"
+        );
     }
 
     #[test]
