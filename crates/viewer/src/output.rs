@@ -405,7 +405,9 @@ mod tests {
         let e = write_image(&nowhere, &px, 2, 2).unwrap_err();
         assert!(format!("{e:#}").contains("does not exist"), "{e:#}");
         assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 1);
-        assert!(temporaries().is_empty());
+        // Other tests write files at the same time in this process: none of ours is left
+        // in the list.
+        assert!(!temporaries().iter().any(|p| p.starts_with(tmp.path())));
     }
 
     #[test]
