@@ -7,11 +7,6 @@ use std::process::ExitCode;
 use viewer::cli::{Cli, Command};
 use viewer::commands::{bench, bench_load, convert, ies, lux, render};
 
-/// mimalloc returns freed pages to the system; with glibc's allocator the window's
-/// resident memory crept up over a 10-minute soak (docs/reliability.md).
-#[global_allocator]
-static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 fn main() -> ExitCode {
     viewer::signals::install();
     let cli = Cli::parse();
