@@ -86,14 +86,14 @@ fn stdout_error(e: std::io::Error) -> anyhow::Error {
     anyhow::Error::new(e).context("cannot write to standard output")
 }
 
-/// As [`line`] for standard error, where a failure has nowhere to be reported: it is
+/// As [`line()`] for standard error, where a failure has nowhere to be reported: it is
 /// ignored (never a panic, as `eprintln!` would on a full disk).
 pub fn err_line(args: fmt::Arguments<'_>) {
     let mut e = std::io::stderr().lock();
     let _ = e.write_fmt(args).and_then(|()| e.write_all(b"\n"));
 }
 
-/// `println!` that returns an error instead of panicking (see [`line`]).
+/// `println!` that returns an error instead of panicking (see [`line()`]).
 #[macro_export]
 macro_rules! outln {
     ($($t:tt)*) => {

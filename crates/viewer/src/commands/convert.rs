@@ -131,7 +131,7 @@ fn cube_outputs(layout: Layout, output: &Path) -> Result<Vec<PathBuf>> {
 /// [`Layout::Files`], else one layout image (PNG or JPEG by extension). Atomic per file.
 ///
 /// # Errors
-/// As [`cube_outputs`], or a file that cannot be written.
+/// As `cube_outputs`, or a file that cannot be written.
 pub fn write_cube(cube: &CubeMap, layout: Layout, output: &Path) -> Result<()> {
     let n = cube.face_size();
     let outputs = cube_outputs(layout, output)?;

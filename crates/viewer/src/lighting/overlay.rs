@@ -46,7 +46,7 @@ pub fn project_segment(room: &Room, cam: &Camera, a: DVec3, b: DVec3) -> Option<
 const CURVE_PIECES: usize = 48;
 
 /// The 3-D segment `a`–`b` (room coordinates) as drawn in `cam`'s image: one clipped
-/// segment for a rectilinear view, else [`CURVE_PIECES`] pieces of the curve it becomes
+/// segment for a rectilinear view, else `CURVE_PIECES` pieces of the curve it becomes
 /// (pieces the view does not show, or that jump across the image where the projection
 /// wraps, are left out).
 pub fn edge_pieces(room: &Room, cam: &Camera, a: DVec3, b: DVec3) -> Vec<Segment> {
