@@ -109,48 +109,63 @@ fn padded<const N: usize>(src: &[u32]) -> [u32; N] {
     a
 }
 
+/// The two batch entry points of one instruction set, written once: `tri_jobs` and `jobs`
+/// compiled under that set's `target_feature`, so the span setup, the closures and the
+/// module's own `bilinear`/`nearest` inline into one loop per set.
+macro_rules! batch_entries {
+    ($feature:literal) => {
+        /// A batch of trilinear spans (see [`super::super::tri_jobs`]).
+        #[target_feature(enable = $feature)]
+        pub(super) fn tri_jobs(
+            levels: &[Texels],
+            row: &mut [u32],
+            jobs: &[SpanJob],
+            lods: &[i32],
+        ) -> u64 {
+            run_tri_jobs(
+                levels,
+                row,
+                jobs,
+                lods,
+                |t, out, s| match Local::new(t, s, out.len(), true) {
+                    Some(l) if out.len() >= 2 => bilinear::<false, 1>(t.px, t.stride(), out, l, 0),
+                    _ => scalar::bilinear(t, out, s),
+                },
+                |t, out, s, frac| match Local::new(t, s, out.len(), true) {
+                    Some(l) if out.len() >= 2 => {
+                        bilinear::<true, 2>(t.px, t.stride(), out, l, frac)
+                    }
+                    _ => scalar::blend_bilinear(t, out, s, frac),
+                },
+            )
+        }
+
+        /// A batch of spans of one row (see [`super::super::jobs`]): the span setup and the
+        /// kernel compiled together, the constants loaded once.
+        #[target_feature(enable = $feature)]
+        pub(super) fn jobs<const BILINEAR: bool>(
+            t: &Texels,
+            row: &mut [u32],
+            jobs: &[SpanJob],
+        ) -> u64 {
+            run_jobs::<BILINEAR>(t, row, jobs, |out, s| {
+                match Local::new(t, s, out.len(), BILINEAR) {
+                    Some(l) if out.len() >= 2 && BILINEAR => {
+                        bilinear::<false, 0>(t.px, t.stride(), out, l, 0)
+                    }
+                    Some(l) if out.len() >= 2 => nearest(t.px, t.stride(), out, l),
+                    _ if BILINEAR => scalar::bilinear(t, out, s),
+                    _ => scalar::nearest(t, out, s),
+                }
+            })
+        }
+    };
+}
+
 mod avx2 {
     use super::*;
 
-    /// A batch of trilinear spans (see [`super::super::tri_jobs`]).
-    #[target_feature(enable = "avx2")]
-    pub(super) fn tri_jobs(
-        levels: &[Texels],
-        row: &mut [u32],
-        jobs: &[SpanJob],
-        lods: &[i32],
-    ) -> u64 {
-        run_tri_jobs(
-            levels,
-            row,
-            jobs,
-            lods,
-            |t, out, s| match Local::new(t, s, out.len(), true) {
-                Some(l) if out.len() >= 2 => bilinear::<false, 1>(t.px, t.stride(), out, l, 0),
-                _ => scalar::bilinear(t, out, s),
-            },
-            |t, out, s, frac| match Local::new(t, s, out.len(), true) {
-                Some(l) if out.len() >= 2 => bilinear::<true, 2>(t.px, t.stride(), out, l, frac),
-                _ => scalar::blend_bilinear(t, out, s, frac),
-            },
-        )
-    }
-
-    /// A batch of spans of one row (see [`super::super::jobs`]): the span setup and the
-    /// kernel compiled together, the constants loaded once.
-    #[target_feature(enable = "avx2")]
-    pub(super) fn jobs<const BILINEAR: bool>(t: &Texels, row: &mut [u32], jobs: &[SpanJob]) -> u64 {
-        run_jobs::<BILINEAR>(t, row, jobs, |out, s| {
-            match Local::new(t, s, out.len(), BILINEAR) {
-                Some(l) if out.len() >= 2 && BILINEAR => {
-                    bilinear::<false, 0>(t.px, t.stride(), out, l, 0)
-                }
-                Some(l) if out.len() >= 2 => nearest(t.px, t.stride(), out, l),
-                _ if BILINEAR => scalar::bilinear(t, out, s),
-                _ => scalar::nearest(t, out, s),
-            }
-        })
-    }
+    batch_entries!("avx2");
 
     /// Per 32-bit lane: the fraction byte (bits 8..16) in both 16-bit halves.
     #[inline]
@@ -392,45 +407,7 @@ mod avx2 {
 mod sse41 {
     use super::*;
 
-    /// A batch of trilinear spans (see [`super::super::tri_jobs`]).
-    #[target_feature(enable = "sse4.1")]
-    pub(super) fn tri_jobs(
-        levels: &[Texels],
-        row: &mut [u32],
-        jobs: &[SpanJob],
-        lods: &[i32],
-    ) -> u64 {
-        run_tri_jobs(
-            levels,
-            row,
-            jobs,
-            lods,
-            |t, out, s| match Local::new(t, s, out.len(), true) {
-                Some(l) if out.len() >= 2 => bilinear::<false, 1>(t.px, t.stride(), out, l, 0),
-                _ => scalar::bilinear(t, out, s),
-            },
-            |t, out, s, frac| match Local::new(t, s, out.len(), true) {
-                Some(l) if out.len() >= 2 => bilinear::<true, 2>(t.px, t.stride(), out, l, frac),
-                _ => scalar::blend_bilinear(t, out, s, frac),
-            },
-        )
-    }
-
-    /// A batch of spans of one row (see [`super::super::jobs`]): the span setup and the
-    /// kernel compiled together, the constants loaded once.
-    #[target_feature(enable = "sse4.1")]
-    pub(super) fn jobs<const BILINEAR: bool>(t: &Texels, row: &mut [u32], jobs: &[SpanJob]) -> u64 {
-        run_jobs::<BILINEAR>(t, row, jobs, |out, s| {
-            match Local::new(t, s, out.len(), BILINEAR) {
-                Some(l) if out.len() >= 2 && BILINEAR => {
-                    bilinear::<false, 0>(t.px, t.stride(), out, l, 0)
-                }
-                Some(l) if out.len() >= 2 => nearest(t.px, t.stride(), out, l),
-                _ if BILINEAR => scalar::bilinear(t, out, s),
-                _ => scalar::nearest(t, out, s),
-            }
-        })
-    }
+    batch_entries!("sse4.1");
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
