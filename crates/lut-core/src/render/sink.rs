@@ -187,23 +187,15 @@ pub(crate) struct TriSink<'a> {
     pub(crate) lod: i32,
     /// The frame's exact footprints and this row's index.
     pub(crate) exact: (&'a ExactFootprint, usize),
-    /// Whole levels only (bilinear on the level matching the footprint, see
-    /// `Renderer::set_bilinear_level`): the level of detail is rounded down to a level.
-    pub(crate) whole_levels: bool,
     /// Spans waiting for the batch kernel, with their levels of detail.
     pub(crate) batch: Batch,
 }
 
 impl TriSink<'_> {
-    /// Set the level of detail (Q.8); with `whole_levels`, level k for footprints in
-    /// [2^k, 2^(k+1)) map pixels (the −½ bias of `lod_q8` undone, the blend weight 0).
+    /// Set the level of detail (Q.8).
     #[inline(always)]
     pub(crate) fn set_lod(&mut self, lod: i32) {
-        self.lod = if self.whole_levels {
-            (lod + 128) & !0xFF
-        } else {
-            lod
-        };
+        self.lod = lod;
     }
 }
 
@@ -233,11 +225,6 @@ impl Sink for TriSink<'_> {
         // 170 the edge columns beyond the wide table see a fraction of the centre's).
         let (fp, y) = self.exact;
         let lod = fp.lod(x, y, uv);
-        let lod = if self.whole_levels {
-            (lod + 128) & !0xFF
-        } else {
-            lod
-        };
         self.row[x] = sample_at_lod(self.map, uv, lod);
     }
     #[inline(always)]
@@ -332,7 +319,6 @@ impl RowSinks for TriRows<'_> {
             fy: [0.0; STEP_REGIONS],
             lod: 0,
             exact: (self.exact, y),
-            whole_levels: false,
             batch: Batch::new(),
         }
     }
