@@ -1,6 +1,6 @@
-//! The pixel storage of maps and pyramid levels: a zeroed `u32` buffer that, on Linux and
-//! from 2 MiB up, is 2 MiB-aligned and asks the kernel for transparent huge pages
-//! (`madvise(MADV_HUGEPAGE)`) before any pixel is written.
+//! The pixel storage of maps and pyramid levels: a zeroed `u32` buffer that, on Linux,
+//! asks the kernel for transparent huge pages (`madvise(MADV_HUGEPAGE)`) on its whole
+//! 2 MiB pages before any pixel is written.
 //!
 //! Why: a scanline of a panorama walks the map's rows 32 KiB (8k map) to 128 KiB (32k)
 //! apart, so nearly every texel row it crosses is another 4 KiB page, and a 128 MiB to
@@ -9,30 +9,29 @@
 //! (`/sys/kernel/mm/transparent_hugepage/enabled`), where only memory that asks for them
 //! gets them. Measured in `docs/huge.md` ("Huge pages").
 //!
-//! The buffer comes from the global allocator (so allocation counters see the map), with
-//! a 2 MiB alignment so whole huge pages fit; the advice is given while the memory is
-//! still untouched, then the buffer is zeroed in parallel bands (the first write faults
-//! the pages in, as huge pages where the kernel has them). Elsewhere, below 2 MiB, when
-//! the kernel refuses the advice (no THP, `never` mode) or with `LUTPANO_HUGE_PAGES=off`
-//! (for A/B measurements), it is an ordinary zeroed allocation: the pixels are the same
-//! either way. This module alone may use `unsafe` (allocation, `madvise`), each block
-//! with its `// SAFETY:`.
+//! The buffer is a zeroed allocation from the global allocator (so allocation counters
+//! see the map; for large blocks the system allocator maps fresh zero pages and touches
+//! none of them), and the advice covers the 2 MiB-aligned part of it (all but less than
+//! 2 MiB at each end) while it is still untouched: the pages are then faulted in as huge
+//! pages when the pixels are first written, zeroed once by the kernel. (A 2 MiB-aligned
+//! allocation was tried first: the allocator cannot hand it out zeroed without writing
+//! it, and the extra zeroing pass made loading a 32k map slower.) Elsewhere, below 4 MiB,
+//! when the kernel refuses the advice (no THP, `never` mode) or with
+//! `LUTPANO_HUGE_PAGES=off` (for A/B measurements), it is an ordinary zeroed allocation:
+//! the pixels are the same either way. This module alone may use `unsafe` (allocation,
+//! `madvise`), each block with its `// SAFETY:`.
 
 #![allow(unsafe_code)]
 
-use rayon::prelude::*;
 use std::alloc::Layout;
 use std::ptr::NonNull;
 use std::sync::OnceLock;
 
-/// The huge page size the buffer aligns to (x86-64 and aarch64 with 4 KiB base pages).
+/// The transparent huge page size (x86-64, and aarch64 with 4 KiB base pages).
 pub const HUGE_PAGE: usize = 2 << 20;
 
 /// Environment variable: `off` (or `0`) turns the huge-page advice off (read once).
 pub const HUGE_PAGES_ENV: &str = "LUTPANO_HUGE_PAGES";
-
-/// Alignment of buffers too small for huge pages: a cache line.
-const SMALL_ALIGN: usize = 64;
 
 /// Whether large buffers ask for huge pages: on Linux unless [`HUGE_PAGES_ENV`] says
 /// `off` / `0` / `no` / `false`.
@@ -67,46 +66,20 @@ impl PixelBuf {
     /// `len` zeroed pixels, or `None` when the memory cannot be had (or `len · 4`
     /// overflows).
     pub fn try_zeroed(len: usize) -> Option<PixelBuf> {
-        let bytes = len.checked_mul(4)?;
-        if bytes == 0 {
+        let layout = Layout::array::<u32>(len).ok()?;
+        if layout.size() == 0 {
             return Some(PixelBuf {
                 ptr: NonNull::dangling(),
                 len: 0,
                 layout: None,
             });
         }
-        let huge = bytes >= HUGE_PAGE && huge_pages_enabled();
-        let align = if huge { HUGE_PAGE } else { SMALL_ALIGN };
-        let layout = Layout::from_size_align(bytes, align).ok()?;
-        if !huge {
-            // SAFETY: `layout` has a nonzero size.
-            let p = unsafe { std::alloc::alloc_zeroed(layout) };
-            return NonNull::new(p.cast::<u32>()).map(|ptr| PixelBuf {
-                ptr,
-                len,
-                layout: Some(layout),
-            });
-        }
-        // Not zeroed by the allocator: `alloc_zeroed` with a large alignment writes the
-        // zeros itself, which would fault the pages in (as 4 KiB pages) before the
-        // advice below.
         // SAFETY: `layout` has a nonzero size.
-        let p = unsafe { std::alloc::alloc(layout) };
+        let p = unsafe { std::alloc::alloc_zeroed(layout) };
         let ptr = NonNull::new(p.cast::<u32>())?;
-        advise_huge(p, bytes);
-        // Zero in parallel bands of whole huge pages (each band's first writes fault its
-        // pages in). The address goes to the workers as an integer.
-        let base = p as usize;
-        (0..bytes.div_ceil(HUGE_PAGE))
-            .into_par_iter()
-            .with_min_len(8)
-            .for_each(|k| {
-                let start = k * HUGE_PAGE;
-                let n = HUGE_PAGE.min(bytes - start);
-                // SAFETY: [start, start + n) lies inside the allocation of `bytes` bytes
-                // made above, and the bands are disjoint; nothing else refers to it yet.
-                unsafe { std::ptr::write_bytes((base + start) as *mut u8, 0, n) };
-            });
+        if layout.size() >= 2 * HUGE_PAGE && huge_pages_enabled() {
+            advise_huge(p, layout.size());
+        }
         Some(PixelBuf {
             ptr,
             len,
@@ -129,23 +102,26 @@ impl PixelBuf {
         b.copy_from_slice(px);
         b
     }
-
-    /// The alignment of the allocation (tests: 2 MiB for huge-page buffers).
-    pub fn align(&self) -> usize {
-        self.layout.map_or(1, |l| l.align())
-    }
 }
 
-/// Ask for transparent huge pages on `[p, p + bytes)` (whole huge pages only; `p` is
-/// 2 MiB-aligned). Advice only: an error (no THP in this kernel) changes nothing.
+/// The 2 MiB-aligned part of `[p, p + bytes)`: its start and length (0 if none).
+fn huge_part(p: usize, bytes: usize) -> (usize, usize) {
+    let start = p.next_multiple_of(HUGE_PAGE);
+    let end = (p + bytes) / HUGE_PAGE * HUGE_PAGE;
+    (start, end.saturating_sub(start))
+}
+
+/// Ask for transparent huge pages on the whole 2 MiB pages of `[p, p + bytes)`. Advice
+/// only: an error (no THP in this kernel) changes nothing.
 #[cfg(target_os = "linux")]
 fn advise_huge(p: *mut u8, bytes: usize) {
-    let len = bytes / HUGE_PAGE * HUGE_PAGE;
+    let (start, len) = huge_part(p as usize, bytes);
     if len > 0 {
-        // SAFETY: `p` is the start of a live allocation of `bytes` ≥ `len` bytes, aligned
-        // to 2 MiB (a multiple of the page size, as madvise requires); MADV_HUGEPAGE
+        // SAFETY: [start, start + len) lies inside the live allocation [p, p + bytes)
+        // and starts on a 2 MiB (so a page) boundary, as madvise requires; MADV_HUGEPAGE
         // changes how the kernel backs the range, never its contents or validity.
-        let _ = unsafe { libc::madvise(p.cast(), len, libc::MADV_HUGEPAGE) };
+        let _ =
+            unsafe { libc::madvise(p.add(start - p as usize).cast(), len, libc::MADV_HUGEPAGE) };
     }
 }
 
@@ -187,10 +163,7 @@ impl Clone for PixelBuf {
 
 impl std::fmt::Debug for PixelBuf {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("PixelBuf")
-            .field("len", &self.len)
-            .field("align", &self.align())
-            .finish()
+        f.debug_struct("PixelBuf").field("len", &self.len).finish()
     }
 }
 
@@ -221,25 +194,20 @@ mod tests {
     }
 
     #[test]
-    fn zeroed_writable_and_aligned() {
+    fn zeroed_and_writable() {
         for len in [
             0usize,
             1,
             3,
             1000,
             HUGE_PAGE / 4 - 1,
-            HUGE_PAGE / 4,
-            3 * HUGE_PAGE / 4 + 5,
+            HUGE_PAGE / 2,
+            HUGE_PAGE + 5,
         ] {
             let mut b = PixelBuf::zeroed(len);
             assert_eq!(b.len(), len);
             assert!(b.iter().all(|&p| p == 0), "len {len}");
-            let huge = len * 4 >= HUGE_PAGE && huge_pages_enabled();
-            if len > 0 {
-                let want = if huge { HUGE_PAGE } else { SMALL_ALIGN };
-                assert_eq!(b.align(), want, "len {len}");
-                assert_eq!(b.as_ptr() as usize % want, 0, "len {len}");
-            }
+            assert_eq!(b.as_ptr() as usize % 4, 0);
             for (i, p) in b.iter_mut().enumerate() {
                 *p = (i as u32).wrapping_mul(2654435761);
             }
@@ -253,8 +221,23 @@ mod tests {
         assert!(PixelBuf::try_zeroed(usize::MAX / 2).is_none());
     }
 
+    #[test]
+    fn the_advised_part_is_whole_huge_pages_inside() {
+        let h = HUGE_PAGE;
+        assert_eq!(huge_part(h, 2 * h), (h, 2 * h));
+        assert_eq!(huge_part(h + 16, h), (2 * h, 0));
+        assert_eq!(huge_part(h + 16, 3 * h), (2 * h, 2 * h));
+        assert_eq!(huge_part(16, 8 * h + 5), (h, 7 * h));
+        for p in [16usize, 4096 + 16, 3 * h - 8] {
+            let bytes = 64 * h + 12;
+            let (s, n) = huge_part(p, bytes);
+            assert!(s >= p && s + n <= p + bytes && s % h == 0 && n % h == 0);
+            assert!(bytes - n < 2 * h, "all but less than 2 MiB at each end");
+        }
+    }
+
     /// A map's padded pixels (and its pyramid levels') sit in such a buffer: the same
-    /// pixels as given, 2 MiB-aligned when large.
+    /// pixels as given.
     #[test]
     fn maps_and_levels_keep_their_pixels() {
         use crate::{EnvMap, Projection};
@@ -271,9 +254,6 @@ mod tests {
         let (data, stride) = m.padded();
         assert_eq!(stride, w as usize + 1);
         assert_eq!(data.len(), (w as usize + 1) * (h as usize + 1));
-        if huge_pages_enabled() {
-            assert_eq!(data.as_ptr() as usize % HUGE_PAGE, 0);
-        }
         let c = m.clone();
         assert_eq!(c.padded().0, data);
         assert_eq!(m.pyramid()[0].width(), w / 2);
@@ -285,8 +265,10 @@ mod tests {
     #[test]
     fn large_buffers_ask_for_huge_pages() {
         let thp = std::fs::read_to_string("/sys/kernel/mm/transparent_hugepage/enabled");
-        let b = PixelBuf::zeroed(3 * HUGE_PAGE / 4);
-        let flags = vm_flags_at(b.as_ptr() as usize).expect("the buffer's mapping in smaps");
+        let b = PixelBuf::zeroed(3 * HUGE_PAGE / 2);
+        let (start, len) = huge_part(b.as_ptr() as usize, b.len() * 4);
+        assert!(len > 0);
+        let flags = vm_flags_at(start).expect("the buffer's mapping in smaps");
         let hg = flags.split_whitespace().any(|f| f == "hg");
         match (thp, huge_pages_enabled()) {
             (Ok(_), true) => assert!(hg, "{flags}"),
