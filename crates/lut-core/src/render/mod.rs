@@ -531,11 +531,7 @@ impl Renderer {
         ) {
             let (scans, table, setup, row_scale) = k;
             for_each_row_init(out, w, threads, new_scratch, |scratch, y, row| {
-                let mut s = PixelSink::<BILINEAR, CROP> {
-                    row,
-                    map,
-                    batch: Batch::new(),
-                };
+                let mut s = PixelSink::<BILINEAR, CROP>::new(row, map);
                 render_row(&scans[y], table, setup, row_scale, scratch, &mut s);
                 s.flush();
             });

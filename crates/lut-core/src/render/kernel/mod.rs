@@ -253,6 +253,26 @@ pub(crate) fn sample_span<const BILINEAR: bool>(
     }
 }
 
+/// Nearest samples of one span straight into `out`, with no batch: the renderer's short
+/// nearest spans. At the 8 pixels of a span at hfov 90 the scalar loop costs less than
+/// queueing the span and setting up SIMD lanes for it (docs/performance.md, "Nearest
+/// without the batch"); the bytes are the scalar kernel's, which every SIMD kernel
+/// equals (`tests.rs`). `t` is [`texels`] of `map`, or `None` for
+/// maps whose rows wrap within their own length (per pixel, as [`sample_spans`]).
+#[inline(always)]
+pub(crate) fn nearest_span_direct(
+    map: &EnvMap,
+    t: Option<&Texels>,
+    out: &mut [u32],
+    (u, v): (Fx, Fx),
+    (du, dv): (Fx, Fx),
+) {
+    match t.and_then(|t| Some((t, jobs::prepare::<false>(t, out.len(), (u, v), (du, dv))?))) {
+        Some((t, s)) => scalar::nearest(t, out, s),
+        None => sample_span_slow::<false>(map, out, u, v, du, dv),
+    }
+}
+
 /// [`sample_span`] for a batch of spans of one output row (at most [`MAX_JOBS`]): one
 /// kernel call for them all; spans leaving the map are sampled per pixel.
 pub(crate) fn sample_spans<const BILINEAR: bool>(map: &EnvMap, row: &mut [u32], spans: &[SpanJob]) {

@@ -524,3 +524,46 @@ fn span_equals_per_pixel() {
         }
     }
 }
+
+/// The renderer's short nearest spans, sampled without the batch
+/// (`nearest_span_direct`), equal the per-pixel sampler and the batch path, inside the
+/// map, across the seam, off its edges (the per-pixel fallback) and on maps whose rows
+/// wrap within their length (no texels: per pixel).
+#[test]
+fn direct_nearest_spans_equal_per_pixel_samples() {
+    for proj in [Projection::Equirect, Projection::Elliptical] {
+        let m = grid_map(64, 32, proj).unwrap();
+        let t = (!proj.scaled_rows()).then(|| texels(&m));
+        let wfx = 64i64 << FX_BITS;
+        for &(u, v, du, dv) in &[
+            (3.3, 4.2, 0.7, 0.1),
+            (60.0, 10.0, 0.5, 0.0),
+            (-2.0, 31.5, 0.25, 0.02),
+            (10.0, 0.1, -0.3, -0.01),
+            (0.2, 16.0, 1.9, 0.4),
+            (63.99, 31.99, 0.0, 0.0),
+        ] {
+            let (u, v, du, dv) = (to_fx(u), to_fx(v), to_fx(du), to_fx(dv));
+            for len in [1usize, 2, 7, 8, 9, 40] {
+                let mut direct = vec![0u32; len];
+                let mut batch = vec![0u32; len];
+                nearest_span_direct(&m, t.as_ref(), &mut direct, (u, v), (du, dv));
+                let job = SpanJob {
+                    x: 0,
+                    len: len as u32,
+                    u,
+                    v,
+                    du,
+                    dv,
+                };
+                sample_spans::<false>(&m, &mut batch, &[job]);
+                assert_eq!(direct, batch, "{proj} len {len}");
+                for (i, &d) in direct.iter().enumerate() {
+                    let uu = u + du * i as i64;
+                    let uu = if proj.wraps() { uu.rem_euclid(wfx) } else { uu };
+                    assert_eq!(d, m.nearest(uu, v + dv * i as i64), "{proj} pixel {i}");
+                }
+            }
+        }
+    }
+}
