@@ -679,12 +679,15 @@ fn new_scratch() -> Scratch {
 /// sides divisible by 2^k is exactly the map at 1/2^k scale; see `map/pyramid.rs`).
 /// Levels end at a side of 2, as the pyramid does.
 pub(crate) fn frame_level(centre: f64, w: u32, h: u32) -> usize {
-    if !(centre >= std::f64::consts::SQRT_2) {
+    // (NaN too.)
+    if centre.partial_cmp(&std::f64::consts::SQRT_2) != Some(std::cmp::Ordering::Greater) {
         return 0;
     }
     let want = (centre.log2() + 0.5).floor().min(31.0) as u32;
     (1..=want)
-        .take_while(|&k| w % (1 << k) == 0 && h % (1 << k) == 0 && (w.min(h) >> k) >= 2)
+        .take_while(|&k| {
+            w.is_multiple_of(1 << k) && h.is_multiple_of(1 << k) && (w.min(h) >> k) >= 2
+        })
         .last()
         .map_or(0, |k| k as usize)
 }

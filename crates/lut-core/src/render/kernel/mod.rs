@@ -48,7 +48,9 @@
 //! compiled into one `#[target_feature]` function (each SIMD loop has a single caller, so
 //! it is inlined there; a non-inlined kernel taking its span setup through memory cost a
 //! failed store-to-load forward per span, and made AVX2 nearest slower than scalar).
-//! Single spans are batches of one.
+//! Single spans are batches of one. Nearest spans of up to 8 pixels skip the batch:
+//! the renderer samples them at once with the scalar loop (`nearest_span_direct`),
+//! which costs less than the queueing and the lane setup at that length.
 //!
 //! # Identical bytes
 //! Every SIMD kernel computes exactly what its scalar twin in `scalar.rs` computes: the
