@@ -20,15 +20,24 @@
 //! rounding everywhere in between and every pixel's per-pixel face choice is that face,
 //! strictly. Ends that fail the check (a pixel center within `δ` of a face edge, or a
 //! scanline lying in an edge plane) are peeled off and handled per pixel; a run that still
-//! fails is done per pixel. Inside a verified run the loop neither chooses a face nor
-//! branches on one, and the face's axis selection is compiled in.
+//! fails is done per pixel.
 //!
-//! The face coordinates come from [`face_uv`] on the bit-identical ray in both renderers,
-//! so the two images are byte-identical (tested over sweeps of views, sizes and both
-//! samplers in `tests/cube.rs`).
+//! # Runs on the span kernels
+//! On a verified run's face the ray's axes `(a, b, m)` are linear in `dx` and the face
+//! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line. The run goes to
+//! the span kernels (`render/kernel/face.rs`: AVX2, SSE4.1 or the scalar twin, chosen
+//! once per process as for the map's spans, `LUTPANO_KERNEL=scalar` forcing the portable
+//! one), which evaluate that line exactly at every pixel in `f64` SIMD lanes with the
+//! arithmetic of [`face_uv`] (one division per pixel) and gather and blend with the map
+//! kernels' code. No position is interpolated: the per-pixel path's face coordinates
+//! come from [`face_uv`] on the bit-identical ray, the kernels' from the same operations,
+//! so the two renderers' images are byte-identical (tested over sweeps of views, sizes
+//! and both samplers in `tests/cube.rs`, with every kernel), and the sampling-position
+//! error of the cube renderers is zero.
 
 use super::exact::render_exact;
 use super::frame::Frame;
+use super::kernel::{face_span, FaceRun, Texels};
 use crate::cube::{
     check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
 };
@@ -157,6 +166,8 @@ fn ray(p: DVec3, b: DVec3, dx: f64) -> DVec3 {
 /// Texel fetch, monomorphized per sampler so the inner loops do not branch on it.
 trait Fetch: Copy + Send + Sync {
     fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32;
+    /// A verified run on one face (`t`: its bordered texels), with the span kernel.
+    fn span(self, t: &Texels, run: &FaceRun, out: &mut [u32]);
 }
 
 #[derive(Clone, Copy)]
@@ -169,12 +180,20 @@ impl Fetch for NearestFetch {
     fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32 {
         cube.nearest(face, u, v)
     }
+    #[inline(always)]
+    fn span(self, t: &Texels, run: &FaceRun, out: &mut [u32]) {
+        face_span::<false>(t, run, out)
+    }
 }
 
 impl Fetch for BilinearFetch {
     #[inline(always)]
     fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32 {
         cube.bilinear(face, u, v)
+    }
+    #[inline(always)]
+    fn span(self, t: &Texels, run: &FaceRun, out: &mut [u32]) {
+        face_span::<true>(t, run, out)
     }
 }
 
@@ -209,6 +228,14 @@ fn render_with<S: Fetch>(
     threads: bool,
 ) {
     let w = frame.w as usize;
+    // Each face's bordered texels as the span kernels read them (side n + 1: the
+    // (n + 2)² stored texels).
+    let side = cube.face_size() + 1;
+    let faces: [Texels; 6] = std::array::from_fn(|k| {
+        Texels::new(cube.bordered_face(Face::from_index(k)), side, side, false)
+            .expect("a cube face holds (n + 2)^2 texels, fewer than 2^31")
+    });
+    let faces = &faces;
     // Bands of whole rows, at least ~16k pixels each so small frames stay on one thread.
     let rows_per_band = (16384 / w).clamp(1, frame.h as usize);
     let band = |(bi, chunk): (usize, &mut [u32])| {
@@ -217,7 +244,7 @@ fn render_with<S: Fetch>(
             let y = bi * rows_per_band + r;
             match renderer {
                 CubeRenderer::Basic => basic_row(cube, frame, s, y, line),
-                CubeRenderer::Accelerated => accel_row(cube, frame, s, y, line, &mut segs),
+                CubeRenderer::Accelerated => accel_row(cube, faces, frame, s, y, line, &mut segs),
             }
         }
     };
@@ -306,6 +333,7 @@ fn margin(face: Face, d: DVec3) -> f64 {
 
 fn accel_row<S: Fetch>(
     cube: &CubeMap,
+    faces: &[Texels; 6],
     frame: &Rays,
     s: S,
     y: usize,
@@ -340,36 +368,18 @@ fn accel_row<S: Fetch>(
             per_pixel(cube, frame, s, y, line, a, e);
             continue;
         }
-        match seg.face {
-            Face::Front => run::<0, S>(cube, frame, s, p, line, a, e),
-            Face::Right => run::<1, S>(cube, frame, s, p, line, a, e),
-            Face::Back => run::<2, S>(cube, frame, s, p, line, a, e),
-            Face::Left => run::<3, S>(cube, frame, s, p, line, a, e),
-            Face::Up => run::<4, S>(cube, frame, s, p, line, a, e),
-            Face::Down => run::<5, S>(cube, frame, s, p, line, a, e),
-        }
-    }
-}
-
-/// A verified run on face `F`: step the ray along the scanline, no face choice.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn run<const F: usize, S: Fetch>(
-    cube: &CubeMap,
-    frame: &Rays,
-    s: S,
-    p: DVec3,
-    line: &mut [u32],
-    a: usize,
-    e: usize,
-) {
-    let face = Face::from_index(F);
-    let b = frame.b;
-    let half = frame.half_face;
-    for (x, px) in line[a..e].iter_mut().enumerate() {
-        let d = ray(p, b, frame.dx(a + x));
-        let (u, v) = face_uv(face, d, half);
-        *px = s.fetch(cube, face, u, v);
+        // A verified run: the ray's coordinates on the face's axes are linear in dx,
+        // the face coordinates a projective line, evaluated exactly per pixel by the
+        // span kernel (render/kernel/face.rs) with the per-pixel path's arithmetic.
+        let (pa, pb, pm) = face_axes(seg.face, p);
+        let (ba, bb, bm) = face_axes(seg.face, b);
+        let run = FaceRun {
+            p: [pa, pb, pm],
+            d: [ba, bb, bm],
+            dx: frame.dx(a),
+            half: frame.half_face,
+        };
+        s.span(&faces[seg.face.index()], &run, &mut line[a..e]);
     }
 }
 
