@@ -38,17 +38,22 @@
 use super::exact::render_exact;
 use super::frame::Frame;
 use super::kernel::{face_span, FaceRun, Texels};
+use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
     check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
 };
 use crate::geom::camera::View;
 use crate::map::envmap::EnvMap;
+use crate::map::pyramid::lod_q8;
+use crate::map::sample::lerp_px;
 use crate::map::sample::Sampler;
 use crate::named::{parse_name, unknown_name, Named};
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// Which of the paper's renderers to use. Both give byte-identical images.
+/// Which of the paper's renderers to use. Both give byte-identical images with nearest
+/// and bilinear sampling; with trilinear the scanline renderer takes the level of detail
+/// per 16 pixels of a face run, the basic one per pixel (`cube/pyramid.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum CubeRenderer {
     /// Section 1: per pixel, ray → face by the largest |coordinate| → face coordinates.
@@ -163,44 +168,105 @@ fn ray(p: DVec3, b: DVec3, dx: f64) -> DVec3 {
     DVec3::new(p.x + dx * b.x, p.y + dx * b.y, p.z + dx * b.z)
 }
 
+/// A face's bordered texels as the span kernels read them (side n + 1: the (n + 2)²
+/// stored texels).
+#[inline]
+fn face_texels(cube: &CubeMap, face: Face) -> Texels<'_> {
+    let side = cube.face_size() + 1;
+    Texels::new(cube.bordered_face(face), side, side, false)
+        .expect("a cube face holds (n + 2)^2 texels, fewer than 2^31")
+}
+
 /// Texel fetch, monomorphized per sampler so the inner loops do not branch on it.
 trait Fetch: Copy + Send + Sync {
-    fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32;
-    /// A verified run on one face (`t`: its bordered texels), with the span kernel.
-    fn span(self, t: &Texels, run: &FaceRun, out: &mut [u32]);
+    /// The sample of ray `d` on `face` (the face of `d`), per pixel.
+    fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32;
+    /// A verified run on `face` (`run`: its projective line), with the span kernels.
+    fn span(self, cube: &CubeMap, frame: &Rays, face: Face, run: &FaceRun, out: &mut [u32]);
 }
 
 #[derive(Clone, Copy)]
 struct NearestFetch;
 #[derive(Clone, Copy)]
 struct BilinearFetch;
+#[derive(Clone, Copy)]
+struct TrilinearFetch;
 
 impl Fetch for NearestFetch {
     #[inline(always)]
-    fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32 {
+    fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32 {
+        let (u, v) = face_uv(face, d, frame.half_face);
         cube.nearest(face, u, v)
     }
     #[inline(always)]
-    fn span(self, t: &Texels, run: &FaceRun, out: &mut [u32]) {
-        face_span::<false>(t, run, out)
+    fn span(self, cube: &CubeMap, _: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
+        face_span::<false>(&face_texels(cube, face), run, out)
     }
 }
 
 impl Fetch for BilinearFetch {
     #[inline(always)]
-    fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32 {
+    fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32 {
+        let (u, v) = face_uv(face, d, frame.half_face);
         cube.bilinear(face, u, v)
     }
     #[inline(always)]
-    fn span(self, t: &Texels, run: &FaceRun, out: &mut [u32]) {
-        face_span::<true>(t, run, out)
+    fn span(self, cube: &CubeMap, _: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
+        face_span::<true>(&face_texels(cube, face), run, out)
+    }
+}
+
+/// Trilinear on the face pyramid (`cube/pyramid.rs`): per pixel, the level of detail of
+/// the pixel's own footprint; on a run, one per [`TRILINEAR_RUN_CHUNK`] pixels (at the
+/// chunk's middle pixel), the chunk drawn by the span kernels on the two levels and
+/// blended.
+impl Fetch for TrilinearFetch {
+    #[inline(always)]
+    fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32 {
+        let lod = lod_of(face, d, frame.b, frame.r1, frame.half_face);
+        cube.trilinear_dir(face, d, lod)
+    }
+
+    fn span(self, cube: &CubeMap, frame: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
+        // The image's x and y steps on the face's axes (y: −R₁ per row; the sign does not
+        // change the footprint).
+        let (sx, sy) = (face_axes(face, frame.b), face_axes(face, frame.r1));
+        let mut scratch = [0u32; TRILINEAR_RUN_CHUNK];
+        for (c, chunk) in out.chunks_mut(TRILINEAR_RUN_CHUNK).enumerate() {
+            let dx = run.dx + (c * TRILINEAR_RUN_CHUNK) as f64;
+            let mid = dx + (chunk.len() / 2) as f64;
+            let at = |i: usize| run.p[i] + mid * run.d[i];
+            let lod = lod_q8(footprint((at(0), at(1), at(2)), sx, sy, frame.half_face));
+            let sub = FaceRun { dx, ..*run };
+            let on_level = |k: usize, out: &mut [u32]| {
+                let (l, _) = cube.level(k);
+                let half = l.face_size() as f64 / 2.0;
+                face_span::<true>(&face_texels(l, face), &FaceRun { half, ..sub }, out)
+            };
+            if lod <= 0 {
+                on_level(0, chunk);
+                continue;
+            }
+            let (k, frac) = ((lod >> 8) as usize, (lod & 0xFF) as u32);
+            let (ka, kb) = (cube.level(k).1, cube.level(k + 1).1);
+            on_level(ka, chunk);
+            if frac == 0 || ka == kb {
+                continue;
+            }
+            let s = &mut scratch[..chunk.len()];
+            on_level(kb, s);
+            for (o, b) in chunk.iter_mut().zip(s.iter()) {
+                *o = lerp_px(*o, *b, frac);
+            }
+        }
     }
 }
 
 /// Render `view` of `cube` into `frame` with the chosen renderer (the entry is
 /// [`crate::Renderer::render`] of a [`crate::Scene::Cube`]). `threads` splits rows into
 /// bands across the rayon pool; the output is identical either way, and identical between
-/// the two renderers.
+/// the two renderers (nearest, bilinear; see [`CubeRenderer`] for trilinear, which builds
+/// the face pyramid on first use).
 pub(crate) fn render_cube(
     cube: &CubeMap,
     view: View,
@@ -213,8 +279,10 @@ pub(crate) fn render_cube(
     let out = frame.pixels_mut();
     match sampler {
         Sampler::Nearest => render_with(cube, &rays, NearestFetch, renderer, out, threads),
-        Sampler::Bilinear | Sampler::Trilinear => {
-            render_with(cube, &rays, BilinearFetch, renderer, out, threads)
+        Sampler::Bilinear => render_with(cube, &rays, BilinearFetch, renderer, out, threads),
+        Sampler::Trilinear => {
+            cube.pyramid(); // built here, not inside a row band
+            render_with(cube, &rays, TrilinearFetch, renderer, out, threads)
         }
     }
 }
@@ -228,14 +296,6 @@ fn render_with<S: Fetch>(
     threads: bool,
 ) {
     let w = frame.w as usize;
-    // Each face's bordered texels as the span kernels read them (side n + 1: the
-    // (n + 2)² stored texels).
-    let side = cube.face_size() + 1;
-    let faces: [Texels; 6] = std::array::from_fn(|k| {
-        Texels::new(cube.bordered_face(Face::from_index(k)), side, side, false)
-            .expect("a cube face holds (n + 2)^2 texels, fewer than 2^31")
-    });
-    let faces = &faces;
     // Bands of whole rows, at least ~16k pixels each so small frames stay on one thread.
     let rows_per_band = (16384 / w).clamp(1, frame.h as usize);
     let band = |(bi, chunk): (usize, &mut [u32])| {
@@ -244,7 +304,7 @@ fn render_with<S: Fetch>(
             let y = bi * rows_per_band + r;
             match renderer {
                 CubeRenderer::Basic => basic_row(cube, frame, s, y, line),
-                CubeRenderer::Accelerated => accel_row(cube, faces, frame, s, y, line, &mut segs),
+                CubeRenderer::Accelerated => accel_row(cube, frame, s, y, line, &mut segs),
             }
         }
     };
@@ -272,9 +332,7 @@ fn per_pixel<S: Fetch>(
     for (x, px) in line.iter_mut().enumerate().take(x1).skip(x0) {
         // The whole rotation per pixel; bit-identical to the accelerated path's ray.
         let d = ray(frame.row(dy), frame.b, frame.dx(x));
-        let face = face_of(d);
-        let (u, v) = face_uv(face, d, frame.half_face);
-        *px = s.fetch(cube, face, u, v);
+        *px = s.fetch(cube, frame, face_of(d), d);
     }
 }
 
@@ -333,7 +391,6 @@ fn margin(face: Face, d: DVec3) -> f64 {
 
 fn accel_row<S: Fetch>(
     cube: &CubeMap,
-    faces: &[Texels; 6],
     frame: &Rays,
     s: S,
     y: usize,
@@ -379,7 +436,7 @@ fn accel_row<S: Fetch>(
             dx: frame.dx(a),
             half: frame.half_face,
         };
-        s.span(&faces[seg.face.index()], &run, &mut line[a..e]);
+        s.span(cube, frame, seg.face, &run, &mut line[a..e]);
     }
 }
 

@@ -185,6 +185,11 @@ pub fn load(
                 naming,
             };
             let cube = crate::panorama::load_cube(paths, cube).map_err(|e| format!("{e:#}"))?;
+            // The face pyramid (the window's default sampler is trilinear) now, so the
+            // first frames do not wait for it.
+            progress(LoadStep::Tables, Some(0.0));
+            cube.pyramid();
+            progress(LoadStep::Tables, Some(1.0));
             return Ok(Box::new(Loaded {
                 scene: Scene::Cube(cube),
                 source,
