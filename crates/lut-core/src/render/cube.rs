@@ -37,7 +37,7 @@
 
 use super::exact::render_exact;
 use super::frame::Frame;
-use super::kernel::{face_span, FaceRun, Texels};
+use super::kernel::{face_blend, face_span, FaceRun, Texels};
 use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
     check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
@@ -45,7 +45,6 @@ use crate::cube::{
 use crate::geom::camera::View;
 use crate::map::envmap::EnvMap;
 use crate::map::pyramid::lod_q8;
-use crate::map::sample::lerp_px;
 use crate::map::sample::Sampler;
 use crate::named::{parse_name, unknown_name, Named};
 use glam::DVec3;
@@ -231,7 +230,6 @@ impl Fetch for TrilinearFetch {
         // The image's x and y steps on the face's axes (y: −R₁ per row; the sign does not
         // change the footprint).
         let (sx, sy) = (face_axes(face, frame.b), face_axes(face, frame.r1));
-        let mut scratch = [0u32; TRILINEAR_RUN_CHUNK];
         for (c, chunk) in out.chunks_mut(TRILINEAR_RUN_CHUNK).enumerate() {
             let dx = run.dx + (c * TRILINEAR_RUN_CHUNK) as f64;
             let mid = dx + (chunk.len() / 2) as f64;
@@ -253,11 +251,9 @@ impl Fetch for TrilinearFetch {
             if frac == 0 || ka == kb {
                 continue;
             }
-            let s = &mut scratch[..chunk.len()];
-            on_level(kb, s);
-            for (o, b) in chunk.iter_mut().zip(s.iter()) {
-                *o = lerp_px(*o, *b, frac);
-            }
+            let (l, _) = cube.level(kb);
+            let half = l.face_size() as f64 / 2.0;
+            face_blend(&face_texels(l, face), &FaceRun { half, ..sub }, chunk, frac);
         }
     }
 }

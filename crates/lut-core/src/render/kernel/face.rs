@@ -53,8 +53,14 @@ pub(super) fn face_side(t: &Texels) -> usize {
 }
 
 /// The portable kernel, one pixel at a time: the reference the SIMD kernels equal, and
-/// the per-pixel renderer's arithmetic (see the module docs).
-pub(super) fn scalar<const BILINEAR: bool>(t: &Texels, r: &FaceRun, out: &mut [u32]) {
+/// the per-pixel renderer's arithmetic (see the module docs)
+/// (`BLEND`: bilinear blended into `out` by `frac`, `lerp_px(out, sample, frac)`).
+pub(super) fn scalar<const BILINEAR: bool, const BLEND: bool>(
+    t: &Texels,
+    r: &FaceRun,
+    out: &mut [u32],
+    frac: u32,
+) {
     let n = face_side(t);
     let stride = t.stride();
     let nf = n as f64;
@@ -65,7 +71,7 @@ pub(super) fn scalar<const BILINEAR: bool>(t: &Texels, r: &FaceRun, out: &mut [u
         let m = r.p[2] + dx * r.d[2];
         let q = r.half / m;
         let (u, v) = (r.half + a * q, r.half - b * q);
-        *o = if BILINEAR {
+        let sample = if BILINEAR {
             // `CubeMap::bilinear`: Q.16 rounded half up, + ½ − ½ (border, centres).
             let uu = (u.max(0.0).min(nf) * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
             let vv = (v.max(0.0).min(nf) * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
@@ -86,25 +92,42 @@ pub(super) fn scalar<const BILINEAR: bool>(t: &Texels, r: &FaceRun, out: &mut [u
             let y = (v.max(0.0) as usize).min(n - 1);
             t.px[(y + 1) * stride + x + 1]
         };
+        *o = if BLEND {
+            lerp_px(*o, sample, frac)
+        } else {
+            sample
+        };
     }
 }
 
-/// [`Kernel::face_span`] with kernel `k`.
+/// [`Kernel::face_span`] / [`Kernel::face_blend`] with kernel `k`.
 #[inline]
-fn run<const BILINEAR: bool>(k: Selected, t: &Texels, r: &FaceRun, out: &mut [u32]) {
+fn run<const BILINEAR: bool, const BLEND: bool>(
+    k: Selected,
+    t: &Texels,
+    r: &FaceRun,
+    out: &mut [u32],
+    frac: u32,
+) {
+    debug_assert!(t.width == t.height && t.width >= 2, "bordered face texels");
     #[cfg(target_arch = "x86_64")]
-    if x86::face::face_span::<BILINEAR>(k, t, r, out) {
+    if x86::face::face_span::<BILINEAR, BLEND>(k, t, r, out, frac) {
         return;
     }
     let _ = k;
-    scalar::<BILINEAR>(t, r, out)
+    scalar::<BILINEAR, BLEND>(t, r, out, frac)
 }
 
 /// [`Kernel::face_span`] with the [`active_kernel`](super::active_kernel).
 #[inline]
 pub(crate) fn face_span<const BILINEAR: bool>(t: &Texels, r: &FaceRun, out: &mut [u32]) {
-    debug_assert!(t.width == t.height && t.width >= 2, "bordered face texels");
-    run::<BILINEAR>(active(), t, r, out)
+    run::<BILINEAR, false>(active(), t, r, out, 0)
+}
+
+/// [`Kernel::face_blend`] with the [`active_kernel`](super::active_kernel).
+#[inline]
+pub(crate) fn face_blend(t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
+    run::<true, true>(active(), t, r, out, frac)
 }
 
 #[cfg(test)]
@@ -118,7 +141,17 @@ impl Kernel {
     /// (a square of side 2 or more).
     pub(crate) fn face_span<const BILINEAR: bool>(self, t: &Texels, r: &FaceRun, out: &mut [u32]) {
         assert!(t.width == t.height && t.width >= 2, "bordered face texels");
-        run::<BILINEAR>(self.selected(), t, r, out)
+        run::<BILINEAR, false>(self.selected(), t, r, out, 0)
+    }
+
+    /// `out[i]` = `lerp_px(out[i], bilinear sample i, frac)` along a [`FaceRun`] (the
+    /// second level of a trilinear chunk; see [`Kernel::face_span`]).
+    ///
+    /// # Panics
+    /// As [`Kernel::face_span`].
+    pub(crate) fn face_blend(self, t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
+        assert!(t.width == t.height && t.width >= 2, "bordered face texels");
+        run::<true, true>(self.selected(), t, r, out, frac)
     }
 }
 
@@ -185,8 +218,9 @@ mod tests {
     }
 
     /// Every kernel against the scalar twin, and the twin against `CubeMap`'s samplers,
-    /// with sentinels around the output.
-    fn check(ci: usize, f: Face, r: &FaceRun, len: usize, off: usize) {
+    /// with sentinels around the output; the blend with weight `frac` (into random
+    /// pixels) against `lerp_px` of the per-pixel bilinear sample.
+    fn check(ci: usize, f: Face, r: &FaceRun, len: usize, off: usize, frac: u32) {
         let c = &cubes()[ci];
         let t = face_texels(c, f);
         for bilinear in [false, true] {
@@ -211,6 +245,35 @@ mod tests {
                     &buf[off..off + len],
                     &want[..],
                     "{} bilinear={bilinear} {f:?} {r:?} len {len}",
+                    k.name()
+                );
+            }
+        }
+        let want = per_pixel(c, f, r, len, true);
+        let under: Vec<u32> = (0..len as u32)
+            .map(|i| i.wrapping_mul(0x9E37_79B9))
+            .collect();
+        for k in Kernel::available() {
+            let mut buf = vec![0xDEAD_BEEFu32; off + len + 3];
+            buf[off..off + len].copy_from_slice(&under);
+            k.face_blend(&t, r, &mut buf[off..off + len], frac);
+            assert!(
+                buf[..off]
+                    .iter()
+                    .chain(&buf[off + len..])
+                    .all(|&x| x == 0xDEAD_BEEF),
+                "{} blend wrote outside its run",
+                k.name()
+            );
+            for (i, (&got, (&u, &b))) in buf[off..off + len]
+                .iter()
+                .zip(under.iter().zip(&want))
+                .enumerate()
+            {
+                assert_eq!(
+                    got,
+                    lerp_px(u, b, frac),
+                    "{} blend {frac} pixel {i} {r:?}",
                     k.name()
                 );
             }
@@ -264,12 +327,13 @@ mod tests {
             yf in 0.0f64..1.0,
             len in 1usize..=64,
             off in 0usize..9,
+            frac in 0u32..256,
         ) {
             let h = 300;
             let y = ((yf * h as f64) as u32).min(h - 1);
             let n = cubes()[ci].face_size();
             let (f, r) = view_run((yaw, pitch, hfov), (w, h), (x, y), n);
-            check(ci, f, &r, len, off);
+            check(ci, f, &r, len, off, frac);
         }
 
         /// Arbitrary lines: rays behind the face (m ≤ 0: infinite positions; 0/0: NaN),
@@ -283,10 +347,11 @@ mod tests {
             len in 1usize..=64,
             off in 0usize..9,
             fi in 0usize..6,
+            frac in 0u32..256,
         ) {
             let n = cubes()[ci].face_size();
             let r = FaceRun { p, d, dx: dx as f64 * 0.5, half: n as f64 / 2.0 };
-            check(ci, Face::from_index(fi), &r, len, off);
+            check(ci, Face::from_index(fi), &r, len, off, frac);
         }
     }
 
@@ -300,8 +365,8 @@ mod tests {
             (10.0, 10.0, 1.0, 5),
         ] {
             let (f, r) = view_run((yaw, pitch, hfov), (w, 1080), (0, 540), 61);
-            check(4, f, &r, w as usize, 1);
-            check(4, f, &r, 1, 0);
+            check(4, f, &r, w as usize, 1, 77);
+            check(4, f, &r, 1, 0, 255);
         }
     }
 }

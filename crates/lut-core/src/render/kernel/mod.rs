@@ -119,7 +119,7 @@ pub use select::{
     KernelError, KernelInfo, KernelSource, KERNEL_ENV,
 };
 
-pub(crate) use face::{face_span, FaceRun};
+pub(crate) use face::{face_blend, face_span, FaceRun};
 
 use crate::geom::fixed::{Fx, FX_BITS};
 use crate::map::envmap::EnvMap;

@@ -184,7 +184,7 @@ mod avx2 {
     /// 0RGB pixels → (blue and red, green and top byte), one channel per 16-bit lane.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn split(p: __m256i) -> (__m256i, __m256i) {
+    pub(super) fn split(p: __m256i) -> (__m256i, __m256i) {
         (
             _mm256_and_si256(p, _mm256_set1_epi32(0x00FF_00FF)),
             _mm256_srli_epi16::<8>(p),
@@ -194,7 +194,7 @@ mod avx2 {
     /// Per channel `(a·iw + b·w + 128) >> 8` (at most 255·256 + 128: no 16-bit overflow).
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn lerp(
+    pub(super) fn lerp(
         a: (__m256i, __m256i),
         b: (__m256i, __m256i),
         w: (__m256i, __m256i),
@@ -423,7 +423,7 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    fn split(p: __m128i) -> (__m128i, __m128i) {
+    pub(super) fn split(p: __m128i) -> (__m128i, __m128i) {
         (
             _mm_and_si128(p, _mm_set1_epi32(0x00FF_00FF)),
             _mm_srli_epi16::<8>(p),
@@ -432,7 +432,7 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    fn lerp(
+    pub(super) fn lerp(
         a: (__m128i, __m128i),
         b: (__m128i, __m128i),
         w: (__m128i, __m128i),

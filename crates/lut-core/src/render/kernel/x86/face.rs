@@ -8,19 +8,21 @@ use super::{padded, Kernel, Local, Selected, Texels};
 use crate::geom::fixed::{FX_HALF, FX_ONE};
 use std::arch::x86_64::*;
 
-/// The face run with a SIMD kernel; `false` (nothing written) for the scalar one.
+/// The face run with a SIMD kernel (`BLEND`: bilinear blended into `out` by `frac`);
+/// `false` (nothing written) for the scalar one.
 #[inline(always)]
-pub(in super::super) fn face_span<const BILINEAR: bool>(
+pub(in super::super) fn face_span<const BILINEAR: bool, const BLEND: bool>(
     k: Selected,
     t: &Texels,
     r: &FaceRun,
     out: &mut [u32],
+    frac: u32,
 ) -> bool {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        Kernel::Avx2 => unsafe { avx2::face::<BILINEAR>(t, r, out) },
+        Kernel::Avx2 => unsafe { avx2::face::<BILINEAR, BLEND>(t, r, out, frac) },
         // SAFETY: as above.
-        Kernel::Sse41 => unsafe { sse41::face::<BILINEAR>(t, r, out) },
+        Kernel::Sse41 => unsafe { sse41::face::<BILINEAR, BLEND>(t, r, out, frac) },
         Kernel::Scalar => return false,
     }
     true
@@ -42,7 +44,7 @@ fn absolute(t: &Texels) -> Local {
 }
 
 mod avx2 {
-    use super::super::avx2::{bilinear8, merge};
+    use super::super::avx2::{bilinear8, lerp, merge, split};
     use super::*;
 
     /// Face coordinates of the 4 pixels at lane offsets `i` (f64, from the run's start),
@@ -76,10 +78,13 @@ mod avx2 {
     /// 0RGB) or nearest.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn px8<const BILINEAR: bool>(
+    #[allow(clippy::too_many_arguments)]
+    fn px8<const BILINEAR: bool, const BLEND: bool>(
         t: &Texels,
         r: &FaceRun,
         l: &Local,
+        prev: __m256i,
+        w: (__m256i, __m256i),
         lo: __m256d,
         hi: __m256d,
     ) -> __m256i {
@@ -98,7 +103,11 @@ mod avx2 {
                 _mm256_add_epi32(u, h),
                 _mm256_add_epi32(v, h),
             );
-            return merge(c);
+            return if BLEND {
+                merge(lerp(split(prev), c, w))
+            } else {
+                merge(c)
+            };
         }
         let last = _mm256_set1_epi32(n as i32 - 1);
         let (x, y) = (_mm256_min_epi32(u, last), _mm256_min_epi32(v, last));
@@ -119,18 +128,32 @@ mod avx2 {
         _mm256_setr_epi32(g(0), g(1), g(2), g(3), g(4), g(5), g(6), g(7))
     }
 
-    /// The run, 8 pixels per step; the tail's lanes past the end repeat the last pixel.
+    /// The run, 8 pixels per step (`BLEND`: blended into `out` by `frac`); the tail's
+    /// lanes past the end repeat the last pixel.
     #[target_feature(enable = "avx2")]
-    pub(super) fn face<const BILINEAR: bool>(t: &Texels, r: &FaceRun, out: &mut [u32]) {
+    pub(super) fn face<const BILINEAR: bool, const BLEND: bool>(
+        t: &Texels,
+        r: &FaceRun,
+        out: &mut [u32],
+        frac: u32,
+    ) {
         let m = out.len();
         let l = absolute(t);
+        let fw = _mm256_set1_epi32((frac as i32) * 0x10001);
+        let w = (fw, _mm256_sub_epi16(_mm256_set1_epi16(256), fw));
         let (four, eight) = (_mm256_set1_pd(4.0), _mm256_set1_pd(8.0));
         let mut fi = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
         let mut i = 0;
         while i + 8 <= m {
-            let c = px8::<BILINEAR>(t, r, &l, fi, _mm256_add_pd(fi, four));
             let q = out[i..i + 8].as_mut_ptr().cast::<__m256i>();
-            // SAFETY: `q` points at 8 u32 of `out` (the slice above); unaligned store.
+            let prev = if BLEND {
+                // SAFETY: `q` points at 8 u32 of `out` (the slice above); unaligned load.
+                unsafe { _mm256_loadu_si256(q) }
+            } else {
+                _mm256_setzero_si256()
+            };
+            let c = px8::<BILINEAR, BLEND>(t, r, &l, prev, w, fi, _mm256_add_pd(fi, four));
+            // SAFETY: as above; unaligned store.
             unsafe { _mm256_storeu_si256(q, c) };
             fi = _mm256_add_pd(fi, eight);
             i += 8;
@@ -142,11 +165,14 @@ mod avx2 {
                 _mm256_min_pd(fi, last),
                 _mm256_min_pd(_mm256_add_pd(fi, four), last),
             );
-            let c = px8::<BILINEAR>(t, r, &l, lo, hi);
             let tail = &mut out[i..];
             let mut buf = padded::<8>(tail);
-            // SAFETY: `buf` holds 8 u32; unaligned store.
-            unsafe { _mm256_storeu_si256(buf.as_mut_ptr().cast(), c) };
+            let q = buf.as_mut_ptr().cast::<__m256i>();
+            // SAFETY: `buf` holds 8 u32; unaligned load.
+            let prev = unsafe { _mm256_loadu_si256(q) };
+            let c = px8::<BILINEAR, BLEND>(t, r, &l, prev, w, lo, hi);
+            // SAFETY: as above; unaligned store.
+            unsafe { _mm256_storeu_si256(q, c) };
             let n = tail.len();
             tail.copy_from_slice(&buf[..n]);
         }
@@ -154,7 +180,7 @@ mod avx2 {
 }
 
 mod sse41 {
-    use super::super::sse41::{bilinear4, merge};
+    use super::super::sse41::{bilinear4, lerp, merge, split};
     use super::*;
 
     /// [`super::avx2`]'s `uv4` for 2 pixels.
@@ -185,10 +211,13 @@ mod sse41 {
     /// 4 pixels at lane offsets `lo` (lanes 0..2) and `hi` (2..4).
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    fn px4<const BILINEAR: bool>(
+    #[allow(clippy::too_many_arguments)]
+    fn px4<const BILINEAR: bool, const BLEND: bool>(
         t: &Texels,
         r: &FaceRun,
         l: &Local,
+        prev: __m128i,
+        w: (__m128i, __m128i),
         lo: __m128d,
         hi: __m128d,
     ) -> __m128i {
@@ -200,7 +229,11 @@ mod sse41 {
         if BILINEAR {
             let h = _mm_set1_epi32(FX_HALF as i32);
             let c = bilinear4(t.px, stride, l, _mm_add_epi32(u, h), _mm_add_epi32(v, h));
-            return merge(c);
+            return if BLEND {
+                merge(lerp(split(prev), c, w))
+            } else {
+                merge(c)
+            };
         }
         let last = _mm_set1_epi32(n as i32 - 1);
         let (x, y) = (_mm_min_epi32(u, last), _mm_min_epi32(v, last));
@@ -221,18 +254,31 @@ mod sse41 {
         _mm_setr_epi32(g(0), g(1), g(2), g(3))
     }
 
-    /// The run, 4 pixels per step.
+    /// The run, 4 pixels per step (see [`super::avx2`]'s `face`).
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn face<const BILINEAR: bool>(t: &Texels, r: &FaceRun, out: &mut [u32]) {
+    pub(super) fn face<const BILINEAR: bool, const BLEND: bool>(
+        t: &Texels,
+        r: &FaceRun,
+        out: &mut [u32],
+        frac: u32,
+    ) {
         let m = out.len();
         let l = absolute(t);
+        let fw = _mm_set1_epi32((frac as i32) * 0x10001);
+        let w = (fw, _mm_sub_epi16(_mm_set1_epi16(256), fw));
         let (two, four) = (_mm_set1_pd(2.0), _mm_set1_pd(4.0));
         let mut fi = _mm_setr_pd(0.0, 1.0);
         let mut i = 0;
         while i + 4 <= m {
-            let c = px4::<BILINEAR>(t, r, &l, fi, _mm_add_pd(fi, two));
             let q = out[i..i + 4].as_mut_ptr().cast::<__m128i>();
-            // SAFETY: `q` points at 4 u32 of `out` (the slice above); unaligned store.
+            let prev = if BLEND {
+                // SAFETY: `q` points at 4 u32 of `out` (the slice above); unaligned load.
+                unsafe { _mm_loadu_si128(q) }
+            } else {
+                _mm_setzero_si128()
+            };
+            let c = px4::<BILINEAR, BLEND>(t, r, &l, prev, w, fi, _mm_add_pd(fi, two));
+            // SAFETY: as above; unaligned store.
             unsafe { _mm_storeu_si128(q, c) };
             fi = _mm_add_pd(fi, four);
             i += 4;
@@ -240,11 +286,14 @@ mod sse41 {
         if i < m {
             let last = _mm_set1_pd((m - 1) as f64);
             let (lo, hi) = (_mm_min_pd(fi, last), _mm_min_pd(_mm_add_pd(fi, two), last));
-            let c = px4::<BILINEAR>(t, r, &l, lo, hi);
             let tail = &mut out[i..];
             let mut buf = padded::<4>(tail);
-            // SAFETY: `buf` holds 4 u32; unaligned store.
-            unsafe { _mm_storeu_si128(buf.as_mut_ptr().cast(), c) };
+            let q = buf.as_mut_ptr().cast::<__m128i>();
+            // SAFETY: `buf` holds 4 u32; unaligned load.
+            let prev = unsafe { _mm_loadu_si128(q) };
+            let c = px4::<BILINEAR, BLEND>(t, r, &l, prev, w, lo, hi);
+            // SAFETY: as above; unaligned store.
+            unsafe { _mm_storeu_si128(q, c) };
             let n = tail.len();
             tail.copy_from_slice(&buf[..n]);
         }
