@@ -333,6 +333,21 @@ mod tests {
         assert_eq!(kind, "cube");
         assert_eq!(loaded.label(), format!("skyfantasy (cube, {n}px faces)"));
         assert!(loaded.map().is_none());
-        assert_eq!(steps, [(LoadStep::Decoding, None)]);
+        // Decoding, then the face pyramid (the default sampler is trilinear), built.
+        assert_eq!(
+            steps,
+            [
+                (LoadStep::Decoding, None),
+                (LoadStep::Tables, Some(0.0)),
+                (LoadStep::Tables, Some(1.0))
+            ]
+        );
+        let Scene::Cube(cube) = &loaded.scene else {
+            panic!("a cube folder loads as a cube");
+        };
+        assert!(
+            cube.pyramid_bytes() > 0,
+            "the face pyramid is built while loading"
+        );
     }
 }
