@@ -18,9 +18,18 @@
 //! but the egui painter (`egui_software_backend`) allocates its changed primitives'
 //! canvases (about the window's size) afresh every frame: mapped, they cost ~700 page
 //! faults and 1–2 ms of CPU per 800×500 frame. Instead [`give_back`] (`malloc_trim(0)`)
-//! returns the free pages of every arena once the window has settled (see
-//! [`next_trim`]); the frames keep reusing heap blocks as before. Elsewhere (musl, macOS,
-//! Windows) nothing is done.
+//! returns the free pages of the arenas once the window has settled (see
+//! [`next_trim`]); the frames keep reusing heap blocks as before.
+//!
+//! `malloc_trim` gives back the free blocks inside every arena but shrinks only the main
+//! arena's top: the top of a thread's arena (rayon's workers, the loading thread) grows
+//! with the temporaries freed there and stays resident (its trim threshold rises with the
+//! mmap threshold). With the trim alone the soak's resident memory still rose by 8 MiB at
+//! flat bytes in use. [`one_arena`], called once at window start, makes every thread
+//! allocate from the main arena (`mallopt(M_ARENA_MAX, 1)`, which leaves the dynamic
+//! threshold alone), so one trim reaches all of it; the render loops allocate nothing per
+//! pixel, so the shared arena's lock costs nothing measurable. Elsewhere (musl, macOS,
+//! Windows) neither does anything.
 
 use std::time::{Duration, Instant};
 
@@ -36,6 +45,13 @@ pub const TRIM_EVERY: Duration = Duration::from_secs(2);
 pub fn next_trim(last_frame: Option<Instant>, last_trim: Instant) -> Option<Instant> {
     let last_frame = last_frame.filter(|&f| f > last_trim)?;
     Some((last_frame + TRIM_QUIET).min(last_trim + TRIM_EVERY))
+}
+
+/// Make every thread allocate from glibc's main arena (see the module docs): call once
+/// at window start, before the loading and rendering threads first allocate. Returns
+/// whether the allocator took it (always `false` off glibc).
+pub fn one_arena() -> bool {
+    glibc::one_arena()
 }
 
 /// Give the free memory of every heap arena back to the system (glibc's
@@ -57,11 +73,23 @@ mod glibc {
         // nothing extra at the heap's top. It returns 1 when memory was given back.
         unsafe { libc::malloc_trim(0) == 1 }
     }
+
+    pub fn one_arena() -> bool {
+        // SAFETY: mallopt(3) takes two integers and changes only the allocator's own
+        // parameters under its lock (any thread may call it while others allocate);
+        // M_ARENA_MAX 1 is valid and only stops new arenas from being created (threads
+        // then share the main one). It returns 1 on success.
+        unsafe { libc::mallopt(libc::M_ARENA_MAX, 1) == 1 }
+    }
 }
 
 #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
 mod glibc {
     pub fn trim() -> bool {
+        false
+    }
+
+    pub fn one_arena() -> bool {
         false
     }
 }
@@ -80,7 +108,7 @@ mod tests {
         assert_eq!(next_trim(Some(t0), t0), None);
         assert_eq!(next_trim(Some(t0), t0 + s(1)), None);
         // A frame after the trim: half a second after it.
-        assert_eq!(next_trim(Some(t0 + s(3)), t0), Some(t0 + s(3) + ms(500)));
+        assert_eq!(next_trim(Some(t0 + s(1)), t0), Some(t0 + ms(1_500)));
         // Frames still coming 2 s after the trim: at 2 s.
         assert_eq!(next_trim(Some(t0 + ms(1_800)), t0), Some(t0 + s(2)));
         assert_eq!(next_trim(Some(t0 + s(25)), t0), Some(t0 + s(2)));
