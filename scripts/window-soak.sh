@@ -373,6 +373,16 @@ ACTIONS=(drag drag flick wheel key key resize_storm minimize fullscreen drop dro
 
 log "driving the window for $DURATION s (seed $SEED)"
 START=$SECONDS
+# The largest window of the run first (the whole screen, then fullscreen), inside the
+# warm-up: buffers sized to the largest window so far and kept (egui_software_backend's
+# canvas, softbuffer's shared image) reach their size before the checkpoints are judged.
+xdotool windowsize "$WID" 1280 800 2>/dev/null || true
+sleep 1
+key f
+sleep 1
+key Escape
+xdotool windowsize "$WID" 800 500 2>/dev/null || true
+sleep 0.5
 CHECK_EVERY=$((DURATION / 12 > 20 ? DURATION / 12 : 20))
 LAST_CHECK=$START
 while [ $((SECONDS - START)) -lt "$DURATION" ]; do
