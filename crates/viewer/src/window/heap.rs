@@ -25,11 +25,12 @@
 //! arena's top: the top of a thread's arena (rayon's workers, the loading thread) grows
 //! with the temporaries freed there and stays resident (its trim threshold rises with the
 //! mmap threshold). With the trim alone the soak's resident memory still rose by 8 MiB at
-//! flat bytes in use. [`one_arena`], called once at window start, makes every thread
-//! allocate from the main arena (`mallopt(M_ARENA_MAX, 1)`, which leaves the dynamic
-//! threshold alone), so one trim reaches all of it; the render loops allocate nothing per
-//! pixel, so the shared arena's lock costs nothing measurable. Elsewhere (musl, macOS,
-//! Windows) neither does anything.
+//! flat bytes in use. [`one_arena`], called before any other thread starts, makes every
+//! thread allocate from the main arena (`mallopt(M_ARENA_MAX, 1)`, which leaves the
+//! dynamic threshold alone), so one trim reaches all of it; the render loops allocate
+//! nothing per pixel, and the shared arena's lock cost nothing measurable (CPU time per
+//! frame, A/B on the shared machine). Elsewhere (musl, macOS, Windows) neither does
+//! anything.
 
 use std::time::{Duration, Instant};
 
@@ -47,8 +48,9 @@ pub fn next_trim(last_frame: Option<Instant>, last_trim: Instant) -> Option<Inst
     Some((last_frame + TRIM_QUIET).min(last_trim + TRIM_EVERY))
 }
 
-/// Make every thread allocate from glibc's main arena (see the module docs): call once
-/// at window start, before the loading and rendering threads first allocate. Returns
+/// Make every thread allocate from glibc's main arena (see the module docs): call once,
+/// before the process starts any other thread (glibc fixes its arena limit when a
+/// second thread first allocates; `main` calls it first thing for the window). Returns
 /// whether the allocator took it (always `false` off glibc).
 pub fn one_arena() -> bool {
     glibc::one_arena()

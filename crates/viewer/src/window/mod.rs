@@ -100,9 +100,6 @@ fn parse_hfov(s: &str) -> Result<f64, String> {
 /// A missing panorama file, or no display to open a window on (a clear message; the
 /// process exits nonzero, it does not panic).
 pub fn run(mut a: OpenArgs) -> anyhow::Result<()> {
-    // Before any loading or rendering thread first allocates: one heap arena, which the
-    // window's trims reach whole (glibc; see `heap`).
-    heap::one_arena();
     // A scene file names the panorama and view when the command line does not.
     let (scene_pano, scene_view) = a.lights.room.scene_panorama()?;
     if a.panorama.is_empty() {
