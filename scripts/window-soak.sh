@@ -64,15 +64,10 @@ done
 
 fail() { echo "window-soak: FAIL: $*" >&2; exit 1; }
 log() { echo "window-soak: $*"; }
+# shellcheck source=scripts/lib/xvfb.sh
+. scripts/lib/xvfb.sh
 
-if [ "$INSTALL" = 1 ]; then
-  SUDO=""
-  [ "$(id -u)" = 0 ] || SUDO=sudo
-  $SUDO apt-get update
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y xvfb xdotool x11-utils x11-apps \
-    imagemagick python3-xlib libx11-6 libx11-xcb1 libxcursor1 libxi6 libxkbcommon-x11-0 \
-    libxkbcommon0 libxcb1 libxcb-xkb1
-fi
+[ "$INSTALL" = 0 ] || xvfb_install python3-xlib
 PY=/usr/bin/python3
 TOOLS="Xvfb xdotool xdpyinfo mkfifo"
 [ "$HEAP" = 0 ] || TOOLS="$TOOLS gdb"
@@ -129,11 +124,6 @@ GOOD=("$F/pano.jpg" "$F/interior.exr" "$F/skyfantasy" "$F/view.png" "$F/cross.pn
 BAD=("$F/truncated.jpg" "$F/cut.exr" "$F/text.jpg" "$F/pipe.jpg" "$F/loop-a.jpg" "$F/huge-header.png" "$F/claims-32k.jpg")
 
 # --- X and the viewer -------------------------------------------------------------------
-DISP=""
-for n in $(seq 121 160); do
-  if [ ! -e /tmp/.X11-unix/X$n ] && [ ! -e /tmp/.X$n-lock ]; then DISP=:$n; break; fi
-done
-[ -n "$DISP" ] || fail "no free X display number"
 XVFB_PID=""
 VIEWER_PID=""
 SAMPLER_PID=""
@@ -143,16 +133,7 @@ cleanup() {
   if [ -n "$XVFB_PID" ] && kill -0 "$XVFB_PID" 2>/dev/null; then kill "$XVFB_PID" || true; fi
 }
 trap cleanup EXIT
-log "starting Xvfb on $DISP"
-Xvfb "$DISP" -screen 0 1280x800x24 -nolisten tcp >"$OUT/xvfb.log" 2>&1 &
-XVFB_PID=$!
-export DISPLAY=$DISP
-for _ in $(seq 1 300); do
-  xdpyinfo >/dev/null 2>&1 && break
-  kill -0 "$XVFB_PID" 2>/dev/null || fail "Xvfb exited: $(cat "$OUT/xvfb.log")"
-  sleep 0.1
-done
-xdpyinfo >/dev/null 2>&1 || fail "Xvfb did not answer in 30 s (see $OUT/xvfb.log)"
+xvfb_start 121 160 "$OUT/xvfb.log"
 
 alive() { kill -0 "$VIEWER_PID" 2>/dev/null || fail "the viewer exited (see $ERRLOG)"; }
 wait_for() { # pattern, from line, timeout
