@@ -64,15 +64,42 @@ pub(crate) fn table() -> &'static [u8] {
     })
 }
 
+/// The form of the row loop this CPU runs (detected once, see [`ShadeRow::detect`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ShadeRow {
+    avx2: bool,
+}
+
+impl ShadeRow {
+    /// The fastest form this CPU runs.
+    pub(crate) fn detect() -> ShadeRow {
+        #[cfg(target_arch = "x86_64")]
+        let avx2 = std::arch::is_x86_feature_detected!("avx2");
+        #[cfg(not(target_arch = "x86_64"))]
+        let avx2 = false;
+        // Build the table now, not inside the first row.
+        let _ = table();
+        ShadeRow { avx2 }
+    }
+
+    /// Shade `pixels` (0RGB albedo) in place with light factor ambient + exposure · E
+    /// per pixel, E from `lux`.
+    #[inline]
+    pub(crate) fn run(self, pixels: &mut [u32], lux: &[f32], ambient: f32, exposure: f32) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            simd::shade_row_avx2(pixels, lux, ambient, exposure);
+            return;
+        }
+        shade_row_scalar(pixels, lux, ambient, exposure);
+    }
+}
+
 /// Shade `pixels` (0RGB albedo) in place with light factor ambient + exposure · E per
 /// pixel, E from `lux`; the fastest form this CPU runs.
+#[cfg(test)]
 pub(crate) fn shade_row(pixels: &mut [u32], lux: &[f32], ambient: f32, exposure: f32) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        simd::shade_row_avx2(pixels, lux, ambient, exposure);
-        return;
-    }
-    shade_row_scalar(pixels, lux, ambient, exposure);
+    ShadeRow::detect().run(pixels, lux, ambient, exposure);
 }
 
 /// The portable form of [`shade_row`].
@@ -98,7 +125,8 @@ mod simd {
     use super::{row_of, shade_row_scalar, table, BASE_BITS, ROWS, SHIFT};
     use std::arch::x86_64::*;
 
-    /// [`super::shade_row`] with AVX2; the caller has checked that the CPU has it.
+    /// [`super::shade_row_scalar`] with AVX2; the caller has checked that the CPU has it
+    /// ([`super::ShadeRow::detect`]).
     pub(super) fn shade_row_avx2(pixels: &mut [u32], lux: &[f32], ambient: f32, exposure: f32) {
         // SAFETY: only called after `is_x86_feature_detected!("avx2")` returned true.
         unsafe { shade_row_avx2_impl(pixels, lux, ambient, exposure) }

@@ -10,7 +10,7 @@ mod scene_file;
 mod state;
 
 pub use files::{file_kind, FileKind};
-pub use lit::LitCache;
+pub use lit::{LitCache, LitRenderError};
 pub use scene_file::{
     is_scene, is_scene_file, SceneFile, SceneLight, SceneRoom, SceneView, FORMAT as SCENE_FORMAT,
     VERSION as SCENE_VERSION,

@@ -37,11 +37,19 @@ impl App {
         }
     }
 
-    /// Light the freshly rendered scene from `map` (as `viewer render` does), then draw
-    /// the room and luminaires ("Show room") and the false colours' legend over it.
-    pub(super) fn light_scene(&mut self, map: Option<&IlluminanceMap>, view: View, r: SceneRect) {
+    /// Light the freshly rendered scene from `unlit` (the map, when the render did not
+    /// light the rows as it drew them; as `viewer render` does), then draw the room and
+    /// luminaires ("Show room") and, when the scene is lit (`map`), the false colours'
+    /// legend over it.
+    pub(super) fn light_scene(
+        &mut self,
+        map: Option<&IlluminanceMap>,
+        unlit: Option<&IlluminanceMap>,
+        view: View,
+        r: SceneRect,
+    ) {
         let (w, h) = (r.w, r.h);
-        if let Some(map) = map {
+        if let Some(map) = unlit {
             let cam = Camera::new(view, w, h);
             let opts = self.lights.shade_options();
             if let Err(e) = map.shade_frame(&cam, &mut self.scene, w, h, &opts) {
