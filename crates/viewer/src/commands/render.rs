@@ -167,9 +167,8 @@ impl RenderArgs {
 
     /// The panorama these arguments name: a cube map, or a map placed by `--coverage` or
     /// its GPano XMP.
-    fn load(&self, from_scene: Option<PathBuf>) -> Result<Scene> {
+    fn load(&self, scene_pano: Vec<PathBuf>) -> Result<Scene> {
         let input = &self.input;
-        let scene_pano: Vec<PathBuf> = from_scene.into_iter().collect();
         let panorama = if self.panorama.is_empty() {
             &scene_pano
         } else {

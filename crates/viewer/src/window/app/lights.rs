@@ -216,13 +216,14 @@ impl App {
         self.scene_file = Some(path.clone());
         self.prefs.panel = true;
         self.notices.info(format!("scene {}", path.display()), t);
-        if let Some(p) = file.panorama_path(&dir) {
+        let paths = file.panorama_paths(&dir);
+        if let Some(p) = paths.first().cloned() {
             let start = file.view.map_or_else(StartArgs::default, |v| StartArgs {
                 yaw: Some(v.yaw),
                 pitch: Some(v.pitch),
                 hfov: Some(v.hfov),
             });
-            let source = Source::of_paths(vec![p.clone()], false, None).unwrap_or(Source::File(p));
+            let source = Source::of_paths(paths, false, None).unwrap_or(Source::File(p));
             let fx = self
                 .doc
                 .open(source, None, start, self.ctl.settings.exposure_ev);
@@ -261,8 +262,7 @@ impl App {
         let panorama = self
             .doc
             .current()
-            .and_then(|c| c.source.single_path())
-            .map(Path::to_path_buf);
+            .map_or_else(Vec::new, |c| c.source.paths());
         let look = self.ctl.look();
         let view = SceneView {
             yaw: look.yaw,
@@ -273,7 +273,7 @@ impl App {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
-        let file = SceneFile::from_state(&self.lights, panorama.as_deref(), Some(view), dir);
+        let file = SceneFile::from_state(&self.lights, &panorama, Some(view), dir);
         let status = match file.save(path) {
             Ok(()) => {
                 self.scene_file = Some(path.to_path_buf());
