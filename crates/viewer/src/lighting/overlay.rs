@@ -319,6 +319,63 @@ pub fn drag_room_edge(
     ))
 }
 
+/// The room corner (an index into [`Room::corners`]) drawn nearest to (px, py) in a
+/// `cam` frame, within `radius` pixels (corners behind the camera left out).
+pub fn pick_room_corner(
+    room: &Room,
+    cam: &Camera,
+    (px, py): (f64, f64),
+    radius: f64,
+) -> Option<usize> {
+    room.corners()
+        .iter()
+        .enumerate()
+        .filter_map(|(k, &c)| {
+            let (x, y) = project_point(room, cam, c)?;
+            let d = (x - px).hypot(y - py);
+            (d <= radius).then_some((k, d))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(k, _)| k)
+}
+
+/// The room box after its corner `corner` (an index into [`Room::corners`]) is dragged
+/// to (px, py) of a `cam` frame, as (width, depth, centre x, centre z): the two walls
+/// meeting at the corner move so that it sits where the cursor's ray meets the corner's
+/// floor (a bottom corner) or ceiling (a top one); the other two walls, the height, the
+/// camera height and the turn stay. The camera stays at least 5 cm inside. `None` when
+/// the cursor's ray does not meet that floor or ceiling in front of the camera.
+pub fn drag_room_corner(
+    room: &Room,
+    cam: &Camera,
+    corner: usize,
+    (px, py): (f64, f64),
+) -> Option<(f64, f64, f64, f64)> {
+    const INSIDE: f64 = 0.05;
+    let c = *room.corners().get(corner)?;
+    let (mut lo, mut hi) = room.bounds();
+    let o = room.camera_position();
+    let d = room.to_room(cam.ray(px, py)?);
+    let t = (c.y - o.y) / d.y;
+    if !(t > 0.0 && t.is_finite()) {
+        return None;
+    }
+    let p = o + d * t;
+    for (axis, bit) in [(0, 1), (2, 4)] {
+        if corner & bit != 0 {
+            hi[axis] = p[axis].max(o[axis] + INSIDE);
+        } else {
+            lo[axis] = p[axis].min(o[axis] - INSIDE);
+        }
+    }
+    Some((
+        hi.x - lo.x,
+        hi.z - lo.z,
+        (lo.x + hi.x) / 2.0,
+        (lo.z + hi.z) / 2.0,
+    ))
+}
+
 /// Draw the room's wireframe and the lights' markers of `st` over a rendered `w × h`
 /// frame of `view` (what `viewer render --show-room` adds and the window shows with
 /// "Show room"); the selected light ([`super::LightsState::selected`]) is drawn larger,
@@ -503,6 +560,67 @@ mod tests {
         let far = drag_room_edge(&room, &cam, k, (319.0, 100.0)).unwrap();
         let (lo3, hi3) = rebuilt(far).bounds();
         assert!(lo3.x <= -0.05 + 1e-12 && hi3.z >= 0.05 - 1e-12);
+    }
+
+    #[test]
+    fn dragged_room_corners_move_both_walls() {
+        let room = Room::new(4.0, 6.0, 2.8, 1.5)
+            .unwrap()
+            .with_yaw(-25.0)
+            .unwrap()
+            .with_center(0.3, -0.4)
+            .unwrap();
+        let (lo, hi) = room.bounds();
+        let rebuilt = |(w, d, cx, cz): (f64, f64, f64, f64)| {
+            Room::new(w, d, 2.8, 1.5)
+                .unwrap()
+                .with_yaw(-25.0)
+                .unwrap()
+                .with_center(cx, cz)
+                .unwrap()
+        };
+        // The floor corner at x high, z high, and the ceiling corner at x low, z low:
+        // each dragged to a point of its floor / ceiling; picked under the cursor.
+        for (corner, target, pitch) in [
+            (1 | 4, DVec3::new(hi.x + 0.3, 0.0, hi.z - 0.5), -30.0),
+            (2, DVec3::new(lo.x + 0.4, 2.8, lo.z - 0.2), 30.0),
+        ] {
+            // A view that sees both the corner and the target.
+            let inside = |cam: &Camera, p: DVec3| {
+                project_point(&room, cam, p)
+                    .is_some_and(|(x, y)| (0.0..320.0).contains(&x) && (0.0..200.0).contains(&y))
+            };
+            let cam = (0..36)
+                .map(|k| Camera::new(View::new(k as f64 * 10.0, pitch, 100.0).unwrap(), 320, 200))
+                .find(|cam| inside(cam, room.corners()[corner]) && inside(cam, target))
+                .expect("a view of the corner");
+            let here = project_point(&room, &cam, room.corners()[corner]).unwrap();
+            assert_eq!(pick_room_corner(&room, &cam, here, 6.0), Some(corner));
+            assert_eq!(
+                pick_room_corner(&room, &cam, (here.0 + 40.0, here.1), 6.0),
+                None
+            );
+            let at = project_point(&room, &cam, target).unwrap();
+            let moved = rebuilt(drag_room_corner(&room, &cam, corner, at).unwrap());
+            let got = moved.corners()[corner];
+            assert!(
+                (got - target).length() < 1e-9,
+                "{corner}: {got} vs {target}"
+            );
+            // The opposite walls stay.
+            let (lo2, hi2) = moved.bounds();
+            let opposite = moved.corners()[7 - corner];
+            assert!((opposite - room.corners()[7 - corner]).length() < 1e-9);
+            assert!((lo2.y - lo.y).abs() < 1e-12 && (hi2.y - hi.y).abs() < 1e-12);
+        }
+        // Never past the camera: a bottom corner dragged to a floor point behind it.
+        let cam = Camera::new(View::new(0.0, -80.0, 100.0).unwrap(), 320, 200);
+        let at = project_point(&room, &cam, DVec3::new(-0.5, 0.0, -0.5)).unwrap();
+        let (_, hi3) = rebuilt(drag_room_corner(&room, &cam, 1 | 4, at).unwrap()).bounds();
+        assert!(hi3.x >= 0.05 - 1e-12 && hi3.z >= 0.05 - 1e-12, "{hi3}");
+        // The cursor above the horizon never meets the floor.
+        let cam = Camera::new(View::new(0.0, 60.0, 60.0).unwrap(), 320, 200);
+        assert!(drag_room_corner(&room, &cam, 1, (160.0, 100.0)).is_none());
     }
 
     #[test]

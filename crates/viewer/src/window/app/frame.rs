@@ -97,7 +97,7 @@ impl App {
                 }
             }
         }
-        if self.light_drag.is_some() || self.edge_drag.is_some() {
+        if self.light_drag.is_some() || self.edge_drag.is_some() || self.corner_drag.is_some() {
             match resp.interact_pointer_pos() {
                 Some(p) if resp.dragged_by(primary) => self.drag_light(to_px(p), size),
                 _ => self.end_light_drag(),
