@@ -276,47 +276,61 @@ pub fn drag_room_edge(
     room: &Room,
     cam: &Camera,
     edge: usize,
-    (px, py): (f64, f64),
+    at: (f64, f64),
 ) -> Option<(f64, f64, f64, f64)> {
-    const INSIDE: f64 = 0.05;
     let (i, j) = *Room::EDGES.get(edge)?;
     let axis = (i ^ j).trailing_zeros() as usize;
     let high = |bit: usize| i & (1 << bit) != 0;
     let (mut lo, mut hi) = room.bounds();
-    let (floor, ceiling) = (lo.y, hi.y);
-    let o = room.camera_position();
-    let d = room.to_room(cam.ray(px, py)?);
-    let mut set = |a: usize, v: f64| {
-        if high(a) {
-            hi[a] = v.max(INSIDE);
-        } else {
-            lo[a] = v.min(-INSIDE);
-        }
-    };
     if axis == 1 {
+        let d = room.to_room(cam.ray(at.0, at.1)?);
         let c = room.corners()[i];
         let bearing = DVec3::new(d.x, 0.0, d.z);
         if bearing.length() < 1e-9 {
             return None;
         }
         let p = bearing.normalize() * c.x.hypot(c.z);
-        set(0, p.x);
-        set(2, p.z);
+        set_wall(&mut lo, &mut hi, 0, high(0), p.x);
+        set_wall(&mut lo, &mut hi, 2, high(2), p.z);
     } else {
-        let y = if high(1) { ceiling } else { floor };
-        let t = (y - o.y) / d.y;
-        if !(t > 0.0 && t.is_finite()) {
-            return None;
-        }
+        let y = if high(1) { hi.y } else { lo.y };
+        let p = cursor_at_height(room, cam, at, y)?;
         let wall = 2 - axis;
-        set(wall, o[wall] + d[wall] * t);
+        set_wall(&mut lo, &mut hi, wall, high(wall), p[wall]);
     }
-    Some((
+    Some(box_walls(lo, hi))
+}
+
+/// How close (metres) a dragged wall may come to the camera.
+const INSIDE: f64 = 0.05;
+
+/// Move the wall on `axis` (0: X, 2: Z) at the box's `high` or low end to `v`, keeping
+/// it [`INSIDE`] from the camera (at 0 on both axes).
+fn set_wall(lo: &mut DVec3, hi: &mut DVec3, axis: usize, high: bool, v: f64) {
+    if high {
+        hi[axis] = v.max(INSIDE);
+    } else {
+        lo[axis] = v.min(-INSIDE);
+    }
+}
+
+/// (width, depth, centre x, centre z) of the box `lo` … `hi`.
+fn box_walls(lo: DVec3, hi: DVec3) -> (f64, f64, f64, f64) {
+    (
         hi.x - lo.x,
         hi.z - lo.z,
         (lo.x + hi.x) / 2.0,
         (lo.z + hi.z) / 2.0,
-    ))
+    )
+}
+
+/// Where the ray through (px, py) of a `cam` frame meets the horizontal plane at height
+/// `y` (room coordinates), in front of the camera.
+fn cursor_at_height(room: &Room, cam: &Camera, (px, py): (f64, f64), y: f64) -> Option<DVec3> {
+    let o = room.camera_position();
+    let d = room.to_room(cam.ray(px, py)?);
+    let t = (y - o.y) / d.y;
+    (t > 0.0 && t.is_finite()).then(|| o + d * t)
 }
 
 /// The room corner (an index into [`Room::corners`]) drawn nearest to (px, py) in a
@@ -349,31 +363,14 @@ pub fn drag_room_corner(
     room: &Room,
     cam: &Camera,
     corner: usize,
-    (px, py): (f64, f64),
+    at: (f64, f64),
 ) -> Option<(f64, f64, f64, f64)> {
-    const INSIDE: f64 = 0.05;
     let c = *room.corners().get(corner)?;
+    let p = cursor_at_height(room, cam, at, c.y)?;
     let (mut lo, mut hi) = room.bounds();
-    let o = room.camera_position();
-    let d = room.to_room(cam.ray(px, py)?);
-    let t = (c.y - o.y) / d.y;
-    if !(t > 0.0 && t.is_finite()) {
-        return None;
-    }
-    let p = o + d * t;
-    for (axis, bit) in [(0, 1), (2, 4)] {
-        if corner & bit != 0 {
-            hi[axis] = p[axis].max(o[axis] + INSIDE);
-        } else {
-            lo[axis] = p[axis].min(o[axis] - INSIDE);
-        }
-    }
-    Some((
-        hi.x - lo.x,
-        hi.z - lo.z,
-        (lo.x + hi.x) / 2.0,
-        (lo.z + hi.z) / 2.0,
-    ))
+    set_wall(&mut lo, &mut hi, 0, corner & 1 != 0, p.x);
+    set_wall(&mut lo, &mut hi, 2, corner & 4 != 0, p.z);
+    Some(box_walls(lo, hi))
 }
 
 /// Draw the room's wireframe and the lights' markers of `st` over a rendered `w × h`
