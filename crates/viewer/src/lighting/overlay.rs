@@ -251,16 +251,20 @@ pub fn pick_room_edge(
     radius: f64,
 ) -> Option<usize> {
     let c = room.corners();
-    Room::EDGES
-        .iter()
-        .enumerate()
-        .filter_map(|(k, &(i, j))| {
-            let d = edge_pieces(room, cam, c[i], c[j])
-                .into_iter()
-                .map(|s| segment_distance(s, px, py))
-                .min_by(f64::total_cmp)?;
-            (d <= radius).then_some((k, d))
-        })
+    let edges = Room::EDGES.iter().enumerate().filter_map(|(k, &(i, j))| {
+        let d = edge_pieces(room, cam, c[i], c[j])
+            .into_iter()
+            .map(|s| segment_distance(s, px, py))
+            .min_by(f64::total_cmp)?;
+        Some((k, d))
+    });
+    nearest_within(edges, radius)
+}
+
+/// The index of the nearest of (index, distance) pairs within `radius`.
+fn nearest_within(pairs: impl Iterator<Item = (usize, f64)>, radius: f64) -> Option<usize> {
+    pairs
+        .filter(|&(_, d)| d <= radius)
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(k, _)| k)
 }
@@ -341,16 +345,12 @@ pub fn pick_room_corner(
     (px, py): (f64, f64),
     radius: f64,
 ) -> Option<usize> {
-    room.corners()
-        .iter()
-        .enumerate()
-        .filter_map(|(k, &c)| {
-            let (x, y) = project_point(room, cam, c)?;
-            let d = (x - px).hypot(y - py);
-            (d <= radius).then_some((k, d))
-        })
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(k, _)| k)
+    let all = room.corners();
+    let corners = all.iter().enumerate().filter_map(|(k, &c)| {
+        let (x, y) = project_point(room, cam, c)?;
+        Some((k, (x - px).hypot(y - py)))
+    });
+    nearest_within(corners, radius)
 }
 
 /// The room box after its corner `corner` (an index into [`Room::corners`]) is dragged
