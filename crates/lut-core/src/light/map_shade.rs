@@ -187,37 +187,28 @@ impl IlluminanceMap {
         }
     }
 
-    /// The illuminance of the band of rows `band_y .. band_y + rows` (at most
-    /// [`BLOCK`]`.1 rows), block by block: `f(x0, nx, block)` gets each block of `nx`
-    /// columns from `x0` on as rows of [`BLOCK`]`.0` values (the first `nx` of each row
-    /// filled), while it is in L1.
-    fn band_blocks(
-        &self,
-        rays: &Rays,
-        w: usize,
-        (band_y, rows): (usize, usize),
-        mut f: impl FnMut(usize, usize, &[f32]),
-    ) {
+    /// The illuminance of the band of rows starting at `band_y` (`es` holds whole rows of
+    /// `w` values, at most [`BLOCK`]`.1` of them), block by block.
+    fn band_lux(&self, rays: &Rays, w: usize, band_y: usize, es: &mut [f32]) {
+        let rows = es.len() / w;
         debug_assert!(rows <= BLOCK.1);
-        let mut es = [0f32; BLOCK.0 * BLOCK.1];
         let y1 = band_y + rows;
         let mut x0 = 0;
         let mut l = [rays.probe(self, 0, band_y), rays.probe(self, 0, y1)];
+        let mut out = Lux {
+            es,
+            stride: w,
+            y0: band_y,
+        };
         while x0 < w {
             let x1 = (x0 + BLOCK.0).min(w);
             let r = [rays.probe(self, x1, band_y), rays.probe(self, x1, y1)];
-            let mut out = Lux {
-                es: &mut es,
-                x0,
-                y0: band_y,
-            };
             self.fill(
                 rays,
                 (x0, band_y, x1, y1),
                 [l[0], r[0], l[1], r[1]],
                 &mut out,
             );
-            f(x0, x1 - x0, &es);
             (x0, l) = (x1, r);
         }
     }
@@ -262,14 +253,7 @@ impl IlluminanceMap {
         let rays = Rays::new(self, cam);
         out.par_chunks_mut(w * BLOCK.1)
             .enumerate()
-            .for_each(|(band, band_es)| {
-                let rows = band_es.len() / w;
-                self.band_blocks(&rays, w, (band * BLOCK.1, rows), |x0, nx, es| {
-                    for j in 0..rows {
-                        band_es[j * w + x0..][..nx].copy_from_slice(&es[j * BLOCK.0..][..nx]);
-                    }
-                });
-            });
+            .for_each(|(band, es)| self.band_lux(&rays, w, band * BLOCK.1, es));
         Ok(())
     }
 
@@ -384,32 +368,37 @@ impl FrameShader<'_> {
             }
             return;
         };
-        // The map's blocks: BLOCK.1 rows from each multiple of BLOCK.1 (cut at the band).
-        let mut y = y0;
-        while y < y0 + n {
-            let y1 = ((y / BLOCK.1 + 1) * BLOCK.1).min(y0 + n);
-            let band = &mut rows[(y - y0) * w..(y1 - y0) * w];
-            map.band_blocks(rays, w, (y, y1 - y), |x0, nx, es| {
-                for j in 0..y1 - y {
-                    let px = &mut band[j * w + x0..][..nx];
-                    let e = &es[j * BLOCK.0..][..nx];
-                    if o.false_color {
-                        px.iter_mut().zip(e).for_each(|(p, &e)| false_colour(p, e));
-                    } else {
-                        self.colour.run(px, e, ambient, exposure);
-                    }
-                }
-            });
-            y = y1;
+        // The map's blocks: BLOCK.1 rows from each multiple of BLOCK.1 (cut at the band),
+        // their lux in this thread's buffer (a block row: in L2), then the colour.
+        thread_local! {
+            static LUX: std::cell::RefCell<Vec<f32>> = const { std::cell::RefCell::new(Vec::new()) };
         }
+        LUX.with_borrow_mut(|buf| {
+            let mut y = y0;
+            while y < y0 + n {
+                let y1 = ((y / BLOCK.1 + 1) * BLOCK.1).min(y0 + n);
+                let band = &mut rows[(y - y0) * w..(y1 - y0) * w];
+                buf.resize(band.len(), 0.0);
+                let es = &mut buf[..band.len()];
+                map.band_lux(rays, w, y, es);
+                if o.false_color {
+                    band.iter_mut()
+                        .zip(es.iter())
+                        .for_each(|(p, &e)| false_colour(p, e));
+                } else {
+                    self.colour.run(band, es, ambient, exposure);
+                }
+                y = y1;
+            }
+        });
     }
 }
 
-/// Where [`IlluminanceMap::fill`] writes: rows of [`BLOCK`]`.0` values, the first one
-/// pixel (x0, y0).
+/// Where [`IlluminanceMap::fill`] writes: whole rows of `stride` values, the first one
+/// row `y0`.
 struct Lux<'a> {
     es: &'a mut [f32],
-    x0: usize,
+    stride: usize,
     y0: usize,
 }
 
@@ -417,7 +406,7 @@ impl Lux<'_> {
     /// The index of pixel (x, y).
     #[inline]
     fn at(&self, x: usize, y: usize) -> usize {
-        (y - self.y0) * BLOCK.0 + x - self.x0
+        (y - self.y0) * self.stride + x
     }
 }
 
