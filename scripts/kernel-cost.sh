@@ -8,6 +8,8 @@
 #   FRAMES=4 bash scripts/kernel-cost.sh        # more frames per count (default 2)
 #   VIEWS="pitch=0;pitch=80;pitch=10 hfov=150" bash scripts/kernel-cost.sh  # views, bilinear
 #   KERNELS="scalar avx2" bash scripts/kernel-cost.sh  # only these kernels
+#   CUBE=1 bash scripts/kernel-cost.sh          # the cube scanline renderer (2048² faces
+#                                               # converted from the map), per sampler
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v valgrind >/dev/null || { echo "kernel-cost.sh: valgrind is not installed" >&2; exit 1; }
@@ -44,6 +46,19 @@ done
 header="|"
 sep="|---|"
 for k in "${kernels[@]}"; do header+=" $k |"; sep+="---:|"; done
+
+if [ -n "${CUBE:-}" ]; then
+  # The cube's faces, kept beside the map (converting under valgrind takes minutes).
+  [ -f "$map_cache.cube2048" ] || "$bin" frames=0 mode=cube cache="$map_cache" >/dev/null
+  echo "| cube scanline $header"
+  echo "$sep"
+  for s in nearest bilinear trilinear; do
+    row="| $s |"
+    for k in "${kernels[@]}"; do row+=" $(cost mode=cube sampler="$s" kernel="$k") |"; done
+    echo "$row"
+  done
+  exit 0
+fi
 
 if [ -n "${VIEWS:-}" ]; then
   echo "| bilinear, view $header"

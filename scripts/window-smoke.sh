@@ -46,15 +46,10 @@ done
 
 fail() { echo "window-smoke: FAIL: $*" >&2; exit 1; }
 log() { echo "window-smoke: $*"; }
+# shellcheck source=scripts/lib/xvfb.sh
+. scripts/lib/xvfb.sh
 
-if [ "$INSTALL" = 1 ]; then
-  SUDO=""
-  [ "$(id -u)" = 0 ] || SUDO=sudo
-  $SUDO apt-get update
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y xvfb xdotool x11-utils x11-apps \
-    imagemagick libx11-6 libx11-xcb1 libxcursor1 libxi6 libxkbcommon-x11-0 libxkbcommon0 \
-    libxcb1 libxcb-xkb1
-fi
+[ "$INSTALL" = 0 ] || xvfb_install
 
 # /usr/local/bin/convert on some machines is a stand-in: use ImageMagick's own paths.
 IMPORT=/usr/bin/import
@@ -80,13 +75,6 @@ mkdir -p "$OUT"
 VIEWLOG=$OUT/viewer.stdout
 ERRLOG=$OUT/viewer.stderr
 
-# A free display number.
-DISP=""
-for n in $(seq 90 120); do
-  if [ ! -e /tmp/.X11-unix/X$n ] && [ ! -e /tmp/.X$n-lock ]; then DISP=:$n; break; fi
-done
-[ -n "$DISP" ] || fail "no free X display number"
-
 XVFB_PID=""
 VIEWER_PID=""
 cleanup() {
@@ -95,15 +83,7 @@ cleanup() {
 }
 trap cleanup EXIT
 
-log "starting Xvfb on $DISP"
-Xvfb "$DISP" -screen 0 1280x800x24 -nolisten tcp >"$OUT/xvfb.log" 2>&1 &
-XVFB_PID=$!
-export DISPLAY=$DISP
-for _ in $(seq 1 100); do
-  xdpyinfo >/dev/null 2>&1 && break
-  sleep 0.1
-done
-xdpyinfo >/dev/null 2>&1 || fail "Xvfb did not start (see $OUT/xvfb.log)"
+xvfb_start 90 120 "$OUT/xvfb.log"
 
 # Wait until `pattern` appears in the viewer's stdout after line `from` (timeout seconds).
 wait_for() {

@@ -15,7 +15,8 @@
 # (a turn, then R back to the start view; Ctrl+Q exits 0), and — for runs of 5 minutes
 # or more — the resident memory stays flat after the warm-up (the first fifth of the run,
 # at least 60 s): every twelfth of the run the soak returns to one checkpoint state (the
-# sample panorama loaded, MAX_LIGHTS lights, rectilinear, 800x500, idle) and reads VmRSS; every
+# sample panorama loaded, MAX_LIGHTS lights, rectilinear, 800x500, auto-rotation off,
+# idle) and reads VmRSS (and its anonymous, file and shared parts); every
 # checkpoint after the warm-up must be within 5 % of the first one after it. (The
 # once-a-second curve is reported too, not judged: it follows what is on show — a cube,
 # an EXR, how many lights.) Shorter runs (CI's minute) report without judging: their
@@ -25,12 +26,17 @@
 # checkpoints.csv (seconds, VmRSS kB, lights), rss-table.md (the memory curve: one row
 # per tenth of the run, and the checkpoints), summary.txt, the viewer's logs.
 #
-# Usage: scripts/window-soak.sh [--duration SECONDS] [--seed N] [--install] [--no-build]
+# Usage: scripts/window-soak.sh [--duration SECONDS] [--seed N] [--install] [--no-build] [--heap]
 #   --duration S  how long to drive the window (default 600)
 #   --seed N      the random seed (default 1): the same seed repeats the same actions
 #   --install     apt-get the X tools first (as scripts/window-smoke.sh --install, plus
 #                 python3-xlib for the drops)
 #   --no-build    use the existing release binary
+#   --heap        at each checkpoint also read glibc's own heap figures (gdb attaches and
+#                 calls malloc_stats(): bytes in use by live allocations, and bytes held
+#                 from the system) into checkpoints.csv: live bytes growing means a
+#                 leak, flat live bytes under a growing RSS means the allocator retains
+#                 freed memory (needs gdb and glibc; the viewer pauses for a moment)
 # Honours CARGO_TARGET_DIR; VIEWER_BIN=path tests another binary (implies --no-build);
 # SOAK_OUT=folder puts the output elsewhere.
 set -euo pipefail
@@ -42,13 +48,15 @@ DURATION=600
 SEED=1
 INSTALL=0
 BUILD=1
+HEAP=0
 while [ $# -gt 0 ]; do
   case $1 in
     --duration) DURATION=$2; shift ;;
     --seed) SEED=$2; shift ;;
     --install) INSTALL=1 ;;
     --no-build) BUILD=0 ;;
-    -h|--help) sed -n '2,36p' "$0"; exit 0 ;;
+    --heap) HEAP=1 ;;
+    -h|--help) sed -n '2,41p' "$0"; exit 0 ;;
     *) echo "window-soak: unknown argument '$1'" >&2; exit 2 ;;
   esac
   shift
@@ -56,17 +64,14 @@ done
 
 fail() { echo "window-soak: FAIL: $*" >&2; exit 1; }
 log() { echo "window-soak: $*"; }
+# shellcheck source=scripts/lib/xvfb.sh
+. scripts/lib/xvfb.sh
 
-if [ "$INSTALL" = 1 ]; then
-  SUDO=""
-  [ "$(id -u)" = 0 ] || SUDO=sudo
-  $SUDO apt-get update
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y xvfb xdotool x11-utils x11-apps \
-    imagemagick python3-xlib libx11-6 libx11-xcb1 libxcursor1 libxi6 libxkbcommon-x11-0 \
-    libxkbcommon0 libxcb1 libxcb-xkb1
-fi
+[ "$INSTALL" = 0 ] || xvfb_install python3-xlib
 PY=/usr/bin/python3
-for tool in Xvfb xdotool xdpyinfo mkfifo; do
+TOOLS="Xvfb xdotool xdpyinfo mkfifo"
+[ "$HEAP" = 0 ] || TOOLS="$TOOLS gdb"
+for tool in $TOOLS; do
   command -v "$tool" >/dev/null || fail "$tool not found (run with --install)"
 done
 "$PY" -c 'import Xlib' 2>/dev/null || fail "python3-xlib not found (run with --install)"
@@ -119,11 +124,6 @@ GOOD=("$F/pano.jpg" "$F/interior.exr" "$F/skyfantasy" "$F/view.png" "$F/cross.pn
 BAD=("$F/truncated.jpg" "$F/cut.exr" "$F/text.jpg" "$F/pipe.jpg" "$F/loop-a.jpg" "$F/huge-header.png" "$F/claims-32k.jpg")
 
 # --- X and the viewer -------------------------------------------------------------------
-DISP=""
-for n in $(seq 121 160); do
-  if [ ! -e /tmp/.X11-unix/X$n ] && [ ! -e /tmp/.X$n-lock ]; then DISP=:$n; break; fi
-done
-[ -n "$DISP" ] || fail "no free X display number"
 XVFB_PID=""
 VIEWER_PID=""
 SAMPLER_PID=""
@@ -133,16 +133,7 @@ cleanup() {
   if [ -n "$XVFB_PID" ] && kill -0 "$XVFB_PID" 2>/dev/null; then kill "$XVFB_PID" || true; fi
 }
 trap cleanup EXIT
-log "starting Xvfb on $DISP"
-Xvfb "$DISP" -screen 0 1280x800x24 -nolisten tcp >"$OUT/xvfb.log" 2>&1 &
-XVFB_PID=$!
-export DISPLAY=$DISP
-for _ in $(seq 1 300); do
-  xdpyinfo >/dev/null 2>&1 && break
-  kill -0 "$XVFB_PID" 2>/dev/null || fail "Xvfb exited: $(cat "$OUT/xvfb.log")"
-  sleep 0.1
-done
-xdpyinfo >/dev/null 2>&1 || fail "Xvfb did not answer in 30 s (see $OUT/xvfb.log)"
+xvfb_start 121 160 "$OUT/xvfb.log"
 
 alive() { kill -0 "$VIEWER_PID" 2>/dev/null || fail "the viewer exited (see $ERRLOG)"; }
 wait_for() { # pattern, from line, timeout
@@ -291,10 +282,24 @@ idle() {
 }
 # A checkpoint: the same state every time — dialogs, help and fullscreen closed, the
 # window at 800x500, the sample panorama loaded, MAX_LIGHTS lights, the rectilinear
-# projection, idle — and its
+# projection, auto-rotation off, idle — and its
 # resident memory. The memory of the checkpoints after the warm-up is what is judged.
 CHECKS=$OUT/checkpoints.csv
-echo "seconds,rss_kb,lights,projection" >"$CHECKS"
+echo "seconds,rss_kb,lights,projection,heap_inuse_kb,heap_system_kb,anon_kb,file_kb,shmem_kb" >"$CHECKS"
+# glibc's heap at this moment (with --heap): "in use kB,system kB" of malloc_stats()'s
+# total (arenas and mmapped blocks), printed by the viewer to its stderr; "," without.
+heap_now() {
+  [ "$HEAP" = 1 ] || { echo ","; return; }
+  local n
+  n=$(wc -l <"$ERRLOG")
+  timeout 60 gdb -p "$VIEWER_PID" -batch -ex 'call (void)malloc_stats()' >>"$OUT/gdb.log" 2>&1 || true
+  sleep 0.2
+  tail -n +"$((n + 1))" "$ERRLOG" | awk '
+    /^Total \(incl. mmap\):/ { t = 1; next }
+    t && /^system bytes/ { sys = $NF }
+    t && /^in use bytes/ { use = $NF }
+    END { if (use != "") printf "%d,%d\n", use / 1024, sys / 1024; else print "," }'
+}
 checkpoint() {
   local n l
   for _ in 1 2 3; do key Escape; sleep 0.2; done
@@ -319,8 +324,18 @@ checkpoint() {
     key v
     wait_new '^view ' "$n" 30 || true
   done
+  # Auto-rotation (Space, kept in the settings file) never lets the window idle: off.
+  if grep -q '"auto_rotate": true' "$OUT/config/settings.json"; then
+    key space
+    sleep 1.5 # the settings file is written at most once a second
+  fi
   idle || log "checkpoint: the window did not become idle in 40 s"
-  echo "$((SECONDS - START)),$(awk '/^VmRSS:/ {print $2}' "/proc/$VIEWER_PID/status"),$(lights_now),$(proj_now)" >>"$CHECKS"
+  local rss kinds
+  rss=$(awk '/^VmRSS:/ {print $2}' "/proc/$VIEWER_PID/status")
+  # The resident set by kind: anonymous (the heap, stacks), files (the binary's and the
+  # libraries' pages, faulted in as code runs), shared memory (softbuffer's image).
+  kinds=$(awk '/^RssAnon:/ {a = $2} /^RssFile:/ {f = $2} /^RssShmem:/ {s = $2} END {print a "," f "," s}' "/proc/$VIEWER_PID/status")
+  echo "$((SECONDS - START)),$rss,$(lights_now),$(proj_now),$(heap_now),$kinds" >>"$CHECKS"
 }
 act_save() {
   local n
@@ -339,6 +354,16 @@ ACTIONS=(drag drag flick wheel key key resize_storm minimize fullscreen drop dro
 
 log "driving the window for $DURATION s (seed $SEED)"
 START=$SECONDS
+# The largest window of the run first (the whole screen, then fullscreen), inside the
+# warm-up: buffers sized to the largest window so far and kept (egui_software_backend's
+# canvas, softbuffer's shared image) reach their size before the checkpoints are judged.
+xdotool windowsize "$WID" 1280 800 2>/dev/null || true
+sleep 1
+key f
+sleep 1
+key Escape
+xdotool windowsize "$WID" 800 500 2>/dev/null || true
+sleep 0.5
 CHECK_EVERY=$((DURATION / 12 > 20 ? DURATION / 12 : 20))
 LAST_CHECK=$START
 while [ $((SECONDS - START)) -lt "$DURATION" ]; do
@@ -400,6 +425,11 @@ ERRORS=$(sort -u "$ERRLOG" | grep -c '^viewer: ' || true)
 import csv, statistics, sys
 rows = [(float(r["seconds"]), int(r["rss_kb"])) for r in csv.DictReader(open(sys.argv[1]))]
 checks = [(float(r["seconds"]), int(r["rss_kb"]), r["lights"], r["projection"]) for r in csv.DictReader(open(sys.argv[2]))]
+# The resident set by kind (anonymous, files, shared memory) in kB.
+kinds = [(int(r["anon_kb"]), int(r["file_kb"]), int(r["shmem_kb"])) for r in csv.DictReader(open(sys.argv[2]))]
+# glibc's live and held heap at the checkpoints (with --heap), in kB, or None.
+heap = [(int(r["heap_inuse_kb"]), int(r["heap_system_kb"])) if r.get("heap_inuse_kb") else None
+        for r in csv.DictReader(open(sys.argv[2]))]
 if len(rows) < 10:
     print("FLAT no: too few samples"); sys.exit()
 end = rows[-1][0]
@@ -419,9 +449,12 @@ with open(sys.argv[3], "w") as f:
         if p:
             f.write(f"| {warm + i*span:.0f} | {warm + (i+1)*span:.0f} | {min(p)/1024:.1f} | {statistics.median(p)/1024:.1f} | {max(p)/1024:.1f} |\n")
     f.write("\nCheckpoints (the same state each time: the sample loaded, the same lights and projection, 800x500):\n\n")
-    f.write("| s | RSS MiB | lights | projection |\n|---:|---:|---:|---|\n")
-    for t, kb, lights, proj in checks:
-        f.write(f"| {t:.0f}{' (warm-up)' if t < warm else ''} | {kb/1024:.1f} | {lights} | {proj} |\n")
+    f.write("| s | RSS MiB | anonymous | files | shared | lights | projection | heap in use MiB | heap held MiB |\n"
+            "|---:|---:|---:|---:|---:|---:|---|---:|---:|\n")
+    for (t, kb, lights, proj), h, k in zip(checks, heap, kinds):
+        hs = f"{h[0]/1024:.1f} | {h[1]/1024:.1f}" if h else "- | -"
+        ks = " | ".join(f"{v/1024:.1f}" for v in k)
+        f.write(f"| {t:.0f}{' (warm-up)' if t < warm else ''} | {kb/1024:.1f} | {ks} | {lights} | {proj} | {hs} |\n")
 print(f"warm-up {warm:.0f} s; every second after it: {min(kb for _, kb in after)/1024:.1f} to "
       f"{max(kb for _, kb in after)/1024:.1f} MiB (what is on show varies)")
 judged = [(t, kb) for t, kb, _, _ in checks if t >= warm]
@@ -432,6 +465,11 @@ dev = [(kb - ref) / ref for _, kb in judged]
 print(f"{len(judged)} checkpoints after the warm-up: {min(kb for _, kb in judged)/1024:.1f} to "
       f"{max(kb for _, kb in judged)/1024:.1f} MiB, from {100*min(dev):+.1f} % to {100*max(dev):+.1f} % "
       f"of the first")
+hj = [h for (t, _, _, _), h in zip(checks, heap) if t >= warm and h]
+if hj:
+    print(f"glibc heap at those checkpoints: in use {min(u for u, _ in hj)/1024:.1f} to "
+          f"{max(u for u, _ in hj)/1024:.1f} MiB, held {min(s for _, s in hj)/1024:.1f} to "
+          f"{max(s for _, s in hj)/1024:.1f} MiB")
 print("FLAT yes" if max(abs(d) for d in dev) <= 0.05 else "FLAT no")
 EOF
 {

@@ -285,6 +285,123 @@ fn accelerated_renderer_really_runs_segments() {
 }
 
 #[test]
+fn trilinear_magnified_is_bilinear() {
+    // Zoomed in (far below one texel per pixel) the level of detail is 0 everywhere:
+    // trilinear is the bilinear image, byte for byte, with either renderer.
+    let cube = noise_cube(24);
+    for &(yaw, pitch) in EDGE_VIEWS {
+        let view = View::new(yaw, pitch, 30.0).unwrap();
+        let want = render(
+            &cube,
+            view,
+            Sampler::Bilinear,
+            CubeRenderer::Basic,
+            96,
+            72,
+            false,
+        );
+        for r in [CubeRenderer::Basic, CubeRenderer::Accelerated] {
+            let got = render(&cube, view, Sampler::Trilinear, r, 96, 72, true);
+            assert!(got == want, "({yaw}, {pitch}) {r:?}: trilinear differs");
+        }
+    }
+}
+
+/// A `w × h` view of `cube` rendered `s`× larger with the basic bilinear renderer and
+/// box-averaged back (8-bit, per channel): the minified truth the pyramid approximates.
+fn supersampled(cube: &CubeMap, view: View, w: u32, h: u32, s: u32) -> Vec<u32> {
+    let big = render(
+        cube,
+        view,
+        Sampler::Bilinear,
+        CubeRenderer::Basic,
+        w * s,
+        h * s,
+        true,
+    );
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let mut acc = [0u32; 3];
+            for j in 0..s * s {
+                let p = big[((y * s + j / s) * w * s + x * s + j % s) as usize];
+                for (a, sh) in acc.iter_mut().zip([16, 8, 0]) {
+                    *a += (p >> sh) & 0xFF;
+                }
+            }
+            let n = s * s;
+            acc.iter()
+                .zip([16, 8, 0])
+                .fold(0, |c, (a, sh)| c | ((a + n / 2) / n) << sh)
+        })
+        .collect()
+}
+
+#[test]
+fn trilinear_minified_is_closer_to_the_supersampled_truth() {
+    // Zoomed out on a noise cube (about 4 texels per pixel at the center, more towards
+    // the edges of hfov 120): bilinear aliases, the face pyramid averages. Both renderers'
+    // trilinear images are much closer to the 8×8 supersampled bilinear render than
+    // bilinear is, and close to each other (the scanline renderer takes the level of
+    // detail per 16 pixels, the basic one per pixel).
+    let cube = noise_cube(512);
+    let (w, h) = (160, 120);
+    for &(yaw, pitch) in &[(10.0, 5.0), (45.0, 35.26), (0.0, 90.0), (-135.0, -60.0)] {
+        let view = View::new(yaw, pitch, 120.0).unwrap();
+        let truth = supersampled(&cube, view, w, h, 8);
+        let bil = render(
+            &cube,
+            view,
+            Sampler::Bilinear,
+            CubeRenderer::Accelerated,
+            w,
+            h,
+            false,
+        );
+        let p_bil = psnr(&bil, &truth);
+        let basic = render(
+            &cube,
+            view,
+            Sampler::Trilinear,
+            CubeRenderer::Basic,
+            w,
+            h,
+            false,
+        );
+        let scan = render(
+            &cube,
+            view,
+            Sampler::Trilinear,
+            CubeRenderer::Accelerated,
+            w,
+            h,
+            true,
+        );
+        let (p_basic, p_scan, p_pair) = (
+            psnr(&basic, &truth),
+            psnr(&scan, &truth),
+            psnr(&scan, &basic),
+        );
+        eprintln!(
+            "minified ({yaw}, {pitch}): bilinear {p_bil:.1} dB, trilinear basic {p_basic:.1}, \
+             scanline {p_scan:.1}; scanline vs basic {p_pair:.1}"
+        );
+        assert!(
+            p_basic >= p_bil + 6.0,
+            "({yaw}, {pitch}): basic {p_basic:.1} vs bilinear {p_bil:.1}"
+        );
+        assert!(
+            p_scan >= p_bil + 6.0,
+            "({yaw}, {pitch}): scanline {p_scan:.1} vs bilinear {p_bil:.1}"
+        );
+        assert!(
+            p_pair >= 35.0,
+            "({yaw}, {pitch}): scanline vs basic {p_pair:.1} dB"
+        );
+    }
+}
+
+#[test]
 fn edges_and_corners_show_no_seam_nan_or_bad_read() {
     const TOL: u32 = 8;
     // Faces of 4² texels of a smooth function of direction, magnified: bilinear reading

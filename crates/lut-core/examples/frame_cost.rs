@@ -15,10 +15,13 @@
 //! (8192x4096), `size` WxH (1920x1080), `hfov` (90), `pitch` (10), `yaw` (start, 30; each
 //! frame turns 7.3°), `step` adaptive|1|2|4|8|16 (adaptive), `mode` lut|gather (lut:
 //! gather = a plain gather along the frame's precomputed nearest indices, the floor the
-//! nearest kernel is compared with), `cache` PATH (keep the generated map's pixels there
-//! and read them on later runs: much faster under valgrind).
+//! nearest kernel is compared with; cube = the cube scanline renderer on a cube of faces a
+//! quarter of the map's width, converted from the map as `viewer bench` does; cube-basic =
+//! the per-pixel cube renderer), `cache` PATH (keep the generated map's pixels there, and
+//! a cube's faces in PATH.cubeN, and read them on later runs: much faster under valgrind).
 
 use lut_core::grid_map;
+use lut_core::{CubeMap, CubeRenderer, Face};
 use lut_core::{Frame, IndexStep, Projection, RenderOptions, Renderer, Sampler, Scene, View};
 use std::time::Instant;
 
@@ -93,6 +96,41 @@ fn load_map(
     Ok(map)
 }
 
+/// The cube of `n`-texel faces converted from `map` (bilinear, as `viewer bench` does), or
+/// its faces read from `cache` (raw little-endian 0RGB, six faces in [`Face::ALL`] order).
+fn load_cube(
+    map: &lut_core::EnvMap,
+    n: u32,
+    cache: Option<&std::path::Path>,
+) -> Result<CubeMap, String> {
+    let texels = n as usize * n as usize;
+    let cache = cache.map(|p| {
+        let mut s = p.as_os_str().to_owned();
+        s.push(format!(".cube{n}"));
+        std::path::PathBuf::from(s)
+    });
+    if let Some(bytes) = cache.as_ref().and_then(|p| std::fs::read(p).ok()) {
+        if bytes.len() == 6 * texels * 4 {
+            let px: Vec<u32> = bytes
+                .chunks_exact(4)
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect();
+            let faces: [&[u32]; 6] = std::array::from_fn(|k| &px[k * texels..(k + 1) * texels]);
+            return CubeMap::from_faces(n, faces).map_err(|e| e.to_string());
+        }
+    }
+    let cube = CubeMap::from_envmap(map, n, Sampler::Bilinear).map_err(|e| e.to_string())?;
+    if let Some(p) = cache {
+        let bytes: Vec<u8> = Face::ALL
+            .iter()
+            .flat_map(|&f| cube.face_pixels(f))
+            .flat_map(|px| px.to_le_bytes())
+            .collect();
+        std::fs::write(&p, bytes).map_err(|e| format!("{}: {e}", p.display()))?;
+    }
+    Ok(cube)
+}
+
 fn run() -> Result<(), String> {
     let mut sampler = Sampler::Bilinear;
     let mut kernel = None;
@@ -101,6 +139,7 @@ fn run() -> Result<(), String> {
     let (mut hfov, mut pitch, mut yaw) = (90.0, 10.0, 30.0);
     let mut step = IndexStep::Adaptive;
     let mut gather = false;
+    let mut cube_renderer = None;
     let mut cache = None;
     for a in std::env::args().skip(1) {
         let (k, v) = a
@@ -126,7 +165,17 @@ fn run() -> Result<(), String> {
                     n => IndexStep::Fixed(num(n)? as u32),
                 }
             }
-            "mode" => gather = v == "gather",
+            "mode" => match v {
+                "lut" => {}
+                "gather" => gather = true,
+                "cube" => cube_renderer = Some(CubeRenderer::Accelerated),
+                "cube-basic" => cube_renderer = Some(CubeRenderer::Basic),
+                _ => {
+                    return Err(format!(
+                        "mode={v}: expected lut, gather, cube or cube-basic"
+                    ))
+                }
+            },
             "cache" => cache = Some(std::path::PathBuf::from(v)),
             _ => return Err(format!("unknown argument '{k}'")),
         }
@@ -141,7 +190,16 @@ fn run() -> Result<(), String> {
         sampler,
         index_step: step,
         threads: threads > 1,
+        cube: cube_renderer.unwrap_or_default(),
         ..RenderOptions::default()
+    };
+    let cube = match cube_renderer {
+        Some(_) => Some(load_cube(&map, (map_wh.0 / 4).max(1), cache.as_deref())?),
+        None => None,
+    };
+    let scene = match &cube {
+        Some(c) => Scene::Cube(c),
+        None => Scene::Map(&map),
     };
     let (w, h) = out_wh;
     let mut out = vec![0u32; w as usize * h as usize];
@@ -182,7 +240,7 @@ fn run() -> Result<(), String> {
         // The first frame builds the tables and sizes the scratch: not counted.
         let rep = pool.install(|| {
             let mut f = Frame::new(&mut out, w, h).map_err(|e| e.to_string())?;
-            r.render(Scene::Map(&map), view(0)?, &opts, &mut f)
+            r.render(scene, view(0)?, &opts, &mut f)
                 .map_err(|e| e.to_string())
         })?;
         eprintln!(
@@ -192,7 +250,7 @@ fn run() -> Result<(), String> {
         times = pool.install(|| {
             timed_frames(frames, &mut |i| {
                 let mut f = Frame::new(&mut out, w, h).map_err(|e| e.to_string())?;
-                r.render(Scene::Map(&map), view(i + 1)?, &opts, &mut f)
+                r.render(scene, view(i + 1)?, &opts, &mut f)
                     .map(|_| ())
                     .map_err(|e| e.to_string())
             })
@@ -207,7 +265,11 @@ fn run() -> Result<(), String> {
     println!(
         "{} | {} {} {}x{} from {}x{}, hfov {hfov}, {threads} thread(s): median {med:.2} ms over {} frame(s) (checksum {checksum:016x})",
         lut_core::kernel_info(),
-        if gather { "gather" } else { "lut" },
+        match (gather, cube_renderer) {
+            (true, _) => "gather",
+            (_, Some(r)) => r.name(),
+            _ => "lut",
+        },
         sampler.name(),
         w,
         h,

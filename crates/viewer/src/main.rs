@@ -8,8 +8,14 @@ use viewer::cli::{Cli, Command};
 use viewer::commands::{bench, bench_load, convert, ies, lux, render};
 
 fn main() -> ExitCode {
-    viewer::signals::install();
     let cli = Cli::parse();
+    if cli.command.is_none() {
+        // The window: one heap arena, which its trims reach whole (glibc; see
+        // `viewer::window::heap`). Before any other thread exists: glibc fixes its arena
+        // limit at the first allocation of a second thread (the signal thread's, next).
+        viewer::window::heap::one_arena();
+    }
+    viewer::signals::install();
     // A bad LUTPANO_KERNEL (the span kernel override) is refused up front.
     if let Err(e) = lut_core::kernel_from_env() {
         viewer::errln!("viewer: {e}");

@@ -33,11 +33,13 @@
 //! without choosing a face). Both compute every ray and every face coordinate with the
 //! same expressions, and the accelerated path *proves* each segment's face before using
 //! it (falling back to the per-pixel choice where it cannot), so the two images are
-//! byte-identical. See `docs/cube.md`.
+//! byte-identical (nearest, bilinear). Trilinear sampling reads a face pyramid
+//! (`cube/pyramid.rs`). See `docs/cube.md`.
 //!
 //! Loading from files is `io/cube.rs`; layouts and namings are `cube/layout.rs`.
 
 pub(crate) mod layout;
+pub(crate) mod pyramid;
 
 use crate::error::ViewError;
 use crate::geom::camera::{check_size, lat_long_to_dir, View};
@@ -47,6 +49,7 @@ use glam::DVec3;
 use layout::Layout;
 use rayon::prelude::*;
 use std::path::PathBuf;
+use std::sync::OnceLock;
 
 /// Largest accepted face side: six 8192² faces are 1.6 GB of 0RGB texels.
 pub const MAX_FACE_SIZE: u32 = 8192;
@@ -377,12 +380,23 @@ pub enum UsageProblem {
 
 /// A cube map: six equal square faces of 0RGB texels, each stored with a one-texel border
 /// taken from its neighbours (see the module docs).
-#[derive(Clone, PartialEq, Eq)]
+#[derive(Clone)]
 pub struct CubeMap {
     size: u32,
     /// `(size + 2)²` texels per face, row-major, border included.
     faces: [Vec<u32>; 6],
+    /// The face pyramid (levels 1, 2, ...), built on first use (`cube/pyramid.rs`).
+    levels: OnceLock<Vec<CubeMap>>,
 }
+
+/// Equal faces (the pyramid, derived from them, is not compared).
+impl PartialEq for CubeMap {
+    fn eq(&self, other: &Self) -> bool {
+        self.size == other.size && self.faces == other.faces
+    }
+}
+
+impl Eq for CubeMap {}
 
 impl std::fmt::Debug for CubeMap {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -469,7 +483,11 @@ impl CubeMap {
             }
             out[k] = data;
         }
-        Ok(CubeMap { size, faces: out })
+        Ok(CubeMap {
+            size,
+            faces: out,
+            levels: OnceLock::new(),
+        })
     }
 
     /// Face side in texels.
@@ -506,7 +524,8 @@ impl CubeMap {
         self.faces.iter().map(|f| f.len() * 4).sum()
     }
 
-    /// Sample at face pixel coordinates (u, v) (clamped to [0, size]).
+    /// Sample at face pixel coordinates (u, v) (clamped to [0, size]); trilinear is
+    /// bilinear here (no footprint is known: [`CubeMap::trilinear_dir`] takes one).
     #[inline(always)]
     pub fn sample_uv(&self, sampler: Sampler, face: Face, u: f64, v: f64) -> u32 {
         match sampler {
@@ -591,6 +610,7 @@ impl CubeMap {
     /// be able to detect seams.
     pub fn with_clamped_borders(&self) -> CubeMap {
         let mut c = self.clone();
+        c.levels = OnceLock::new();
         let n = self.size as usize;
         let s = n + 2;
         for f in c.faces.iter_mut() {

@@ -20,26 +20,39 @@
 //! rounding everywhere in between and every pixel's per-pixel face choice is that face,
 //! strictly. Ends that fail the check (a pixel center within `δ` of a face edge, or a
 //! scanline lying in an edge plane) are peeled off and handled per pixel; a run that still
-//! fails is done per pixel. Inside a verified run the loop neither chooses a face nor
-//! branches on one, and the face's axis selection is compiled in.
+//! fails is done per pixel.
 //!
-//! The face coordinates come from [`face_uv`] on the bit-identical ray in both renderers,
-//! so the two images are byte-identical (tested over sweeps of views, sizes and both
-//! samplers in `tests/cube.rs`).
+//! # Runs on the span kernels
+//! On a verified run's face the ray's axes `(a, b, m)` are linear in `dx` and the face
+//! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line. The run goes to
+//! the span kernels (`render/kernel/face.rs`: AVX2, SSE4.1 or the scalar twin, chosen
+//! once per process as for the map's spans, `LUTPANO_KERNEL=scalar` forcing the portable
+//! one), which evaluate that line exactly at every pixel in `f64` SIMD lanes with the
+//! arithmetic of [`face_uv`] (one division per pixel) and gather and blend with the map
+//! kernels' code. No position is interpolated: the per-pixel path's face coordinates
+//! come from [`face_uv`] on the bit-identical ray, the kernels' from the same operations,
+//! so the two renderers' images are byte-identical (tested over sweeps of views, sizes
+//! and both samplers in `tests/cube.rs`, with every kernel), and the sampling-position
+//! error of the cube renderers is zero.
 
 use super::exact::render_exact;
 use super::frame::Frame;
+use super::kernel::{face_blend, face_span, FaceRun, Texels};
+use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
     check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
 };
 use crate::geom::camera::View;
 use crate::map::envmap::EnvMap;
+use crate::map::pyramid::lod_q8;
 use crate::map::sample::Sampler;
 use crate::named::{parse_name, unknown_name, Named};
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// Which of the paper's renderers to use. Both give byte-identical images.
+/// Which of the paper's renderers to use. Both give byte-identical images with nearest
+/// and bilinear sampling; with trilinear the scanline renderer takes the level of detail
+/// per 16 pixels of a face run, the basic one per pixel (`cube/pyramid.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum CubeRenderer {
     /// Section 1: per pixel, ray → face by the largest |coordinate| → face coordinates.
@@ -154,34 +167,102 @@ fn ray(p: DVec3, b: DVec3, dx: f64) -> DVec3 {
     DVec3::new(p.x + dx * b.x, p.y + dx * b.y, p.z + dx * b.z)
 }
 
+/// A face's bordered texels as the span kernels read them (side n + 1: the (n + 2)²
+/// stored texels).
+#[inline]
+fn face_texels(cube: &CubeMap, face: Face) -> Texels<'_> {
+    let side = cube.face_size() + 1;
+    Texels::new(cube.bordered_face(face), side, side, false)
+        .expect("a cube face holds (n + 2)^2 texels, fewer than 2^31")
+}
+
 /// Texel fetch, monomorphized per sampler so the inner loops do not branch on it.
 trait Fetch: Copy + Send + Sync {
-    fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32;
+    /// The sample of ray `d` on `face` (the face of `d`), per pixel.
+    fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32;
+    /// A verified run on `face` (`run`: its projective line), with the span kernels.
+    fn span(self, cube: &CubeMap, frame: &Rays, face: Face, run: &FaceRun, out: &mut [u32]);
 }
 
 #[derive(Clone, Copy)]
 struct NearestFetch;
 #[derive(Clone, Copy)]
 struct BilinearFetch;
+#[derive(Clone, Copy)]
+struct TrilinearFetch;
 
 impl Fetch for NearestFetch {
     #[inline(always)]
-    fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32 {
+    fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32 {
+        let (u, v) = face_uv(face, d, frame.half_face);
         cube.nearest(face, u, v)
+    }
+    #[inline(always)]
+    fn span(self, cube: &CubeMap, _: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
+        face_span::<false>(&face_texels(cube, face), run, out)
     }
 }
 
 impl Fetch for BilinearFetch {
     #[inline(always)]
-    fn fetch(self, cube: &CubeMap, face: Face, u: f64, v: f64) -> u32 {
+    fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32 {
+        let (u, v) = face_uv(face, d, frame.half_face);
         cube.bilinear(face, u, v)
+    }
+    #[inline(always)]
+    fn span(self, cube: &CubeMap, _: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
+        face_span::<true>(&face_texels(cube, face), run, out)
+    }
+}
+
+/// Trilinear on the face pyramid (`cube/pyramid.rs`): per pixel, the level of detail of
+/// the pixel's own footprint; on a run, one per [`TRILINEAR_RUN_CHUNK`] pixels (at the
+/// chunk's middle pixel), the chunk drawn by the span kernels on the two levels and
+/// blended.
+impl Fetch for TrilinearFetch {
+    #[inline(always)]
+    fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32 {
+        let lod = lod_of(face, d, frame.b, frame.r1, frame.half_face);
+        cube.trilinear_dir(face, d, lod)
+    }
+
+    fn span(self, cube: &CubeMap, frame: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
+        // The image's x and y steps on the face's axes (y: −R₁ per row; the sign does not
+        // change the footprint).
+        let (sx, sy) = (face_axes(face, frame.b), face_axes(face, frame.r1));
+        for (c, chunk) in out.chunks_mut(TRILINEAR_RUN_CHUNK).enumerate() {
+            let dx = run.dx + (c * TRILINEAR_RUN_CHUNK) as f64;
+            let mid = dx + (chunk.len() / 2) as f64;
+            let at = |i: usize| run.p[i] + mid * run.d[i];
+            let lod = lod_q8(footprint((at(0), at(1), at(2)), sx, sy, frame.half_face));
+            let sub = FaceRun { dx, ..*run };
+            let on_level = |k: usize, out: &mut [u32]| {
+                let (l, _) = cube.level(k);
+                let half = l.face_size() as f64 / 2.0;
+                face_span::<true>(&face_texels(l, face), &FaceRun { half, ..sub }, out)
+            };
+            if lod <= 0 {
+                on_level(0, chunk);
+                continue;
+            }
+            let (k, frac) = ((lod >> 8) as usize, (lod & 0xFF) as u32);
+            let (ka, kb) = (cube.level(k).1, cube.level(k + 1).1);
+            on_level(ka, chunk);
+            if frac == 0 || ka == kb {
+                continue;
+            }
+            let (l, _) = cube.level(kb);
+            let half = l.face_size() as f64 / 2.0;
+            face_blend(&face_texels(l, face), &FaceRun { half, ..sub }, chunk, frac);
+        }
     }
 }
 
 /// Render `view` of `cube` into `frame` with the chosen renderer (the entry is
 /// [`crate::Renderer::render`] of a [`crate::Scene::Cube`]). `threads` splits rows into
 /// bands across the rayon pool; the output is identical either way, and identical between
-/// the two renderers.
+/// the two renderers (nearest, bilinear; see [`CubeRenderer`] for trilinear, which builds
+/// the face pyramid on first use).
 pub(crate) fn render_cube(
     cube: &CubeMap,
     view: View,
@@ -194,8 +275,10 @@ pub(crate) fn render_cube(
     let out = frame.pixels_mut();
     match sampler {
         Sampler::Nearest => render_with(cube, &rays, NearestFetch, renderer, out, threads),
-        Sampler::Bilinear | Sampler::Trilinear => {
-            render_with(cube, &rays, BilinearFetch, renderer, out, threads)
+        Sampler::Bilinear => render_with(cube, &rays, BilinearFetch, renderer, out, threads),
+        Sampler::Trilinear => {
+            cube.pyramid(); // built here, not inside a row band
+            render_with(cube, &rays, TrilinearFetch, renderer, out, threads)
         }
     }
 }
@@ -245,9 +328,7 @@ fn per_pixel<S: Fetch>(
     for (x, px) in line.iter_mut().enumerate().take(x1).skip(x0) {
         // The whole rotation per pixel; bit-identical to the accelerated path's ray.
         let d = ray(frame.row(dy), frame.b, frame.dx(x));
-        let face = face_of(d);
-        let (u, v) = face_uv(face, d, frame.half_face);
-        *px = s.fetch(cube, face, u, v);
+        *px = s.fetch(cube, frame, face_of(d), d);
     }
 }
 
@@ -340,36 +421,18 @@ fn accel_row<S: Fetch>(
             per_pixel(cube, frame, s, y, line, a, e);
             continue;
         }
-        match seg.face {
-            Face::Front => run::<0, S>(cube, frame, s, p, line, a, e),
-            Face::Right => run::<1, S>(cube, frame, s, p, line, a, e),
-            Face::Back => run::<2, S>(cube, frame, s, p, line, a, e),
-            Face::Left => run::<3, S>(cube, frame, s, p, line, a, e),
-            Face::Up => run::<4, S>(cube, frame, s, p, line, a, e),
-            Face::Down => run::<5, S>(cube, frame, s, p, line, a, e),
-        }
-    }
-}
-
-/// A verified run on face `F`: step the ray along the scanline, no face choice.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn run<const F: usize, S: Fetch>(
-    cube: &CubeMap,
-    frame: &Rays,
-    s: S,
-    p: DVec3,
-    line: &mut [u32],
-    a: usize,
-    e: usize,
-) {
-    let face = Face::from_index(F);
-    let b = frame.b;
-    let half = frame.half_face;
-    for (x, px) in line[a..e].iter_mut().enumerate() {
-        let d = ray(p, b, frame.dx(a + x));
-        let (u, v) = face_uv(face, d, half);
-        *px = s.fetch(cube, face, u, v);
+        // A verified run: the ray's coordinates on the face's axes are linear in dx,
+        // the face coordinates a projective line, evaluated exactly per pixel by the
+        // span kernel (render/kernel/face.rs) with the per-pixel path's arithmetic.
+        let (pa, pb, pm) = face_axes(seg.face, p);
+        let (ba, bb, bm) = face_axes(seg.face, b);
+        let run = FaceRun {
+            p: [pa, pb, pm],
+            d: [ba, bb, bm],
+            dx: frame.dx(a),
+            half: frame.half_face,
+        };
+        s.span(cube, frame, seg.face, &run, &mut line[a..e]);
     }
 }
 

@@ -109,6 +109,8 @@ struct App {
     renders: VecDeque<Instant>,
     /// When the last frame was drawn, and the display's refresh interval.
     last_redraw: Option<Instant>,
+    /// When freed heap memory was last given back (`super::heap`).
+    last_trim: Instant,
     frame_interval: Duration,
     /// The readouts as last drawn (for the follow-up frame and `--print-view`).
     drawn_readouts: Vec<(&'static str, String)>,
@@ -183,6 +185,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         next_frame_at: None,
         renders: VecDeque::new(),
         last_redraw: None,
+        last_trim: Instant::now(),
         frame_interval: Duration::from_secs_f64(super::input::DEFAULT_FRAME_S),
         drawn_readouts: Vec::new(),
         printed_readouts: String::new(),
@@ -413,14 +416,25 @@ impl ApplicationHandler<LoadEvent> for App {
             let fx = self.doc.open_drops(self.ctl.settings.exposure_ev);
             self.apply(fx);
         }
-        match self.next_frame_at {
-            Some(at) if at <= Instant::now() => {
+        let now = Instant::now();
+        // Freed heap memory back to the system once the window has settled (or every
+        // few seconds while it keeps drawing): see `super::heap`.
+        let mut trim_at = super::heap::next_trim(self.last_redraw, self.last_trim);
+        if trim_at.is_some_and(|at| at <= now) {
+            super::heap::give_back();
+            self.last_trim = Instant::now();
+            trim_at = None;
+        }
+        let wake = match self.next_frame_at {
+            Some(at) if at <= now => {
                 self.next_frame_at = None;
                 self.request_redraw();
-                el.set_control_flow(ControlFlow::Wait);
+                // The redraw comes next; the trim waits for it to settle.
+                None
             }
-            Some(at) => el.set_control_flow(ControlFlow::WaitUntil(at)),
-            None => el.set_control_flow(ControlFlow::Wait),
-        }
+            Some(at) => Some(trim_at.map_or(at, |t| t.min(at))),
+            None => trim_at,
+        };
+        el.set_control_flow(wake.map_or(ControlFlow::Wait, ControlFlow::WaitUntil));
     }
 }

@@ -195,6 +195,11 @@ pub fn load(
                 naming,
             };
             let cube = crate::panorama::load_cube(paths, cube).map_err(|e| format!("{e:#}"))?;
+            // The face pyramid (the window's default sampler is trilinear) now, so the
+            // first frames do not wait for it.
+            progress(LoadStep::Tables, Some(0.0));
+            cube.pyramid();
+            progress(LoadStep::Tables, Some(1.0));
             return Ok(Box::new(Loaded {
                 scene: Scene::Cube(cube),
                 source,
@@ -338,6 +343,21 @@ mod tests {
         assert_eq!(kind, "cube");
         assert_eq!(loaded.label(), format!("skyfantasy (cube, {n}px faces)"));
         assert!(loaded.map().is_none());
-        assert_eq!(steps, [(LoadStep::Decoding, None)]);
+        // Decoding, then the face pyramid (the default sampler is trilinear), built.
+        assert_eq!(
+            steps,
+            [
+                (LoadStep::Decoding, None),
+                (LoadStep::Tables, Some(0.0)),
+                (LoadStep::Tables, Some(1.0))
+            ]
+        );
+        let Scene::Cube(cube) = &loaded.scene else {
+            panic!("a cube folder loads as a cube");
+        };
+        assert!(
+            cube.pyramid_bytes() > 0,
+            "the face pyramid is built while loading"
+        );
     }
 }

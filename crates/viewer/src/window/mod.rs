@@ -15,6 +15,8 @@
 //! * [`paint`]: the scene and the UI composed on the CPU into one 0RGB buffer; the
 //!   upscaling of degraded frames; the window icon.
 //! * [`export`]: HDR exposure steps and the "Save view…" size and file name (pure).
+//! * [`heap`]: freed heap memory given back to the system when the window settles, so
+//!   that a long session's resident memory does not creep up (glibc).
 //! * `app`: the winit event loop and softbuffer surface; it runs the document's effects.
 //!
 //! The luminaires the panel edits are [`crate::lighting::LightsState`].
@@ -27,6 +29,7 @@ pub mod dialogs;
 pub mod document;
 pub mod export;
 pub mod folder;
+pub mod heap;
 pub mod input;
 pub mod keys;
 pub mod lights_panel;

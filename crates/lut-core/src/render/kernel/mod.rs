@@ -36,8 +36,10 @@
 //! # Layout
 //! `mod.rs` (this file): the kernels' data types and the entries the renderer calls on an
 //! [`EnvMap`]; `jobs.rs`: the span check, batches and the dispatch; `scalar.rs`: the
-//! portable kernels (the reference); `x86.rs`: SSE4.1 and AVX2 (the only file where
-//! `unsafe` is allowed); `select.rs`: choosing the kernel; `tests.rs`: the property tests.
+//! portable kernels (the reference); `x86.rs`: SSE4.1 and AVX2 (the only module where
+//! `unsafe` is allowed; `x86/face.rs` is its child); `select.rs`: choosing the kernel;
+//! `tests.rs`: the property tests; `face.rs`: cube-face runs, whose positions are a
+//! projective line evaluated exactly per pixel (the cube scanline renderer's kernels).
 //!
 //! # Batches
 //! Spans are short (8–16 pixels at hfov 90), so what a span costs besides its pixels
@@ -103,6 +105,7 @@
 //!
 //! aarch64 and x86 CPUs without SSE4.1 run the scalar kernel.
 
+mod face;
 mod jobs;
 mod scalar;
 mod select;
@@ -115,6 +118,8 @@ pub use select::{
     active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
     KernelError, KernelInfo, KernelSource, KERNEL_ENV,
 };
+
+pub(crate) use face::{face_blend, face_span, FaceRun};
 
 use crate::geom::fixed::{Fx, FX_BITS};
 use crate::map::envmap::EnvMap;

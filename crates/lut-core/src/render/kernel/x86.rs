@@ -19,6 +19,8 @@ use super::{scalar, SpanJob, Texels};
 use crate::geom::fixed::FX_BITS;
 use std::arch::x86_64::*;
 
+pub(super) mod face;
+
 /// The span's start split for 32-bit lanes: `base` = the start pixel's index in the
 /// slice, lanes hold `f + i·d` (Q.16, relative to that pixel).
 #[derive(Debug, Clone, Copy)]
@@ -182,7 +184,7 @@ mod avx2 {
     /// 0RGB pixels → (blue and red, green and top byte), one channel per 16-bit lane.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn split(p: __m256i) -> (__m256i, __m256i) {
+    pub(super) fn split(p: __m256i) -> (__m256i, __m256i) {
         (
             _mm256_and_si256(p, _mm256_set1_epi32(0x00FF_00FF)),
             _mm256_srli_epi16::<8>(p),
@@ -192,7 +194,7 @@ mod avx2 {
     /// Per channel `(a·iw + b·w + 128) >> 8` (at most 255·256 + 128: no 16-bit overflow).
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn lerp(
+    pub(super) fn lerp(
         a: (__m256i, __m256i),
         b: (__m256i, __m256i),
         w: (__m256i, __m256i),
@@ -208,7 +210,7 @@ mod avx2 {
     /// Split channels back to 0RGB (the top byte dropped).
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn merge(c: (__m256i, __m256i)) -> __m256i {
+    pub(super) fn merge(c: (__m256i, __m256i)) -> __m256i {
         let g = _mm256_and_si256(_mm256_slli_epi32::<8>(c.1), _mm256_set1_epi32(0xFF00));
         _mm256_or_si256(c.0, g)
     }
@@ -247,7 +249,7 @@ mod avx2 {
     /// Bilinear samples at 8 lane positions (split channels).
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn bilinear8(
+    pub(super) fn bilinear8(
         px: &[u32],
         stride: usize,
         l: &Local,
@@ -421,7 +423,7 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    fn split(p: __m128i) -> (__m128i, __m128i) {
+    pub(super) fn split(p: __m128i) -> (__m128i, __m128i) {
         (
             _mm_and_si128(p, _mm_set1_epi32(0x00FF_00FF)),
             _mm_srli_epi16::<8>(p),
@@ -430,7 +432,7 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    fn lerp(
+    pub(super) fn lerp(
         a: (__m128i, __m128i),
         b: (__m128i, __m128i),
         w: (__m128i, __m128i),
@@ -445,7 +447,7 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    fn merge(c: (__m128i, __m128i)) -> __m128i {
+    pub(super) fn merge(c: (__m128i, __m128i)) -> __m128i {
         let g = _mm_and_si128(_mm_slli_epi32::<8>(c.1), _mm_set1_epi32(0xFF00));
         _mm_or_si128(c.0, g)
     }
@@ -465,7 +467,7 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    fn bilinear4(
+    pub(super) fn bilinear4(
         px: &[u32],
         stride: usize,
         l: &Local,

@@ -414,7 +414,7 @@ impl App {
         if let SceneRef::Map { renderer, .. } = cur.scene.as_mut() {
             renderer.set_bilinear_level(bilinear_level);
         }
-        self.scene.resize(rect.w as usize * rect.h as usize, 0);
+        fit(&mut self.scene, rect.w as usize * rect.h as usize);
         let t0 = Instant::now();
         let view = look.view();
         let k = level.scale();
@@ -444,7 +444,7 @@ impl App {
             )
         } else {
             let (sw, sh) = (rect.w.div_ceil(k), rect.h.div_ceil(k));
-            self.small.resize(sw as usize * sh as usize, 0);
+            fit(&mut self.small, sw as usize * sh as usize);
             let r = render_scene(cur.scene.as_mut(), view, &opts, &mut self.small, sw, sh);
             crate::window::paint::upscale_bilinear(
                 &self.small,
@@ -571,8 +571,38 @@ impl App {
     }
 }
 
+/// Make `buf` hold `n` pixels. Frames of the same size reuse it as it is; a smaller
+/// scene gives the excess back (a window once maximized and shrunk again would otherwise
+/// keep the largest frame's buffers for the rest of the session).
+fn fit(buf: &mut Vec<u32>, n: usize) {
+    buf.resize(n, 0);
+    buf.shrink_to_fit();
+}
+
 /// Readout rows equal but for the UI time (which every frame changes).
 fn same_rows(a: &[(&'static str, String)], b: &[(&'static str, String)]) -> bool {
     let keep = |r: &&(&str, String)| r.0 != "UI";
     a.iter().filter(keep).eq(b.iter().filter(keep))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fit;
+
+    #[test]
+    fn a_smaller_scene_gives_its_buffer_back_and_the_same_size_reuses_it() {
+        let mut buf = Vec::new();
+        fit(&mut buf, 1280 * 800);
+        assert_eq!(buf.len(), 1280 * 800);
+        fit(&mut buf, 800 * 500);
+        assert_eq!(buf.len(), 800 * 500);
+        assert!(
+            buf.capacity() < 1280 * 800,
+            "kept {} pixels",
+            buf.capacity()
+        );
+        let at = buf.as_ptr();
+        fit(&mut buf, 800 * 500);
+        assert_eq!(buf.as_ptr(), at, "the same size reallocated");
+    }
 }
