@@ -16,7 +16,8 @@
 #   saves the view where the settings say; docs/screenshot.png is taken here.
 # Run 3 (panel hidden): a scene file with --show-room opens its panorama at its view with
 #   its five luminaires; a click on a marker selects that light, dragging it moves it
-#   along the ceiling without turning the view; dragging a room edge resizes the room.
+#   along the ceiling without turning the view; dragging a room edge resizes the room, and
+#   so does dragging a room corner (its two walls).
 #
 # Screenshots and logs: target/window-smoke/ (kept as CI artifacts). The settings live
 # in a temporary config folder (LUTPANO_CONFIG_DIR), never the real home.
@@ -444,6 +445,27 @@ grep -q '^room 4.170x2.990x2.700 centre 0.485,0.045' "$VIEWLOG" &&
   fail "dragging a room edge left the room as it was"
 [ "$(field yaw)" = "$YAW0" ] && [ "$(field pitch)" = "$PITCH0" ] ||
   fail "dragging a room edge turned the view"
+# Drag a room corner (clear of the toolbar): both its walls move, the view does not turn.
+settle
+ROOM0=$(grep '^room ' "$VIEWLOG" | tail -n 1)
+CORNER=$(grep '^corners ' "$VIEWLOG" | tail -n 1 | tr ' ' '\n' | grep '=' |
+  awk -F'[=,]' -v w="$SW" -v h="$SH" '$2 > 60 && $2 < w - 60 && $3 > 80 && $3 < h - 60 { print; exit }')
+[ -n "$CORNER" ] || fail "no room corner inside the view: $(grep '^corners ' "$VIEWLOG" | tail -n 1)"
+{
+  KXY=${CORNER#*=}; KX=$((X + ${KXY%,*})); KY=$((Y + ${KXY#*,}))
+  log "room corner ${CORNER%%=*} at $KX,$KY"
+  N=$(lines)
+  xdotool mousemove "$KX" "$KY"; sleep 0.2; xdotool mousedown 1; sleep 0.1
+  for i in 1 2 3 4 5 6; do xdotool mousemove $((KX + 5 * i)) $((KY - 3 * i)); sleep 0.05; done
+  sleep 0.2; xdotool mouseup 1
+  wait_for "^room " "$N" 5
+  settle
+  ROOM1=$(grep '^room ' "$VIEWLOG" | tail -n 1)
+  log "$ROOM1"
+  [ "$ROOM1" != "$ROOM0" ] || fail "dragging a room corner left the room as it was: $ROOM1"
+  [ "$(field yaw)" = "$YAW0" ] && [ "$(field pitch)" = "$PITCH0" ] ||
+    fail "dragging a room corner turned the view"
+}
 sleep 0.3
 $IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/lights.png"
 quit_viewer

@@ -492,3 +492,132 @@ fn curved_view_projections_probe_every_pixel() {
         lit.len()
     );
 }
+
+#[test]
+fn frames_lit_as_they_are_drawn_equal_render_then_shade() {
+    // `Renderer::render_with` runs the shader on each band of rows as it is drawn (the
+    // LUT renderer) or after the frame (the others): the pixels must be exactly those of
+    // rendering, then `IlluminanceMap::shade_frame`, for every renderer, sampler, view
+    // projection, thread count and a height that is not a multiple of the band.
+    use lut_core::{
+        grid_map, CubeMap, Frame, Projection, RenderOptions, Renderer, RendererKind, Sampler,
+        Scene, ViewProjection, HOOK_BAND_ROWS,
+    };
+    use std::sync::Mutex;
+    let scene = ring(&bench_table());
+    let map = IlluminanceMap::build(&scene, &MapOptions::default()).unwrap();
+    let pano = grid_map(1024, 512, Projection::Equirect).unwrap();
+    let cube = CubeMap::from_envmap(&pano, 128, Sampler::Bilinear).unwrap();
+    let (w, h) = (333u32, 211u32);
+    let views = [
+        View::new(40.0, -20.0, 110.0).unwrap(),
+        View::new(-100.0, 35.0, 50.0).unwrap(),
+        View::with_projection(30.0, -60.0, 200.0, ViewProjection::Fisheye).unwrap(),
+    ];
+    let mut renderer = Renderer::new(&pano);
+    for view in views {
+        for (kind, sampler) in [
+            (RendererKind::Lut, Sampler::Bilinear),
+            (RendererKind::Lut, Sampler::Nearest),
+            (RendererKind::Lut, Sampler::Trilinear),
+            (RendererKind::Grid, Sampler::Bilinear),
+            (RendererKind::Exact, Sampler::Bilinear),
+        ] {
+            for (threads, false_color, on_cube) in [
+                (true, false, false),
+                (false, true, false),
+                (true, false, true),
+            ] {
+                let opts = RenderOptions {
+                    renderer: kind,
+                    sampler,
+                    threads,
+                    ..RenderOptions::default()
+                };
+                let shade = ShadeOptions {
+                    false_color,
+                    ..ShadeOptions::default()
+                };
+                let what = if on_cube {
+                    Scene::Cube(&cube)
+                } else {
+                    Scene::Map(&pano)
+                };
+                let label = format!("{view:?} {kind:?} {sampler:?} {threads} {false_color}");
+                let cam = Camera::new(view, w, h);
+                let mut want = vec![0u32; (w * h) as usize];
+                let mut f = Frame::new(&mut want, w, h).unwrap();
+                renderer.render(what, view, &opts, &mut f).unwrap();
+                map.shade_frame(&cam, &mut want, w, h, &shade).unwrap();
+                let shader = map.frame_shader(&cam, &shade).unwrap();
+                let bands = Mutex::new(Vec::new());
+                let hook = |y0: usize, rows: &mut [u32]| {
+                    bands.lock().unwrap().push((y0, rows.len() / w as usize));
+                    shader.shade_band(y0, rows);
+                };
+                let mut got = vec![0u32; (w * h) as usize];
+                let mut f = Frame::new(&mut got, w, h).unwrap();
+                renderer
+                    .render_with(what, view, &opts, &mut f, &hook)
+                    .unwrap();
+                assert!(want == got, "{label}: the pixels differ");
+                // Every row in exactly one band; bands aligned, whole multiples of the
+                // alignment but the last.
+                let mut bands = bands.into_inner().unwrap();
+                bands.sort();
+                let mut next = 0;
+                for &(y0, n) in &bands {
+                    assert_eq!(y0, next, "{label}: {bands:?}");
+                    assert_eq!(y0 % HOOK_BAND_ROWS, 0, "{label}: {bands:?}");
+                    assert!(n > 0 && (n % HOOK_BAND_ROWS == 0 || y0 + n == h as usize));
+                    next = y0 + n;
+                }
+                assert_eq!(next, h as usize, "{label}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_band_lights_only_its_rows() {
+    // A band given alone (any start row, rows past the frame's height) lights its own
+    // rows, as the whole frame's pass lights them when it starts on a block row.
+    let scene = ring(&bench_table());
+    let map = IlluminanceMap::build(&scene, &MapOptions::default()).unwrap();
+    let (w, h) = (97u32, 70u32);
+    let cam = Camera::new(View::new(10.0, -30.0, 100.0).unwrap(), w, h);
+    let base: Vec<u32> = (0..w * h)
+        .map(|i| i.wrapping_mul(2_654_435_761) & 0xff_ffff)
+        .collect();
+    let mut whole = base.clone();
+    let opts = ShadeOptions::default();
+    map.shade_frame(&cam, &mut whole, w, h, &opts).unwrap();
+    let shader = map.frame_shader(&cam, &opts).unwrap();
+    assert_eq!(shader.size(), (w, h));
+    let wu = w as usize;
+    // Rows 32..48 (a block row): exactly the whole pass's; the rest untouched.
+    let mut band = base.clone();
+    shader.shade_band(32, &mut band[32 * wu..48 * wu]);
+    assert_eq!(band[32 * wu..48 * wu], whole[32 * wu..48 * wu]);
+    assert_eq!(band[..32 * wu], base[..32 * wu]);
+    assert_eq!(band[48 * wu..], base[48 * wu..]);
+    // Rows 64..70 given with room for 16: only the frame's 6 rows are lit.
+    let mut tail = base[64 * wu..].to_vec();
+    tail.resize(16 * wu, 0x123456);
+    shader.shade_band(64, &mut tail);
+    assert_eq!(tail[..6 * wu], whole[64 * wu..]);
+    assert!(tail[6 * wu..].iter().all(|&p| p == 0x123456));
+    // A band starting off a block row is lit within the tolerance of the whole pass.
+    let mut off = base.clone();
+    shader.shade_band(5, &mut off[5 * wu..27 * wu]);
+    let worst = off[5 * wu..27 * wu]
+        .iter()
+        .zip(&whole[5 * wu..27 * wu])
+        .map(|(a, b)| test_support::pixels::max_channel_diff(*a, *b))
+        .max()
+        .unwrap();
+    assert!(worst <= 2, "{worst}");
+    // Beyond the frame: nothing to do.
+    shader.shade_band(70, &mut off[..wu]);
+    assert_eq!(off[..wu], base[..wu]);
+}

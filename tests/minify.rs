@@ -161,6 +161,27 @@ fn bilinear_level_reads_the_matching_level() {
         };
         assert!(f == want, "bilinear_level {on}");
     }
+    // With a band hook (`render_with`, the lit frames): the same pixels, every row
+    // handed to the hook once.
+    let rows = std::sync::atomic::AtomicUsize::new(0);
+    let hook = |_y0: usize, band: &mut [u32]| {
+        rows.fetch_add(
+            band.len() / w as usize,
+            std::sync::atomic::Ordering::Relaxed,
+        );
+    };
+    let mut px = vec![0u32; (w * h) as usize];
+    r.set_bilinear_level(true);
+    r.render_with(
+        Scene::Map(&map),
+        view,
+        &opts,
+        &mut Frame::new(&mut px, w, h).unwrap(),
+        &hook,
+    )
+    .unwrap();
+    assert!(px == lut(level3, view, Sampler::Bilinear, w, h));
+    assert_eq!(rows.into_inner(), h as usize);
     // Trilinear and nearest ignore the switch.
     for s in [Sampler::Trilinear, Sampler::Nearest] {
         let o = RenderOptions {

@@ -6,10 +6,14 @@
 //! * `lights_pan`: whole frames of a pan (yaw +7.3° per frame, pitch −15°, hfov 100°) of a
 //!   4096×2048 equirectangular grid map with the default render options (LUT, bilinear,
 //!   adaptive step): `unlit`, then lit from the illuminance map with 0, 1 and 8 lights
-//!   (`map/N`, as the window does), and lit per pixel with 1 light (`per_pixel/1`, as
-//!   `viewer render` does).
-//! * `lights_shade`: the shading pass alone on a fixed view: from the map (`map/N`; its
-//!   cost does not depend on the number of lights) and per pixel with 1 and 8 lights,
+//!   (`map/N`: each band of rows lit as soon as it is drawn, `Renderer::render_with` with
+//!   `FrameShader::shade_band` as the hook, as the window and `viewer render` do; the
+//!   shading's cost is `map/N` − `unlit`), the same with 8 lights lit in a second pass over
+//!   the rendered frame (`map_second_pass/8`, what both did before), and lit per pixel
+//!   with 1 light (`per_pixel/1`).
+//! * `lights_shade`: the shading pass alone over a whole frame on a fixed view, each
+//!   iteration copying the unlit frame first (8 MB in, 8 MB out: the copy is in the time):
+//!   from the map (`map/N`) and per pixel with 1 and 8 lights,
 //!   linear and Catmull-Rom.
 //! * `lights_relight`: building the illuminance map (the cost of changing a light) with
 //!   0, 1 and 8 lights, default and preview spacing.
@@ -138,18 +142,37 @@ fn pan(c: &mut Criterion) {
             g.bench_with_input(BenchmarkId::new("map", n), &n, |b, _| {
                 pool.install(|| {
                     b.iter(|| {
+                        // Lit as the rows are drawn, as the window and `viewer render` do.
                         let view = pan_view(&mut k);
+                        let cam = Camera::new(view, W, H);
+                        let shader = lmap.frame_shader(&cam, &shade).expect("shader");
+                        let hook = |y0: usize, rows: &mut [u32]| shader.shade_band(y0, rows);
                         let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
                         renderer
-                            .render(Scene::Map(&map), view, &opts, &mut frame)
+                            .render_with(Scene::Map(&map), view, &opts, &mut frame, &hook)
                             .expect("render");
-                        let cam = Camera::new(view, W, H);
-                        lmap.shade_frame(&cam, &mut pixels, W, H, &shade)
-                            .expect("shade");
                         black_box(&pixels);
                     })
                 })
             });
+            if n == 8 {
+                // The same frames rendered, then lit in a second pass over the frame.
+                g.bench_function(BenchmarkId::new("map_second_pass", n), |b| {
+                    pool.install(|| {
+                        b.iter(|| {
+                            let view = pan_view(&mut k);
+                            let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
+                            renderer
+                                .render(Scene::Map(&map), view, &opts, &mut frame)
+                                .expect("render");
+                            let cam = Camera::new(view, W, H);
+                            lmap.shade_frame(&cam, &mut pixels, W, H, &shade)
+                                .expect("shade");
+                            black_box(&pixels);
+                        })
+                    })
+                });
+            }
         }
         let s = scene(1, &table);
         g.bench_function(BenchmarkId::new("per_pixel", 1), |b| {

@@ -3,11 +3,14 @@
 //!
 //!     valgrind --tool=callgrind target/release/examples/lights_profile unlit
 //!     valgrind --tool=callgrind target/release/examples/lights_profile map 8
+//!     valgrind --tool=callgrind target/release/examples/lights_profile lit 8
 //!     valgrind --tool=callgrind target/release/examples/lights_profile build 8
 //!
 //! `unlit` renders one frame of a 4096×2048 grid map (the benchmark's view and options,
 //! one thread); `map N` lights it from an illuminance map of N lights (built before);
-//! `build N` builds the map; `pixel N` shades per pixel.
+//! `lit N` renders and lights it in one pass (the shading run on each band of rows as
+//! it is drawn, as the window does); `build N` builds the map; `pixel N` shades per pixel;
+//! `time N` prints the minimum wall-clock times of 15 runs of each (one thread).
 
 use glam::DVec3;
 use lut_core::{grid_map, Frame, Projection, RenderOptions, Renderer, Scene};
@@ -57,6 +60,7 @@ fn main() {
     let mode = args.get(1).map_or("unlit", String::as_str);
     let n: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(8);
     let (w, h) = (1920u32, 1080u32);
+    let threads: usize = std::env::var("THREADS").map_or(1, |s| s.parse().expect("THREADS"));
     let t = Arc::new(table());
     let room = Room::new(6.0, 5.0, 2.8, 1.5).expect("room");
     let lights = (0..n)
@@ -69,11 +73,11 @@ fn main() {
     let view = View::new(30.0, -15.0, 100.0).expect("view");
     let cam = Camera::new(view, w, h);
     let opts = RenderOptions {
-        threads: false,
+        threads: threads > 1,
         ..RenderOptions::default()
     };
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
+        .num_threads(threads)
         .build()
         .expect("pool");
     pool.install(|| {
@@ -91,35 +95,56 @@ fn main() {
                 m.shade_frame(&cam, &mut pixels, w, h, &ShadeOptions::default())
                     .expect("shade");
             }
-            "time" => {
-                // Minimum over repeats (robust to other load on the machine), one thread.
+            "lit" => {
                 let map = grid_map(4096, 2048, Projection::Equirect).expect("map");
                 let mut r = Renderer::new(&map);
                 let m = IlluminanceMap::build(&scene, &MapOptions::default()).expect("map");
-                let min_ms = |f: &mut dyn FnMut()| {
-                    (0..15)
-                        .map(|_| {
-                            let t = std::time::Instant::now();
-                            f();
-                            t.elapsed().as_secs_f64() * 1e3
-                        })
-                        .fold(f64::INFINITY, f64::min)
-                };
-                let unlit = min_ms(&mut || {
+                let shader = m
+                    .frame_shader(&cam, &ShadeOptions::default())
+                    .expect("shader");
+                let hook = |y0: usize, rows: &mut [u32]| shader.shade_band(y0, rows);
+                for _ in 0..std::env::var("REPS").map_or(1, |s| s.parse().unwrap()) {
+                    let mut frame = Frame::new(&mut pixels, w, h).expect("frame");
+                    r.render_with(Scene::Map(&map), view, &opts, &mut frame, &hook)
+                        .expect("render");
+                }
+            }
+            "time" => {
+                // Minimum over interleaved repeats (robust to other load on the machine).
+                let map = grid_map(4096, 2048, Projection::Equirect).expect("map");
+                let mut r = Renderer::new(&map);
+                let m = IlluminanceMap::build(&scene, &MapOptions::default()).expect("map");
+                let shader = m
+                    .frame_shader(&cam, &ShadeOptions::default())
+                    .expect("shader");
+                let hook = |y0: usize, rows: &mut [u32]| shader.shade_band(y0, rows);
+                let ms = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;
+                let mut best = [f64::INFINITY; 4];
+                for _ in 0..15 {
+                    let t = std::time::Instant::now();
                     let mut frame = Frame::new(&mut pixels, w, h).expect("frame");
                     r.render(Scene::Map(&map), view, &opts, &mut frame)
                         .expect("render");
-                });
-                let shade = min_ms(&mut || {
+                    best[0] = best[0].min(ms(t));
+                    let t = std::time::Instant::now();
                     m.shade_frame(&cam, &mut pixels, w, h, &ShadeOptions::default())
                         .expect("shade");
-                });
-                let build = min_ms(&mut || {
+                    best[1] = best[1].min(ms(t));
+                    let t = std::time::Instant::now();
+                    let mut frame = Frame::new(&mut pixels, w, h).expect("frame");
+                    r.render_with(Scene::Map(&map), view, &opts, &mut frame, &hook)
+                        .expect("render");
+                    best[2] = best[2].min(ms(t));
+                    let t = std::time::Instant::now();
                     IlluminanceMap::build(&scene, &MapOptions::default()).expect("map");
-                });
+                    best[3] = best[3].min(ms(t));
+                }
+                let [unlit, shade, lit, build] = best;
                 println!(
-                    "unlit {unlit:.2} ms, map shading {shade:.2} ms ({:.2}x), build {build:.2} ms",
-                    shade / unlit
+                    "{threads} thread(s): unlit {unlit:.2} ms, map shading {shade:.2} ms \
+                     ({:.2}x), lit in one pass {lit:.2} ms ({:.2}x), build {build:.2} ms",
+                    shade / unlit,
+                    lit / unlit
                 );
             }
             "build" => {

@@ -133,8 +133,8 @@ pub use render::kernel::{
 };
 pub use render::steps::{ADAPTIVE_MAX_STEP, SPAN_ERROR_BUDGET};
 pub use render::{
-    IndexStep, LutChoice, Positions, RenderOptions, RenderPath, RenderReport, Renderer,
-    RendererKind, Scene, LUT_SWITCH_HFOV,
+    BandHook, IndexStep, LutChoice, Positions, RenderOptions, RenderPath, RenderReport, Renderer,
+    RendererKind, Scene, HOOK_BAND_ROWS, LUT_SWITCH_HFOV,
 };
 
 // Input.
@@ -159,11 +159,11 @@ pub use cube::{
 
 // Lights.
 pub use light::{
-    detect_format, false_color, false_color_position, lux_at, shade_frame, IesError, IesFile,
-    IesFormat, IlluminanceMap, Interpolation, LampSet, LdtError, LdtFile, LdtSymmetry, LdtType,
-    LightError, LightFileFormat, LightScene, LightTable, Luminaire, MapOptions, PhotometricType,
-    Photometry, PhotometrySource, Room, RoomFace, ShadeOptions, Symmetry, TableOptions, Tilt,
-    TiltData, MAP_SHADE_BLOCK, MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES,
+    detect_format, false_color, false_color_position, lux_at, shade_frame, FrameShader, IesError,
+    IesFile, IesFormat, IlluminanceMap, Interpolation, LampSet, LdtError, LdtFile, LdtSymmetry,
+    LdtType, LightError, LightFileFormat, LightScene, LightTable, Luminaire, MapOptions,
+    PhotometricType, Photometry, PhotometrySource, Room, RoomFace, ShadeOptions, Symmetry,
+    TableOptions, Tilt, TiltData, MAP_SHADE_BLOCK, MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES,
 };
 
 /// The module layout's rules, checked from the source: dependencies between the stages

@@ -4,7 +4,8 @@
 //! bench` all render through it.
 
 use lut_core::{
-    CubeMap, EnvMap, ErrorMap, Frame, RenderOptions, RenderReport, Renderer, View, ViewError,
+    CubeMap, EnvMap, ErrorMap, Frame, FrameShader, RenderOptions, RenderReport, Renderer, View,
+    ViewError,
 };
 
 /// A panorama ready to render, owning its data (and, for a map, its tables).
@@ -71,14 +72,41 @@ pub fn render_scene(
     width: u32,
     height: u32,
 ) -> Result<RenderReport, ViewError> {
+    render_scene_lit(scene, view, opts, out, width, height, None)
+}
+
+/// [`render_scene`], lit by `shader` (made for `width × height`) as the rows are drawn:
+/// the renderer runs [`FrameShader::shade_band`] on each band of rows while it is in
+/// cache (lut-core's `Renderer::render_with`), so lighting costs no second pass over the
+/// frame. The pixels are those of [`render_scene`] then `IlluminanceMap::shade_frame`.
+///
+/// # Errors
+/// As [`render_scene`].
+///
+/// # Panics
+/// When `shader` was made for another frame size (a caller's bug).
+pub fn render_scene_lit(
+    scene: SceneRef<'_>,
+    view: View,
+    opts: &RenderOptions,
+    out: &mut [u32],
+    width: u32,
+    height: u32,
+    shader: Option<&FrameShader<'_>>,
+) -> Result<RenderReport, ViewError> {
     let mut frame = Frame::new(out, width, height)?;
-    match scene {
-        SceneRef::Map { map, renderer } => {
-            renderer.render(lut_core::Scene::Map(map), view, opts, &mut frame)
+    let mut cube_renderer = Renderer::default();
+    let (scene, renderer) = match scene {
+        SceneRef::Map { map, renderer } => (lut_core::Scene::Map(map), renderer),
+        SceneRef::Cube(cube) => (lut_core::Scene::Cube(cube), &mut cube_renderer),
+    };
+    match shader {
+        Some(s) => {
+            assert_eq!(s.size(), (width, height), "shader made for another frame");
+            let hook = |y0: usize, rows: &mut [u32]| s.shade_band(y0, rows);
+            renderer.render_with(scene, view, opts, &mut frame, &hook)
         }
-        SceneRef::Cube(cube) => {
-            Renderer::default().render(lut_core::Scene::Cube(cube), view, opts, &mut frame)
-        }
+        None => renderer.render(scene, view, opts, &mut frame),
     }
 }
 

@@ -7,7 +7,7 @@ mod common;
 use common::{s, tmpdir, viewer};
 use lut_core::Interpolation;
 use std::path::Path;
-use viewer::lighting::{is_scene_file, LightsState, SceneFile, SceneView};
+use viewer::lighting::{is_scene_file, LightsState, SceneFile, ScenePanorama, SceneView};
 
 fn data(rel: &str) -> std::path::PathBuf {
     test_support::test_data(rel)
@@ -80,7 +80,7 @@ fn a_scene_round_trips_through_its_file() {
         hfov: 110.0,
     };
     let pano = test_support::repo_root().join("assets/courtyard.jpg");
-    let file = SceneFile::from_state(&st, Some(&pano), Some(view), &dir);
+    let file = SceneFile::from_state(&st, std::slice::from_ref(&pano), Some(view), &dir);
     let path = dir.join("room.json");
     file.save(&path).unwrap();
     assert!(is_scene_file(&path));
@@ -92,7 +92,7 @@ fn a_scene_round_trips_through_its_file() {
     same_state(&st, &st2);
     assert_eq!(back.view, Some(view));
     assert_eq!(
-        std::fs::canonicalize(back.panorama_path(&dir).unwrap()).unwrap(),
+        std::fs::canonicalize(&back.panorama_paths(&dir)[0]).unwrap(),
         std::fs::canonicalize(&pano).unwrap()
     );
     // The lit frame is the same.
@@ -118,7 +118,7 @@ fn a_scene_moves_with_its_files() {
     .unwrap();
     let mut st = LightsState::default();
     st.load_and_add(&a.join("lamp.ies")).unwrap();
-    SceneFile::from_state(&st, Some(&a.join("p.jpg")), None, &a)
+    SceneFile::from_state(&st, &[a.join("p.jpg")], None, &a)
         .save(&a.join("s.json"))
         .unwrap();
     let b = tmpdir("scene", "move-b");
@@ -127,9 +127,99 @@ fn a_scene_moves_with_its_files() {
     }
     std::fs::remove_dir_all(&a).unwrap();
     let loaded = SceneFile::load(&b.join("s.json")).unwrap();
-    assert_eq!(loaded.panorama.as_deref(), Some(Path::new("p.jpg")));
+    assert_eq!(
+        loaded.panorama,
+        Some(ScenePanorama::One(Path::new("p.jpg").into()))
+    );
     let st2 = loaded.to_state(&b).unwrap();
     assert_eq!(st2.lights[0].path, b.join("lamp.ies"));
+}
+
+#[test]
+fn a_cube_opened_from_six_face_files_round_trips() {
+    // A scene saved while a cube opened from six separate face files is shown records
+    // those files (relative to the scene's folder, in their order), and reopens them:
+    // `render --scene` draws what the six files given on the command line draw.
+    let dir = tmpdir("scene", "faces");
+    let faces_dir = dir.join("faces");
+    std::fs::create_dir_all(&faces_dir).unwrap();
+    let mut faces = Vec::new();
+    for f in ["ft", "rt", "bk", "lf", "up", "dn"] {
+        let name = format!("skyfantasy_{f}.jpg");
+        std::fs::copy(
+            data(&format!("cube/skyfantasy/{name}")),
+            faces_dir.join(&name),
+        )
+        .unwrap();
+        faces.push(faces_dir.join(&name));
+    }
+    // An unrelated image in the same folder: opening the folder would not be the same.
+    std::fs::copy(
+        test_support::repo_root().join("assets/courtyard.jpg"),
+        faces_dir.join("other.jpg"),
+    )
+    .unwrap();
+    let mut st = LightsState::default();
+    st.load_and_add(&data("ies/label_lines.ies")).unwrap();
+    let view = SceneView {
+        yaw: 10.0,
+        pitch: 5.0,
+        hfov: 90.0,
+    };
+    let file = SceneFile::from_state(&st, &faces, Some(view), &dir);
+    let relative: Vec<std::path::PathBuf> = faces
+        .iter()
+        .map(|f| f.strip_prefix(&dir).unwrap().to_path_buf())
+        .collect();
+    assert_eq!(file.panorama, Some(ScenePanorama::Faces(relative)));
+    let path = dir.join("cube.json");
+    file.save(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("\"panorama\": ["), "{text}");
+    let back = SceneFile::load(&path).unwrap();
+    assert_eq!(back, file);
+    assert_eq!(back.panorama_paths(&dir), faces);
+    let by_scene = dir.join("scene.png");
+    let out = viewer(&[
+        "render",
+        "--scene",
+        s(&path),
+        "-o",
+        s(&by_scene),
+        "--size",
+        "96x64",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let by_files = dir.join("files.png");
+    let mut args = vec!["render"];
+    args.extend(faces.iter().map(|f| s(f)));
+    args.extend_from_slice(&["--scene", s(&path), "-o", s(&by_files), "--size", "96x64"]);
+    let out = viewer(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        image::open(&by_scene).unwrap().to_rgb8().as_raw(),
+        image::open(&by_files).unwrap().to_rgb8().as_raw()
+    );
+    // An empty list is refused, naming the file.
+    let empty = dir.join("empty.json");
+    std::fs::write(
+        &empty,
+        text.replace(
+            &text[text.find("\"panorama\"").unwrap()..text.find("\"view\"").unwrap()],
+            "\"panorama\": [],\n  ",
+        ),
+    )
+    .unwrap();
+    let e = SceneFile::load(&empty).unwrap_err().to_string();
+    assert!(e.contains("empty.json") && e.contains("empty list"), "{e}");
 }
 
 #[test]

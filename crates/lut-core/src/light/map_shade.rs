@@ -17,7 +17,7 @@ use super::shade::{
     blend, check_frame, decode_lut, encode_lut, false_color, false_color_position, shade_pixel,
     ShadeOptions,
 };
-use super::shade_table::shade_row;
+use super::shade_table::ShadeRow;
 use super::LightError;
 use crate::geom::camera::Camera;
 use glam::DVec3;
@@ -114,24 +114,22 @@ impl IlluminanceMap {
         }
     }
 
-    /// Fill the block of columns x0 .. x1 − 1 and rows y0 .. y1 − 1 of the band `es`
-    /// (rows of `w` values, the band's first row at `band_y`) given the probes at its
+    /// Fill the block of columns x0 .. x1 − 1 and rows y0 .. y1 − 1 of `out` given the
+    /// probes at its
     /// corners (x1, y1 may be one past the image): bilinear between them when all four lie
     /// on one face within the tiles' `max_len` of each other, else split in four (or two),
     /// down to single pixels, which take their own probe.
-    #[allow(clippy::too_many_arguments)]
     fn fill(
         &self,
         rays: &Rays,
         (x0, y0, x1, y1): (usize, usize, usize, usize),
         [tl, tr, bl, br]: [Probe; 4],
-        w: usize,
-        band_y: usize,
-        es: &mut [f32],
+        out: &mut Lux<'_>,
     ) {
         let (nx, ny) = (x1 - x0, y1 - y0);
         if nx == 1 && ny == 1 {
-            es[(y0 - band_y) * w + x0] = tl.e;
+            let at = out.at(x0, y0);
+            out.es[at] = tl.e;
             return;
         }
         let len = tl.max_len.min(tr.max_len).min(bl.max_len).min(br.max_len) as f64;
@@ -145,7 +143,8 @@ impl IlluminanceMap {
             for (j, &fj) in RAMP[..ny].iter().enumerate() {
                 let (l, r) = (tl.e + dl * fj, tr.e + dr * fj);
                 let step = (r - l) / nx as f32;
-                let row = &mut es[(y0 + j - band_y) * w + x0..][..nx];
+                let at = out.at(x0, y0 + j);
+                let row = &mut out.es[at..][..nx];
                 for (e, &i) in row.iter_mut().zip(RAMP.iter()) {
                     *e = l + step * i;
                 }
@@ -160,7 +159,8 @@ impl IlluminanceMap {
                         (0, 0) => tl.e,
                         _ => rays.probe(self, x0 + i, y0 + j).e,
                     };
-                    es[(y0 + j - band_y) * w + x0 + i] = e;
+                    let k = out.at(x0 + i, y0 + j);
+                    out.es[k] = e;
                 }
             }
             return;
@@ -168,32 +168,38 @@ impl IlluminanceMap {
         let (xm, ym) = (x0 + nx / 2, y0 + ny / 2);
         if ny == 1 {
             let (t, b) = (rays.probe(self, xm, y0), rays.probe(self, xm, y1));
-            self.fill(rays, (x0, y0, xm, y1), [tl, t, bl, b], w, band_y, es);
-            self.fill(rays, (xm, y0, x1, y1), [t, tr, b, br], w, band_y, es);
+            self.fill(rays, (x0, y0, xm, y1), [tl, t, bl, b], out);
+            self.fill(rays, (xm, y0, x1, y1), [t, tr, b, br], out);
         } else if nx == 1 {
             let (l, r) = (rays.probe(self, x0, ym), rays.probe(self, x1, ym));
-            self.fill(rays, (x0, y0, x1, ym), [tl, tr, l, r], w, band_y, es);
-            self.fill(rays, (x0, ym, x1, y1), [l, r, bl, br], w, band_y, es);
+            self.fill(rays, (x0, y0, x1, ym), [tl, tr, l, r], out);
+            self.fill(rays, (x0, ym, x1, y1), [l, r, bl, br], out);
         } else {
             let t = rays.probe(self, xm, y0);
             let b = rays.probe(self, xm, y1);
             let l = rays.probe(self, x0, ym);
             let r = rays.probe(self, x1, ym);
             let m = rays.probe(self, xm, ym);
-            self.fill(rays, (x0, y0, xm, ym), [tl, t, l, m], w, band_y, es);
-            self.fill(rays, (xm, y0, x1, ym), [t, tr, m, r], w, band_y, es);
-            self.fill(rays, (x0, ym, xm, y1), [l, m, bl, b], w, band_y, es);
-            self.fill(rays, (xm, ym, x1, y1), [m, r, b, br], w, band_y, es);
+            self.fill(rays, (x0, y0, xm, ym), [tl, t, l, m], out);
+            self.fill(rays, (xm, y0, x1, ym), [t, tr, m, r], out);
+            self.fill(rays, (x0, ym, xm, y1), [l, m, bl, b], out);
+            self.fill(rays, (xm, ym, x1, y1), [m, r, b, br], out);
         }
     }
 
     /// The illuminance of the band of rows starting at `band_y` (`es` holds whole rows of
-    /// `w` values), block by block.
+    /// `w` values, at most [`BLOCK`]`.1` of them), block by block.
     fn band_lux(&self, rays: &Rays, w: usize, band_y: usize, es: &mut [f32]) {
         let rows = es.len() / w;
+        debug_assert!(rows <= BLOCK.1);
         let y1 = band_y + rows;
         let mut x0 = 0;
         let mut l = [rays.probe(self, 0, band_y), rays.probe(self, 0, y1)];
+        let mut out = Lux {
+            es,
+            stride: w,
+            y0: band_y,
+        };
         while x0 < w {
             let x1 = (x0 + BLOCK.0).min(w);
             let r = [rays.probe(self, x1, band_y), rays.probe(self, x1, y1)];
@@ -201,9 +207,7 @@ impl IlluminanceMap {
                 rays,
                 (x0, band_y, x1, y1),
                 [l[0], r[0], l[1], r[1]],
-                w,
-                band_y,
-                es,
+                &mut out,
             );
             (x0, l) = (x1, r);
         }
@@ -253,10 +257,38 @@ impl IlluminanceMap {
         Ok(())
     }
 
+    /// A shader of `cam`'s frames (`cam.width × cam.height` pixels) lit from this map with
+    /// `opts`, band by band ([`FrameShader::shade_band`]): what
+    /// [`IlluminanceMap::shade_frame`] runs over a rendered frame, and what a renderer's
+    /// [`crate::BandHook`] runs on each band as soon as it is drawn
+    /// ([`crate::Renderer::render_with`]).
+    ///
+    /// # Errors
+    /// [`LightError::BadOption`] as [`ShadeOptions::check`].
+    pub fn frame_shader<'a>(
+        &'a self,
+        cam: &'a Camera,
+        opts: &ShadeOptions,
+    ) -> Result<FrameShader<'a>, LightError> {
+        opts.check()?;
+        Ok(FrameShader {
+            map: self,
+            cam,
+            rays: cam
+                .projection()
+                .is_rectilinear()
+                .then(|| Rays::new(self, cam)),
+            opts: *opts,
+            colour: ShadeRow::detect(),
+        })
+    }
+
     /// Light a rendered frame in place from the map, as [`super::shade_frame`] does from
     /// the luminaires: each pixel's colour is the albedo of the room surface its camera ray
     /// hits, times ambient + exposure · E, in linear light. Rows run in parallel; the
-    /// result does not depend on the number of threads.
+    /// result does not depend on the number of threads. The same as rendering with
+    /// [`IlluminanceMap::frame_shader`]'s [`FrameShader::shade_band`] as the band hook,
+    /// which saves this second pass over the frame.
     ///
     /// # Errors
     /// As [`super::shade_frame`].
@@ -269,52 +301,112 @@ impl IlluminanceMap {
         opts: &ShadeOptions,
     ) -> Result<(), LightError> {
         check_frame(cam, frame, w, h)?;
-        opts.check()?;
+        let shader = self.frame_shader(cam, opts)?;
         if frame.is_empty() {
             return Ok(());
         }
+        frame
+            .par_chunks_mut(w as usize * BLOCK.1)
+            .enumerate()
+            .for_each(|(band, pixels)| shader.shade_band(band * BLOCK.1, pixels));
+        Ok(())
+    }
+}
+
+/// Lights the bands of one camera's frames from an [`IlluminanceMap`]
+/// ([`IlluminanceMap::frame_shader`]).
+pub struct FrameShader<'a> {
+    map: &'a IlluminanceMap,
+    cam: &'a Camera,
+    /// The camera rays (rectilinear views only: the others probe every pixel).
+    rays: Option<Rays>,
+    opts: ShadeOptions,
+    colour: ShadeRow,
+}
+
+impl FrameShader<'_> {
+    /// The frame size (width, height) it lights: its camera's.
+    pub fn size(&self) -> (u32, u32) {
+        (self.cam.width, self.cam.height)
+    }
+
+    /// Light the rows `y0 ..` of the frame held in `rows` (whole rows of the camera's
+    /// width; rows past the camera's height are left alone), in place, exactly as
+    /// [`IlluminanceMap::shade_frame`] lights them when `y0` is a multiple of
+    /// [`BLOCK`]`.1` (the map's blocks start there; any `y0` is lit correctly, a band
+    /// starting elsewhere interpolates over blocks cut at its edge).
+    pub fn shade_band(&self, y0: usize, rows: &mut [u32]) {
+        let (w, h) = (self.cam.width as usize, self.cam.height as usize);
+        if w == 0 || y0 >= h {
+            return;
+        }
+        let n = (rows.len() / w).min(h - y0);
+        let rows = &mut rows[..n * w];
+        let map = self.map;
+        let o = &self.opts;
+        let (ambient, exposure) = (o.ambient as f32, o.exposure as f32);
         let dec = decode_lut();
         let enc = encode_lut();
-        let (ambient, exposure) = (opts.ambient as f32, opts.exposure as f32);
-        let w = w as usize;
-        if !cam.projection().is_rectilinear() {
+        let false_colour = |px: &mut u32, e: f32| {
+            let shaded = shade_pixel(*px, ambient + exposure * e, dec, enc);
+            let c = false_color(false_color_position(e as f64, o.false_color_max_lux));
+            *px = blend(c, shaded, 0.65);
+        };
+        let Some(rays) = &self.rays else {
             // Each pixel through its own ray; pixels with no direction stay as rendered.
-            frame.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            for (j, row) in rows.chunks_mut(w).enumerate() {
                 for (x, px) in row.iter_mut().enumerate() {
-                    let Some(e) = self.pixel_lux(cam, x, y) else {
+                    let Some(e) = map.pixel_lux(self.cam, x, y0 + j) else {
                         continue;
                     };
-                    let shaded = shade_pixel(*px, ambient + exposure * e, dec, enc);
-                    *px = if opts.false_color {
-                        let c =
-                            false_color(false_color_position(e as f64, opts.false_color_max_lux));
-                        blend(c, shaded, 0.65)
+                    if o.false_color {
+                        false_colour(px, e);
                     } else {
-                        shaded
-                    };
-                }
-            });
-            return Ok(());
-        }
-        let rays = Rays::new(self, cam);
-        frame.par_chunks_mut(w * BLOCK.1).enumerate().for_each_init(
-            || vec![0f32; w * BLOCK.1],
-            |es, (band, pixels)| {
-                let es = &mut es[..pixels.len()];
-                self.band_lux(&rays, w, band * BLOCK.1, es);
-                if opts.false_color {
-                    let max = opts.false_color_max_lux;
-                    for (px, &e) in pixels.iter_mut().zip(es.iter()) {
-                        let shaded = shade_pixel(*px, ambient + exposure * e, dec, enc);
-                        let c = false_color(false_color_position(e as f64, max));
-                        *px = blend(c, shaded, 0.65);
+                        *px = shade_pixel(*px, ambient + exposure * e, dec, enc);
                     }
-                } else {
-                    shade_row(pixels, es, ambient, exposure);
                 }
-            },
-        );
-        Ok(())
+            }
+            return;
+        };
+        // The map's blocks: BLOCK.1 rows from each multiple of BLOCK.1 (cut at the band),
+        // their lux in this thread's buffer (a block row: in L2), then the colour.
+        thread_local! {
+            static LUX: std::cell::RefCell<Vec<f32>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        LUX.with_borrow_mut(|buf| {
+            let mut y = y0;
+            while y < y0 + n {
+                let y1 = ((y / BLOCK.1 + 1) * BLOCK.1).min(y0 + n);
+                let band = &mut rows[(y - y0) * w..(y1 - y0) * w];
+                buf.resize(band.len(), 0.0);
+                let es = &mut buf[..band.len()];
+                map.band_lux(rays, w, y, es);
+                if o.false_color {
+                    band.iter_mut()
+                        .zip(es.iter())
+                        .for_each(|(p, &e)| false_colour(p, e));
+                } else {
+                    self.colour.run(band, es, ambient, exposure);
+                }
+                y = y1;
+            }
+        });
+    }
+}
+
+/// Where [`IlluminanceMap::fill`] writes: whole rows of `stride` values, the first one
+/// row `y0`.
+struct Lux<'a> {
+    es: &'a mut [f32],
+    stride: usize,
+    y0: usize,
+}
+
+impl Lux<'_> {
+    /// The index of pixel (x, y).
+    #[inline]
+    fn at(&self, x: usize, y: usize) -> usize {
+        (y - self.y0) * self.stride + x
     }
 }
 

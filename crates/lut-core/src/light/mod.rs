@@ -37,7 +37,7 @@ pub mod table;
 pub use ies::{IesError, IesFile, IesFormat, PhotometricType, Tilt, TiltData};
 pub use illum::{IlluminanceMap, MapOptions};
 pub use ldt::{LampSet, LdtError, LdtFile, LdtSymmetry, LdtType};
-pub use map_shade::BLOCK as MAP_SHADE_BLOCK;
+pub use map_shade::{FrameShader, BLOCK as MAP_SHADE_BLOCK};
 pub use photometry::{detect_format, LightFileFormat, Photometry, PhotometrySource};
 pub use room::{Room, RoomFace};
 pub use shade::{

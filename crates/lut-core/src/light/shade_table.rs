@@ -11,8 +11,13 @@
 //! within one level of the exact path's (tested for every byte over the whole range).
 //! k below 2⁻¹² gives black, above 2¹² the last step (every byte but 0 already saturates).
 //!
-//! The row loop has a scalar form and, on x86-64 with AVX2 (detected at run time), an
-//! 8-pixel form that reads the table with gathers; both write the same bytes (tested).
+//! The row loop has a scalar form and, on x86-64 (detected at run time), an 8-pixel AVX2
+//! form that reads the table with gathers and a 16-pixel AVX-512 form (F, BW, VBMI): k
+//! changes slowly across a frame, so many runs of 16 pixels use one table row (all of
+//! them with no light in view, about a third next to eight lights in the benchmark's
+//! view); that row is held in four registers and read with byte permutes (`vpermi2b`:
+//! 64 bytes, 16 pixels, per instruction and 128 table entries), no memory access per
+//! pixel; the other runs take 16-lane gathers. All forms write the same bytes (tested).
 
 use super::shade::{decode_lut, encode, encode_lut};
 use std::sync::OnceLock;
@@ -64,15 +69,76 @@ pub(crate) fn table() -> &'static [u8] {
     })
 }
 
+/// The form of the row loop this CPU runs (detected once, see [`ShadeRow::detect`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ShadeRow {
+    avx2: bool,
+    avx512: bool,
+}
+
+impl ShadeRow {
+    /// The fastest form this CPU runs.
+    pub(crate) fn detect() -> ShadeRow {
+        #[cfg(target_arch = "x86_64")]
+        let (avx2, avx512) = {
+            use std::arch::is_x86_feature_detected as has;
+            let avx2 = has!("avx2");
+            (
+                avx2,
+                avx2 && has!("avx512f") && has!("avx512bw") && has!("avx512vbmi"),
+            )
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let (avx2, avx512) = (false, false);
+        // Build the table now, not inside the first row.
+        let _ = table();
+        ShadeRow { avx2, avx512 }
+    }
+
+    /// The forms this CPU runs, the fastest first (for tests: each is checked against
+    /// the scalar form).
+    #[cfg(test)]
+    pub(crate) fn all() -> Vec<ShadeRow> {
+        let best = ShadeRow::detect();
+        let mut v = vec![best];
+        if best.avx512 {
+            v.push(ShadeRow {
+                avx512: false,
+                ..best
+            });
+        }
+        if best.avx2 {
+            v.push(ShadeRow {
+                avx2: false,
+                avx512: false,
+            });
+        }
+        v
+    }
+
+    /// Shade `pixels` (0RGB albedo) in place with light factor ambient + exposure · E
+    /// per pixel, E from `lux`.
+    #[inline]
+    pub(crate) fn run(self, pixels: &mut [u32], lux: &[f32], ambient: f32, exposure: f32) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx512 {
+            simd::shade_row_avx512(pixels, lux, ambient, exposure);
+            return;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            simd::shade_row_avx2(pixels, lux, ambient, exposure);
+            return;
+        }
+        shade_row_scalar(pixels, lux, ambient, exposure);
+    }
+}
+
 /// Shade `pixels` (0RGB albedo) in place with light factor ambient + exposure · E per
 /// pixel, E from `lux`; the fastest form this CPU runs.
+#[cfg(test)]
 pub(crate) fn shade_row(pixels: &mut [u32], lux: &[f32], ambient: f32, exposure: f32) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        simd::shade_row_avx2(pixels, lux, ambient, exposure);
-        return;
-    }
-    shade_row_scalar(pixels, lux, ambient, exposure);
+    ShadeRow::detect().run(pixels, lux, ambient, exposure);
 }
 
 /// The portable form of [`shade_row`].
@@ -98,10 +164,106 @@ mod simd {
     use super::{row_of, shade_row_scalar, table, BASE_BITS, ROWS, SHIFT};
     use std::arch::x86_64::*;
 
-    /// [`super::shade_row`] with AVX2; the caller has checked that the CPU has it.
+    /// [`super::shade_row_scalar`] with AVX2; the caller has checked that the CPU has it
+    /// ([`super::ShadeRow::detect`]).
     pub(super) fn shade_row_avx2(pixels: &mut [u32], lux: &[f32], ambient: f32, exposure: f32) {
         // SAFETY: only called after `is_x86_feature_detected!("avx2")` returned true.
         unsafe { shade_row_avx2_impl(pixels, lux, ambient, exposure) }
+    }
+
+    /// [`super::shade_row_scalar`] with AVX-512 (F, BW, VBMI) and AVX2; the caller has
+    /// checked that the CPU has them ([`super::ShadeRow::detect`]).
+    pub(super) fn shade_row_avx512(pixels: &mut [u32], lux: &[f32], ambient: f32, exposure: f32) {
+        // SAFETY: only called after `is_x86_feature_detected!` returned true for avx2,
+        // avx512f, avx512bw and avx512vbmi.
+        unsafe { shade_row_avx512_impl(pixels, lux, ambient, exposure) }
+    }
+
+    /// The 256 entries of table row `r` (≤ ROWS − 1) as four registers.
+    #[target_feature(enable = "avx512f")]
+    fn load_row(t: &[u8], r: usize) -> [__m512i; 4] {
+        let row = &t[r * 256..r * 256 + 256];
+        // SAFETY: `row` holds 256 bytes: four unaligned 64-byte loads inside it.
+        unsafe {
+            let p = row.as_ptr();
+            [
+                _mm512_loadu_si512(p.cast()),
+                _mm512_loadu_si512(p.add(64).cast()),
+                _mm512_loadu_si512(p.add(128).cast()),
+                _mm512_loadu_si512(p.add(192).cast()),
+            ]
+        }
+    }
+
+    /// Each byte `i` of `idx` replaced by entry `i` of the table row `row`.
+    #[target_feature(enable = "avx512f,avx512bw,avx512vbmi")]
+    fn lookup(row: &[__m512i; 4], idx: __m512i) -> __m512i {
+        let lo = _mm512_permutex2var_epi8(row[0], idx, row[1]);
+        let hi = _mm512_permutex2var_epi8(row[2], idx, row[3]);
+        _mm512_mask_blend_epi8(_mm512_movepi8_mask(idx), lo, hi)
+    }
+
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vbmi")]
+    fn shade_row_avx512_impl(pixels: &mut [u32], lux: &[f32], ambient: f32, exposure: f32) {
+        let n = pixels.len().min(lux.len());
+        let t = table();
+        let (head, tail) = pixels[..n].split_at_mut(n - n % 16);
+        let (lux_head, lux_tail) = lux[..n].split_at(n - n % 16);
+        let a = _mm512_set1_ps(ambient);
+        let x = _mm512_set1_ps(exposure);
+        let base = _mm512_set1_epi32(BASE_BITS);
+        let one = _mm512_set1_epi32(1);
+        let zero = _mm512_setzero_si512();
+        let top = _mm512_set1_epi32(ROWS as i32 - 1);
+        let rgb = _mm512_set1_epi32(0xff_ffff);
+        let byte = _mm512_set1_epi32(0xff);
+        // The table row held in registers, and its number.
+        let mut first = usize::MAX;
+        let mut held = [zero; 4];
+        for (p16, e16) in head.chunks_exact_mut(16).zip(lux_head.chunks_exact(16)) {
+            // SAFETY: `e16` and `p16` hold exactly 16 f32 / u32 (chunks_exact); loadu
+            // takes unaligned pointers.
+            let e = unsafe { _mm512_loadu_ps(e16.as_ptr()) };
+            // The rows as in `row_of` (k < 0, sign bit set, → row 0).
+            let bits = _mm512_castps_si512(_mm512_add_ps(a, _mm512_mul_ps(x, e)));
+            let mut row = _mm512_add_epi32(
+                _mm512_srai_epi32::<{ SHIFT }>(_mm512_sub_epi32(bits, base)),
+                one,
+            );
+            row = _mm512_min_epi32(_mm512_max_epi32(row, zero), top);
+            let negative = _mm512_cmplt_epi32_mask(bits, zero);
+            row = _mm512_maskz_mov_epi32(!negative, row);
+            // SAFETY: as for the load above.
+            let px = unsafe { _mm512_loadu_si512(p16.as_ptr().cast()) };
+            let r0 = _mm_cvtsi128_si32(_mm512_castsi512_si128(row));
+            let out = if _mm512_cmpneq_epi32_mask(row, _mm512_set1_epi32(r0)) == 0 {
+                // One table row for all 16 pixels: read it with byte permutes.
+                let r0 = r0 as usize;
+                if r0 != first {
+                    first = r0;
+                    held = load_row(t, r0);
+                }
+                lookup(&held, px)
+            } else {
+                // Rows differ: one gather per channel.
+                let off = _mm512_slli_epi32::<8>(row);
+                let p = t.as_ptr().cast::<i32>();
+                let ch = |shift: u32| {
+                    let c = _mm512_and_si512(
+                        _mm512_srlv_epi32(px, _mm512_set1_epi32(shift as i32)),
+                        byte,
+                    );
+                    // SAFETY: every index is row·256 + byte ≤ (ROWS − 1)·256 + 255 and the
+                    // table has 3 bytes of padding after that: each 4-byte read is inside.
+                    let g = unsafe { _mm512_i32gather_epi32::<1>(_mm512_add_epi32(off, c), p) };
+                    _mm512_sllv_epi32(_mm512_and_si512(g, byte), _mm512_set1_epi32(shift as i32))
+                };
+                _mm512_or_si512(_mm512_or_si512(ch(16), ch(8)), ch(0))
+            };
+            // SAFETY: as for the loads above.
+            unsafe { _mm512_storeu_si512(p16.as_mut_ptr().cast(), _mm512_and_si512(out, rgb)) };
+        }
+        shade_row_avx2_impl(tail, lux_tail, ambient, exposure);
     }
 
     #[target_feature(enable = "avx2")]
@@ -216,13 +378,55 @@ mod tests {
                 _ => 2f32.powf((i as f32 * 0.37) % 30.0 - 15.0) * 300.0,
             })
             .collect();
-        for len in [0, 1, 7, 8, 9, 63, 1000] {
+        for len in [0, 1, 7, 8, 9, 15, 16, 17, 63, 1000] {
             for (a, x) in [(0.15, 1.0 / 300.0), (0.0, 1.0), (1.0, 0.0)] {
                 let mut s = pixels[..len].to_vec();
                 shade_row_scalar(&mut s, &lux[..len], a, x);
                 let mut f = pixels[..len].to_vec();
                 shade_row(&mut f, &lux[..len], a, x);
                 assert_eq!(s, f, "len {len}");
+            }
+        }
+    }
+
+    #[test]
+    fn every_form_agrees_with_the_scalar_one_on_smooth_and_rough_rows() {
+        // Smooth ramps of E (runs of 16 on one table row, on two adjacent rows, and on
+        // more: every path of the AVX-512 form), steps, the ends of the table (rows 0 and
+        // ROWS − 1, where the second row is clamped), negative and huge k; pixels with
+        // every byte value in every channel, and a top byte that must not leak through.
+        let n = 4096;
+        let pixels: Vec<u32> = (0..n as u32)
+            .map(|i| i.wrapping_mul(2_654_435_761) ^ (i << 24))
+            .collect();
+        let mut rows: Vec<Vec<f32>> = Vec::new();
+        for slope in [0.0f32, 1e-4, 1e-3, 3e-3, 1e-2, 0.1] {
+            rows.push((0..n).map(|i| 300.0 * (1.0 + slope * i as f32)).collect());
+        }
+        rows.push(
+            (0..n)
+                .map(|i| if i % 40 < 20 { 10.0 } else { 5000.0 })
+                .collect(),
+        );
+        rows.push((0..n).map(|i| (i as f32 - 2000.0) * 0.5).collect());
+        rows.push(vec![1e30; n]);
+        rows.push(vec![0.0; n]);
+        rows.push(
+            (0..n)
+                .map(|i| 2f32.powf(-13.0 + i as f32 * 30.0 / n as f32))
+                .collect(),
+        );
+        for form in ShadeRow::all() {
+            for lux in &rows {
+                for (a, x) in [(0.15, 1.0 / 300.0), (0.0, 1.0), (1.0, 0.0), (0.0, 1e-4)] {
+                    for (start, len) in [(0, n), (3, 1000), (5, 17), (0, 31)] {
+                        let mut s = pixels[start..start + len].to_vec();
+                        shade_row_scalar(&mut s, &lux[start..start + len], a, x);
+                        let mut f = pixels[start..start + len].to_vec();
+                        form.run(&mut f, &lux[start..start + len], a, x);
+                        assert_eq!(s, f, "{form:?}, a {a}, x {x}, {start}+{len}");
+                    }
+                }
             }
         }
     }

@@ -49,7 +49,7 @@ use exact::{render_exact, ExactFootprint};
 use frame::Frame;
 use grid::{Grid, GridStats};
 use kernel::level_texels;
-use rows::{for_each_row, for_each_row_init};
+use rows::{for_each_band_init, for_each_row, for_each_row_init, post_bands};
 use scanline::{render_row, Scratch, BLEND_NODES, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
 use sink::{Batch, PixelRows, PixelSink, PosRows, PosSink, RowSinks, Sink, TriRows, TriSink};
@@ -288,6 +288,16 @@ impl RenderReport {
 /// Sampling positions of a frame, row-major; `None` where the background shows.
 pub type Positions = Vec<Option<(f64, f64)>>;
 
+/// Work run on bands of finished rows right after a renderer wrote them, while they are
+/// still in cache ([`Renderer::render_with`]): `hook(y0, rows)` gets whole rows of the
+/// frame from row `y0` on. Every band starts at a multiple of [`HOOK_BAND_ROWS`] and
+/// holds a multiple of it (the frame's last band may hold fewer); every row is in
+/// exactly one band. Bands may run in parallel.
+pub type BandHook<'a> = &'a (dyn Fn(usize, &mut [u32]) + Sync);
+
+/// The row alignment of the bands a [`BandHook`] gets.
+pub const HOOK_BAND_ROWS: usize = 16;
+
 /// The renderer: owns the tables for one map geometry and per-frame scratch.
 #[derive(Debug, Default)]
 pub struct Renderer {
@@ -448,6 +458,53 @@ impl Renderer {
         opts: &RenderOptions,
         frame: &mut Frame<'_>,
     ) -> Result<RenderReport, ViewError> {
+        self.render_inner(scene, view, opts, frame, None)
+    }
+
+    /// [`Renderer::render`], then `hook` on every band of rows of the frame (see
+    /// [`BandHook`]): the LUT renderer's bilinear and nearest frames call it on each band
+    /// as soon as its rows are drawn, while they are in cache (so a pass over the frame
+    /// after the render, such as lighting it, costs no second trip through memory); the
+    /// other renderers draw the whole frame first. The pixels are the same either way.
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    pub fn render_with(
+        &mut self,
+        scene: Scene<'_>,
+        view: View,
+        opts: &RenderOptions,
+        frame: &mut Frame<'_>,
+        hook: BandHook<'_>,
+    ) -> Result<RenderReport, ViewError> {
+        self.render_inner(scene, view, opts, frame, Some(hook))
+    }
+
+    fn render_inner(
+        &mut self,
+        scene: Scene<'_>,
+        view: View,
+        opts: &RenderOptions,
+        frame: &mut Frame<'_>,
+        hook: Option<BandHook<'_>>,
+    ) -> Result<RenderReport, ViewError> {
+        let report = self.render_fused(scene, view, opts, frame, hook)?;
+        if let (Some(hook), false) = (hook, report.1) {
+            let w = frame.width() as usize;
+            post_bands(frame.pixels_mut(), w, HOOK_BAND_ROWS, opts.threads, hook);
+        }
+        Ok(report.0)
+    }
+
+    /// The frame, and whether `hook` ran on it already (fused into the row bands).
+    fn render_fused(
+        &mut self,
+        scene: Scene<'_>,
+        view: View,
+        opts: &RenderOptions,
+        frame: &mut Frame<'_>,
+        hook: Option<BandHook<'_>>,
+    ) -> Result<(RenderReport, bool), ViewError> {
         check_step(opts.index_step)?;
         let (width, height) = (frame.width(), frame.height());
         let pixels = width as u64 * height as u64;
@@ -455,30 +512,32 @@ impl Renderer {
             Scene::Map(map) => map,
             Scene::Cube(cube) if !view.projection().is_rectilinear() => {
                 projected::render_cube(cube, view, opts.sampler, frame, opts.threads);
-                return Ok(RenderReport {
+                let report = RenderReport {
                     path: RenderPath::CubeProjected,
                     exact_pixels: 0,
                     pixels,
                     table_bytes: cube.bytes(),
                     max_step: 1,
                     min_step: 1,
-                });
+                };
+                return Ok((report, false));
             }
             Scene::Cube(cube) => {
                 render_cube(cube, view, opts.sampler, opts.cube, frame, opts.threads);
-                return Ok(RenderReport {
+                let report = RenderReport {
                     path: RenderPath::Cube(opts.cube),
                     exact_pixels: 0,
                     pixels,
                     table_bytes: cube.bytes(),
                     max_step: 1,
                     min_step: 1,
-                });
+                };
+                return Ok((report, false));
             }
         };
         if opts.renderer == RendererKind::Exact {
             render_exact(map, view, opts.sampler, frame, opts.threads);
-            return Ok(RenderReport::exact(pixels));
+            return Ok((RenderReport::exact(pixels), false));
         }
         if let Some(level) = self.level_map(map, view, opts.sampler, width) {
             // Bilinear on the pyramid level matching the screen: a plain bilinear frame
@@ -486,11 +545,11 @@ impl Renderer {
             let r = self
                 .level
                 .get_or_insert_with(|| Box::new(Renderer::new(level)));
-            return r.render(Scene::Map(level), view, opts, frame);
+            return r.render_fused(Scene::Map(level), view, opts, frame, hook);
         }
         self.set_geometry(map.width(), map.height(), map.projection());
         if uses_grid(view, opts) {
-            return Ok(self.render_grid(map, view, opts, frame));
+            return Ok((self.render_grid(map, view, opts, frame), false));
         }
         let (setup, report) = self.prepare_frame(view, opts, width, height);
         let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
@@ -504,7 +563,7 @@ impl Renderer {
             let (levels, n) = level_texels(map);
             let levels = &levels[..n];
             let fp = ExactFootprint::new(view, width, height, geometry_of(map));
-            for_each_row_init(out, w, opts.threads, new_scratch, |scratch, y, row| {
+            let row = |scratch: &mut Scratch, y: usize, row: &mut [u32]| {
                 let scan = &scans[y];
                 let mut s = TriSink {
                     row,
@@ -518,32 +577,51 @@ impl Renderer {
                 s.set_lod(lod_q8(scan.fy[0] as f64));
                 render_row(scan, table, &setup, row_scale, scratch, &mut s);
                 s.flush();
+            };
+            return Ok(match hook {
+                Some(post) => {
+                    let (b, t) = (HOOK_BAND_ROWS, opts.threads);
+                    for_each_band_init(out, w, b, t, new_scratch, row, post);
+                    (report, true)
+                }
+                None => {
+                    for_each_row_init(out, w, opts.threads, new_scratch, row);
+                    (report, false)
+                }
             });
-            return Ok(report);
         }
         // One monomorphized kernel per (sampler, partial map): no per-pixel dispatch.
+        // `hook` runs on each band of rows as soon as it is drawn.
         fn rows<const BILINEAR: bool, const CROP: bool>(
             out: &mut [u32],
             w: usize,
             threads: bool,
             k: (&[Scan], &LutTable, &Setup, &[i64]),
             map: &EnvMap,
+            hook: Option<BandHook<'_>>,
         ) {
             let (scans, table, setup, row_scale) = k;
-            for_each_row_init(out, w, threads, new_scratch, |scratch, y, row| {
+            let row = |scratch: &mut Scratch, y: usize, row: &mut [u32]| {
                 let mut s = PixelSink::<BILINEAR, CROP>::new(row, map);
                 render_row(&scans[y], table, setup, row_scale, scratch, &mut s);
                 s.flush();
-            });
+            };
+            match hook {
+                Some(post) => {
+                    for_each_band_init(out, w, HOOK_BAND_ROWS, threads, new_scratch, row, post)
+                }
+                None => for_each_row_init(out, w, threads, new_scratch, row),
+            }
         }
         let k = (&scans[..], table, &setup, row_scale);
+        let t = opts.threads;
         match (bilinear, map.crop().is_some()) {
-            (true, false) => rows::<true, false>(out, w, opts.threads, k, map),
-            (false, false) => rows::<false, false>(out, w, opts.threads, k, map),
-            (true, true) => rows::<true, true>(out, w, opts.threads, k, map),
-            (false, true) => rows::<false, true>(out, w, opts.threads, k, map),
+            (true, false) => rows::<true, false>(out, w, t, k, map, hook),
+            (false, false) => rows::<false, false>(out, w, t, k, map, hook),
+            (true, true) => rows::<true, true>(out, w, t, k, map, hook),
+            (false, true) => rows::<false, true>(out, w, t, k, map, hook),
         }
-        Ok(report)
+        Ok((report, hook.is_some()))
     }
 
     /// The grid renderer's frame (see `grid.rs`): pixels through the sinks of the

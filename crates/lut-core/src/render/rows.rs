@@ -49,3 +49,58 @@ pub(crate) fn for_each_row_init<T: Send, St>(
             .for_each(|(y, row)| f(&mut st, y, row));
     }
 }
+
+/// [`for_each_row_init`] in bands of `band_rows` rows (the last one shorter), calling
+/// `post(y0, band)` on each band right after its rows were written (while they are still
+/// in cache). Bands start at multiples of `band_rows`, whatever the threads.
+pub(crate) fn for_each_band_init<T: Send, St>(
+    out: &mut [T],
+    width: usize,
+    band_rows: usize,
+    threads: bool,
+    init: impl Fn() -> St + Sync + Send,
+    f: impl Fn(&mut St, usize, &mut [T]) + Sync + Send,
+    post: impl Fn(usize, &mut [T]) + Sync + Send,
+) {
+    let width = width.max(1);
+    let band_rows = band_rows.max(1);
+    let run = |st: &mut St, (b, band): (usize, &mut [T])| {
+        let y0 = b * band_rows;
+        for (i, row) in band.chunks_mut(width).enumerate() {
+            f(st, y0 + i, row);
+        }
+        post(y0, band);
+    };
+    if threads && out.len() > width * band_rows {
+        out.par_chunks_mut(width * band_rows)
+            .enumerate()
+            .for_each_init(init, run);
+    } else {
+        let mut st = init();
+        out.chunks_mut(width * band_rows)
+            .enumerate()
+            .for_each(|b| run(&mut st, b));
+    }
+}
+
+/// `post(y0, band)` over `out` in bands of `band_rows` rows (the last one shorter), in
+/// parallel when `threads`: a [`for_each_band_init`] hook after a renderer that wrote the
+/// whole frame itself.
+pub(crate) fn post_bands<T: Send>(
+    out: &mut [T],
+    width: usize,
+    band_rows: usize,
+    threads: bool,
+    post: impl Fn(usize, &mut [T]) + Sync + Send,
+) {
+    let chunk = width.max(1) * band_rows.max(1);
+    if threads {
+        out.par_chunks_mut(chunk)
+            .enumerate()
+            .for_each(|(b, band)| post(b * band_rows, band));
+    } else {
+        out.chunks_mut(chunk)
+            .enumerate()
+            .for_each(|(b, band)| post(b * band_rows, band));
+    }
+}

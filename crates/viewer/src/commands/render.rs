@@ -4,10 +4,10 @@ use crate::args::{
     named, named_or_parse, parse_angle, parse_size, parse_stops, InputArgs, MaxPixelsArg,
 };
 use crate::heatmap::{summary, write_error_map};
-use crate::lighting::LightArgs;
+use crate::lighting::{LightArgs, LitRenderError};
 use crate::output::{check_not_input, output_kind, write_image};
 use crate::panorama::{coverage_text, heading_text, load_cube, load_panorama_partial};
-use crate::scene::{measure_errors, render_scene, Scene};
+use crate::scene::{measure_errors, Scene};
 use crate::usage;
 use anyhow::{Context, Result};
 use clap::Args;
@@ -167,9 +167,8 @@ impl RenderArgs {
 
     /// The panorama these arguments name: a cube map, or a map placed by `--coverage` or
     /// its GPano XMP.
-    fn load(&self, from_scene: Option<PathBuf>) -> Result<Scene> {
+    fn load(&self, scene_pano: Vec<PathBuf>) -> Result<Scene> {
         let input = &self.input;
-        let scene_pano: Vec<PathBuf> = from_scene.into_iter().collect();
         let panorama = if self.panorama.is_empty() {
             &scene_pano
         } else {
@@ -237,7 +236,24 @@ pub fn run(a: RenderArgs) -> Result<()> {
         view = lut_core::limit_view(view, w, h, &map.coverage());
     }
     let mut out = vec![0u32; w as usize * h as usize];
-    let report = render_scene(scene.as_mut(), view, &a.options(), &mut out, w, h)?;
+    // Rendered and lit in one pass (each band of rows lit as it is drawn).
+    let mut lit = crate::lighting::LitCache::default();
+    let t0 = std::time::Instant::now();
+    let report = lights
+        .render_lit(
+            &mut lit,
+            false,
+            scene.as_mut(),
+            view,
+            &a.options(),
+            &mut out,
+            (w, h),
+        )
+        .map_err(|e| match e {
+            LitRenderError::Render(e) => anyhow::Error::new(e),
+            LitRenderError::Lights(e) => anyhow::Error::msg(e),
+        })?;
+    let lit_ms = t0.elapsed().as_secs_f64() * 1e3;
     let error_map = if a.verbose || a.error_map.is_some() {
         Some(
             measure_errors(scene.as_mut(), view, &a.options(), w, h)
@@ -255,17 +271,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if let (Some(path), Some(em)) = (&a.error_map, &error_map) {
         write_error_map(path, em)?;
     }
-    let mut lit = crate::lighting::LitCache::default();
-    let t0 = std::time::Instant::now();
-    lights
-        .light_frame_with(&mut lit, false, view, &mut out, w, h)
-        .map_err(anyhow::Error::msg)?;
     if a.verbose && !lights.lights.is_empty() {
         crate::errln!(
-            "lit from an illuminance map of {:.1} KiB ({} luminaires, map and shading {:.0} ms, exposure {:.0} lx)",
+            "lit from an illuminance map of {:.1} KiB ({} luminaires, map, render and shading {:.0} ms, exposure {:.0} lx)",
             lit.bytes() as f64 / 1024.0,
             lights.lights.len(),
-            t0.elapsed().as_secs_f64() * 1e3,
+            lit_ms,
             lights.exposure_lux
         );
     }

@@ -1,11 +1,14 @@
 //! Lighting frames from the illuminance map: the map of the current luminaires is built
-//! once per lighting change ([`LitCache`]), every frame then samples it
-//! ([`lut_core::IlluminanceMap::shade_frame`]), and the automatic exposure is set from it.
+//! once per lighting change ([`LitCache`]), every frame then samples it (rendered and lit
+//! in one pass, [`LightsState::render_lit`]: each band of rows lit by
+//! [`lut_core::FrameShader`] as soon as it is drawn), and the automatic exposure is set
+//! from it.
 //! In the window a change first builds a coarse map ([`lut_core::MapOptions::preview`],
 //! immediate feedback while a value is dragged), refined on the next frame.
 
 use super::state::{LightsKey, LightsState};
-use lut_core::{Camera, IlluminanceMap, MapOptions, View};
+use crate::scene::{render_scene_lit, SceneRef};
+use lut_core::{Camera, IlluminanceMap, MapOptions, RenderOptions, RenderReport, View};
 use std::sync::Arc;
 
 /// The illuminance map of a [`LightsState`]'s luminaires, kept until they change.
@@ -74,7 +77,62 @@ impl LitCache {
     }
 }
 
+/// Why [`LightsState::render_lit`] failed.
+#[derive(Debug)]
+pub enum LitRenderError {
+    /// The lights: a room or luminaire the map cannot be built for, or bad shading
+    /// options (nothing was rendered).
+    Lights(String),
+    /// The render itself.
+    Render(lut_core::ViewError),
+}
+
+impl std::fmt::Display for LitRenderError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LitRenderError::Lights(e) => f.write_str(e),
+            LitRenderError::Render(e) => write!(f, "render failed: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for LitRenderError {}
+
 impl LightsState {
+    /// Render `view` of `scene` into `frame` (`width × height`), lit from the
+    /// illuminance map in `cache` (updated first, see [`LitCache::update`]) as the rows
+    /// are drawn ([`render_scene_lit`]); unlit with no luminaire. The pixels are those
+    /// of rendering, then [`LightsState::light_frame_with`].
+    ///
+    /// # Errors
+    /// [`LitRenderError::Lights`] as [`LightsState::light_frame_with`] (before rendering),
+    /// [`LitRenderError::Render`] as [`crate::scene::render_scene`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_lit(
+        &mut self,
+        cache: &mut LitCache,
+        progressive: bool,
+        scene: SceneRef<'_>,
+        view: View,
+        opts: &RenderOptions,
+        frame: &mut [u32],
+        (width, height): (u32, u32),
+    ) -> Result<RenderReport, LitRenderError> {
+        let map = cache
+            .update(self, progressive)
+            .map_err(LitRenderError::Lights)?;
+        let cam = Camera::new(view, width, height);
+        let shader = match &map {
+            Some(m) => Some(
+                m.frame_shader(&cam, &self.shade_options())
+                    .map_err(|e| LitRenderError::Lights(e.to_string()))?,
+            ),
+            None => None,
+        };
+        render_scene_lit(scene, view, opts, frame, width, height, shader.as_ref())
+            .map_err(LitRenderError::Render)
+    }
+
     /// Light a rendered `width × height` frame of `view` in place from the illuminance
     /// map in `cache` (updated first, see [`LitCache::update`]); a no-op with no
     /// luminaire.

@@ -10,10 +10,10 @@ mod scene_file;
 mod state;
 
 pub use files::{file_kind, FileKind};
-pub use lit::LitCache;
+pub use lit::{LitCache, LitRenderError};
 pub use scene_file::{
-    is_scene, is_scene_file, SceneFile, SceneLight, SceneRoom, SceneView, FORMAT as SCENE_FORMAT,
-    VERSION as SCENE_VERSION,
+    is_scene, is_scene_file, SceneFile, SceneLight, ScenePanorama, SceneRoom, SceneView,
+    FORMAT as SCENE_FORMAT, VERSION as SCENE_VERSION,
 };
 pub use state::{
     format_lux, load_table, LightEntry, LightsKey, LightsState, AUTO_EXPOSURE_QUANTILE,
@@ -244,19 +244,19 @@ impl RoomArgs {
         Ok(st)
     }
 
-    /// The scene file's panorama (resolved against its folder) and view, when a scene
-    /// file is given and names them.
+    /// The scene file's panorama (its file or folder, or a cube's face files, resolved
+    /// against its folder; empty when it names none) and view, when a scene file is given.
     ///
     /// # Errors
     /// As [`SceneFile::load`].
-    pub fn scene_panorama(&self) -> Result<(Option<PathBuf>, Option<SceneView>)> {
+    pub fn scene_panorama(&self) -> Result<(Vec<PathBuf>, Option<SceneView>)> {
         match &self.scene {
             Some(path) => {
                 let scene = SceneFile::load(path)?;
                 let dir = path.parent().unwrap_or(Path::new(""));
-                Ok((scene.panorama_path(dir), scene.view))
+                Ok((scene.panorama_paths(dir), scene.view))
             }
-            None => Ok((None, None)),
+            None => Ok((Vec::new(), None)),
         }
     }
 }

@@ -251,16 +251,20 @@ pub fn pick_room_edge(
     radius: f64,
 ) -> Option<usize> {
     let c = room.corners();
-    Room::EDGES
-        .iter()
-        .enumerate()
-        .filter_map(|(k, &(i, j))| {
-            let d = edge_pieces(room, cam, c[i], c[j])
-                .into_iter()
-                .map(|s| segment_distance(s, px, py))
-                .min_by(f64::total_cmp)?;
-            (d <= radius).then_some((k, d))
-        })
+    let edges = Room::EDGES.iter().enumerate().filter_map(|(k, &(i, j))| {
+        let d = edge_pieces(room, cam, c[i], c[j])
+            .into_iter()
+            .map(|s| segment_distance(s, px, py))
+            .min_by(f64::total_cmp)?;
+        Some((k, d))
+    });
+    nearest_within(edges, radius)
+}
+
+/// The index of the nearest of (index, distance) pairs within `radius`.
+fn nearest_within(pairs: impl Iterator<Item = (usize, f64)>, radius: f64) -> Option<usize> {
+    pairs
+        .filter(|&(_, d)| d <= radius)
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(k, _)| k)
 }
@@ -276,47 +280,97 @@ pub fn drag_room_edge(
     room: &Room,
     cam: &Camera,
     edge: usize,
-    (px, py): (f64, f64),
+    at: (f64, f64),
 ) -> Option<(f64, f64, f64, f64)> {
-    const INSIDE: f64 = 0.05;
     let (i, j) = *Room::EDGES.get(edge)?;
     let axis = (i ^ j).trailing_zeros() as usize;
     let high = |bit: usize| i & (1 << bit) != 0;
     let (mut lo, mut hi) = room.bounds();
-    let (floor, ceiling) = (lo.y, hi.y);
-    let o = room.camera_position();
-    let d = room.to_room(cam.ray(px, py)?);
-    let mut set = |a: usize, v: f64| {
-        if high(a) {
-            hi[a] = v.max(INSIDE);
-        } else {
-            lo[a] = v.min(-INSIDE);
-        }
-    };
     if axis == 1 {
+        let d = room.to_room(cam.ray(at.0, at.1)?);
         let c = room.corners()[i];
         let bearing = DVec3::new(d.x, 0.0, d.z);
         if bearing.length() < 1e-9 {
             return None;
         }
         let p = bearing.normalize() * c.x.hypot(c.z);
-        set(0, p.x);
-        set(2, p.z);
+        set_wall(&mut lo, &mut hi, 0, high(0), p.x);
+        set_wall(&mut lo, &mut hi, 2, high(2), p.z);
     } else {
-        let y = if high(1) { ceiling } else { floor };
-        let t = (y - o.y) / d.y;
-        if !(t > 0.0 && t.is_finite()) {
-            return None;
-        }
+        let y = if high(1) { hi.y } else { lo.y };
+        let p = cursor_at_height(room, cam, at, y)?;
         let wall = 2 - axis;
-        set(wall, o[wall] + d[wall] * t);
+        set_wall(&mut lo, &mut hi, wall, high(wall), p[wall]);
     }
-    Some((
+    Some(box_walls(lo, hi))
+}
+
+/// How close (metres) a dragged wall may come to the camera.
+const INSIDE: f64 = 0.05;
+
+/// Move the wall on `axis` (0: X, 2: Z) at the box's `high` or low end to `v`, keeping
+/// it [`INSIDE`] from the camera (at 0 on both axes).
+fn set_wall(lo: &mut DVec3, hi: &mut DVec3, axis: usize, high: bool, v: f64) {
+    if high {
+        hi[axis] = v.max(INSIDE);
+    } else {
+        lo[axis] = v.min(-INSIDE);
+    }
+}
+
+/// (width, depth, centre x, centre z) of the box `lo` … `hi`.
+fn box_walls(lo: DVec3, hi: DVec3) -> (f64, f64, f64, f64) {
+    (
         hi.x - lo.x,
         hi.z - lo.z,
         (lo.x + hi.x) / 2.0,
         (lo.z + hi.z) / 2.0,
-    ))
+    )
+}
+
+/// Where the ray through (px, py) of a `cam` frame meets the horizontal plane at height
+/// `y` (room coordinates), in front of the camera.
+fn cursor_at_height(room: &Room, cam: &Camera, (px, py): (f64, f64), y: f64) -> Option<DVec3> {
+    let o = room.camera_position();
+    let d = room.to_room(cam.ray(px, py)?);
+    let t = (y - o.y) / d.y;
+    (t > 0.0 && t.is_finite()).then(|| o + d * t)
+}
+
+/// The room corner (an index into [`Room::corners`]) drawn nearest to (px, py) in a
+/// `cam` frame, within `radius` pixels (corners behind the camera left out).
+pub fn pick_room_corner(
+    room: &Room,
+    cam: &Camera,
+    (px, py): (f64, f64),
+    radius: f64,
+) -> Option<usize> {
+    let all = room.corners();
+    let corners = all.iter().enumerate().filter_map(|(k, &c)| {
+        let (x, y) = project_point(room, cam, c)?;
+        Some((k, (x - px).hypot(y - py)))
+    });
+    nearest_within(corners, radius)
+}
+
+/// The room box after its corner `corner` (an index into [`Room::corners`]) is dragged
+/// to (px, py) of a `cam` frame, as (width, depth, centre x, centre z): the two walls
+/// meeting at the corner move so that it sits where the cursor's ray meets the corner's
+/// floor (a bottom corner) or ceiling (a top one); the other two walls, the height, the
+/// camera height and the turn stay. The camera stays at least 5 cm inside. `None` when
+/// the cursor's ray does not meet that floor or ceiling in front of the camera.
+pub fn drag_room_corner(
+    room: &Room,
+    cam: &Camera,
+    corner: usize,
+    at: (f64, f64),
+) -> Option<(f64, f64, f64, f64)> {
+    let c = *room.corners().get(corner)?;
+    let p = cursor_at_height(room, cam, at, c.y)?;
+    let (mut lo, mut hi) = room.bounds();
+    set_wall(&mut lo, &mut hi, 0, corner & 1 != 0, p.x);
+    set_wall(&mut lo, &mut hi, 2, corner & 4 != 0, p.z);
+    Some(box_walls(lo, hi))
 }
 
 /// Draw the room's wireframe and the lights' markers of `st` over a rendered `w × h`
@@ -503,6 +557,67 @@ mod tests {
         let far = drag_room_edge(&room, &cam, k, (319.0, 100.0)).unwrap();
         let (lo3, hi3) = rebuilt(far).bounds();
         assert!(lo3.x <= -0.05 + 1e-12 && hi3.z >= 0.05 - 1e-12);
+    }
+
+    #[test]
+    fn dragged_room_corners_move_both_walls() {
+        let room = Room::new(4.0, 6.0, 2.8, 1.5)
+            .unwrap()
+            .with_yaw(-25.0)
+            .unwrap()
+            .with_center(0.3, -0.4)
+            .unwrap();
+        let (lo, hi) = room.bounds();
+        let rebuilt = |(w, d, cx, cz): (f64, f64, f64, f64)| {
+            Room::new(w, d, 2.8, 1.5)
+                .unwrap()
+                .with_yaw(-25.0)
+                .unwrap()
+                .with_center(cx, cz)
+                .unwrap()
+        };
+        // The floor corner at x high, z high, and the ceiling corner at x low, z low:
+        // each dragged to a point of its floor / ceiling; picked under the cursor.
+        for (corner, target, pitch) in [
+            (1 | 4, DVec3::new(hi.x + 0.3, 0.0, hi.z - 0.5), -30.0),
+            (2, DVec3::new(lo.x + 0.4, 2.8, lo.z - 0.2), 30.0),
+        ] {
+            // A view that sees both the corner and the target.
+            let inside = |cam: &Camera, p: DVec3| {
+                project_point(&room, cam, p)
+                    .is_some_and(|(x, y)| (0.0..320.0).contains(&x) && (0.0..200.0).contains(&y))
+            };
+            let cam = (0..36)
+                .map(|k| Camera::new(View::new(k as f64 * 10.0, pitch, 100.0).unwrap(), 320, 200))
+                .find(|cam| inside(cam, room.corners()[corner]) && inside(cam, target))
+                .expect("a view of the corner");
+            let here = project_point(&room, &cam, room.corners()[corner]).unwrap();
+            assert_eq!(pick_room_corner(&room, &cam, here, 6.0), Some(corner));
+            assert_eq!(
+                pick_room_corner(&room, &cam, (here.0 + 40.0, here.1), 6.0),
+                None
+            );
+            let at = project_point(&room, &cam, target).unwrap();
+            let moved = rebuilt(drag_room_corner(&room, &cam, corner, at).unwrap());
+            let got = moved.corners()[corner];
+            assert!(
+                (got - target).length() < 1e-9,
+                "{corner}: {got} vs {target}"
+            );
+            // The opposite walls stay.
+            let (lo2, hi2) = moved.bounds();
+            let opposite = moved.corners()[7 - corner];
+            assert!((opposite - room.corners()[7 - corner]).length() < 1e-9);
+            assert!((lo2.y - lo.y).abs() < 1e-12 && (hi2.y - hi.y).abs() < 1e-12);
+        }
+        // Never past the camera: a bottom corner dragged to a floor point behind it.
+        let cam = Camera::new(View::new(0.0, -80.0, 100.0).unwrap(), 320, 200);
+        let at = project_point(&room, &cam, DVec3::new(-0.5, 0.0, -0.5)).unwrap();
+        let (_, hi3) = rebuilt(drag_room_corner(&room, &cam, 1 | 4, at).unwrap()).bounds();
+        assert!(hi3.x >= 0.05 - 1e-12 && hi3.z >= 0.05 - 1e-12, "{hi3}");
+        // The cursor above the horizon never meets the floor.
+        let cam = Camera::new(View::new(0.0, 60.0, 60.0).unwrap(), 320, 200);
+        assert!(drag_room_corner(&room, &cam, 1, (160.0, 100.0)).is_none());
     }
 
     #[test]

@@ -97,6 +97,28 @@ fn yes() -> bool {
     true
 }
 
+/// A scene's panorama: `"panorama": "FILE-OR-FOLDER"`, or the face files of a cube
+/// opened from separate files, `"panorama": ["front.jpg", "right.jpg", ...]` (as given,
+/// so the scene reopens exactly those files).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ScenePanorama {
+    /// One image file, or a folder of cube faces.
+    One(PathBuf),
+    /// A cube map's face files.
+    Faces(Vec<PathBuf>),
+}
+
+impl ScenePanorama {
+    /// The paths as written in the file.
+    pub fn paths(&self) -> Vec<PathBuf> {
+        match self {
+            ScenePanorama::One(p) => vec![p.clone()],
+            ScenePanorama::Faces(f) => f.clone(),
+        }
+    }
+}
+
 /// A scene file's content.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -105,9 +127,10 @@ pub struct SceneFile {
     pub format: String,
     /// The version ([`VERSION`](super::SCENE_VERSION)).
     pub version: u32,
-    /// The panorama (a file, or a folder of cube faces); none for the bundled sample.
+    /// The panorama (a file, a folder of cube faces or a cube's face files); none for the
+    /// bundled sample.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub panorama: Option<PathBuf>,
+    pub panorama: Option<ScenePanorama>,
     /// The view to open with.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub view: Option<SceneView>,
@@ -202,11 +225,12 @@ fn relative_to(base: &Path, target: &Path) -> PathBuf {
 }
 
 impl SceneFile {
-    /// The scene of a light state, the panorama shown and the view; paths relative to
-    /// `dir`, the folder the file will be written to.
+    /// The scene of a light state, the panorama shown (its file or folder, or a cube's
+    /// face files; none for the bundled sample) and the view; paths relative to `dir`, the
+    /// folder the file will be written to.
     pub fn from_state(
         state: &LightsState,
-        panorama: Option<&Path>,
+        panorama: &[PathBuf],
         view: Option<SceneView>,
         dir: &Path,
     ) -> SceneFile {
@@ -214,7 +238,13 @@ impl SceneFile {
         SceneFile {
             format: FORMAT.into(),
             version: VERSION,
-            panorama: panorama.map(|p| relative_to(dir, p)),
+            panorama: match panorama {
+                [] => None,
+                [one] => Some(ScenePanorama::One(relative_to(dir, one))),
+                faces => Some(ScenePanorama::Faces(
+                    faces.iter().map(|p| relative_to(dir, p)).collect(),
+                )),
+            },
             view,
             room: SceneRoom {
                 width: w,
@@ -263,6 +293,12 @@ impl SceneFile {
                 scene.format
             );
         }
+        if matches!(&scene.panorama, Some(ScenePanorama::Faces(f)) if f.is_empty()) {
+            bail!(
+                "{}: \"panorama\" is an empty list (give a file, a folder or the cube's face files)",
+                path.display()
+            );
+        }
         if scene.version != VERSION {
             bail!(
                 "{}: scene file version {} (this viewer reads version {VERSION})",
@@ -295,9 +331,12 @@ impl SceneFile {
         Ok(())
     }
 
-    /// The panorama's path resolved against the scene file's folder `dir`.
-    pub fn panorama_path(&self, dir: &Path) -> Option<PathBuf> {
-        self.panorama.as_ref().map(|p| dir.join(p))
+    /// The panorama's paths (one file or folder, or a cube's face files; none for the
+    /// bundled sample) resolved against the scene file's folder `dir`.
+    pub fn panorama_paths(&self, dir: &Path) -> Vec<PathBuf> {
+        self.panorama.as_ref().map_or_else(Vec::new, |p| {
+            p.paths().iter().map(|p| dir.join(p)).collect()
+        })
     }
 
     /// The light state this scene describes: every luminaire file loaded (paths against

@@ -126,6 +126,8 @@ struct App {
     light_drag: Option<usize>,
     /// The room edge being dragged (an index into `lut_core::Room::EDGES`).
     edge_drag: Option<usize>,
+    /// The room corner being dragged (an index into `lut_core::Room::corners`).
+    corner_drag: Option<usize>,
     /// The scene file opened or saved last.
     scene_file: Option<PathBuf>,
     /// The luminaires' marker positions as last printed (`--print-view`).
@@ -193,6 +195,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         lit: LitCache::default(),
         light_drag: None,
         edge_drag: None,
+        corner_drag: None,
         scene_file: args.lights.room.scene.clone(),
         printed_markers: String::new(),
     };

@@ -42,6 +42,16 @@ impl Source {
         }
     }
 
+    /// The files or folder this source was opened from: one image file, a cube's folder,
+    /// layout image or face files; none for the bundled sample.
+    pub fn paths(&self) -> Vec<PathBuf> {
+        match self {
+            Source::Sample => Vec::new(),
+            Source::File(p) => vec![p.clone()],
+            Source::Cube { paths, .. } => paths.clone(),
+        }
+    }
+
     /// The one file or folder this source is (`None`: the sample, or several face files).
     pub fn single_path(&self) -> Option<&std::path::Path> {
         match self {

@@ -4,7 +4,6 @@
 
 use super::frame::FrameRequests;
 use super::App;
-use crate::scene::render_scene;
 use crate::window::dialogs::Chosen;
 use crate::window::document::Effect;
 use crate::window::folder::{self, Step};
@@ -356,9 +355,17 @@ impl App {
         let opts = self.ctl.settings.render_options(Level::Full);
         let view = self.ctl.look().view();
         let mut buf = vec![0u32; w as usize * h as usize];
-        render_scene(cur.scene.as_mut(), view, &opts, &mut buf, w, h).map_err(|e| e.to_string())?;
         self.lights
-            .light_frame_with(&mut self.lit, false, view, &mut buf, w, h)?;
+            .render_lit(
+                &mut self.lit,
+                false,
+                cur.scene.as_mut(),
+                view,
+                &opts,
+                &mut buf,
+                (w, h),
+            )
+            .map_err(|e| e.to_string())?;
         Ok(buf)
     }
 }

@@ -3,7 +3,7 @@
 //! with egui, and decide when the next frame is due.
 
 use super::{App, SceneKey};
-use crate::scene::{measure_errors, render_scene, SceneRef};
+use crate::scene::{measure_errors, render_scene, render_scene_lit, SceneRef};
 use crate::window::dialogs::Chosen;
 use crate::window::input::{resolution_hfov, wheel_notches, Held, Look, WIDE_HFOV_MAX};
 use crate::window::keys::{KeyAction, Route};
@@ -12,7 +12,7 @@ use crate::window::paint::SceneRect;
 use crate::window::quality::{frame_level, FRAME_BUDGET_MS};
 use crate::window::ui::{self, PanelModel, PanelOutput};
 use anyhow::{anyhow, Result};
-use lut_core::{CubeRenderer, RenderOptions, RenderPath, Sampler};
+use lut_core::{Camera, CubeRenderer, RenderOptions, RenderPath, Sampler};
 use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -97,7 +97,7 @@ impl App {
                 }
             }
         }
-        if self.light_drag.is_some() || self.edge_drag.is_some() {
+        if self.light_drag.is_some() || self.edge_drag.is_some() || self.corner_drag.is_some() {
             match resp.interact_pointer_pos() {
                 Some(p) if resp.dragged_by(primary) => self.drag_light(to_px(p), size),
                 _ => self.end_light_drag(),
@@ -418,14 +418,29 @@ impl App {
         let t0 = Instant::now();
         let view = look.view();
         let k = level.scale();
+        // A full-size frame is lit as its rows are drawn (no second pass over it); a
+        // smaller one is lit after it is scaled up, in `light_scene`.
+        let cam = Camera::new(view, rect.w, rect.h);
+        let shader = match (&lit, k == 1 && !s.heat_map) {
+            (Some(map), true) => match map.frame_shader(&cam, &self.lights.shade_options()) {
+                Ok(shader) => Some(shader),
+                Err(e) => {
+                    self.lights.scene_error = Some(e.to_string());
+                    None
+                }
+            },
+            _ => None,
+        };
+        let lit_while_drawn = shader.is_some();
         let result = if k == 1 {
-            render_scene(
+            render_scene_lit(
                 cur.scene.as_mut(),
                 view,
                 &opts,
                 &mut self.scene,
                 rect.w,
                 rect.h,
+                shader.as_ref(),
             )
         } else {
             let (sw, sh) = (rect.w.div_ceil(k), rect.h.div_ceil(k));
@@ -453,7 +468,8 @@ impl App {
         if s.heat_map {
             self.show_heat_map(view, &opts, rect, k);
         } else {
-            self.light_scene(lit.as_deref(), view, rect);
+            let unlit = lit.as_deref().filter(|_| !lit_while_drawn);
+            self.light_scene(lit.as_deref(), unlit, view, rect);
         }
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         self.times.record(level, ms, pixels);

@@ -4,8 +4,8 @@
 
 use super::App;
 use crate::lighting::overlay::{
-    drag_on_surface, drag_room_edge, draw_room_and_lights, pick_light, pick_room_edge,
-    project_point,
+    drag_on_surface, drag_room_corner, drag_room_edge, draw_room_and_lights, pick_light,
+    pick_room_corner, pick_room_edge, project_point,
 };
 use crate::lighting::{legend::draw_legend, SceneFile, SceneView};
 use crate::window::document::StartArgs;
@@ -37,11 +37,19 @@ impl App {
         }
     }
 
-    /// Light the freshly rendered scene from `map` (as `viewer render` does), then draw
-    /// the room and luminaires ("Show room") and the false colours' legend over it.
-    pub(super) fn light_scene(&mut self, map: Option<&IlluminanceMap>, view: View, r: SceneRect) {
+    /// Light the freshly rendered scene from `unlit` (the map, when the render did not
+    /// light the rows as it drew them; as `viewer render` does), then draw the room and
+    /// luminaires ("Show room") and, when the scene is lit (`map`), the false colours'
+    /// legend over it.
+    pub(super) fn light_scene(
+        &mut self,
+        map: Option<&IlluminanceMap>,
+        unlit: Option<&IlluminanceMap>,
+        view: View,
+        r: SceneRect,
+    ) {
         let (w, h) = (r.w, r.h);
-        if let Some(map) = map {
+        if let Some(map) = unlit {
             let cam = Camera::new(view, w, h);
             let opts = self.lights.shade_options();
             if let Err(e) = map.shade_frame(&cam, &mut self.scene, w, h, &opts) {
@@ -94,7 +102,22 @@ impl App {
                 inside.then(|| format!("{k}={x:.0},{y:.0}"))
             })
             .collect();
-        let line = format!("markers {}\nedges {}", line.join(" "), edges.join(" "));
+        // And each room corner in view: "corners K=X,Y" (K into Room::corners).
+        let corners: Vec<String> = c
+            .iter()
+            .enumerate()
+            .filter_map(|(k, &p)| {
+                let (x, y) = project_point(&room, &cam, p)?;
+                let inside = x >= 0.0 && y >= 0.0 && x < r.w as f64 && y < r.h as f64;
+                inside.then(|| format!("{k}={x:.0},{y:.0}"))
+            })
+            .collect();
+        let line = format!(
+            "markers {}\nedges {}\ncorners {}",
+            line.join(" "),
+            edges.join(" "),
+            corners.join(" ")
+        );
         if line != self.printed_markers {
             let _ = crate::outln!("{line}");
             self.printed_markers = line;
@@ -127,8 +150,9 @@ impl App {
     }
 
     /// A drag starts at `at`: on a luminaire's marker (the room shown) it moves that
-    /// luminaire, on an edge of the room box it moves that edge's walls, instead of
-    /// turning the view. True when a luminaire or an edge was taken.
+    /// luminaire, on a corner of the room box the two walls meeting there, on an edge that
+    /// edge's walls, instead of turning the view. True when a luminaire, a corner or an
+    /// edge was taken.
     pub(super) fn press_light(&mut self, at: (f64, f64), size: (u32, u32)) -> bool {
         if !self.lights.show_room {
             return false;
@@ -141,28 +165,39 @@ impl App {
             return true;
         }
         let cam = Camera::new(view, size.0, size.1);
-        self.edge_drag = self
-            .lights
-            .room_box()
-            .ok()
-            .and_then(|room| pick_room_edge(&room, &cam, at, EDGE_RADIUS));
-        self.edge_drag.is_some()
+        let Ok(room) = self.lights.room_box() else {
+            return false;
+        };
+        // A corner first (it lies on three edges), then an edge.
+        self.corner_drag = pick_room_corner(&room, &cam, at, EDGE_RADIUS);
+        if self.corner_drag.is_none() {
+            self.edge_drag = pick_room_edge(&room, &cam, at, EDGE_RADIUS);
+        }
+        self.corner_drag.is_some() || self.edge_drag.is_some()
     }
 
     /// The dragged luminaire follows the cursor along the face it is nearest to; a
-    /// dragged room edge moves its walls to the cursor.
+    /// dragged room corner or edge moves its walls to the cursor.
     pub(super) fn drag_light(&mut self, at: (f64, f64), size: (u32, u32)) {
         let Ok(room) = self.lights.room_box() else {
             return;
         };
         let cam = Camera::new(self.ctl.look().view(), size.0, size.1);
-        if let Some(e) = self.edge_drag {
-            if let Some((w, d, cx, cz)) = drag_room_edge(&room, &cam, e, at) {
+        let walls = match (self.corner_drag, self.edge_drag) {
+            (Some(c), _) => Some(drag_room_corner(&room, &cam, c, at)),
+            (None, Some(e)) => Some(drag_room_edge(&room, &cam, e, at)),
+            (None, None) => None,
+        };
+        match walls {
+            Some(Some((w, d, cx, cz))) => {
                 self.lights.room.0 = w;
                 self.lights.room.1 = d;
                 self.lights.room_center = (cx, cz);
+                return;
             }
-            return;
+            // The cursor's ray misses the floor or ceiling: the room stays.
+            Some(None) => return,
+            None => {}
         }
         let Some(i) = self.light_drag else {
             return;
@@ -176,7 +211,8 @@ impl App {
 
     /// The drag of a luminaire ended (`--print-view`: where it is now).
     pub(super) fn end_light_drag(&mut self) {
-        if let (Some(_), true) = (self.edge_drag.take(), self.print_view) {
+        let room_dragged = self.edge_drag.take().is_some() | self.corner_drag.take().is_some();
+        if room_dragged && self.print_view {
             let (w, d, h) = self.lights.room;
             let (cx, cz) = self.lights.room_center;
             let _ = crate::outln!("room {w:.3}x{d:.3}x{h:.3} centre {cx:.3},{cz:.3}");
@@ -208,13 +244,14 @@ impl App {
         self.scene_file = Some(path.clone());
         self.prefs.panel = true;
         self.notices.info(format!("scene {}", path.display()), t);
-        if let Some(p) = file.panorama_path(&dir) {
+        let paths = file.panorama_paths(&dir);
+        if let Some(p) = paths.first().cloned() {
             let start = file.view.map_or_else(StartArgs::default, |v| StartArgs {
                 yaw: Some(v.yaw),
                 pitch: Some(v.pitch),
                 hfov: Some(v.hfov),
             });
-            let source = Source::of_paths(vec![p.clone()], false, None).unwrap_or(Source::File(p));
+            let source = Source::of_paths(paths, false, None).unwrap_or(Source::File(p));
             let fx = self
                 .doc
                 .open(source, None, start, self.ctl.settings.exposure_ev);
@@ -253,8 +290,7 @@ impl App {
         let panorama = self
             .doc
             .current()
-            .and_then(|c| c.source.single_path())
-            .map(Path::to_path_buf);
+            .map_or_else(Vec::new, |c| c.source.paths());
         let look = self.ctl.look();
         let view = SceneView {
             yaw: look.yaw,
@@ -265,7 +301,7 @@ impl App {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
-        let file = SceneFile::from_state(&self.lights, panorama.as_deref(), Some(view), dir);
+        let file = SceneFile::from_state(&self.lights, &panorama, Some(view), dir);
         let status = match file.save(path) {
             Ok(()) => {
                 self.scene_file = Some(path.to_path_buf());
