@@ -106,11 +106,9 @@ fn trilinear_is_bilinear_when_magnifying() {
     );
 }
 
-/// `Renderer::set_bilinear_level`: bilinear reads one pyramid level, the one whose
-/// texel matches the footprint. Magnified it is plain bilinear byte for byte; zoomed out
-/// it is closer to the supersampled truth than bilinear on the map, and it reads the
-/// level (the same frame as rendering that level as a map of its own, up to the LUT's
-/// sub-pixel position rounding).
+/// `Renderer::set_bilinear_level`: a bilinear frame reads one pyramid level for the
+/// whole frame, the level nearest to the footprint at the view's centre (2^k nearest to
+/// it), drawn as a plain bilinear frame of that level; magnified views are plain bilinear.
 #[test]
 fn bilinear_level_reads_the_matching_level() {
     let map = fine_map(2048, 1024);
@@ -130,28 +128,70 @@ fn bilinear_level_reads_the_matching_level() {
         level_frame(&map, view, 160, 120),
         lut(&map, view, Sampler::Bilinear, 160, 120)
     );
-    // Zoomed out: hfov 90 over 64 columns of a 2048-wide map is 8 map pixels per screen
-    // pixel at the centre (a little less towards the edges): levels 2 and 3.
+    // Zoomed out: hfov 90 over 64 columns of a 2048-wide map is 10.2 map pixels per
+    // screen pixel at the centre (log2 3.35): level 3, the whole frame, byte for byte
+    // the bilinear frame of level 3 (256x128) drawn as a map of its own.
     let (w, h) = (64, 48);
     let view = View::new(10.0, 0.0, 90.0).unwrap();
     let got = level_frame(&map, view, w, h);
+    let level3 = &map.pyramid()[2];
+    assert_eq!((level3.width(), level3.height()), (256, 128));
+    assert_eq!(got, lut(level3, view, Sampler::Bilinear, w, h));
+    // ... which is closer to the supersampled truth than bilinear on the map.
     let bi = lut(&map, view, Sampler::Bilinear, w, h);
     let truth = truth(&map, view, w, h);
     let (pl, pb) = (psnr(&got, &truth), psnr(&bi, &truth));
     assert!(pl >= pb + 3.0, "level {pl:.1} dB vs bilinear {pb:.1} dB");
-    // The middle of the centre column reads level 3 (footprints 9 to 10 map pixels;
-    // towards the top and bottom they fall below 8): the same as bilinear on that level.
-    let level3 = &map.pyramid()[2];
-    let on_level = lut(level3, view, Sampler::Bilinear, w, h);
-    let x = (w / 2) as usize;
-    let mut diff = 0u32;
-    for y in h as usize / 4..3 * h as usize / 4 {
-        let (a, b) = (got[y * w as usize + x], on_level[y * w as usize + x]);
-        for s in [0, 8, 16] {
-            diff = diff.max(((a >> s) & 0xFF).abs_diff((b >> s) & 0xFF));
-        }
+    // Twice the columns: footprint 5.1 (log2 2.35), level 2.
+    let got = level_frame(&map, view, 2 * w, 2 * h);
+    assert_eq!(
+        got,
+        lut(&map.pyramid()[1], view, Sampler::Bilinear, 2 * w, 2 * h)
+    );
+    // The same renderer draws the still (plain) frame and the level frame in turn, each
+    // as a renderer of its own would.
+    let mut r = Renderer::new(&map);
+    for on in [true, false, true] {
+        r.set_bilinear_level(on);
+        let f = render_frame(&mut r, Scene::Map(&map), view, &opts, w, h).0;
+        let want = if on {
+            lut(level3, view, Sampler::Bilinear, w, h)
+        } else {
+            lut(&map, view, Sampler::Bilinear, w, h)
+        };
+        assert!(f == want, "bilinear_level {on}");
     }
-    assert!(diff <= 8, "centre column differs from level 3 by {diff}");
+    // With a band hook (`render_with`, the lit frames): the same pixels, every row
+    // handed to the hook once.
+    let rows = std::sync::atomic::AtomicUsize::new(0);
+    let hook = |_y0: usize, band: &mut [u32]| {
+        rows.fetch_add(
+            band.len() / w as usize,
+            std::sync::atomic::Ordering::Relaxed,
+        );
+    };
+    let mut px = vec![0u32; (w * h) as usize];
+    r.set_bilinear_level(true);
+    r.render_with(
+        Scene::Map(&map),
+        view,
+        &opts,
+        &mut Frame::new(&mut px, w, h).unwrap(),
+        &hook,
+    )
+    .unwrap();
+    assert!(px == lut(level3, view, Sampler::Bilinear, w, h));
+    assert_eq!(rows.into_inner(), h as usize);
+    // Trilinear and nearest ignore the switch.
+    for s in [Sampler::Trilinear, Sampler::Nearest] {
+        let o = RenderOptions {
+            sampler: s,
+            ..RenderOptions::default()
+        };
+        r.set_bilinear_level(true);
+        let f = render_frame(&mut r, Scene::Map(&map), view, &o, w, h).0;
+        assert!(f == lut(&map, view, s, w, h), "{s:?}");
+    }
 }
 
 /// Maps with odd sides deeper down get every level too (1800×900: 225×113 at level 3,

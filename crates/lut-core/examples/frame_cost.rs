@@ -18,7 +18,12 @@
 //! nearest kernel is compared with; cube = the cube scanline renderer on a cube of faces a
 //! quarter of the map's width, converted from the map as `viewer bench` does; cube-basic =
 //! the per-pixel cube renderer), `cache` PATH (keep the generated map's pixels there, and
-//! a cube's faces in PATH.cubeN, and read them on later runs: much faster under valgrind).
+//! a cube's faces in PATH.cubeN, and read them on later runs: much faster under valgrind),
+//! `level` 0|1 (0; 1: bilinear reads the pyramid level matching the footprint,
+//! `Renderer::set_bilinear_level`, as the window does while moving; the pyramid is built
+//! before timing). `LUTPANO_HUGE_PAGES=off` keeps the map off huge pages (A/B runs).
+//! `file` PATH: render that panorama instead of the generated map (e.g. `viewer
+//! bench-load`'s cached JPEGs; `map` is then ignored).
 
 use lut_core::grid_map;
 use lut_core::{CubeMap, CubeRenderer, Face};
@@ -40,19 +45,40 @@ fn size(s: &str) -> Result<(u32, u32), String> {
     Ok((p(w)?, p(h)?))
 }
 
+/// CPU time of the process so far in ms (all threads), where the platform tells it: on a
+/// shared machine it is steadier than wall time (time slices given to other processes do
+/// not count; their cache pollution still does).
+#[cfg(unix)]
+#[allow(unsafe_code)]
+fn cpu_ms() -> f64 {
+    let mut t = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `t` is a valid timespec for the call to write.
+    unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut t) };
+    t.tv_sec as f64 * 1e3 + t.tv_nsec as f64 * 1e-6
+}
+
+#[cfg(not(unix))]
+fn cpu_ms() -> f64 {
+    0.0
+}
+
 /// The frames measured (callgrind: `--toggle-collect=frame_cost::timed_frames`).
 #[inline(never)]
 fn timed_frames(
     frames: usize,
     f: &mut dyn FnMut(usize) -> Result<(), String>,
-) -> Result<Vec<f64>, String> {
+) -> Result<(Vec<f64>, f64), String> {
     let mut times = Vec::with_capacity(frames);
+    let cpu0 = cpu_ms();
     for i in 0..frames {
         let t = Instant::now();
         f(i)?;
         times.push(t.elapsed().as_secs_f64() * 1e3);
     }
-    Ok(times)
+    Ok((times, (cpu_ms() - cpu0) / frames.max(1) as f64))
 }
 
 /// One frame of a plain gather along precomputed indices, in row bands.
@@ -141,6 +167,8 @@ fn run() -> Result<(), String> {
     let mut gather = false;
     let mut cube_renderer = None;
     let mut cache = None;
+    let mut level = false;
+    let mut file = None;
     for a in std::env::args().skip(1) {
         let (k, v) = a
             .split_once('=')
@@ -177,11 +205,20 @@ fn run() -> Result<(), String> {
                 }
             },
             "cache" => cache = Some(std::path::PathBuf::from(v)),
+            "level" => level = num(v)? != 0.0,
+            "file" => file = Some(std::path::PathBuf::from(v)),
             _ => return Err(format!("unknown argument '{k}'")),
         }
     }
     lut_core::set_kernel(kernel).map_err(|e| e.to_string())?;
-    let map = load_map(map_wh, cache.as_deref())?;
+    let t_load = Instant::now();
+    let map = match &file {
+        Some(p) => lut_core::load_map(p, &lut_core::LoadOptions::default(), &mut |_| {})
+            .map_err(|e| e.to_string())?,
+        None => load_map(map_wh, cache.as_deref())?,
+    };
+    let map_wh = (map.width(), map.height());
+    eprintln!("map ready in {:.2} s", t_load.elapsed().as_secs_f64());
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.max(1))
         .build()
@@ -204,8 +241,14 @@ fn run() -> Result<(), String> {
     let (w, h) = out_wh;
     let mut out = vec![0u32; w as usize * h as usize];
     let mut r = Renderer::new(&map);
+    r.set_bilinear_level(level);
+    if level {
+        let t = Instant::now();
+        map.pyramid();
+        eprintln!("pyramid built in {:.2} s", t.elapsed().as_secs_f64());
+    }
     let view = |i: usize| View::new(yaw + 7.3 * i as f64, pitch, hfov).map_err(|e| e.to_string());
-    let mut times;
+    let (mut times, cpu);
     if gather {
         // Indices of the padded map (stride W + 1) for the first view's nearest samples.
         let (pos, _) = r
@@ -230,7 +273,7 @@ fn run() -> Result<(), String> {
             .collect();
         let f = || gather_frame(&src, &idx, &mut out, w as usize);
         pool.install(f);
-        times = pool.install(|| {
+        (times, cpu) = pool.install(|| {
             timed_frames(frames, &mut |_| {
                 gather_frame(&src, &idx, &mut out, w as usize);
                 Ok(())
@@ -247,7 +290,7 @@ fn run() -> Result<(), String> {
             "first view: index steps {}..={}, {} pixels evaluated exactly",
             rep.min_step, rep.max_step, rep.exact_pixels
         );
-        times = pool.install(|| {
+        (times, cpu) = pool.install(|| {
             timed_frames(frames, &mut |i| {
                 let mut f = Frame::new(&mut out, w, h).map_err(|e| e.to_string())?;
                 r.render(scene, view(i + 1)?, &opts, &mut f)
@@ -259,11 +302,12 @@ fn run() -> Result<(), String> {
     let timed = &mut times[..];
     timed.sort_by(f64::total_cmp);
     let med = timed.get(timed.len() / 2).copied().unwrap_or(0.0);
+    let min = timed.first().copied().unwrap_or(0.0);
     let checksum = out
         .iter()
         .fold(0u64, |a, &p| a.wrapping_mul(31).wrapping_add(p as u64));
     println!(
-        "{} | {} {} {}x{} from {}x{}, hfov {hfov}, {threads} thread(s): median {med:.2} ms over {} frame(s) (checksum {checksum:016x})",
+        "{} | {} {} {}x{} from {}x{}, hfov {hfov}, {threads} thread(s): median {med:.2} ms (min {min:.2}; CPU {cpu:.2} ms per frame, all threads) over {} frame(s) (checksum {checksum:016x})",
         lut_core::kernel_info(),
         match (gather, cube_renderer) {
             (true, _) => "gather",

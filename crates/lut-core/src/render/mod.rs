@@ -310,6 +310,8 @@ pub struct Renderer {
     /// Bilinear reads the pyramid level matching the footprint
     /// ([`Renderer::set_bilinear_level`]).
     bilinear_level: bool,
+    /// The renderer of those frames: its tables are for the level's geometry.
+    level: Option<Box<Renderer>>,
 }
 
 /// The table of `surface` and `kind` among `tables` (built by [`Renderer::table`]).
@@ -329,20 +331,24 @@ impl Renderer {
         r
     }
 
-    /// Bilinear frames of the LUT renderer read the pyramid level whose texel matches
-    /// the pixel footprint (`on`), or the map itself (`false`, the default).
+    /// Bilinear frames read the pyramid level that matches the screen (`on`), or the map
+    /// itself (`false`, the default): what the window draws while the view moves.
     ///
     /// Zoomed out on a big map, a bilinear frame reads texels far apart: each sample a
-    /// cache miss, so the frame costs more the bigger the map. With this on, the frame
-    /// reads level k of the pyramid (one level, no blend: bilinear's cost), where 2^k
-    /// map pixels ≤ the footprint < 2^(k+1), the same footprint the trilinear sampler
-    /// uses: a 32768-wide map then pans at the cost of the level that matches the screen
-    /// (about an 8k map at 1080p, hfov 90), with less aliasing than the map itself. At
-    /// footprints below 2 map pixels it is plain bilinear, byte for byte, and a frame
-    /// whose view centre shows fewer than 2 map pixels per screen pixel is rendered as
-    /// plain bilinear outright (at plain bilinear's cost). Meant for a window while the
-    /// view moves; partial maps (no pyramid) are unaffected. The pyramid is built on the
-    /// first such frame if it was not (`EnvMap::pyramid`).
+    /// cache miss, so the frame costs more the bigger the map. With this on, the frame is
+    /// drawn as a plain bilinear frame of pyramid level k, one level for the whole frame,
+    /// where 2^k is the power of two nearest to the footprint at the view's centre (map
+    /// pixels per screen pixel; k = ⌊log2(footprint) + ½⌋, the nearest mip level, so the
+    /// centre reads between 0.71 and 1.41 level texels per pixel), with the level's own
+    /// look-up tables: a 32768-wide map at 1080p and hfov 90 (footprint 5.4) is drawn from
+    /// its 8192-wide level exactly as an 8192-wide map would be, at that map's cost, and
+    /// aliases less than bilinear on the map. Only levels that divide the map's sides
+    /// exactly are used (positions on them are exact; a 6000×3000 map goes down to level
+    /// 3, 750×375); footprints below √2 at the centre are plain bilinear, byte for byte.
+    /// Towards the edges of a wide view the footprint shrinks (at hfov 90 to about half),
+    /// so the edges are magnified there as they are on a map of the level's size. Partial
+    /// maps (no pyramid) are unaffected. The pyramid is built on the first such frame if
+    /// it was not (`EnvMap::pyramid`); the level's tables on the first frame of a level.
     pub fn set_bilinear_level(&mut self, on: bool) {
         self.bilinear_level = on;
     }
@@ -380,6 +386,23 @@ impl Renderer {
         self.tables
             .push((surface, kind, LutTable::build(spec, p, w, h)));
         &self.tables.last().expect("just pushed").2
+    }
+
+    /// The pyramid level a bilinear frame of `view` on `width` columns reads instead of
+    /// `map` ([`Renderer::set_bilinear_level`]), or `None` for the map itself.
+    fn level_map<'m>(
+        &self,
+        map: &'m EnvMap,
+        view: View,
+        sampler: Sampler,
+        width: u32,
+    ) -> Option<&'m EnvMap> {
+        if !(self.bilinear_level && sampler == Sampler::Bilinear) || map.crop().is_some() {
+            return None;
+        }
+        let centre = 2.0 * (view.hfov() * 0.5).tan() / width as f64 * map.width() as f64 / TAU;
+        let k = frame_level(centre, map.width(), map.height());
+        (k > 0).then(|| map.level(k).0)
     }
 
     /// Per-frame setup for the geometry set last: builds the table `opts` selects (if
@@ -516,6 +539,14 @@ impl Renderer {
             render_exact(map, view, opts.sampler, frame, opts.threads);
             return Ok((RenderReport::exact(pixels), false));
         }
+        if let Some(level) = self.level_map(map, view, opts.sampler, width) {
+            // Bilinear on the pyramid level matching the screen: a plain bilinear frame
+            // of the level, with tables for its geometry (`set_bilinear_level`).
+            let r = self
+                .level
+                .get_or_insert_with(|| Box::new(Renderer::new(level)));
+            return r.render_fused(Scene::Map(level), view, opts, frame, hook);
+        }
         self.set_geometry(map.width(), map.height(), map.projection());
         if uses_grid(view, opts) {
             return Ok((self.render_grid(map, view, opts, frame), false));
@@ -527,14 +558,7 @@ impl Renderer {
         let w = width as usize;
         let out = frame.pixels_mut();
         let bilinear = opts.sampler != Sampler::Nearest;
-        // Bilinear on the pyramid level only where the view is minified: at the view's
-        // centre 2 map pixels or more per screen pixel (below that the frame would read
-        // level 0 nearly everywhere, at the level sink's cost).
-        let centre_footprint =
-            2.0 * (view.hfov() * 0.5).tan() / width as f64 * map.width() as f64 / TAU;
-        let level_bilinear =
-            opts.sampler == Sampler::Bilinear && self.bilinear_level && centre_footprint >= 2.0;
-        if (opts.sampler == Sampler::Trilinear || level_bilinear) && map.crop().is_none() {
+        if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
             // The pyramid is built here once, before the rows run in parallel.
             let (levels, n) = level_texels(map);
             let levels = &levels[..n];
@@ -548,7 +572,6 @@ impl Renderer {
                     fy: scan.fy,
                     lod: 0,
                     exact: (&fp, y),
-                    whole_levels: level_bilinear,
                     batch: Batch::new(),
                 };
                 s.set_lod(lod_q8(scan.fy[0] as f64));
@@ -579,11 +602,7 @@ impl Renderer {
         ) {
             let (scans, table, setup, row_scale) = k;
             let row = |scratch: &mut Scratch, y: usize, row: &mut [u32]| {
-                let mut s = PixelSink::<BILINEAR, CROP> {
-                    row,
-                    map,
-                    batch: Batch::new(),
-                };
+                let mut s = PixelSink::<BILINEAR, CROP>::new(row, map);
                 render_row(&scans[y], table, setup, row_scale, scratch, &mut s);
                 s.flush();
             };
@@ -731,6 +750,26 @@ fn new_scratch() -> Scratch {
 }
 
 /// The map geometry the renderers use: (width, height, projection) of the full panorama.
+/// The pyramid level a bilinear frame on the level reads for a footprint of `centre`
+/// map pixels per screen pixel at the view's centre, on a `w × h` map
+/// ([`Renderer::set_bilinear_level`]): the nearest level, k = ⌊log2(centre) + ½⌋, or the
+/// deepest level above it whose sides divide the map's exactly (level k of a map with
+/// sides divisible by 2^k is exactly the map at 1/2^k scale; see `map/pyramid.rs`).
+/// Levels end at a side of 2, as the pyramid does.
+pub(crate) fn frame_level(centre: f64, w: u32, h: u32) -> usize {
+    // (NaN too.)
+    if centre.partial_cmp(&std::f64::consts::SQRT_2) != Some(std::cmp::Ordering::Greater) {
+        return 0;
+    }
+    let want = (centre.log2() + 0.5).floor().min(31.0) as u32;
+    (1..=want)
+        .take_while(|&k| {
+            w.is_multiple_of(1 << k) && h.is_multiple_of(1 << k) && (w.min(h) >> k) >= 2
+        })
+        .last()
+        .map_or(0, |k| k as usize)
+}
+
 fn geometry_of(map: &EnvMap) -> (u32, u32, Projection) {
     (map.width(), map.height(), map.projection())
 }
@@ -750,5 +789,44 @@ fn grid_report(stats: GridStats, width: u32, height: u32) -> RenderReport {
         table_bytes: 0,
         max_step: stats.max_cell,
         min_step: stats.min_cell,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::frame_level;
+
+    /// The level of a bilinear frame on the level: the nearest power of two to the
+    /// centre's footprint, among the levels that divide the map's sides.
+    #[test]
+    fn frame_level_is_the_nearest_level_that_divides_the_map() {
+        let (w, h) = (32768, 16384);
+        // 1080p, hfov 90: 2 tan 45° / 1920 · W / 2π map pixels per screen pixel.
+        let centre = |w: u32, hfov: f64| {
+            2.0 * (hfov.to_radians() / 2.0).tan() / 1920.0 * w as f64 / std::f64::consts::TAU
+        };
+        assert_eq!(frame_level(centre(w, 90.0), w, h), 2); // 5.43: the 8192-wide level
+        assert_eq!(frame_level(centre(w, 120.0), w, h), 3); // 9.41: the 4096-wide level
+        assert_eq!(frame_level(centre(16384, 90.0), 16384, 8192), 1); // 2.72
+        assert_eq!(frame_level(centre(8192, 90.0), 8192, 4096), 0); // 1.36: the map
+        assert_eq!(frame_level(centre(8192, 120.0), 8192, 4096), 1); // 2.35
+                                                                     // The boundaries: √2 and 2√2.
+        for (fp, k) in [
+            (0.3, 0),
+            (1.41, 0),
+            (1.42, 1),
+            (2.82, 1),
+            (2.83, 2),
+            (1e9, 13),
+        ] {
+            assert_eq!(frame_level(fp, w, h), k, "footprint {fp}");
+        }
+        assert_eq!(frame_level(f64::NAN, w, h), 0);
+        // Levels that do not divide the map are skipped: 6000x3000 divides down to level
+        // 3 (750x375); 6002x3001 only level 0.
+        assert_eq!(frame_level(40.0, 6000, 3000), 3);
+        assert_eq!(frame_level(40.0, 6002, 3001), 0);
+        // Never below a side of 2.
+        assert_eq!(frame_level(1e6, 64, 32), 4);
     }
 }

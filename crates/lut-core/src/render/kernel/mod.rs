@@ -50,7 +50,9 @@
 //! compiled into one `#[target_feature]` function (each SIMD loop has a single caller, so
 //! it is inlined there; a non-inlined kernel taking its span setup through memory cost a
 //! failed store-to-load forward per span, and made AVX2 nearest slower than scalar).
-//! Single spans are batches of one.
+//! Single spans are batches of one. Nearest spans of up to 8 pixels skip the batch:
+//! the renderer samples them at once with the scalar loop (`nearest_span_direct`),
+//! which costs less than the queueing and the lane setup at that length.
 //!
 //! # Identical bytes
 //! Every SIMD kernel computes exactly what its scalar twin in `scalar.rs` computes: the
@@ -255,6 +257,26 @@ pub(crate) fn sample_span<const BILINEAR: bool>(
     };
     if !done {
         sample_span_slow::<BILINEAR>(map, out, u, v, du, dv);
+    }
+}
+
+/// Nearest samples of one span straight into `out`, with no batch: the renderer's short
+/// nearest spans. At the 8 pixels of a span at hfov 90 the scalar loop costs less than
+/// queueing the span and setting up SIMD lanes for it (docs/performance.md, "Nearest
+/// without the batch"); the bytes are the scalar kernel's, which every SIMD kernel
+/// equals (`tests.rs`). `t` is [`texels`] of `map`, or `None` for
+/// maps whose rows wrap within their own length (per pixel, as [`sample_spans`]).
+#[inline(always)]
+pub(crate) fn nearest_span_direct(
+    map: &EnvMap,
+    t: Option<&Texels>,
+    out: &mut [u32],
+    (u, v): (Fx, Fx),
+    (du, dv): (Fx, Fx),
+) {
+    match t.and_then(|t| Some((t, jobs::prepare::<false>(t, out.len(), (u, v), (du, dv))?))) {
+        Some((t, s)) => scalar::nearest(t, out, s),
+        None => sample_span_slow::<false>(map, out, u, v, du, dv),
     }
 }
 

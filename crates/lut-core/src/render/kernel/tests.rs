@@ -471,6 +471,17 @@ fn names_parse_and_selection() {
         .starts_with(&format!("kernel {}", info.active)));
 }
 
+/// Spans (u, v, du, dv) of a 64×32 map: inside, across the seam, off the edges; the last
+/// one stands still on the last pixel.
+const PER_PIXEL_SPANS: [(f64, f64, f64, f64); 6] = [
+    (3.3, 4.2, 0.7, 0.1),
+    (60.0, 10.0, 0.5, 0.0),
+    (-2.0, 31.5, 0.25, 0.02),
+    (10.0, 0.1, -0.3, -0.01),
+    (0.2, 16.0, 1.9, 0.4),
+    (63.99, 31.99, 0.0, 0.0),
+];
+
 /// The span kernels against the per-pixel samplers, inside the map, across the seam
 /// and off its edges (the slow path), for a wrapping and a clamping projection.
 #[test]
@@ -478,13 +489,7 @@ fn spans_equal_per_pixel_samples() {
     for proj in [Projection::Equirect, Projection::Elliptical] {
         let m = grid_map(64, 32, proj).unwrap();
         let wfx = 64i64 << FX_BITS;
-        for &(u, v, du, dv) in &[
-            (3.3, 4.2, 0.7, 0.1),
-            (60.0, 10.0, 0.5, 0.0),
-            (-2.0, 31.5, 0.25, 0.02),
-            (10.0, 0.1, -0.3, -0.01),
-            (0.2, 16.0, 1.9, 0.4),
-        ] {
+        for &(u, v, du, dv) in &PER_PIXEL_SPANS[..5] {
             let (u, v, du, dv) = (to_fx(u), to_fx(v), to_fx(du), to_fx(dv));
             let mut nb = vec![0u32; 40];
             let mut nn = vec![0u32; 40];
@@ -520,6 +525,42 @@ fn span_equals_per_pixel() {
                     a.abs_diff(b) <= 2,
                     "lod {lod} pixel {i}: {o:06x} vs {want:06x}"
                 );
+            }
+        }
+    }
+}
+
+/// The renderer's short nearest spans, sampled without the batch
+/// (`nearest_span_direct`), equal the per-pixel sampler and the batch path, inside the
+/// map, across the seam, off its edges (the per-pixel fallback) and on maps whose rows
+/// wrap within their length (no texels: per pixel).
+#[test]
+fn direct_nearest_spans_equal_per_pixel_samples() {
+    for proj in [Projection::Equirect, Projection::Elliptical] {
+        let m = grid_map(64, 32, proj).unwrap();
+        let t = (!proj.scaled_rows()).then(|| texels(&m));
+        let wfx = 64i64 << FX_BITS;
+        for &(u, v, du, dv) in &PER_PIXEL_SPANS {
+            let (u, v, du, dv) = (to_fx(u), to_fx(v), to_fx(du), to_fx(dv));
+            for len in [1usize, 2, 7, 8, 9, 40] {
+                let mut direct = vec![0u32; len];
+                let mut batch = vec![0u32; len];
+                nearest_span_direct(&m, t.as_ref(), &mut direct, (u, v), (du, dv));
+                let job = SpanJob {
+                    x: 0,
+                    len: len as u32,
+                    u,
+                    v,
+                    du,
+                    dv,
+                };
+                sample_spans::<false>(&m, &mut batch, &[job]);
+                assert_eq!(direct, batch, "{proj} len {len}");
+                for (i, &d) in direct.iter().enumerate() {
+                    let uu = u + du * i as i64;
+                    let uu = if proj.wraps() { uu.rem_euclid(wfx) } else { uu };
+                    assert_eq!(d, m.nearest(uu, v + dv * i as i64), "{proj} pixel {i}");
+                }
             }
         }
     }
