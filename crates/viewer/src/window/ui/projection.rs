@@ -98,7 +98,7 @@ fn legend(ui: &mut egui::Ui) {
             egui::pos2(b, bar.top() - 2.0),
             egui::pos2(b, bar.bottom() + 2.0),
         ],
-        egui::Stroke::new(2.0, ink),
+        egui::Stroke::new(2.0_f32, ink),
     );
     let font = egui::FontId::proportional(10.0);
     for t in TICKS {
