@@ -16,9 +16,16 @@
 //! pages when the pixels are first written, zeroed once by the kernel. (A 2 MiB-aligned
 //! allocation was tried first: the allocator cannot hand it out zeroed without writing
 //! it, and the extra zeroing pass made loading a 32k map slower.) Elsewhere, below 4 MiB,
-//! when the kernel refuses the advice (no THP, `never` mode) or with
-//! `LUTPANO_HUGE_PAGES=off` (for A/B measurements), it is an ordinary zeroed allocation:
-//! the pixels are the same either way. This module alone may use `unsafe` (allocation,
+//! when the kernel refuses the advice (no THP, `never` mode) or without
+//! `LUTPANO_HUGE_PAGES=on`, it is an ordinary zeroed allocation: the pixels are the same
+//! either way.
+//!
+//! **Off by default.** The idle-machine run of `scripts/perf-report.sh` (1 December 2026,
+//! docs/huge.md) showed no frame gain beyond the run-to-run noise with the advice on,
+//! while loading a 32k map took 4.5 s instead of 1.9 s on this VM (the first huge-page
+//! faults of fresh guest memory are slow); interleaved CPU-time runs on a loaded machine
+//! had shown 6–15 % per frame. Until a physical machine says otherwise, the advice is an
+//! opt-in (`LUTPANO_HUGE_PAGES=on`). This module alone may use `unsafe` (allocation,
 //! `madvise`), each block with its `// SAFETY:`.
 
 #![allow(unsafe_code)]
@@ -30,19 +37,20 @@ use std::sync::OnceLock;
 /// The transparent huge page size (x86-64, and aarch64 with 4 KiB base pages).
 pub const HUGE_PAGE: usize = 2 << 20;
 
-/// Environment variable: `off` (or `0`) turns the huge-page advice off (read once).
+/// Environment variable: `on` (or `1`) turns the huge-page advice on (read once; off by
+/// default, see the module docs).
 pub const HUGE_PAGES_ENV: &str = "LUTPANO_HUGE_PAGES";
 
-/// Whether large buffers ask for huge pages: on Linux unless [`HUGE_PAGES_ENV`] says
-/// `off` / `0` / `no` / `false`.
+/// Whether large buffers ask for huge pages: on Linux when [`HUGE_PAGES_ENV`] says
+/// `on` / `1` / `yes` / `true`.
 pub fn huge_pages_enabled() -> bool {
     static ON: OnceLock<bool> = OnceLock::new();
     *ON.get_or_init(|| {
         cfg!(target_os = "linux")
-            && !std::env::var(HUGE_PAGES_ENV).is_ok_and(|v| {
+            && std::env::var(HUGE_PAGES_ENV).is_ok_and(|v| {
                 matches!(
                     v.trim().to_ascii_lowercase().as_str(),
-                    "off" | "0" | "no" | "false"
+                    "on" | "1" | "yes" | "true"
                 )
             })
     })
