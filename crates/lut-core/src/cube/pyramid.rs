@@ -19,7 +19,7 @@
 //! map's LUT renderer takes one per span).
 
 use super::{face_axes, face_uv, CubeMap, Face};
-use crate::map::pyramid::lod_q8;
+use crate::map::pyramid::{lod_q8, pick_level};
 use crate::map::sample::lerp_px;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -43,17 +43,7 @@ impl CubeMap {
 
     /// Level `k` (0 = this cube), clamped to the last level, and its index.
     pub(crate) fn level(&self, k: usize) -> (&CubeMap, usize) {
-        if k == 0 {
-            return (self, 0);
-        }
-        let levels = self.pyramid();
-        match levels.len() {
-            0 => (self, 0),
-            n => {
-                let k = k.min(n);
-                (&levels[k - 1], k)
-            }
-        }
+        pick_level(self, k, CubeMap::pyramid)
     }
 
     /// Trilinear sample of direction `d` on `face` (the face of `d`) with level of detail

@@ -71,17 +71,8 @@ impl EnvMap {
 
     /// Level `k` of the pyramid (0 = this map); clamped to the last level built.
     pub(crate) fn level(&self, k: usize) -> (&EnvMap, u32) {
-        if k == 0 {
-            return (self, 0);
-        }
-        let levels = self.pyramid();
-        match levels.len() {
-            0 => (self, 0),
-            n => {
-                let k = k.min(n);
-                (&levels[k - 1], k as u32)
-            }
-        }
+        let (level, k) = pick_level(self, k, EnvMap::pyramid);
+        (level, k as u32)
     }
 
     /// Trilinear sample at level-0 position (u, v) (Q.16; u in [0, W) for 360° maps) with
@@ -112,6 +103,27 @@ impl EnvMap {
 }
 
 /// Levels 1.. of `map` (empty for partial maps).
+/// Level `k` of `base`'s pyramid (0 = `base`; `levels` gives levels 1, 2, ..., built on
+/// first use) clamped to the last level, and its index. Shared by maps and cubes; level 0
+/// never builds the pyramid.
+pub(crate) fn pick_level<'a, T>(
+    base: &'a T,
+    k: usize,
+    levels: impl FnOnce(&'a T) -> &'a [T],
+) -> (&'a T, usize) {
+    if k == 0 {
+        return (base, 0);
+    }
+    let levels = levels(base);
+    match levels.len() {
+        0 => (base, 0),
+        n => {
+            let k = k.min(n);
+            (&levels[k - 1], k)
+        }
+    }
+}
+
 fn build_levels(map: &EnvMap) -> Vec<EnvMap> {
     let mut levels: Vec<EnvMap> = Vec::new();
     if map.crop.is_some() {
