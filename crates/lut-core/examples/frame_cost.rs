@@ -21,7 +21,7 @@
 //! a cube's faces in PATH.cubeN, and read them on later runs: much faster under valgrind),
 //! `level` 0|1 (0; 1: bilinear reads the pyramid level matching the footprint,
 //! `Renderer::set_bilinear_level`, as the window does while moving; the pyramid is built
-//! before timing). `LUTPANO_HUGE_PAGES=on` puts the map on huge pages (off by default; A/B runs).
+//! before timing).
 //! `file` PATH: render that panorama instead of the generated map (e.g. `viewer
 //! bench-load`'s cached JPEGs; `map` is then ignored).
 

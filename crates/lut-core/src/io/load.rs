@@ -50,7 +50,6 @@ use crate::geom::projection::Projection;
 use crate::io::exr::Exr;
 use crate::io::jpeg::{check_jpeg_size, Jpeg};
 use crate::map::envmap::{check_map_size, EnvMap};
-use crate::map::pixbuf::PixelBuf;
 use crate::map::tone::{tone_map, Tone};
 use image::{ColorType, DynamicImage, ImageDecoder, Limits};
 use rayon::prelude::*;
@@ -390,7 +389,7 @@ fn decode_jpeg<R: BufRead + Seek>(
     let ct = jpeg.color;
     let mut data = alloc_map(what, w, h)?;
     let n = w as usize * h as usize * usize::from(ct.bytes_per_pixel());
-    jpeg.decode_into(&mut bytemuck::cast_slice_mut(&mut data[..])[..n], what)?;
+    jpeg.decode_into(&mut bytemuck::cast_slice_mut(&mut data)[..n], what)?;
     drop(bytes);
     Ok(finish_8bit(data, ct, w, h, projection, sink))
 }
@@ -457,7 +456,7 @@ fn decode_with_image<R: BufRead + Seek>(
             let mut data = alloc_map(what, w, h)?;
             let n = w as usize * h as usize * usize::from(ct.bytes_per_pixel());
             decoder
-                .read_image(&mut bytemuck::cast_slice_mut(&mut data[..])[..n])
+                .read_image(&mut bytemuck::cast_slice_mut(&mut data)[..n])
                 .map_err(|e| err(e.to_string()))?;
             sink.bytes_phase.set(None);
             Ok(finish_8bit(data, ct, w, h, projection, sink))
@@ -480,7 +479,7 @@ fn decode_with_image<R: BufRead + Seek>(
 /// buffer): expanded in place to padded 0RGB, reporting the end of decoding and the
 /// conversion.
 fn finish_8bit(
-    mut data: PixelBuf,
+    mut data: Vec<u32>,
     ct: ColorType,
     w: u32,
     h: u32,
@@ -490,7 +489,7 @@ fn finish_8bit(
     sink.report(LoadPhase::Decoding, Some(1.0));
     sink.report(LoadPhase::Converting, Some(0.0));
     {
-        let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut data[..]);
+        let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut data);
         let mut rows = |f: f32| sink.report(LoadPhase::Converting, Some(f));
         let wraps = projection.wraps();
         match ct {
@@ -505,18 +504,24 @@ fn finish_8bit(
     EnvMap::from_padded(w, h, projection, data)
 }
 
-/// A zeroed padded map buffer, `(w + 1) × (h + 1)` pixels (on huge pages where the
-/// system has them: `map/pixbuf.rs`), or an error when the memory cannot be had.
-fn alloc_map(what: &str, w: u32, h: u32) -> Result<PixelBuf, MapError> {
+/// A zeroed padded map buffer, `(w + 1) × (h + 1)` pixels, or an error when the memory
+/// cannot be had.
+fn alloc_map(what: &str, w: u32, h: u32) -> Result<Vec<u32>, MapError> {
     let n = (w as usize + 1) * (h as usize + 1);
-    PixelBuf::try_zeroed(n).ok_or_else(|| MapError::Size {
+    // Ask first, so a refusal is an error rather than an abort; then take zeroed memory
+    // from the system (calloc: pages are zeroed lazily as the decoder writes them,
+    // rather than cleared up front).
+    let mut probe: Vec<u32> = Vec::new();
+    probe.try_reserve_exact(n).map_err(|_| MapError::Size {
         what: what.into(),
         width: w,
         height: h,
         problem: SizeProblem::OutOfMemory {
             bytes: n as u64 * 4,
         },
-    })
+    })?;
+    drop(probe);
+    Ok(vec![0u32; n])
 }
 
 /// Row `h` repeats row `h − 1` (vertical clamp for the bilinear sampler).
@@ -612,7 +617,7 @@ fn fill_rows(
     wraps: bool,
     rows_done: &mut dyn FnMut(f32),
     row: impl Fn(usize, &mut [u32]) + Sync,
-) -> Result<PixelBuf, MapError> {
+) -> Result<Vec<u32>, MapError> {
     let mut data = alloc_map(what, w, h)?;
     let (wu, hu) = (w as usize, h as usize);
     let s = wu + 1;

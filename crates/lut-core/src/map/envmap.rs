@@ -12,7 +12,6 @@ use crate::geom::coverage::Crop;
 use crate::geom::fixed::{Fx, FX_BITS};
 use crate::geom::limits::{MAX_MAP_HEIGHT, MAX_MAP_PIXELS, MAX_MAP_WIDTH};
 use crate::geom::projection::Projection;
-use crate::map::pixbuf::PixelBuf;
 
 /// An environment map: pixels plus the projection that tells how to read them.
 #[derive(Clone)]
@@ -22,9 +21,8 @@ pub struct EnvMap {
     /// Stored height.
     pub(crate) height: u32,
     pub(crate) projection: Projection,
-    /// (width + 1) × (height + 1) pixels, row-major, padded as described in the module
-    /// docs; on huge pages where the system has them (`map/pixbuf.rs`).
-    data: PixelBuf,
+    /// (width + 1) × (height + 1) pixels, row-major, padded as described in the module docs.
+    data: Vec<u32>,
     pub(crate) background: u32,
     /// For a partial panorama: where the stored pixels sit in the full one (see
     /// `map/crop.rs`).
@@ -105,7 +103,7 @@ impl EnvMap {
         }
         let (w, h) = (width as usize, height as usize);
         let stride = w + 1;
-        let mut data = PixelBuf::zeroed(stride * (h + 1));
+        let mut data = vec![0u32; stride * (h + 1)];
         for y in 0..h {
             let src = &pixels[y * w..(y + 1) * w];
             let dst = &mut data[y * stride..(y + 1) * stride];
@@ -126,7 +124,7 @@ impl EnvMap {
         width: u32,
         height: u32,
         projection: Projection,
-        data: PixelBuf,
+        data: Vec<u32>,
     ) -> EnvMap {
         debug_assert_eq!(data.len(), (width as usize + 1) * (height as usize + 1));
         EnvMap {

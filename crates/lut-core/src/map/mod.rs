@@ -4,7 +4,6 @@
 
 pub(crate) mod crop;
 pub(crate) mod envmap;
-pub(crate) mod pixbuf;
 pub(crate) mod pyramid;
 pub(crate) mod sample;
 pub(crate) mod synth;
