@@ -196,16 +196,11 @@ pub fn pick_light(
 ) -> Option<usize> {
     let room = st.room_box().ok()?;
     let cam = Camera::new(view, w, h);
-    st.lights
-        .iter()
-        .enumerate()
-        .filter_map(|(i, l)| {
-            let (x, y) = project_point(&room, &cam, DVec3::from(l.position))?;
-            let d = ((x - px).powi(2) + (y - py).powi(2)).sqrt();
-            (d <= radius).then_some((i, d))
-        })
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(i, _)| i)
+    let lights = st.lights.iter().enumerate().filter_map(|(i, l)| {
+        let (x, y) = project_point(&room, &cam, DVec3::from(l.position))?;
+        Some((i, (x - px).hypot(y - py)))
+    });
+    nearest_within(lights, radius)
 }
 
 /// Where a luminaire at `position` moves when dragged to (px, py) of a `cam` frame: along
