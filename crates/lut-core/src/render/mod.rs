@@ -28,6 +28,7 @@ pub(crate) mod grid;
 pub(crate) mod heat;
 pub(crate) mod kernel;
 pub(crate) mod projected;
+pub(crate) mod rowpass;
 pub(crate) mod rows;
 pub(crate) mod scanline;
 pub(crate) mod setup;
@@ -48,9 +49,10 @@ use cube::{render_cube, CubeRenderer};
 use exact::{render_exact, ExactFootprint};
 use frame::Frame;
 use grid::{Grid, GridStats};
-use kernel::level_texels;
+use kernel::{level_texels, sample_q8, texels};
+use rowpass::{row_pass, HalfRun};
 use rows::{for_each_band_init, for_each_row, for_each_row_init, post_bands};
-use scanline::{render_row, Scratch, BLEND_NODES, ROW_SCALE_ONE};
+use scanline::{render_row, RowScratch, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
 use sink::{Batch, PixelRows, PixelSink, PosRows, PosSink, RowSinks, Sink, TriRows, TriSink};
 use std::f64::consts::TAU;
@@ -563,7 +565,7 @@ impl Renderer {
             let (levels, n) = level_texels(map);
             let levels = &levels[..n];
             let fp = ExactFootprint::new(view, width, height, geometry_of(map));
-            let row = |scratch: &mut Scratch, y: usize, row: &mut [u32]| {
+            let row = |scratch: &mut RowScratch, y: usize, row: &mut [u32]| {
                 let scan = &scans[y];
                 let mut s = TriSink {
                     row,
@@ -575,7 +577,7 @@ impl Renderer {
                     batch: Batch::new(),
                 };
                 s.set_lod(lod_q8(scan.fy[0] as f64));
-                render_row(scan, table, &setup, row_scale, scratch, &mut s);
+                render_row(scan, table, &setup, row_scale, &mut scratch.nodes, &mut s);
                 s.flush();
             };
             return Ok(match hook {
@@ -601,10 +603,42 @@ impl Renderer {
             hook: Option<BandHook<'_>>,
         ) {
             let (scans, table, setup, row_scale) = k;
-            let row = |scratch: &mut Scratch, y: usize, row: &mut [u32]| {
+            let t = texels(map);
+            let pass = rowpass::applies(setup);
+            let wq = (map.width() as i32) << 8;
+            let row = |scratch: &mut RowScratch, y: usize, row: &mut [u32]| {
                 let mut s = PixelSink::<BILINEAR, CROP>::new(row, map);
-                render_row(&scans[y], table, setup, row_scale, scratch, &mut s);
-                s.flush();
+                if pass {
+                    // The row pass: positions, then the row kernels (left half, right half).
+                    let RowScratch { nodes, row: buf } = scratch;
+                    row_pass(&scans[y], table, setup, (nodes, buf), &mut s, |s, r| {
+                        let n = r.u.len();
+                        if CROP {
+                            // Partial maps: per pixel, at the same positions.
+                            let q = |u: i32| (u.rem_euclid(wq) as i64) << 8;
+                            for (j, (&u, &v)) in r.u.iter().zip(r.v).enumerate() {
+                                let v = (v as i64) << 8;
+                                s.put(r.left_end - 1 - j, q(r.mirror - u), v);
+                                s.put(r.right + j, q(u), v);
+                            }
+                            return;
+                        }
+                        let left = &mut s.row[r.left_end - n..r.left_end];
+                        sample_q8::<BILINEAR, true>(&t, r.u, r.v, r.mirror, left);
+                        let right = &mut s.row[r.right..r.right + n];
+                        sample_q8::<BILINEAR, false>(&t, r.u, r.v, r.mirror, right);
+                    });
+                } else {
+                    render_row(
+                        &scans[y],
+                        table,
+                        setup,
+                        row_scale,
+                        &mut scratch.nodes,
+                        &mut s,
+                    );
+                    s.flush();
+                }
             };
             match hook {
                 Some(post) => {
@@ -730,6 +764,9 @@ impl Renderer {
         let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
+        // The pixels' path: the row pass for nearest and bilinear on full maps.
+        let pass = rowpass::applies(&setup) && opts.sampler != Sampler::Trilinear;
+        let wq = (map_w as i32) << 8;
         for_each_row_init(
             &mut out,
             width as usize,
@@ -737,16 +774,43 @@ impl Renderer {
             new_scratch,
             |scratch, y, row| {
                 let mut s = PosSink { row };
-                render_row(&scans[y], table, &setup, row_scale, scratch, &mut s);
+                if pass {
+                    let RowScratch { nodes, row: buf } = scratch;
+                    let run = |s: &mut PosSink<'_>, r: HalfRun<'_>| pass_positions(s, r, wq);
+                    row_pass(&scans[y], table, &setup, (nodes, buf), &mut s, run);
+                    return;
+                }
+                render_row(
+                    &scans[y],
+                    table,
+                    &setup,
+                    row_scale,
+                    &mut scratch.nodes,
+                    &mut s,
+                );
             },
         );
         Ok((out, report))
     }
 }
 
-/// A row task's room for blended table nodes (on the stack: no allocation per frame).
-fn new_scratch() -> Scratch {
-    [[0; 2]; BLEND_NODES]
+/// The positions of a run of the row pass as its kernels sample them (Q.8, u wrapped into
+/// the map, `wq` = 256·W): the left half's pixels, then the right half's (the centre
+/// pixel of an odd width is the right half's).
+fn pass_positions(s: &mut PosSink<'_>, r: HalfRun<'_>, wq: i32) {
+    let px = |u: i32, v: i32| Some((u.rem_euclid(wq) as f64 / 256.0, v as f64 / 256.0));
+    for (j, (&u, &v)) in r.u.iter().zip(r.v).enumerate() {
+        s.row[r.left_end - 1 - j] = px(r.mirror - u, v);
+    }
+    for (j, (&u, &v)) in r.u.iter().zip(r.v).enumerate() {
+        s.row[r.right + j] = px(u, v);
+    }
+}
+
+/// A row task's room for blended table nodes and a row's positions (on the stack: no
+/// allocation per frame).
+fn new_scratch() -> RowScratch {
+    RowScratch::new()
 }
 
 /// The map geometry the renderers use: (width, height, projection) of the full panorama.

@@ -1,8 +1,11 @@
-//! The scanline walk: per output row, the pixels the table covers are stepped span by
-//! span (a table read every 2^shift pixels, Q.16 steps between, longitude unwrapped across
-//! each span so a span over the ±180° seam steps continuously), and the rest (pole zones,
-//! beyond the table) are evaluated exactly. Spans go to a [`Sink`].
+//! The scanline walk: per output row, the pixels the table covers are read every 2^shift
+//! pixels outward from the screen's centre column in both halves (the same reads for both:
+//! the one-eighth symmetry), the column coordinate stepped in whole numbers; Q.16 steps
+//! between reads, longitude unwrapped across each span so a span over the ±180° seam
+//! steps continuously. The rest (pole zones, beyond the table) is evaluated exactly.
+//! Spans go to a [`Sink`].
 
+use super::rowpass::HalfBuf;
 use super::setup::{Scan, Setup};
 use super::sink::Sink;
 use super::steps::STEP_REGIONS;
@@ -15,7 +18,31 @@ pub(crate) const BLEND_NODES: usize = 512;
 /// Room for a scanline's blended table nodes, kept from row to row (no allocation).
 pub(crate) type Scratch = [[i32; 2]; BLEND_NODES];
 
+/// What a row task keeps from row to row (made once per task: no allocation per frame):
+/// room for the blended table nodes and for a run of a row's positions (the row pass).
+pub(crate) struct RowScratch {
+    pub(crate) nodes: Scratch,
+    pub(crate) row: HalfBuf,
+}
+
+impl RowScratch {
+    pub(crate) fn new() -> RowScratch {
+        RowScratch {
+            nodes: [[0; 2]; BLEND_NODES],
+            row: HalfBuf::new(),
+        }
+    }
+}
+
 /// Render one scanline into `sink` (`scratch`: room for its blended table nodes).
+///
+/// The table covers a run of pixels symmetric about the screen's centre column (X = 0),
+/// less the exact zone around it near a pole: the *right half* from `xa` to `xe` and its
+/// mirror image, the *left half*. Both halves read the table at the same |X| (the
+/// one-eighth symmetry: X → −X negates Λ), every 2^shift pixels outward from the centre
+/// (the shift of the region the span starts in, [`Half`]); the column coordinate is a
+/// whole-number step per pixel (`Scan::node_per_2x`), no floating point per read. The
+/// pixels are emitted left to right: exact, left half, exact zone, right half, exact.
 #[inline]
 pub(crate) fn render_row<S: Sink>(
     scan: &Scan,
@@ -26,50 +53,108 @@ pub(crate) fn render_row<S: Sink>(
     sink: &mut S,
 ) {
     let w = fr.w_out as i64;
-    if !scan.lut || scan.lut_lo > scan.lut_hi {
+    let Some(h) = Half::of(scan, fr) else {
         exact_run(scan, fr, 0, w - 1, sink);
         return;
-    }
-    exact_run(scan, fr, 0, scan.lut_lo - 1, sink);
-    let zl = scan.zone_lo.max(scan.lut_lo);
-    let zh = scan.zone_hi.min(scan.lut_hi);
-    if zl <= zh {
-        lut_run(
-            scan,
-            table,
-            fr,
-            row_scale,
-            (scan.lut_lo, zl - 1),
-            scratch,
-            sink,
-        );
-        exact_run(scan, fr, zl, zh, sink);
-        lut_run(
-            scan,
-            table,
-            fr,
-            row_scale,
-            (zh + 1, scan.lut_hi),
-            scratch,
-            sink,
-        );
+    };
+    let band = table.band(scan.band, scan.wa);
+    // The nodes the row reads: from the smallest |X| to the largest, and the next node.
+    let k0 = band.node_q(h.a0 * scan.node_per_2x).0;
+    let k1 = band.node_q((h.a0 + 2 * h.dn) * scan.node_per_2x).0 + 1;
+    let count = k1 + 1 - k0;
+    let pixels = 2 * (h.dn + 1) as usize;
+    if count <= BLEND_NODES && blend_pays(scan, count, pixels) {
+        let nodes = &mut scratch[..count];
+        band.blend_nodes(k0, nodes);
+        let blended = Blended { band, k0, nodes };
+        halves(scan, &blended, fr, row_scale, &h, sink);
     } else {
-        lut_run(
-            scan,
-            table,
-            fr,
-            row_scale,
-            (scan.lut_lo, scan.lut_hi),
-            scratch,
-            sink,
-        );
+        halves(scan, &band, fr, row_scale, &h, sink);
     }
-    exact_run(scan, fr, scan.lut_hi + 1, w - 1, sink);
+}
+
+/// The pixels of a scanline in order, its table covered part read through `nodes`.
+#[inline(always)]
+fn halves<S: Sink, N: Nodes>(
+    scan: &Scan,
+    nodes: &N,
+    fr: &Setup,
+    row_scale: &[i64],
+    h: &Half,
+    sink: &mut S,
+) {
+    let w = fr.w_out as i64;
+    exact_run(scan, fr, 0, w - 2 - h.xe, sink);
+    left_half(scan, nodes, fr, row_scale, h, sink);
+    exact_run(scan, fr, w - h.xa, h.xa - 1, sink);
+    right_half(scan, nodes, fr, row_scale, h, sink);
+    exact_run(scan, fr, h.xe + 1, w - 1, sink);
+}
+
+/// The right half of a scanline's table-covered pixels, `xa..=xe` (`xa` the first pixel
+/// right of the centre or of the exact zone), and where its table reads fall: at pixel
+/// offsets d from `xa`, from 0 on by the step of the region d lies in, and at `dn`.
+/// The reads of region r are `e[r] + k·2^shift[r]` below `e[r + 1]`, so both halves can
+/// walk them in either direction.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Half {
+    pub(super) xa: i64,
+    pub(super) xe: i64,
+    /// 2X at `xa` (≥ 0).
+    pub(super) a0: i64,
+    /// `xe − xa`.
+    pub(super) dn: i64,
+    /// The first read in each region (regions before `xa`'s: 0).
+    pub(super) e: [i64; STEP_REGIONS],
+    /// The region of `xa`.
+    pub(super) r0: usize,
+}
+
+impl Half {
+    /// The right half of `scan` (`None`: the table covers none of it).
+    #[inline]
+    pub(super) fn of(scan: &Scan, fr: &Setup) -> Option<Half> {
+        if !scan.lut || scan.lut_lo > scan.lut_hi {
+            return None;
+        }
+        let w = fr.w_out as i64;
+        let mut xa = w / 2;
+        let (zl, zh) = (scan.zone_lo.max(scan.lut_lo), scan.zone_hi.min(scan.lut_hi));
+        if zl <= zh {
+            xa = xa.max(zh + 1);
+        }
+        let xe = scan.lut_hi.min(w - 1);
+        if xe < xa {
+            return None;
+        }
+        let a0 = 2 * xa + 1 - w;
+        let thr = &fr.region_2x;
+        let mut r0 = 0;
+        while r0 + 1 < STEP_REGIONS && a0 >= thr[r0 + 1] {
+            r0 += 1;
+        }
+        let mut e = [0i64; STEP_REGIONS];
+        for r in r0..STEP_REGIONS - 1 {
+            let n = 1i64 << scan.shifts[r];
+            // The first offset in region r + 1, then the first read there.
+            let t = (thr[r + 1] - a0 + 1).div_euclid(2);
+            let gap = (t - e[r]).max(0);
+            e[r + 1] = e[r] + (gap + n - 1) / n * n;
+        }
+        Some(Half {
+            xa,
+            xe,
+            a0,
+            dn: xe - xa,
+            e,
+            r0,
+        })
+    }
 }
 
 /// Exact evaluation of pixels x0..=x1 of a scanline (pole zones, beyond the table).
 #[inline(never)]
-fn exact_run<S: Sink>(scan: &Scan, fr: &Setup, x0: i64, x1: i64, sink: &mut S) {
+pub(super) fn exact_run<S: Sink>(scan: &Scan, fr: &Setup, x0: i64, x1: i64, sink: &mut S) {
     let half_w = fr.w_out as f64 * 0.5;
     let c2 = scan.ca * scan.ca;
     for x in x0.max(0)..=x1 {
@@ -81,28 +166,30 @@ fn exact_run<S: Sink>(scan: &Scan, fr: &Setup, x0: i64, x1: i64, sink: &mut S) {
 }
 
 /// Unfolded table read at pixel x: (Λ, V) in Q.16 for the yaw-0 frame.
-#[inline(always)]
+#[inline]
 pub(crate) fn read(scan: &Scan, table: &LutTable, fr: &Setup, x: i64) -> (Fx, Fx) {
-    let big_x = x as f64 + 0.5 - fr.w_out as f64 * 0.5;
-    read_band(scan, &table.band(scan.band, scan.wa), fr, big_x)
+    let a = 2 * x + 1 - fr.w_out as i64;
+    let band = table.band(scan.band, scan.wa);
+    let u = Unfold::new(scan, fr, a < 0);
+    u.apply(band.lookup_q(a.abs() * scan.node_per_2x))
 }
 
 /// The table reads of a scanline: straight from its band, or from its nodes blended once.
-trait Nodes {
-    fn lookup(&self, col: f64) -> (Fx, Fx);
+pub(super) trait Nodes {
+    fn lookup_q(&self, c: i64) -> (Fx, Fx);
 }
 
 impl Nodes for Band<'_> {
     #[inline(always)]
-    fn lookup(&self, col: f64) -> (Fx, Fx) {
-        Band::lookup(self, col)
+    fn lookup_q(&self, c: i64) -> (Fx, Fx) {
+        Band::lookup_q(self, c)
     }
 }
 
 impl Nodes for Blended<'_> {
     #[inline(always)]
-    fn lookup(&self, col: f64) -> (Fx, Fx) {
-        Blended::lookup(self, col)
+    fn lookup_q(&self, c: i64) -> (Fx, Fx) {
+        Blended::lookup_q(self, c)
     }
 }
 
@@ -113,120 +200,140 @@ impl Nodes for Blended<'_> {
 /// the benchmark views, docs/performance.md.) Only the cost depends on it, not the
 /// output.
 #[inline(never)]
-fn blend_pays(scan: &Scan, nodes: usize, pixels: usize) -> bool {
+pub(super) fn blend_pays(scan: &Scan, nodes: usize, pixels: usize) -> bool {
     // Reads per 256 pixels, summed over the regions.
     let per_256: usize = scan.shifts.iter().map(|&s| 256 >> s).sum();
     nodes * 256 * STEP_REGIONS <= 2 * pixels * per_256
 }
 
-/// [`read`] in the scanline's band, at X = x + ½ − W/2.
-#[inline(always)]
-fn read_band<N: Nodes>(scan: &Scan, band: &N, fr: &Setup, big_x: f64) -> (Fx, Fx) {
-    let (mut l, mut v) = band.lookup(big_x.abs() * scan.col_per_x);
-    if scan.back {
-        l = fr.half_map_w_fx - l;
-    }
-    if big_x < 0.0 {
-        l = -l;
-    }
-    if scan.neg_v {
-        v = -v;
-    }
-    (l, v)
+/// The one-eighth unfolding of one half of a scanline, hoisted out of its reads: Λ =
+/// ±Λ₈ + offset (behind the viewer W/2 − Λ₈, negated left of the centre), V = ±V₈ (negated
+/// below the horizon), as sign masks.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Unfold {
+    neg_l: i64,
+    off_l: i64,
+    neg_v: i64,
 }
 
-/// LUT evaluation of pixels x0..=x1: table reads every 2^shift pixels (the shift of the
-/// region the span starts in), fixed-point steps between.
-#[inline(always)]
-fn lut_run<S: Sink>(
-    scan: &Scan,
-    table: &LutTable,
-    fr: &Setup,
-    row_scale: &[i64],
-    (x0, x1): (i64, i64),
-    scratch: &mut Scratch,
-    sink: &mut S,
-) {
-    if x0 > x1 {
-        return;
+impl Unfold {
+    #[inline(always)]
+    pub(super) fn new(scan: &Scan, fr: &Setup, left: bool) -> Unfold {
+        let mask = |b: bool| -(b as i64);
+        let off = if scan.back { fr.half_map_w_fx } else { 0 };
+        Unfold {
+            neg_l: mask(scan.back != left),
+            off_l: if left { -off } else { off },
+            neg_v: mask(scan.neg_v),
+        }
     }
-    let band = table.band(scan.band, scan.wa);
-    // The nodes the run reads: from the smallest |X| to the largest (the column and its
-    // node are monotonic in |X|), and the next node.
-    let half_w = fr.w_out as f64 * 0.5;
-    let (xa, xb) = (x0 as f64 + 0.5 - half_w, x1 as f64 + 0.5 - half_w);
-    let x_min = if xa < 0.0 && xb > 0.0 {
-        0.0
+
+    #[inline(always)]
+    fn apply(&self, (l, v): (Fx, Fx)) -> (Fx, Fx) {
+        (
+            ((l ^ self.neg_l) - self.neg_l) + self.off_l,
+            (v ^ self.neg_v) - self.neg_v,
+        )
+    }
+}
+
+/// The unfolded read at offset d of the half `h`.
+#[inline(always)]
+pub(super) fn read_at<N: Nodes>(scan: &Scan, nodes: &N, h: &Half, u: &Unfold, d: i64) -> (Fx, Fx) {
+    u.apply(nodes.lookup_q((h.a0 + 2 * d) * scan.node_per_2x))
+}
+
+/// The span from (l0, v0) to the next read (l1, v1) over `m` pixels (`shift`: log2 of
+/// the region's step, used when m is the whole step): Λ unwrapped across the ±180° seam
+/// (a jump of one map width), and the per-pixel steps.
+#[inline(always)]
+pub(super) fn span_step(
+    fr: &Setup,
+    (l0, v0): (Fx, Fx),
+    (l1, v1): (Fx, Fx),
+    m: i64,
+    shift: u32,
+) -> (Fx, (Fx, Fx)) {
+    let d = l1 - l0;
+    let mut l1 = l1;
+    if d > fr.half_map_w_fx {
+        l1 -= fr.map_w_fx;
+    } else if d < -fr.half_map_w_fx {
+        l1 += fr.map_w_fx;
+    }
+    let step = if m == 1i64 << shift {
+        ((l1 - l0) >> shift, (v1 - v0) >> shift)
     } else {
-        xa.abs().min(xb.abs())
+        ((l1 - l0) / m, (v1 - v0) / m)
     };
-    let k0 = band.node(x_min * scan.col_per_x).0;
-    let k1 = band.node(xa.abs().max(xb.abs()) * scan.col_per_x).0 + 1;
-    let count = k1 + 1 - k0;
-    if count <= BLEND_NODES && blend_pays(scan, count, (x1 - x0 + 1) as usize) {
-        let nodes = &mut scratch[..count];
-        band.blend_nodes(k0, nodes);
-        let blended = Blended { band, k0, nodes };
-        lut_run_in(scan, &blended, fr, row_scale, x0, x1, sink);
-        return;
-    }
-    lut_run_in(scan, &band, fr, row_scale, x0, x1, sink);
+    (l1, step)
 }
 
-/// [`lut_run`] with the scanline's nodes read through `band`.
+/// The right half, left to right (outward): a read at d, spans to the next read.
 #[inline(always)]
-fn lut_run_in<S: Sink, N: Nodes>(
+fn right_half<S: Sink, N: Nodes>(
     scan: &Scan,
-    band: &N,
+    nodes: &N,
     fr: &Setup,
     row_scale: &[i64],
-    x0: i64,
-    x1: i64,
+    h: &Half,
     sink: &mut S,
 ) {
-    let half_w = fr.w_out as f64 * 0.5;
-    let last_region = STEP_REGIONS as i64 - 1;
-    let mut xs = x0;
-    // X of xs, carried from span to span (whole numbers plus ½: exact in f64).
-    let mut big_x = xs as f64 + 0.5 - half_w;
-    let (mut l0, mut v0) = read_band(scan, band, fr, big_x);
-    loop {
-        // Through i64 (as usize: the same value, as |X| ≥ 0, but a longer conversion).
-        let region = ((big_x.abs() * scan.region_per_x) as i64).min(last_region) as usize;
-        let shift = scan.shifts[region] as u32;
-        let n = 1i64 << shift;
-        let xe = (xs + n).min(x1);
-        if xe == xs {
-            emit(fr, row_scale, xs, 1, (l0, v0), (0, 0), sink);
-            return;
+    let u = Unfold::new(scan, fr, false);
+    let mut d = 0;
+    let mut r = h.r0;
+    let mut p0 = read_at(scan, nodes, h, &u, 0);
+    while d < h.dn {
+        while r + 1 < STEP_REGIONS && d >= h.e[r + 1] {
+            r += 1;
         }
-        let big_xe = xe as f64 + 0.5 - half_w;
-        let (mut l1, v1) = read_band(scan, band, fr, big_xe);
-        // Unwrap longitude across the span: a ±180° seam is a jump of one map width.
-        let d = l1 - l0;
-        if d > fr.half_map_w_fx {
-            l1 -= fr.map_w_fx;
-        } else if d < -fr.half_map_w_fx {
-            l1 += fr.map_w_fx;
+        let shift = scan.shifts[r] as u32;
+        let d1 = (d + (1 << shift)).min(h.dn);
+        let p1 = read_at(scan, nodes, h, &u, d1);
+        let m = d1 - d;
+        let (l1, step) = span_step(fr, p0, p1, m, shift);
+        sink.footprint(step.0, step.1, r);
+        emit(fr, row_scale, h.xa + d, m, p0, step, sink);
+        d = d1;
+        // Λ carried unwrapped from span to span.
+        p0 = (l1, p1.1);
+    }
+    emit(fr, row_scale, h.xa + h.dn, 1, p0, (0, 0), sink);
+}
+
+/// The left half, left to right (inward): the right half's reads mirrored, walked from
+/// the last one back (the centre pixel of an odd width belongs to the right half).
+#[inline(always)]
+fn left_half<S: Sink, N: Nodes>(
+    scan: &Scan,
+    nodes: &N,
+    fr: &Setup,
+    row_scale: &[i64],
+    h: &Half,
+    sink: &mut S,
+) {
+    let u = Unfold::new(scan, fr, true);
+    let x_of = |d: i64| fr.w_out as i64 - 1 - (h.xa + d);
+    let mut d = h.dn;
+    let mut r = STEP_REGIONS - 1;
+    let mut p0 = read_at(scan, nodes, h, &u, d);
+    while d > 0 {
+        // The region of d − 1 (e[r0] = 0 ≤ d − 1 ends the search).
+        while h.e[r] > d - 1 {
+            r -= 1;
         }
-        let m = xe - xs;
-        let (dl, dv) = if m == n {
-            ((l1 - l0) >> shift, (v1 - v0) >> shift)
-        } else {
-            ((l1 - l0) / m, (v1 - v0) / m)
-        };
-        sink.footprint(dl, dv, region);
-        if xe == x1 {
-            // Last span: emit through x1 inclusive, ending exactly on the read value.
-            emit(fr, row_scale, xs, m, (l0, v0), (dl, dv), sink);
-            emit(fr, row_scale, x1, 1, (l1, v1), (0, 0), sink);
-            return;
-        }
-        emit(fr, row_scale, xs, m, (l0, v0), (dl, dv), sink);
-        xs = xe;
-        big_x = big_xe;
-        l0 = l1;
-        v0 = v1;
+        let shift = scan.shifts[r] as u32;
+        let d1 = h.e[r] + ((d - 1 - h.e[r]) & !((1i64 << shift) - 1));
+        let p1 = read_at(scan, nodes, h, &u, d1);
+        let m = d - d1;
+        let (l1, step) = span_step(fr, p0, p1, m, shift);
+        sink.footprint(step.0, step.1, r);
+        emit(fr, row_scale, x_of(d), m, p0, step, sink);
+        d = d1;
+        p0 = (l1, p1.1);
+    }
+    if h.a0 > 0 {
+        emit(fr, row_scale, x_of(0), 1, p0, (0, 0), sink);
     }
 }
 

@@ -109,6 +109,7 @@
 
 mod face;
 mod jobs;
+mod row;
 mod scalar;
 mod select;
 #[cfg(test)]
@@ -122,6 +123,7 @@ pub use select::{
 };
 
 pub(crate) use face::{face_blend, face_span, FaceRun};
+pub(crate) use row::{expand, sample_q8, SpanQ8};
 
 use crate::geom::fixed::{Fx, FX_BITS};
 use crate::map::envmap::EnvMap;

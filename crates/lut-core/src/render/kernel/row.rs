@@ -1,0 +1,173 @@
+//! Row kernels: the gather (nearest) or gather-and-blend (bilinear) pass over a run of a
+//! scanline's positions, for full 360° maps (the LUT renderer's rows, `render/scanline.rs`
+//! "The row pass").
+//!
+//! The positions come as `i32` Q.8 map coordinates (the 8 fraction bits are all the
+//! bilinear weights use), one per pixel, in the order of the right half of the scanline;
+//! the same positions serve the left half mirrored (Λ negated: u = `mirror` − u, the
+//! pixels in reverse order). Per pixel the kernel wraps x by one map width (two for the
+//! mirror) in lanes, clamps y at the poles (dropping the weight there as the per-pixel
+//! sampler does), and gathers: no span checks, no refusals, no per-span setup.
+//!
+//! [`sample_q8_scalar`] is the reference: every SIMD kernel (`x86/row.rs`) writes the
+//! same pixels (`tests.rs`), and they equal the per-pixel samplers' (`EnvMap::nearest` /
+//! `EnvMap::bilinear` at the wrapped position u/256, v/256).
+
+use super::select::{active, Selected};
+use super::Texels;
+use crate::map::sample::lerp_px;
+
+#[cfg(target_arch = "x86_64")]
+use super::x86;
+
+/// The sample of `t` at the Q.8 position (u, v): x wrapped into the map (u within two map
+/// widths of it), y clamped; bilinear reads the 2×2 block around (u − ½, v − ½).
+#[inline(always)]
+pub(super) fn sample_at<const BILINEAR: bool>(t: &Texels, u: i32, v: i32) -> u32 {
+    let (w, h1, stride) = (t.width as i32, t.height as i32 - 1, t.stride());
+    let (u, v) = if BILINEAR { (u - 128, v - 128) } else { (u, v) };
+    let mut x = u >> 8;
+    if x < 0 {
+        x += w;
+    }
+    if x < 0 {
+        x += w;
+    }
+    if x >= w {
+        x -= w;
+    }
+    let x = x.clamp(0, w - 1) as usize;
+    let y = v >> 8;
+    if BILINEAR {
+        let fx = (u & 0xFF) as u32;
+        let (y, fy) = if y < 0 {
+            (0, 0)
+        } else if y >= h1 {
+            (h1, 0)
+        } else {
+            (y, (v & 0xFF) as u32)
+        };
+        let i = y as usize * stride + x;
+        let q = &t.px[i..i + stride + 2];
+        lerp_px(
+            lerp_px(q[0], q[1], fx),
+            lerp_px(q[stride], q[stride + 1], fx),
+            fy,
+        )
+    } else {
+        t.px[y.clamp(0, h1) as usize * stride + x]
+    }
+}
+
+/// The scalar kernel: `out[j]` = the sample at (`u[j]`, `v[j]`), or with `MIRROR`
+/// `out[n − 1 − j]` = the sample at (`mirror` − `u[j]`, `v[j]`) (n = `out.len()` ≤ the
+/// positions).
+#[inline(always)]
+pub(super) fn sample_q8_scalar<const BILINEAR: bool, const MIRROR: bool>(
+    t: &Texels,
+    u: &[i32],
+    v: &[i32],
+    mirror: i32,
+    out: &mut [u32],
+) {
+    let n = out.len();
+    for (j, (&uu, &vv)) in u[..n].iter().zip(&v[..n]).enumerate() {
+        if MIRROR {
+            out[n - 1 - j] = sample_at::<BILINEAR>(t, mirror - uu, vv);
+        } else {
+            out[j] = sample_at::<BILINEAR>(t, uu, vv);
+        }
+    }
+}
+
+/// [`sample_q8_scalar`] with kernel `k`.
+#[inline]
+pub(super) fn sample_q8_with<const BILINEAR: bool, const MIRROR: bool>(
+    k: Selected,
+    t: &Texels,
+    u: &[i32],
+    v: &[i32],
+    mirror: i32,
+    out: &mut [u32],
+) {
+    assert!(
+        u.len() >= out.len() && v.len() >= out.len(),
+        "a position per pixel"
+    );
+    #[cfg(target_arch = "x86_64")]
+    if x86::row::sample_q8::<BILINEAR, MIRROR>(k, t, u, v, mirror, out) {
+        return;
+    }
+    let _ = k;
+    sample_q8_scalar::<BILINEAR, MIRROR>(t, u, v, mirror, out);
+}
+
+/// [`sample_q8_scalar`] with the [`active_kernel`](super::active_kernel): the row pass's
+/// pixels. Positions must lie within one map width of the map in u (two for the mirror,
+/// whose `mirror` is in `[0, 256·W)`); y is clamped.
+///
+/// # Panics
+/// When there are fewer positions than pixels.
+#[inline]
+pub(crate) fn sample_q8<const BILINEAR: bool, const MIRROR: bool>(
+    t: &Texels,
+    u: &[i32],
+    v: &[i32],
+    mirror: i32,
+    out: &mut [u32],
+) {
+    sample_q8_with::<BILINEAR, MIRROR>(active(), t, u, v, mirror, out);
+}
+
+/// A span of a row's positions (see [`expand`]): pixels `k..k + m` of the buffers get
+/// `hu + ((lu + j·du) >> 8)` and `hv + ((lv + j·dv) >> 8)` (j = 0..m): Q.8 positions
+/// of a Q.16 start `256·hu + lu` (0 ≤ lu < 256) stepping by du.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct SpanQ8 {
+    pub(crate) k: u32,
+    pub(crate) m: u32,
+    pub(crate) hu: i32,
+    pub(crate) lu: i32,
+    pub(crate) du: i32,
+    pub(crate) hv: i32,
+    pub(crate) lv: i32,
+    pub(crate) dv: i32,
+}
+
+/// The scalar kernel of [`expand`]: exactly pixels `k..k + m` of each span.
+#[inline(always)]
+pub(super) fn expand_scalar(spans: &[SpanQ8], u: &mut [i32], v: &mut [i32]) {
+    for s in spans {
+        let (k, m) = (s.k as usize, s.m as usize);
+        let (mut lu, mut lv) = (s.lu, s.lv);
+        for (a, b) in u[k..k + m].iter_mut().zip(&mut v[k..k + m]) {
+            *a = s.hu.wrapping_add(lu >> 8);
+            *b = s.hv.wrapping_add(lv >> 8);
+            lu = lu.wrapping_add(s.du);
+            lv = lv.wrapping_add(s.dv);
+        }
+    }
+}
+
+/// Expand `spans` (in order of `k`, each starting where the one before ended) into the
+/// position buffers `u` and `v`, which hold at least 8 entries past the last span (the
+/// SIMD kernels write whole vectors; the next span overwrites what lies past a span).
+/// The row pass's per-pixel positions, one kernel call per run.
+///
+/// # Panics
+/// When a span (rounded up to 8 pixels) does not fit in the buffers.
+#[inline]
+pub(crate) fn expand(spans: &[SpanQ8], u: &mut [i32], v: &mut [i32]) {
+    expand_with(active(), spans, u, v);
+}
+
+/// [`expand`] with kernel `k`.
+#[inline]
+pub(super) fn expand_with(k: Selected, spans: &[SpanQ8], u: &mut [i32], v: &mut [i32]) {
+    #[cfg(target_arch = "x86_64")]
+    if x86::row::expand(k, spans, u, v) {
+        return;
+    }
+    let _ = k;
+    expand_scalar(spans, u, v);
+}
