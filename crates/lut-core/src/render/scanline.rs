@@ -194,16 +194,16 @@ impl Nodes for Blended<'_> {
 }
 
 /// Whether to blend a run's `nodes` once instead of two per read: when there are at
-/// most 2 nodes per read, the reads estimated from the run's length and the mean step of
-/// the regions. (Callgrind: about 20 instructions per blended node against 27 saved per
-/// read puts the break-even near 1.35; a limit of 1.25 and one of 2 measured alike on
-/// the benchmark views, docs/performance.md.) Only the cost depends on it, not the
-/// output.
+/// most 1.25 nodes per read, the reads estimated from the run's length and the mean step
+/// of the regions. (Callgrind: about 20 instructions per blended node against 27 saved
+/// per read puts the break-even near 1.35; with the row pass, which reads only the right
+/// half, a limit of 2 blended at about 1.9 nodes per read and cost 0.6 instructions per
+/// pixel at hfov 90, docs/performance.md.) Only the cost depends on it, not the output.
 #[inline(never)]
 pub(super) fn blend_pays(scan: &Scan, nodes: usize, pixels: usize) -> bool {
     // Reads per 256 pixels, summed over the regions.
     let per_256: usize = scan.shifts.iter().map(|&s| 256 >> s).sum();
-    nodes * 256 * STEP_REGIONS <= 2 * pixels * per_256
+    4 * nodes * 256 * STEP_REGIONS <= 5 * pixels * per_256
 }
 
 /// The one-eighth unfolding of one half of a scanline, hoisted out of its reads: Λ =

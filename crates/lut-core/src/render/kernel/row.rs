@@ -103,8 +103,9 @@ pub(super) fn sample_q8_with<const BILINEAR: bool, const MIRROR: bool>(
 }
 
 /// [`sample_q8_scalar`] with the [`active_kernel`](super::active_kernel): the row pass's
-/// pixels. Positions must lie within one map width of the map in u (two for the mirror,
-/// whose `mirror` is in `[0, 256·W)`); y is clamped.
+/// pixels. Positions must lie within W − 1 map pixels of the map in u (`mirror` in
+/// `[0, 256·W)`), as the row pass's do (a span starts in the map and travels less than
+/// that); outside, x is clamped (never a read outside the map). y is clamped.
 ///
 /// # Panics
 /// When there are fewer positions than pixels.
