@@ -16,11 +16,10 @@
 //! reads the same buffers, so the measured sampling error is this pass's.
 
 use super::kernel::{expand, SpanQ8};
-use super::scanline::{blend_pays, exact_run, read_at, span_step, wrap_u, Half, Nodes, Unfold};
+use super::scanline::{blend_pays, exact_run, mirror_q8, with_nodes, wrap_u, Half, RightSpans};
 use super::scanline::{Scratch, BLEND_NODES};
 use super::setup::{Scan, Setup};
 use super::sink::Sink;
-use super::steps::STEP_REGIONS;
 use crate::geom::fixed::{Fx, FX_ONE};
 use crate::lut::{Blended, LutTable};
 
@@ -82,7 +81,7 @@ pub(crate) fn row_pass<S: Sink>(
     fr: &Setup,
     (scratch, buf): (&mut Scratch, &mut HalfBuf),
     sink: &mut S,
-    run: impl FnMut(&mut S, HalfRun<'_>),
+    mut run: impl FnMut(&mut S, HalfRun<'_>),
 ) {
     let w = fr.w_out as i64;
     let Some(h) = Half::of(scan, fr) else {
@@ -92,71 +91,33 @@ pub(crate) fn row_pass<S: Sink>(
     exact_run(scan, fr, 0, w - 2 - h.xe, sink);
     exact_run(scan, fr, w - h.xa, h.xa - 1, sink);
     exact_run(scan, fr, h.xe + 1, w - 1, sink);
-    let band = table.band(scan.band, scan.wa);
-    let k0 = band.node_q(h.a0 * scan.node_per_2x).0;
-    let k1 = band.node_q((h.a0 + 2 * h.dn) * scan.node_per_2x).0 + 1;
-    let count = k1 + 1 - k0;
-    // One read per span of the right half only: half the reads of `render_row`.
-    if count <= BLEND_NODES && blend_pays(scan, count, (h.dn + 1) as usize) {
-        let nodes = &mut scratch[..count];
-        band.blend_nodes(k0, nodes);
-        let blended = Blended { band, k0, nodes };
-        walk(scan, &blended, fr, &h, buf, sink, run);
-    } else {
-        walk(scan, &band, fr, &h, buf, sink, run);
-    }
-}
-
-/// The right half's spans into `buf`, handed to `run` a chunk at a time.
-#[inline(always)]
-fn walk<S: Sink, N: Nodes>(
-    scan: &Scan,
-    nodes: &N,
-    fr: &Setup,
-    h: &Half,
-    buf: &mut HalfBuf,
-    sink: &mut S,
-    mut run: impl FnMut(&mut S, HalfRun<'_>),
-) {
-    let un = Unfold::new(scan, fr, false);
-    let mirror = ((2 * fr.off_fx).rem_euclid(fr.map_w_fx) >> 8) as i32;
+    let mirror = mirror_q8(fr) as i32;
     let (xa, w) = (h.xa as usize, fr.w_out);
-    let mut flush = |buf: &mut HalfBuf, sink: &mut S, c0: i64, n: usize| {
+    let mut flush = |buf: &mut HalfBuf, sink: &mut S, c0: i64, n: i64| {
         buf.expand();
         let c0 = c0 as usize;
         let r = HalfRun {
             right: xa + c0,
             left_end: w - xa - c0,
             mirror,
-            u: &buf.u[..n],
-            v: &buf.v[..n],
+            u: &buf.u[..n as usize],
+            v: &buf.v[..n as usize],
         };
         run(sink, r);
     };
+    // The first pixel in the buffer.
     let mut c0 = 0i64;
-    let mut d = 0i64;
-    let mut r = h.r0;
-    let mut p0 = read_at(scan, nodes, h, &un, 0);
-    while d < h.dn {
-        while r + 1 < STEP_REGIONS && d >= h.e[r + 1] {
-            r += 1;
+    with_nodes!(scan, table, &h, scratch, |nodes| {
+        let mut spans = RightSpans::new(scan, nodes, fr, &h);
+        while let Some((d, m, p0, step, _)) = spans.next(scan, fr) {
+            fill(fr, buf, (d - c0) as usize, m as usize, p0, step);
+            let end = d + m;
+            if end - c0 >= HALF_CHUNK as i64 || end > h.dn {
+                flush(buf, sink, c0, end - c0);
+                c0 = end;
+            }
         }
-        let shift = scan.shifts[r] as u32;
-        let d1 = (d + (1 << shift)).min(h.dn);
-        let p1 = read_at(scan, nodes, h, &un, d1);
-        let m = d1 - d;
-        let (l1, step) = span_step(fr, p0, p1, m, shift);
-        fill(fr, buf, (d - c0) as usize, m as usize, p0, step);
-        d = d1;
-        // Λ carried unwrapped from span to span.
-        p0 = (l1, p1.1);
-        if d - c0 >= HALF_CHUNK as i64 {
-            flush(buf, sink, c0, (d - c0) as usize);
-            c0 = d;
-        }
-    }
-    fill(fr, buf, (d - c0) as usize, 1, p0, (0, 0));
-    flush(buf, sink, c0, (d - c0 + 1) as usize);
+    });
 }
 
 /// Q.8 positions of `m` pixels from (Λ, V) by (dΛ, dV) (Q.16) at `k` of `buf`: u =

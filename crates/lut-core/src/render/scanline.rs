@@ -38,11 +38,12 @@ impl RowScratch {
 ///
 /// The table covers a run of pixels symmetric about the screen's centre column (X = 0),
 /// less the exact zone around it near a pole: the *right half* from `xa` to `xe` and its
-/// mirror image, the *left half*. Both halves read the table at the same |X| (the
-/// one-eighth symmetry: X → −X negates Λ), every 2^shift pixels outward from the centre
-/// (the shift of the region the span starts in, [`Half`]); the column coordinate is a
-/// whole-number step per pixel (`Scan::node_per_2x`), no floating point per read. The
-/// pixels are emitted left to right: exact, left half, exact zone, right half, exact.
+/// mirror image, the *left half*. The table is read for the right half only, every
+/// 2^shift pixels outward from the centre (the shift of the region the span starts in,
+/// [`Half`]), the column coordinate a whole-number step per pixel
+/// (`Scan::node_per_2x`), no floating point per read; each span is emitted twice, for
+/// the left half mirrored (the one-eighth symmetry: X → −X negates Λ; see
+/// [`emit_mirror`]) and for the right half. The exact pixels go first.
 #[inline]
 pub(crate) fn render_row<S: Sink>(
     scan: &Scan,
@@ -57,39 +58,42 @@ pub(crate) fn render_row<S: Sink>(
         exact_run(scan, fr, 0, w - 1, sink);
         return;
     };
-    let band = table.band(scan.band, scan.wa);
-    // The nodes the row reads: from the smallest |X| to the largest, and the next node.
-    let k0 = band.node_q(h.a0 * scan.node_per_2x).0;
-    let k1 = band.node_q((h.a0 + 2 * h.dn) * scan.node_per_2x).0 + 1;
-    let count = k1 + 1 - k0;
-    let pixels = 2 * (h.dn + 1) as usize;
-    if count <= BLEND_NODES && blend_pays(scan, count, pixels) {
-        let nodes = &mut scratch[..count];
-        band.blend_nodes(k0, nodes);
-        let blended = Blended { band, k0, nodes };
-        halves(scan, &blended, fr, row_scale, &h, sink);
-    } else {
-        halves(scan, &band, fr, row_scale, &h, sink);
-    }
+    exact_run(scan, fr, 0, w - 2 - h.xe, sink);
+    exact_run(scan, fr, w - h.xa, h.xa - 1, sink);
+    exact_run(scan, fr, h.xe + 1, w - 1, sink);
+    with_nodes!(scan, table, &h, scratch, |nodes| {
+        let mut spans = RightSpans::new(scan, nodes, fr, &h);
+        while let Some((d, m, p0, step, r)) = spans.next(scan, fr) {
+            sink.footprint(step.0, step.1, r);
+            emit_mirror(fr, row_scale, w - h.xa - d - m, m, p0, step, sink);
+            emit(fr, row_scale, h.xa + d, m, p0, step, sink);
+        }
+    });
 }
 
-/// The pixels of a scanline in order, its table covered part read through `nodes`.
-#[inline(always)]
-fn halves<S: Sink, N: Nodes>(
-    scan: &Scan,
-    nodes: &N,
-    fr: &Setup,
-    row_scale: &[i64],
-    h: &Half,
-    sink: &mut S,
-) {
-    let w = fr.w_out as i64;
-    exact_run(scan, fr, 0, w - 2 - h.xe, sink);
-    left_half(scan, nodes, fr, row_scale, h, sink);
-    exact_run(scan, fr, w - h.xa, h.xa - 1, sink);
-    right_half(scan, nodes, fr, row_scale, h, sink);
-    exact_run(scan, fr, h.xe + 1, w - 1, sink);
+/// `$body` with `$nodes` bound to the half `$h`'s table nodes: blended once into
+/// `$scratch` when that pays ([`blend_pays`]; the right half's reads only), else read
+/// straight from the band (the body is compiled for both).
+macro_rules! with_nodes {
+    ($scan:expr, $table:expr, $h:expr, $scratch:expr, |$nodes:ident| $body:expr) => {{
+        let (scan, h) = ($scan, $h);
+        let band = $table.band(scan.band, scan.wa);
+        // From the smallest |X| to the largest, and the next node.
+        let k0 = band.node_q(h.a0 * scan.node_per_2x).0;
+        let k1 = band.node_q((h.a0 + 2 * h.dn) * scan.node_per_2x).0 + 1;
+        let count = k1 + 1 - k0;
+        if count <= BLEND_NODES && blend_pays(scan, count, (h.dn + 1) as usize) {
+            let nodes = &mut $scratch[..count];
+            band.blend_nodes(k0, nodes);
+            let $nodes = &Blended { band, k0, nodes };
+            $body
+        } else {
+            let $nodes = &band;
+            $body
+        }
+    }};
 }
+pub(super) use with_nodes;
 
 /// The right half of a scanline's table-covered pixels, `xa..=xe` (`xa` the first pixel
 /// right of the centre or of the exact zone), and where its table reads fall: at pixel
@@ -269,72 +273,102 @@ pub(super) fn span_step(
     (l1, step)
 }
 
-/// The right half, left to right (outward): a read at d, spans to the next read.
-#[inline(always)]
-fn right_half<S: Sink, N: Nodes>(
-    scan: &Scan,
-    nodes: &N,
-    fr: &Setup,
-    row_scale: &[i64],
-    h: &Half,
-    sink: &mut S,
-) {
-    let u = Unfold::new(scan, fr, false);
-    let mut d = 0;
-    let mut r = h.r0;
-    let mut p0 = read_at(scan, nodes, h, &u, 0);
-    while d < h.dn {
-        while r + 1 < STEP_REGIONS && d >= h.e[r + 1] {
-            r += 1;
-        }
-        let shift = scan.shifts[r] as u32;
-        let d1 = (d + (1 << shift)).min(h.dn);
-        let p1 = read_at(scan, nodes, h, &u, d1);
-        let m = d1 - d;
-        let (l1, step) = span_step(fr, p0, p1, m, shift);
-        sink.footprint(step.0, step.1, r);
-        emit(fr, row_scale, h.xa + d, m, p0, step, sink);
-        d = d1;
-        // Λ carried unwrapped from span to span.
-        p0 = (l1, p1.1);
-    }
-    emit(fr, row_scale, h.xa + h.dn, 1, p0, (0, 0), sink);
+/// The right half's spans, outward from its first pixel: [`RightSpans::next`] gives
+/// `(d, m, (Λ, V), (dΛ, dV), region)` for pixels `xa + d..xa + d + m` (Λ unwrapped
+/// from span to span), the last pixel as a span of one with no step. (An iterator the
+/// callers loop over, rather than a closure: it stays inlined.)
+pub(super) struct RightSpans<'n, N: Nodes> {
+    nodes: &'n N,
+    h: Half,
+    u: Unfold,
+    d: i64,
+    r: usize,
+    p0: (Fx, Fx),
+    done: bool,
 }
 
-/// The left half, left to right (inward): the right half's reads mirrored, walked from
-/// the last one back (the centre pixel of an odd width belongs to the right half).
+impl<'n, N: Nodes> RightSpans<'n, N> {
+    #[inline(always)]
+    pub(super) fn new(scan: &Scan, nodes: &'n N, fr: &Setup, h: &Half) -> Self {
+        let u = Unfold::new(scan, fr, false);
+        RightSpans {
+            nodes,
+            h: *h,
+            u,
+            d: 0,
+            r: h.r0,
+            p0: read_at(scan, nodes, h, &u, 0),
+            done: false,
+        }
+    }
+
+    #[allow(clippy::type_complexity)]
+    #[inline(always)]
+    pub(super) fn next(
+        &mut self,
+        scan: &Scan,
+        fr: &Setup,
+    ) -> Option<(i64, i64, (Fx, Fx), (Fx, Fx), usize)> {
+        let (d, h) = (self.d, &self.h);
+        if d == h.dn {
+            if self.done {
+                return None;
+            }
+            self.done = true;
+            return Some((d, 1, self.p0, (0, 0), self.r));
+        }
+        while self.r + 1 < STEP_REGIONS && d >= h.e[self.r + 1] {
+            self.r += 1;
+        }
+        let shift = scan.shifts[self.r] as u32;
+        let d1 = (d + (1 << shift)).min(h.dn);
+        let p1 = read_at(scan, self.nodes, h, &self.u, d1);
+        let m = d1 - d;
+        let p0 = self.p0;
+        let (l1, step) = span_step(fr, p0, p1, m, shift);
+        self.d = d1;
+        self.p0 = (l1, p1.1);
+        Some((d, m, p0, step, self.r))
+    }
+}
+
+/// The Q.8 mirror of u in the left half: a right-half pixel at Q.16 u has its mirror
+/// image at [`mirror_fx`] − u, whose whole Q.8 value is `(mirror_fx >> 8) − (u >> 8)`:
+/// the row kernels' `mirror − u` (`render/rowpass.rs`), so both paths sample alike.
 #[inline(always)]
-fn left_half<S: Sink, N: Nodes>(
-    scan: &Scan,
-    nodes: &N,
+pub(super) fn mirror_q8(fr: &Setup) -> i64 {
+    (2 * fr.off_fx).rem_euclid(fr.map_w_fx) >> 8
+}
+
+/// See [`mirror_q8`]: 256·M + 255 for M = `mirror_q8`.
+#[inline(always)]
+fn mirror_fx(fr: &Setup) -> Fx {
+    (mirror_q8(fr) << 8) + 255
+}
+
+/// Emit the mirror image of the right-half span (Λ, V) + j·(dΛ, dV), j < m, as the `m`
+/// pixels from `x` on (left to right: j = m − 1 first). Rows that scale with latitude
+/// mirror Λ (−Λ); rectangular maps mirror u (see [`mirror_q8`]), which is −Λ to within
+/// 1/256 pixel and what the row pass samples.
+#[inline(always)]
+fn emit_mirror<S: Sink>(
     fr: &Setup,
     row_scale: &[i64],
-    h: &Half,
+    x: i64,
+    m: i64,
+    (l, vv): (Fx, Fx),
+    (dl, dvv): (Fx, Fx),
     sink: &mut S,
 ) {
-    let u = Unfold::new(scan, fr, true);
-    let x_of = |d: i64| fr.w_out as i64 - 1 - (h.xa + d);
-    let mut d = h.dn;
-    let mut r = STEP_REGIONS - 1;
-    let mut p0 = read_at(scan, nodes, h, &u, d);
-    while d > 0 {
-        // The region of d − 1 (e[r0] = 0 ≤ d − 1 ends the search).
-        while h.e[r] > d - 1 {
-            r -= 1;
-        }
-        let shift = scan.shifts[r] as u32;
-        let d1 = h.e[r] + ((d - 1 - h.e[r]) & !((1i64 << shift) - 1));
-        let p1 = read_at(scan, nodes, h, &u, d1);
-        let m = d - d1;
-        let (l1, step) = span_step(fr, p0, p1, m, shift);
-        sink.footprint(step.0, step.1, r);
-        emit(fr, row_scale, x_of(d), m, p0, step, sink);
-        d = d1;
-        p0 = (l1, p1.1);
-    }
-    if h.a0 > 0 {
-        emit(fr, row_scale, x_of(0), 1, p0, (0, 0), sink);
-    }
+    let (l_end, v_end) = (l + (m - 1) * dl, vv + (m - 1) * dvv);
+    let l_start = if fr.scaled {
+        -l_end
+    } else {
+        // u at the span's far end as `emit` computes it, mirrored, back to Λ.
+        let u0 = wrap_u(l + fr.off_fx, fr.map_w_fx);
+        mirror_fx(fr) - (u0 + (m - 1) * dl) - fr.off_fx
+    };
+    emit(fr, row_scale, x, m, (l_start, v_end), (dl, -dvv), sink);
 }
 
 /// Emit `m` pixels from `x` on, starting at (Λ, V) and stepping by (dΛ, dV) (also the
