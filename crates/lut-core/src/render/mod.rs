@@ -5,12 +5,15 @@
 //! * per frame, `setup.rs`: each scanline's table rows, column scale, index steps (from
 //!   the analytic bounds of `steps.rs`) and exact-pixel ranges; nothing else is
 //!   recomputed when the view turns;
-//! * per scanline, `scanline.rs`: the table read every Nth pixel, map coordinates stepped
-//!   in Q.16 fixed point between reads, longitude unwrapped across each span (a span over
-//!   the ±180° seam steps continuously and wraps per pixel instead of smearing across the
-//!   whole map); `rows.rs` runs the rows on one thread or in bands on rayon;
-//! * per pixel, `kernel/`: the span kernels, with the rules they keep;
-//! * `sink.rs`: where a scanline writes (pixels per sampler, or positions).
+//! * per scanline, `scanline.rs`: the table read every Nth pixel of the right half (the
+//!   left half is its mirror image), map coordinates stepped in Q.16 fixed point between
+//!   reads, longitude unwrapped across each span (a span over the ±180° seam steps
+//!   continuously and wraps per pixel instead of smearing across the whole map);
+//!   `rowpass.rs`, for full maps drawn nearest or bilinear: the walk's positions for a run
+//!   of the row at once, then one gather pass (`kernel/row.rs`); `rows.rs` runs the rows
+//!   on one thread or in bands on rayon;
+//! * per pixel, `kernel/`: the row and span kernels, with the rules they keep;
+//! * `sink.rs`: where a scanline's spans go otherwise (pixels per sampler, or positions).
 //!
 //! `exact.rs` is the per-pixel reference renderer, `cube.rs` the cube renderers,
 //! `heat.rs` the error heat map (per-pixel sampling-position error of a renderer),

@@ -16,7 +16,7 @@
 //! reads the same buffers, so the measured sampling error is this pass's.
 
 use super::kernel::{expand, SpanQ8};
-use super::scanline::{blend_pays, exact_run, mirror_q8, with_nodes, wrap_u, Half, RightSpans};
+use super::scanline::{blend_pays, mirror_q8, with_nodes, wrap_u, Half, RightSpans};
 use super::scanline::{Scratch, BLEND_NODES};
 use super::setup::{Scan, Setup};
 use super::sink::Sink;
@@ -83,19 +83,22 @@ pub(crate) fn row_pass<S: Sink>(
     sink: &mut S,
     mut run: impl FnMut(&mut S, HalfRun<'_>),
 ) {
-    let w = fr.w_out as i64;
-    let Some(h) = Half::of(scan, fr) else {
-        exact_run(scan, fr, 0, w - 1, sink);
+    let Some(h) = Half::exact_rest(scan, fr, sink) else {
         return;
     };
-    exact_run(scan, fr, 0, w - 2 - h.xe, sink);
-    exact_run(scan, fr, w - h.xa, h.xa - 1, sink);
-    exact_run(scan, fr, h.xe + 1, w - 1, sink);
     let mirror = mirror_q8(fr) as i32;
     let (xa, w) = (h.xa as usize, fr.w_out);
+    let wq = (fr.mw as i32) << 8;
     let mut flush = |buf: &mut HalfBuf, sink: &mut S, c0: i64, n: i64| {
         buf.expand();
         let c0 = c0 as usize;
+        // The mirror one width up when that puts the run's first left pixel inside the
+        // map (the kernels then seldom wrap; the samples are the same).
+        let mirror = if mirror < buf.u[0] {
+            mirror + wq
+        } else {
+            mirror
+        };
         let r = HalfRun {
             right: xa + c0,
             left_end: w - xa - c0,

@@ -54,13 +54,9 @@ pub(crate) fn render_row<S: Sink>(
     sink: &mut S,
 ) {
     let w = fr.w_out as i64;
-    let Some(h) = Half::of(scan, fr) else {
-        exact_run(scan, fr, 0, w - 1, sink);
+    let Some(h) = Half::exact_rest(scan, fr, sink) else {
         return;
     };
-    exact_run(scan, fr, 0, w - 2 - h.xe, sink);
-    exact_run(scan, fr, w - h.xa, h.xa - 1, sink);
-    exact_run(scan, fr, h.xe + 1, w - 1, sink);
     with_nodes!(scan, table, &h, scratch, |nodes| {
         let mut spans = RightSpans::new(scan, nodes, fr, &h);
         while let Some((d, m, p0, step, r)) = spans.next(scan, fr) {
@@ -117,7 +113,7 @@ pub(super) struct Half {
 impl Half {
     /// The right half of `scan` (`None`: the table covers none of it).
     #[inline]
-    pub(super) fn of(scan: &Scan, fr: &Setup) -> Option<Half> {
+    fn of(scan: &Scan, fr: &Setup) -> Option<Half> {
         if !scan.lut || scan.lut_lo > scan.lut_hi {
             return None;
         }
@@ -156,9 +152,27 @@ impl Half {
     }
 }
 
+impl Half {
+    /// The right half of `scan`, after evaluating exactly into `sink` the pixels neither
+    /// half covers (beyond the table, the pole zone between the halves; the whole row
+    /// when there is no half).
+    #[inline]
+    pub(super) fn exact_rest<S: Sink>(scan: &Scan, fr: &Setup, sink: &mut S) -> Option<Half> {
+        let w = fr.w_out as i64;
+        let Some(h) = Half::of(scan, fr) else {
+            exact_run(scan, fr, 0, w - 1, sink);
+            return None;
+        };
+        exact_run(scan, fr, 0, w - 2 - h.xe, sink);
+        exact_run(scan, fr, w - h.xa, h.xa - 1, sink);
+        exact_run(scan, fr, h.xe + 1, w - 1, sink);
+        Some(h)
+    }
+}
+
 /// Exact evaluation of pixels x0..=x1 of a scanline (pole zones, beyond the table).
 #[inline(never)]
-pub(super) fn exact_run<S: Sink>(scan: &Scan, fr: &Setup, x0: i64, x1: i64, sink: &mut S) {
+fn exact_run<S: Sink>(scan: &Scan, fr: &Setup, x0: i64, x1: i64, sink: &mut S) {
     let half_w = fr.w_out as f64 * 0.5;
     let c2 = scan.ca * scan.ca;
     for x in x0.max(0)..=x1 {

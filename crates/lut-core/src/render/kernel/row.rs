@@ -21,31 +21,27 @@ use crate::map::sample::lerp_px;
 use super::x86;
 
 /// The sample of `t` at the Q.8 position (u, v): x wrapped into the map (u within two map
-/// widths of it), y clamped; bilinear reads the 2×2 block around (u − ½, v − ½).
+/// widths of it: −2W ≤ x < 3W), y clamped; bilinear reads the 2×2 block around
+/// (u − ½, v − ½).
 #[inline(always)]
 pub(super) fn sample_at<const BILINEAR: bool>(t: &Texels, u: i32, v: i32) -> u32 {
     let (w, h1, stride) = (t.width as i32, t.height as i32 - 1, t.stride());
     let (u, v) = if BILINEAR { (u - 128, v - 128) } else { (u, v) };
     let mut x = u >> 8;
-    if x < 0 {
-        x += w;
+    // One test for the common case (inside the map).
+    if x as u32 >= w as u32 {
+        x = wrap_x(x, w);
     }
-    if x < 0 {
-        x += w;
-    }
-    if x >= w {
-        x -= w;
-    }
-    let x = x.clamp(0, w - 1) as usize;
+    let x = x as usize;
     let y = v >> 8;
     if BILINEAR {
         let fx = (u & 0xFF) as u32;
-        let (y, fy) = if y < 0 {
-            (0, 0)
-        } else if y >= h1 {
-            (h1, 0)
-        } else {
+        let (y, fy) = if (y as u32) < h1 as u32 {
             (y, (v & 0xFF) as u32)
+        } else if y < 0 {
+            (0, 0)
+        } else {
+            (h1, 0)
         };
         let i = y as usize * stride + x;
         let q = &t.px[i..i + stride + 2];
@@ -55,8 +51,31 @@ pub(super) fn sample_at<const BILINEAR: bool>(t: &Texels, u: i32, v: i32) -> u32
             fy,
         )
     } else {
-        t.px[y.clamp(0, h1) as usize * stride + x]
+        let y = if (y as u32) <= h1 as u32 {
+            y
+        } else {
+            y.clamp(0, h1)
+        };
+        t.px[y as usize * stride + x]
     }
+}
+
+/// x (outside `0..w`) wrapped by up to two map widths either way, then clamped.
+#[inline(always)]
+fn wrap_x(mut x: i32, w: i32) -> i32 {
+    if x < 0 {
+        x += w;
+    }
+    if x < 0 {
+        x += w;
+    }
+    if x >= w {
+        x -= w;
+    }
+    if x >= w {
+        x -= w;
+    }
+    x.clamp(0, w - 1)
 }
 
 /// The scalar kernel: `out[j]` = the sample at (`u[j]`, `v[j]`), or with `MIRROR`
@@ -103,9 +122,10 @@ pub(super) fn sample_q8_with<const BILINEAR: bool, const MIRROR: bool>(
 }
 
 /// [`sample_q8_scalar`] with the [`active_kernel`](super::active_kernel): the row pass's
-/// pixels. Positions must lie within W − 1 map pixels of the map in u (`mirror` in
-/// `[0, 256·W)`), as the row pass's do (a span starts in the map and travels less than
-/// that); outside, x is clamped (never a read outside the map). y is clamped.
+/// pixels. Positions u (and `mirror − u`) must lie within two map widths of the map, as
+/// the row pass's do (a span starts in the map and travels less than a width; `mirror`
+/// is in `[0, 512·W)`); outside, x is clamped (never a read outside the map). y is
+/// clamped.
 ///
 /// # Panics
 /// When there are fewer positions than pixels.

@@ -570,7 +570,7 @@ fn direct_nearest_spans_equal_per_pixel_samples() {
 /// Q.8 positions as the row pass hands them to the row kernels (`row.rs`): u within W − 1
 /// pixels of the map (mostly inside, at the seam, or a period off), v anywhere from a
 /// map height above the top to one below the bottom (the pole rows), a mirror in
-/// [0, 256·W), 1..=64 pixels written at an offset 0..8 of a sentinel-filled buffer.
+/// [0, 512·W), 1..=64 pixels written at an offset 0..8 of a sentinel-filled buffer.
 #[derive(Debug, Clone)]
 struct RowCase {
     u: Vec<i32>,
@@ -599,7 +599,7 @@ fn row_case(w: u32, h: u32) -> impl Strategy<Value = RowCase> {
         (
             prop::collection::vec(u, n),
             prop::collection::vec(v, n),
-            0..wq,
+            0..2 * wq,
             Just(off),
         )
             .prop_map(|(u, v, mirror, off)| RowCase { u, v, mirror, off })

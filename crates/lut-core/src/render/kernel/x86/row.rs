@@ -76,6 +76,7 @@ macro_rules! lanes {
             let x = $add(x, $and($gt(zero, x), wv));
             let x = $add(x, $and($gt(zero, x), wv));
             let x = $sub(x, $and($gt(x, $set1(w - 1)), wv));
+            let x = $sub(x, $and($gt(x, $set1(w - 1)), wv));
             let x = $min($max(x, zero), $set1(w - 1));
             let y = $srai::<8>(v);
             let ff = $set1(0xFF);
