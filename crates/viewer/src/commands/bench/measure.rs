@@ -220,9 +220,9 @@ pub fn measure_errors(
         }
         for (ci, cfg) in cfgs.iter().enumerate() {
             let e = &mut acc[ci];
-            // Positions per sampler: the LUT rounds bilinear positions to 1/256 pixel and
-            // nearest ones not (`Setup::q8_round` in lut-core).
-            if let (Sampler::Nearest | Sampler::Bilinear, Some(opts)) =
+            // Positions do not depend on the sampler: measured once (nearest), shared
+            // with the bilinear rows below.
+            if let (Sampler::Nearest, Some(opts)) =
                 (cfg.sampler(), position_opts(*cfg, ctx.set.table))
             {
                 let (pos, rep) = renderer.positions(mw, mh, proj, view, &opts, w, h)?;
@@ -246,6 +246,21 @@ pub fn measure_errors(
                 1
             }];
             e.sse += sse(&img, reference);
+        }
+        // Share the sampler-independent position stats with the bilinear rows.
+        for ci in 0..cfgs.len() {
+            let twin = cfgs[ci].nearest_twin();
+            if cfgs[ci].sampler() == Sampler::Bilinear && twin != cfgs[ci] {
+                if let Some(nj) = cfgs.iter().position(|c| *c == twin) {
+                    let src = acc[nj];
+                    let e = &mut acc[ci];
+                    e.pos_count = src.pos_count;
+                    e.max = src.max;
+                    e.sum = src.sum;
+                    e.exact_px = src.exact_px;
+                    e.px = src.px;
+                }
+            }
         }
         gather_idx.push(idx);
         progress(&format!(
@@ -541,11 +556,8 @@ mod tests {
                         "{cfg:?} {}",
                         e.max
                     );
-                    // The bilinear positions are the nearest twin's rounded to 1/256
-                    // pixel (the LUT's `q8_round`): their errors differ by at most that.
                     let twin = cfgs.iter().position(|c| *c == cfg.nearest_twin()).unwrap();
-                    let d = (e.max - errs.per_config[twin].max).abs();
-                    assert!(d <= 1.0 / 256.0, "{cfg:?}: {d}");
+                    assert_eq!(e.max, errs.per_config[twin].max, "{cfg:?}");
                     assert!(e.px > 0 && e.sse < e.samples * 16, "{cfg:?}");
                 }
                 Config::Cube(..) => assert!(e.pos_count.is_none()),
