@@ -135,8 +135,7 @@ fn fill(fr: &Setup, buf: &mut HalfBuf, k: usize, m: usize, (l, vv): (Fx, Fx), (d
     if !(0..wfx).contains(&u) {
         u = u.rem_euclid(wfx);
     }
-    // Rounded to the nearest Q.8 for the blending samplers (`Setup::q8_round`).
-    let (u, v) = (u + fr.q8_round, fr.half_map_h_fx - vv + fr.q8_round);
+    let v = fr.half_map_h_fx - vv;
     let dv = -dvv;
     // Lanes run up to 8 past the span. (|v| < 2³², as table entries and H/2 are i32:
     // v >> 8 fits.)

@@ -62,8 +62,7 @@ pub(crate) fn render_row<S: Sink>(
         while let Some((d, m, p0, step, r)) = spans.next(scan, fr) {
             sink.footprint(step.0, step.1, r);
             emit_mirror(fr, row_scale, w - h.xa - d - m, m, p0, step, sink);
-            let b = fr.q8_round;
-            emit(fr, row_scale, h.xa + d, m, (p0.0 + b, p0.1 - b), step, sink);
+            emit(fr, row_scale, h.xa + d, m, p0, step, sink);
         }
     });
 }
@@ -347,19 +346,18 @@ impl<'n, N: Nodes> RightSpans<'n, N> {
     }
 }
 
-/// The Q.8 mirror M of u in the left half: a right-half pixel at Q.16 u (Q.8: (u + b) >> 8,
-/// b = `Setup::q8_round`) has its mirror image at M − ((u + b) >> 8), M = (2·(W/2 + yaw) +
-/// b) >> 8: the row kernels' `mirror − u` (`render/rowpass.rs`). The span walk emits it
-/// as [`mirror_fx`] − u, whose Q.8 value is that, so both paths sample alike.
+/// The Q.8 mirror of u in the left half: a right-half pixel at Q.16 u has its mirror
+/// image at [`mirror_fx`] − u, whose whole Q.8 value is `(mirror_fx >> 8) − (u >> 8)`:
+/// the row kernels' `mirror − u` (`render/rowpass.rs`), so both paths sample alike.
 #[inline(always)]
 pub(super) fn mirror_q8(fr: &Setup) -> i64 {
-    ((2 * fr.off_fx + fr.q8_round) >> 8).rem_euclid(fr.map_w_fx >> 8)
+    (2 * fr.off_fx).rem_euclid(fr.map_w_fx) >> 8
 }
 
-/// See [`mirror_q8`]: 256·M + 255 − b (then (256·M + 255 − b − u) >> 8 = M − ((u + b) >> 8)).
+/// See [`mirror_q8`]: 256·M + 255 for M = `mirror_q8`.
 #[inline(always)]
 fn mirror_fx(fr: &Setup) -> Fx {
-    (mirror_q8(fr) << 8) + 255 - fr.q8_round
+    (mirror_q8(fr) << 8) + 255
 }
 
 /// Emit the mirror image of the right-half span (Λ, V) + j·(dΛ, dV), j < m, as the `m`
@@ -376,10 +374,9 @@ fn emit_mirror<S: Sink>(
     (dl, dvv): (Fx, Fx),
     sink: &mut S,
 ) {
-    let b = fr.q8_round;
-    let (l_end, v_end) = (l + (m - 1) * dl, vv + (m - 1) * dvv - b);
+    let (l_end, v_end) = (l + (m - 1) * dl, vv + (m - 1) * dvv);
     let l_start = if fr.scaled {
-        b - l_end
+        -l_end
     } else {
         // u at the span's far end as `emit` computes it, mirrored, back to Λ.
         let u0 = wrap_u(l + fr.off_fx, fr.map_w_fx);

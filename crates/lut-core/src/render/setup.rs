@@ -66,10 +66,6 @@ pub(crate) struct Setup {
     pub(crate) yaw: f64,
     pub(crate) coverage: bool,
     pub(crate) scaled: bool,
-    /// Added to the walk's Q.16 positions before the kernels take their Q.8 (bilinear)
-    /// bits: 128 rounds them to the nearest 1/256 pixel for the samplers that blend, 0
-    /// (nearest, and renderers that do not walk the table) keeps the containing pixel.
-    pub(crate) q8_round: Fx,
     /// Where the step regions of a scanline start, in units of 2|X| (region r: 2|X| ≥
     /// `region_2x[r]`, r < [`STEP_REGIONS`]; each region is W/16 pixels wide).
     pub(crate) region_2x: [i64; STEP_REGIONS],
@@ -95,7 +91,6 @@ impl Setup {
             yaw,
             coverage: !proj.full_sphere(),
             scaled: proj.scaled_rows(),
-            q8_round: 0,
             region_2x: std::array::from_fn(|r| (r * w_out as usize).div_ceil(STEP_REGIONS) as i64),
         }
     }
@@ -116,10 +111,7 @@ pub(crate) fn prepare(
     let cam = Camera::new(view, width, height);
     let f = cam.focal;
     let (mwf, mhf) = (mw as f64, mh as f64);
-    let mut frame = Setup::new(width, (mw, mh, proj), view.yaw());
-    if opts.sampler != Sampler::Nearest {
-        frame.q8_round = 128;
-    }
+    let frame = Setup::new(width, (mw, mh, proj), view.yaw());
     let nominal = match opts.index_step {
         IndexStep::Fixed(n) => n,
         IndexStep::Adaptive => ADAPTIVE_MAX_STEP,
