@@ -619,17 +619,19 @@ impl Renderer {
                         if CROP {
                             // Partial maps: per pixel, at the same positions.
                             let q = |u: i32| (u.rem_euclid(wq) as i64) << 8;
-                            for (j, (&u, &v)) in r.u.iter().zip(r.v).enumerate() {
+                            for (j, (&v, (&u, &ul))) in
+                                r.v.iter().zip(r.u.iter().zip(r.ul)).enumerate()
+                            {
                                 let v = (v as i64) << 8;
-                                s.put(r.left_end - 1 - j, q(r.mirror - u), v);
+                                s.put(r.left_end - 1 - j, q(ul), v);
                                 s.put(r.right + j, q(u), v);
                             }
                             return;
                         }
                         let left = &mut s.row[r.left_end - n..r.left_end];
-                        sample_q8::<BILINEAR, true>(&t, r.u, r.v, r.mirror, left);
+                        sample_q8::<BILINEAR, true>(&t, r.ul, r.v, left);
                         let right = &mut s.row[r.right..r.right + n];
-                        sample_q8::<BILINEAR, false>(&t, r.u, r.v, r.mirror, right);
+                        sample_q8::<BILINEAR, false>(&t, r.u, r.v, right);
                     });
                 } else {
                     render_row(
@@ -802,8 +804,8 @@ impl Renderer {
 /// pixel of an odd width is the right half's).
 fn pass_positions(s: &mut PosSink<'_>, r: HalfRun<'_>, wq: i32) {
     let px = |u: i32, v: i32| Some((u.rem_euclid(wq) as f64 / 256.0, v as f64 / 256.0));
-    for (j, (&u, &v)) in r.u.iter().zip(r.v).enumerate() {
-        s.row[r.left_end - 1 - j] = px(r.mirror - u, v);
+    for (j, (&u, &v)) in r.ul.iter().zip(r.v).enumerate() {
+        s.row[r.left_end - 1 - j] = px(u, v);
     }
     for (j, (&u, &v)) in r.u.iter().zip(r.v).enumerate() {
         s.row[r.right + j] = px(u, v);

@@ -15,8 +15,8 @@
 //! The pixels sample exactly the positions [`row_pass`] writes; `Renderer::positions`
 //! reads the same buffers, so the measured sampling error is this pass's.
 
-use super::kernel::{expand, SpanQ8};
-use super::scanline::{blend_pays, mirror_q8, with_nodes, wrap_u, Half, RightSpans};
+use super::kernel::{expand, Positions, SpanQ8};
+use super::scanline::{blend_pays, with_nodes, wrap_u, Half, RightSpans};
 use super::scanline::{Scratch, BLEND_NODES};
 use super::setup::{Scan, Setup};
 use super::sink::Sink;
@@ -33,6 +33,8 @@ const ROOM: usize = HALF_CHUNK + 72;
 pub(crate) struct HalfBuf {
     u: [i32; ROOM],
     v: [i32; ROOM],
+    /// The left half's u (its v is the right half's).
+    ul: [i32; ROOM],
     /// The spans not yet expanded into `u`, `v` (at most one per pixel of a chunk).
     spans: [SpanQ8; HALF_CHUNK + 2],
     n_spans: usize,
@@ -43,6 +45,7 @@ impl HalfBuf {
         HalfBuf {
             u: [0; ROOM],
             v: [0; ROOM],
+            ul: [0; ROOM],
             spans: [SpanQ8::default(); HALF_CHUNK + 2],
             n_spans: 0,
         }
@@ -51,20 +54,25 @@ impl HalfBuf {
     /// Expand the recorded spans into the positions (`kernel::expand`).
     #[inline]
     fn expand(&mut self) {
-        expand(&self.spans[..self.n_spans], &mut self.u, &mut self.v);
+        let p = Positions {
+            u: &mut self.u,
+            v: &mut self.v,
+            ul: &mut self.ul,
+        };
+        expand(&self.spans[..self.n_spans], p);
         self.n_spans = 0;
     }
 }
 
 /// A run of positions of a scanline: pixel `right + j` samples (`u[j]`, `v[j]`) (Q.8 map
-/// coordinates), and pixel `left_end − 1 − j` samples (`mirror − u[j]`, `v[j]`).
+/// coordinates), and pixel `left_end − 1 − j`, its mirror image, (`ul[j]`, `v[j]`).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct HalfRun<'a> {
     pub(crate) right: usize,
     pub(crate) left_end: usize,
-    pub(crate) mirror: i32,
     pub(crate) u: &'a [i32],
     pub(crate) v: &'a [i32],
+    pub(crate) ul: &'a [i32],
 }
 
 /// Whether the row pass draws the LUT rows of `fr`'s map (full 360° maps whose rows do
@@ -86,25 +94,16 @@ pub(crate) fn row_pass<S: Sink>(
     let Some(h) = Half::exact_rest(scan, fr, sink) else {
         return;
     };
-    let mirror = mirror_q8(fr) as i32;
     let (xa, w) = (h.xa as usize, fr.w_out);
-    let wq = (fr.mw as i32) << 8;
     let mut flush = |buf: &mut HalfBuf, sink: &mut S, c0: i64, n: i64| {
         buf.expand();
-        let c0 = c0 as usize;
-        // The mirror one width up when that puts the run's first left pixel inside the
-        // map (the kernels then seldom wrap; the samples are the same).
-        let mirror = if mirror < buf.u[0] {
-            mirror + wq
-        } else {
-            mirror
-        };
+        let (c0, n) = (c0 as usize, n as usize);
         let r = HalfRun {
             right: xa + c0,
             left_end: w - xa - c0,
-            mirror,
-            u: &buf.u[..n as usize],
-            v: &buf.v[..n as usize],
+            u: &buf.u[..n],
+            v: &buf.v[..n],
+            ul: &buf.ul[..n],
         };
         run(sink, r);
     };
@@ -124,8 +123,9 @@ pub(crate) fn row_pass<S: Sink>(
 }
 
 /// Q.8 positions of `m` pixels from (Λ, V) by (dΛ, dV) (Q.16) at `k` of `buf`: u =
-/// Λ + W/2 + yaw wrapped into [0, W) at the start, v = H/2 − V. Recorded as a span for
-/// `kernel::expand` (`i32` lanes relative to the start's whole Q.8 value); a span that
+/// Λ + W/2 + yaw wrapped into [0, W) at the start, v = H/2 − V, and the mirror image's
+/// u = W/2 + yaw − Λ (`Setup::mirror_fx` − u). Recorded as a span for
+/// `kernel::expand` (`i32` lanes relative to the starts' whole Q.8 values); a span that
 /// travels too far for them (a map width or more: far zoomed out on a tiny map) is
 /// written here, u wrapped per pixel.
 #[inline(always)]
@@ -134,6 +134,11 @@ fn fill(fr: &Setup, buf: &mut HalfBuf, k: usize, m: usize, (l, vv): (Fx, Fx), (d
     let mut u = wrap_u(l + fr.off_fx, wfx);
     if !(0..wfx).contains(&u) {
         u = u.rem_euclid(wfx);
+    }
+    // In [0, W] (the kernels' common case: inside the map).
+    let mut ul = fr.mirror_fx - u;
+    if ul < 0 {
+        ul += wfx;
     }
     let v = fr.half_map_h_fx - vv;
     let dv = -dvv;
@@ -150,17 +155,21 @@ fn fill(fr: &Setup, buf: &mut HalfBuf, k: usize, m: usize, (l, vv): (Fx, Fx), (d
             hv: (v >> 8) as i32,
             lv: (v & 0xFF) as i32,
             dv: dv as i32,
+            hl: (ul >> 8) as i32,
+            ll: (ul & 0xFF) as i32,
         };
         buf.n_spans += 1;
         return;
     }
     // The spans recorded before are expanded first (their last vector may reach here).
     buf.expand();
-    let (mut u, mut v) = (u, v);
-    for (a, b) in buf.u[k..k + m].iter_mut().zip(&mut buf.v[k..k + m]) {
-        *a = (u.rem_euclid(wfx) >> 8) as i32;
-        *b = (v >> 8) as i32;
+    let (mut u, mut v, mut ul) = (u, v, ul);
+    for j in k..k + m {
+        buf.u[j] = (u.rem_euclid(wfx) >> 8) as i32;
+        buf.v[j] = (v >> 8) as i32;
+        buf.ul[j] = (ul.rem_euclid(wfx) >> 8) as i32;
         u += dl;
         v += dv;
+        ul -= dl;
     }
 }

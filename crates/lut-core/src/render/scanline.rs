@@ -346,24 +346,8 @@ impl<'n, N: Nodes> RightSpans<'n, N> {
     }
 }
 
-/// The Q.8 mirror of u in the left half: a right-half pixel at Q.16 u has its mirror
-/// image at [`mirror_fx`] − u, whose whole Q.8 value is `(mirror_fx >> 8) − (u >> 8)`:
-/// the row kernels' `mirror − u` (`render/rowpass.rs`), so both paths sample alike.
-#[inline(always)]
-pub(super) fn mirror_q8(fr: &Setup) -> i64 {
-    (2 * fr.off_fx).rem_euclid(fr.map_w_fx) >> 8
-}
-
-/// See [`mirror_q8`]: 256·M + 255 for M = `mirror_q8`.
-#[inline(always)]
-fn mirror_fx(fr: &Setup) -> Fx {
-    (mirror_q8(fr) << 8) + 255
-}
-
-/// Emit the mirror image of the right-half span (Λ, V) + j·(dΛ, dV), j < m, as the `m`
-/// pixels from `x` on (left to right: j = m − 1 first). Rows that scale with latitude
-/// mirror Λ (−Λ); rectangular maps mirror u (see [`mirror_q8`]), which is −Λ to within
-/// 1/256 pixel and what the row pass samples.
+/// Emit the mirror image of the right-half span (Λ, V) + j·(dΛ, dV), j < m (X → −X
+/// negates Λ) as the `m` pixels from `x` on (left to right: j = m − 1 first).
 #[inline(always)]
 fn emit_mirror<S: Sink>(
     fr: &Setup,
@@ -375,14 +359,7 @@ fn emit_mirror<S: Sink>(
     sink: &mut S,
 ) {
     let (l_end, v_end) = (l + (m - 1) * dl, vv + (m - 1) * dvv);
-    let l_start = if fr.scaled {
-        -l_end
-    } else {
-        // u at the span's far end as `emit` computes it, mirrored, back to Λ.
-        let u0 = wrap_u(l + fr.off_fx, fr.map_w_fx);
-        mirror_fx(fr) - (u0 + (m - 1) * dl) - fr.off_fx
-    };
-    emit(fr, row_scale, x, m, (l_start, v_end), (dl, -dvv), sink);
+    emit(fr, row_scale, x, m, (-l_end, v_end), (dl, -dvv), sink);
 }
 
 /// Emit `m` pixels from `x` on, starting at (Λ, V) and stepping by (dΛ, dV) (also the

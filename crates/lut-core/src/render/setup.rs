@@ -61,6 +61,9 @@ pub(crate) struct Setup {
     pub(crate) half_map_h_fx: Fx,
     /// W/2 + yaw, in map pixels, Q.16 (rectangular maps: u = Λ + off).
     pub(crate) off_fx: Fx,
+    /// 2·`off_fx` wrapped into [0, W): u of a pixel's mirror image (X → −X) is this
+    /// minus its u (modulo W).
+    pub(crate) mirror_fx: Fx,
     /// yaw in map pixels, Q.16 (scaled rows: u = W/2 + s · wrap(Λ + yaw)).
     pub(crate) yaw_fx: Fx,
     pub(crate) yaw: f64,
@@ -87,6 +90,7 @@ impl Setup {
             map_h_fx: (mh as i64) << FX_BITS,
             half_map_h_fx: to_fx(mhf * 0.5),
             off_fx: to_fx(mwf * 0.5 + yaw_px),
+            mirror_fx: (2 * to_fx(mwf * 0.5 + yaw_px)).rem_euclid((mw as i64).max(1) << FX_BITS),
             yaw_fx: to_fx(yaw_px),
             yaw,
             coverage: !proj.full_sphere(),

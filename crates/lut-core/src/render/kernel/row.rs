@@ -1,17 +1,18 @@
-//! Row kernels: the gather (nearest) or gather-and-blend (bilinear) pass over a run of a
-//! scanline's positions, for full 360° maps (the LUT renderer's rows, `render/scanline.rs`
-//! "The row pass").
+//! Row kernels: a run of a scanline's positions expanded from its spans, and the gather
+//! (nearest) or gather-and-blend (bilinear) pass over them, for full 360° maps (the LUT
+//! renderer's rows, `render/rowpass.rs`).
 //!
-//! The positions come as `i32` Q.8 map coordinates (the 8 fraction bits are all the
-//! bilinear weights use), one per pixel, in the order of the right half of the scanline;
-//! the same positions serve the left half mirrored (Λ negated: u = `mirror` − u, the
-//! pixels in reverse order). Per pixel the kernel wraps x by one map width (two for the
-//! mirror) in lanes, clamps y at the poles (dropping the weight there as the per-pixel
-//! sampler does), and gathers: no span checks, no refusals, no per-span setup.
+//! The positions are `i32` Q.8 map coordinates (the 8 fraction bits are all the bilinear
+//! weights use), one per pixel, in the order of the right half of the scanline; the left
+//! half's (its mirror image: Λ negated) are kept in the same order and written to the
+//! row reversed. Per pixel the kernel wraps x by up to two map widths either way in lanes,
+//! clamps y at the poles (dropping the weight there as the per-pixel sampler does), and
+//! gathers: no span checks, no refusals, no per-span setup.
 //!
-//! [`sample_q8_scalar`] is the reference: every SIMD kernel (`x86/row.rs`) writes the
-//! same pixels (`tests.rs`), and they equal the per-pixel samplers' (`EnvMap::nearest` /
-//! `EnvMap::bilinear` at the wrapped position u/256, v/256).
+//! [`sample_q8_scalar`] and [`expand_scalar`] are the reference: every SIMD kernel
+//! (`x86/row.rs`) writes the same pixels and positions (`tests.rs`), and the pixels equal
+//! the per-pixel samplers' (`EnvMap::nearest` / `EnvMap::bilinear` at the wrapped
+//! position u/256, v/256).
 
 use super::select::{active, Selected};
 use super::Texels;
@@ -78,24 +79,19 @@ fn wrap_x(mut x: i32, w: i32) -> i32 {
     x.clamp(0, w - 1)
 }
 
-/// The scalar kernel: `out[j]` = the sample at (`u[j]`, `v[j]`), or with `MIRROR`
-/// `out[n − 1 − j]` = the sample at (`mirror` − `u[j]`, `v[j]`) (n = `out.len()` ≤ the
-/// positions).
+/// The scalar kernel: `out[j]` = the sample at (`u[j]`, `v[j]`), or with `MIRROR` (the
+/// left half) `out[n − 1 − j]` (n = `out.len()` ≤ the positions).
 #[inline(always)]
 pub(super) fn sample_q8_scalar<const BILINEAR: bool, const MIRROR: bool>(
     t: &Texels,
     u: &[i32],
     v: &[i32],
-    mirror: i32,
     out: &mut [u32],
 ) {
     let n = out.len();
     for (j, (&uu, &vv)) in u[..n].iter().zip(&v[..n]).enumerate() {
-        if MIRROR {
-            out[n - 1 - j] = sample_at::<BILINEAR>(t, mirror - uu, vv);
-        } else {
-            out[j] = sample_at::<BILINEAR>(t, uu, vv);
-        }
+        let at = if MIRROR { n - 1 - j } else { j };
+        out[at] = sample_at::<BILINEAR>(t, uu, vv);
     }
 }
 
@@ -106,7 +102,6 @@ pub(super) fn sample_q8_with<const BILINEAR: bool, const MIRROR: bool>(
     t: &Texels,
     u: &[i32],
     v: &[i32],
-    mirror: i32,
     out: &mut [u32],
 ) {
     assert!(
@@ -114,18 +109,17 @@ pub(super) fn sample_q8_with<const BILINEAR: bool, const MIRROR: bool>(
         "a position per pixel"
     );
     #[cfg(target_arch = "x86_64")]
-    if x86::row::sample_q8::<BILINEAR, MIRROR>(k, t, u, v, mirror, out) {
+    if x86::row::sample_q8::<BILINEAR, MIRROR>(k, t, u, v, out) {
         return;
     }
     let _ = k;
-    sample_q8_scalar::<BILINEAR, MIRROR>(t, u, v, mirror, out);
+    sample_q8_scalar::<BILINEAR, MIRROR>(t, u, v, out);
 }
 
 /// [`sample_q8_scalar`] with the [`active_kernel`](super::active_kernel): the row pass's
-/// pixels. Positions u (and `mirror − u`) must lie within two map widths of the map, as
-/// the row pass's do (a span starts in the map and travels less than a width; `mirror`
-/// is in `[0, 512·W)`); outside, x is clamped (never a read outside the map). y is
-/// clamped.
+/// pixels. Positions u must lie within two map widths of the map, as the row pass's do
+/// (a span starts in the map and travels less than a width); outside, x is clamped
+/// (never a read outside the map). y is clamped.
 ///
 /// # Panics
 /// When there are fewer positions than pixels.
@@ -134,15 +128,15 @@ pub(crate) fn sample_q8<const BILINEAR: bool, const MIRROR: bool>(
     t: &Texels,
     u: &[i32],
     v: &[i32],
-    mirror: i32,
     out: &mut [u32],
 ) {
-    sample_q8_with::<BILINEAR, MIRROR>(active(), t, u, v, mirror, out);
+    sample_q8_with::<BILINEAR, MIRROR>(active(), t, u, v, out);
 }
 
-/// A span of a row's positions (see [`expand`]): pixels `k..k + m` of the buffers get
-/// `hu + ((lu + j·du) >> 8)` and `hv + ((lv + j·dv) >> 8)` (j = 0..m): Q.8 positions
-/// of a Q.16 start `256·hu + lu` (0 ≤ lu < 256) stepping by du.
+/// A span of a row's positions (see [`expand`]): pixel `k + j` (j < m) of the buffers
+/// gets `hu + ((lu + j·du) >> 8)`, `hv + ((lv + j·dv) >> 8)` and, for the mirror image
+/// in the left half, `hl + ((ll − j·du) >> 8)`: the Q.8 (floored) positions of Q.16
+/// starts `256·h + l` (0 ≤ l < 256) and steps.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub(crate) struct SpanQ8 {
     pub(crate) k: u32,
@@ -153,42 +147,56 @@ pub(crate) struct SpanQ8 {
     pub(crate) hv: i32,
     pub(crate) lv: i32,
     pub(crate) dv: i32,
+    pub(crate) hl: i32,
+    pub(crate) ll: i32,
+}
+
+/// The position buffers of a run: u and v of the right half, u of the left half (its v
+/// is the right half's), indexed alike.
+pub(crate) struct Positions<'a> {
+    pub(crate) u: &'a mut [i32],
+    pub(crate) v: &'a mut [i32],
+    pub(crate) ul: &'a mut [i32],
 }
 
 /// The scalar kernel of [`expand`]: exactly pixels `k..k + m` of each span.
 #[inline(always)]
-pub(super) fn expand_scalar(spans: &[SpanQ8], u: &mut [i32], v: &mut [i32]) {
+pub(super) fn expand_scalar(spans: &[SpanQ8], p: Positions<'_>) {
     for s in spans {
-        let (k, m) = (s.k as usize, s.m as usize);
-        let (mut lu, mut lv) = (s.lu, s.lv);
-        for (a, b) in u[k..k + m].iter_mut().zip(&mut v[k..k + m]) {
+        let r = s.k as usize..(s.k + s.m) as usize;
+        let (mut lu, mut lv, mut ll) = (s.lu, s.lv, s.ll);
+        let out = p.u[r.clone()].iter_mut().zip(&mut p.v[r.clone()]);
+        for ((a, b), c) in out.zip(&mut p.ul[r]) {
             *a = s.hu.wrapping_add(lu >> 8);
             *b = s.hv.wrapping_add(lv >> 8);
+            *c = s.hl.wrapping_add(ll >> 8);
             lu = lu.wrapping_add(s.du);
             lv = lv.wrapping_add(s.dv);
+            ll = ll.wrapping_sub(s.du);
         }
     }
 }
 
 /// Expand `spans` (in order of `k`, each starting where the one before ended) into the
-/// position buffers `u` and `v`, which hold at least 8 entries past the last span (the
-/// SIMD kernels write whole vectors; the next span overwrites what lies past a span).
-/// The row pass's per-pixel positions, one kernel call per run.
+/// position buffers, which hold at least 8 entries past the last span (the SIMD kernels
+/// write whole vectors; the next span overwrites what lies past a span). The row pass's
+/// per-pixel positions, one kernel call per run.
 ///
 /// # Panics
 /// When a span (rounded up to 8 pixels) does not fit in the buffers.
 #[inline]
-pub(crate) fn expand(spans: &[SpanQ8], u: &mut [i32], v: &mut [i32]) {
-    expand_with(active(), spans, u, v);
+pub(crate) fn expand(spans: &[SpanQ8], p: Positions<'_>) {
+    expand_with(active(), spans, p);
 }
 
 /// [`expand`] with kernel `k`.
 #[inline]
-pub(super) fn expand_with(k: Selected, spans: &[SpanQ8], u: &mut [i32], v: &mut [i32]) {
+pub(super) fn expand_with(k: Selected, spans: &[SpanQ8], p: Positions<'_>) {
     #[cfg(target_arch = "x86_64")]
-    if x86::row::expand(k, spans, u, v) {
-        return;
-    }
+    let p = match x86::row::expand(k, spans, p) {
+        None => return,
+        Some(p) => p,
+    };
     let _ = k;
-    expand_scalar(spans, u, v);
+    expand_scalar(spans, p);
 }

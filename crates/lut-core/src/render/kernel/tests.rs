@@ -569,13 +569,12 @@ fn direct_nearest_spans_equal_per_pixel_samples() {
 
 /// Q.8 positions as the row pass hands them to the row kernels (`row.rs`): u within W − 1
 /// pixels of the map (mostly inside, at the seam, or a period off), v anywhere from a
-/// map height above the top to one below the bottom (the pole rows), a mirror in
-/// [0, 512·W), 1..=64 pixels written at an offset 0..8 of a sentinel-filled buffer.
+/// map height above the top to one below the bottom (the pole rows), 1..=64 pixels
+/// written at an offset 0..8 of a sentinel-filled buffer.
 #[derive(Debug, Clone)]
 struct RowCase {
     u: Vec<i32>,
     v: Vec<i32>,
-    mirror: i32,
     off: usize,
 }
 
@@ -599,10 +598,9 @@ fn row_case(w: u32, h: u32) -> impl Strategy<Value = RowCase> {
         (
             prop::collection::vec(u, n),
             prop::collection::vec(v, n),
-            0..2 * wq,
             Just(off),
         )
-            .prop_map(|(u, v, mirror, off)| RowCase { u, v, mirror, off })
+            .prop_map(|(u, v, off)| RowCase { u, v, off })
     })
 }
 
@@ -611,15 +609,16 @@ fn run_row<const B: bool, const M: bool>(k: Kernel, t: &Texels, c: &RowCase) -> 
     let n = c.u.len();
     let mut buf = vec![SENTINEL; n + 16];
     let out = &mut buf[c.off..c.off + n];
-    row::sample_q8_with::<B, M>(k.selected(), t, &c.u, &c.v, c.mirror, out);
+    row::sample_q8_with::<B, M>(k.selected(), t, &c.u, &c.v, out);
     buf
 }
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
 
-    /// The row kernels (nearest, bilinear; straight and mirrored): every kernel writes
-    /// the scalar one's pixels, and only its pixels (the sentinels around stay).
+    /// The row kernels (nearest, bilinear; in order and reversed for the left half):
+    /// every kernel writes the scalar one's pixels, and only its pixels (the sentinels
+    /// around stay).
     #[test]
     fn row_kernels_equal_scalar(
         (mi, cases) in (0..maps().len()).prop_flat_map(|mi| {
@@ -653,7 +652,7 @@ proptest! {
     }
 
     /// The scalar row kernel equals the per-pixel samplers at the Q.8 position, u
-    /// wrapped into the map (mirrored: at `mirror − u`).
+    /// wrapped into the map (reversed: pixel n − 1 − j at position j).
     #[test]
     fn row_scalar_equals_per_pixel(
         (wh, cases) in prop::sample::select(vec![(2u32, 2u32), (5, 3), (64, 32), (300, 150)])
@@ -666,19 +665,19 @@ proptest! {
         let wfx = (w as i64) << 16;
         for c in &cases {
             let n = c.u.len();
-            for (b, mirror) in [(false, false), (false, true), (true, false), (true, true)] {
-                let out = match (b, mirror) {
+            for (b, rev) in [(false, false), (false, true), (true, false), (true, true)] {
+                let out = match (b, rev) {
                     (false, false) => run_row::<false, false>(Kernel::Scalar, &t, c),
                     (false, true) => run_row::<false, true>(Kernel::Scalar, &t, c),
                     (true, false) => run_row::<true, false>(Kernel::Scalar, &t, c),
                     (true, true) => run_row::<true, true>(Kernel::Scalar, &t, c),
                 };
                 for j in 0..n {
-                    let (uq, at) = if mirror { (c.mirror - c.u[j], n - 1 - j) } else { (c.u[j], j) };
-                    let u = ((uq as i64) << 8).rem_euclid(wfx);
+                    let at = if rev { n - 1 - j } else { j };
+                    let u = ((c.u[j] as i64) << 8).rem_euclid(wfx);
                     let v = (c.v[j] as i64) << 8;
                     let want = if b { m.bilinear(u, v) } else { m.nearest(u, v) };
-                    prop_assert_eq!(out[c.off + at], want, "pixel {} bilinear {} mirror {} {:?}", j, b, mirror, c);
+                    prop_assert_eq!(out[c.off + at], want, "pixel {} bilinear {} reversed {} {:?}", j, b, rev, c);
                 }
             }
         }
@@ -686,37 +685,43 @@ proptest! {
 
     /// The positions kernel: every kernel writes what the scalar one writes over a run
     /// of consecutive spans of 1..=64 pixels (what a SIMD kernel writes past a span the
-    /// next one overwrites; past the run it is not compared).
+    /// next one overwrites; past the run it is not compared), and the scalar one the
+    /// floored Q.8 positions of the spans' Q.16 lines.
     #[test]
     fn expand_equals_scalar(
         spans in prop::collection::vec(
-            (1u32..=64, -(1i32 << 24)..(1 << 24), 0i32..256, -(1i32 << 22)..(1 << 22),
-             -(1i32 << 24)..(1 << 24), 0i32..256, -(1i32 << 22)..(1 << 22)),
+            (1u32..=64, -(1i32 << 22)..(1 << 22), (0i32..256, 0i32..256, 0i32..256),
+             -(1i32 << 22)..(1 << 22), -(1i32 << 22)..(1 << 22), -(1i32 << 22)..(1 << 22)),
             1..40,
         )
     ) {
         let mut k = 0u32;
         let spans: Vec<SpanQ8> = spans
             .into_iter()
-            .map(|(m, hu, lu, du, hv, lv, dv)| {
-                let s = SpanQ8 { k, m, hu, lu, du, hv, lv, dv };
+            .map(|(m, hu, (lu, lv, ll), du, hv, dv)| {
+                let s = SpanQ8 { k, m, hu, lu, du, hv, lv, dv, hl: hu ^ 0x5555, ll };
                 k += m;
                 s
             })
             .collect();
         let room = k as usize + 8;
         let run = |kern: Kernel| {
-            let (mut u, mut v) = (vec![0i32; room], vec![0i32; room]);
-            row::expand_with(kern.selected(), &spans, &mut u, &mut v);
-            u.truncate(k as usize);
-            v.truncate(k as usize);
-            (u, v)
+            let mut b = [vec![0i32; room], vec![0i32; room], vec![0i32; room]];
+            let [u, v, ul] = &mut b;
+            row::expand_with(kern.selected(), &spans, row::Positions { u, v, ul });
+            b.map(|mut x| {
+                x.truncate(k as usize);
+                x
+            })
         };
         let want = run(Kernel::Scalar);
         for s in &spans {
-            for j in 0..s.m as usize {
-                let q = ((s.hu as i64) << 8) + s.lu as i64 + j as i64 * s.du as i64;
-                prop_assert_eq!(want.0[s.k as usize + j] as i64, q >> 8);
+            for j in 0..s.m as i64 {
+                let q = |h: i32, l: i32, d: i32| (((h as i64) << 8) + l as i64 + j * d as i64) >> 8;
+                let i = s.k as usize + j as usize;
+                prop_assert_eq!(want[0][i] as i64, q(s.hu, s.lu, s.du));
+                prop_assert_eq!(want[1][i] as i64, q(s.hv, s.lv, s.dv));
+                prop_assert_eq!(want[2][i] as i64, q(s.hl, s.ll, -s.du));
             }
         }
         for kern in others() {

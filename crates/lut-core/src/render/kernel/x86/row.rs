@@ -1,9 +1,9 @@
 //! x86-64 row kernels (see `kernel/row.rs`): 8 (AVX2) or 4 (SSE4.1) pixels per step, the
 //! seam wrap and the pole clamp as lane compares, the texels read as the map kernels read
 //! them (two 64-bit loads per bilinear pixel) and blended with their `split`, `lerp` and
-//! `merge`; the mirrored half's pixels reversed in the register before the store.
+//! `merge`; the left half's pixels reversed in the register before the store.
 
-use super::super::row::{sample_q8_scalar, SpanQ8};
+use super::super::row::{sample_q8_scalar, Positions, SpanQ8};
 use super::{Kernel, Selected, Texels};
 use std::arch::x86_64::*;
 
@@ -15,36 +15,34 @@ pub(in super::super) fn sample_q8<const BILINEAR: bool, const MIRROR: bool>(
     t: &Texels,
     u: &[i32],
     v: &[i32],
-    mirror: i32,
     out: &mut [u32],
 ) -> bool {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        Kernel::Avx2 => unsafe { avx2::sample_q8::<BILINEAR, MIRROR>(t, u, v, mirror, out) },
+        Kernel::Avx2 => unsafe { avx2::sample_q8::<BILINEAR, MIRROR>(t, u, v, out) },
         // SAFETY: as above.
-        Kernel::Sse41 => unsafe { sse41::sample_q8::<BILINEAR, MIRROR>(t, u, v, mirror, out) },
+        Kernel::Sse41 => unsafe { sse41::sample_q8::<BILINEAR, MIRROR>(t, u, v, out) },
         Kernel::Scalar => return false,
     }
     true
 }
 
-/// [`expand`](super::super::row::expand) with a SIMD kernel; `false` (nothing written) for
-/// the scalar one.
+/// [`expand`](super::super::row::expand) with a SIMD kernel; the buffers back, untouched,
+/// for the scalar one.
 #[inline(always)]
-pub(in super::super) fn expand(
+pub(in super::super) fn expand<'a>(
     k: Selected,
     spans: &[SpanQ8],
-    u: &mut [i32],
-    v: &mut [i32],
-) -> bool {
+    p: Positions<'a>,
+) -> Option<Positions<'a>> {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        Kernel::Avx2 => unsafe { avx2::expand(spans, u, v) },
+        Kernel::Avx2 => unsafe { avx2::expand(spans, p) },
         // SAFETY: as above.
-        Kernel::Sse41 => unsafe { sse41::expand(spans, u, v) },
-        Kernel::Scalar => return false,
+        Kernel::Sse41 => unsafe { sse41::expand(spans, p) },
+        Kernel::Scalar => return Some(p),
     }
-    true
+    None
 }
 
 /// The largest index whose read (one texel, or the 2×2 block) stays inside `t`.
@@ -125,28 +123,36 @@ mod avx2 {
 
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn expand(spans: &[SpanQ8], u: &mut [i32], v: &mut [i32]) {
+    pub(super) fn expand(spans: &[SpanQ8], p: Positions<'_>) {
         let iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
         for s in spans {
             let (k, m) = (s.k as usize, s.m as usize);
-            let r = m.next_multiple_of(8);
-            let (bu, bv) = (&mut u[k..k + r], &mut v[k..k + r]);
+            let r = k..k + m.next_multiple_of(8);
+            let cu = p.u[r.clone()].chunks_exact_mut(8);
+            let out = cu.zip(p.v[r.clone()].chunks_exact_mut(8));
             let set = _mm256_set1_epi32;
             let (du, dv) = (set(s.du), set(s.dv));
-            let mut lu = _mm256_add_epi32(set(s.lu), _mm256_mullo_epi32(iota, du));
-            let mut lv = _mm256_add_epi32(set(s.lv), _mm256_mullo_epi32(iota, dv));
+            let (iu, iv) = (_mm256_mullo_epi32(iota, du), _mm256_mullo_epi32(iota, dv));
+            let (mut lu, mut lv) = (
+                _mm256_add_epi32(set(s.lu), iu),
+                _mm256_add_epi32(set(s.lv), iv),
+            );
+            let mut ll = _mm256_sub_epi32(set(s.ll), iu);
             let (su, sv) = (_mm256_slli_epi32::<3>(du), _mm256_slli_epi32::<3>(dv));
-            let (hu, hv) = (set(s.hu), set(s.hv));
-            for (cu, cv) in bu.chunks_exact_mut(8).zip(bv.chunks_exact_mut(8)) {
+            let (hu, hv, hl) = (set(s.hu), set(s.hv), set(s.hl));
+            for ((cu, cv), cl) in out.zip(p.ul[r].chunks_exact_mut(8)) {
                 let a = _mm256_add_epi32(hu, _mm256_srai_epi32::<8>(lu));
                 let b = _mm256_add_epi32(hv, _mm256_srai_epi32::<8>(lv));
-                // SAFETY: `cu`, `cv` are 8 writable i32 each; the stores are unaligned.
+                let c = _mm256_add_epi32(hl, _mm256_srai_epi32::<8>(ll));
+                // SAFETY: `cu`, `cv`, `cl` are 8 writable i32 each; unaligned stores.
                 unsafe {
                     _mm256_storeu_si256(cu.as_mut_ptr().cast(), a);
                     _mm256_storeu_si256(cv.as_mut_ptr().cast(), b);
+                    _mm256_storeu_si256(cl.as_mut_ptr().cast(), c);
                 }
                 lu = _mm256_add_epi32(lu, su);
                 lv = _mm256_add_epi32(lv, sv);
+                ll = _mm256_sub_epi32(ll, su);
             }
         }
     }
@@ -157,7 +163,6 @@ mod avx2 {
         t: &Texels,
         u: &[i32],
         v: &[i32],
-        mirror: i32,
         out: &mut [u32],
     ) {
         let n = out.len();
@@ -178,11 +183,6 @@ mod avx2 {
                     _mm256_loadu_si256(cu.as_ptr().cast()),
                     _mm256_loadu_si256(cv.as_ptr().cast()),
                 )
-            };
-            let uu = if MIRROR {
-                _mm256_sub_epi32(_mm256_set1_epi32(mirror), uu)
-            } else {
-                uu
             };
             let (i, fx, fy) = lanes::<BILINEAR>(t, uu, vv, last);
             let mut a = [0u32; 8];
@@ -235,7 +235,7 @@ mod avx2 {
         } else {
             &mut out[j..]
         };
-        sample_q8_scalar::<BILINEAR, MIRROR>(t, &u[j..], &v[j..], mirror, rest);
+        sample_q8_scalar::<BILINEAR, MIRROR>(t, &u[j..], &v[j..], rest);
     }
 }
 
@@ -270,28 +270,33 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn expand(spans: &[SpanQ8], u: &mut [i32], v: &mut [i32]) {
+    pub(super) fn expand(spans: &[SpanQ8], p: Positions<'_>) {
         let iota = _mm_setr_epi32(0, 1, 2, 3);
         for s in spans {
             let (k, m) = (s.k as usize, s.m as usize);
-            let r = m.next_multiple_of(4);
-            let (bu, bv) = (&mut u[k..k + r], &mut v[k..k + r]);
+            let r = k..k + m.next_multiple_of(4);
+            let cu = p.u[r.clone()].chunks_exact_mut(4);
+            let out = cu.zip(p.v[r.clone()].chunks_exact_mut(4));
             let set = _mm_set1_epi32;
             let (du, dv) = (set(s.du), set(s.dv));
-            let mut lu = _mm_add_epi32(set(s.lu), _mm_mullo_epi32(iota, du));
-            let mut lv = _mm_add_epi32(set(s.lv), _mm_mullo_epi32(iota, dv));
+            let (iu, iv) = (_mm_mullo_epi32(iota, du), _mm_mullo_epi32(iota, dv));
+            let (mut lu, mut lv) = (_mm_add_epi32(set(s.lu), iu), _mm_add_epi32(set(s.lv), iv));
+            let mut ll = _mm_sub_epi32(set(s.ll), iu);
             let (su, sv) = (_mm_slli_epi32::<2>(du), _mm_slli_epi32::<2>(dv));
-            let (hu, hv) = (set(s.hu), set(s.hv));
-            for (cu, cv) in bu.chunks_exact_mut(4).zip(bv.chunks_exact_mut(4)) {
+            let (hu, hv, hl) = (set(s.hu), set(s.hv), set(s.hl));
+            for ((cu, cv), cl) in out.zip(p.ul[r].chunks_exact_mut(4)) {
                 let a = _mm_add_epi32(hu, _mm_srai_epi32::<8>(lu));
                 let b = _mm_add_epi32(hv, _mm_srai_epi32::<8>(lv));
-                // SAFETY: `cu`, `cv` are 4 writable i32 each; the stores are unaligned.
+                let c = _mm_add_epi32(hl, _mm_srai_epi32::<8>(ll));
+                // SAFETY: `cu`, `cv`, `cl` are 4 writable i32 each; unaligned stores.
                 unsafe {
                     _mm_storeu_si128(cu.as_mut_ptr().cast(), a);
                     _mm_storeu_si128(cv.as_mut_ptr().cast(), b);
+                    _mm_storeu_si128(cl.as_mut_ptr().cast(), c);
                 }
                 lu = _mm_add_epi32(lu, su);
                 lv = _mm_add_epi32(lv, sv);
+                ll = _mm_sub_epi32(ll, su);
             }
         }
     }
@@ -302,7 +307,6 @@ mod sse41 {
         t: &Texels,
         u: &[i32],
         v: &[i32],
-        mirror: i32,
         out: &mut [u32],
     ) {
         let n = out.len();
@@ -322,11 +326,6 @@ mod sse41 {
                     _mm_loadu_si128(cu.as_ptr().cast()),
                     _mm_loadu_si128(cv.as_ptr().cast()),
                 )
-            };
-            let uu = if MIRROR {
-                _mm_sub_epi32(_mm_set1_epi32(mirror), uu)
-            } else {
-                uu
             };
             let (i, fx, fy) = lanes::<BILINEAR>(t, uu, vv, last);
             let mut a = [0u32; 4];
@@ -374,6 +373,6 @@ mod sse41 {
         } else {
             &mut out[j..]
         };
-        sample_q8_scalar::<BILINEAR, MIRROR>(t, &u[j..], &v[j..], mirror, rest);
+        sample_q8_scalar::<BILINEAR, MIRROR>(t, &u[j..], &v[j..], rest);
     }
 }
