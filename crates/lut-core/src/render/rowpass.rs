@@ -5,12 +5,13 @@
 //! Only the right half of the table-covered pixels is walked (`scanline.rs`: reads every
 //! 2^shift pixels outward from the centre, the column coordinate stepped in whole
 //! numbers, one-eighth unfolding as sign masks hoisted per half, the seam unwrapped per
-//! span); each span's pixels get their Q.8 map position (u wrapped once at the span's
-//! start, v = H/2 − V) in a buffer of [`HALF_CHUNK`] pixels. The left half is the right
-//! half mirrored: the same reads with Λ negated, so its positions are `mirror − u`
-//! (`mirror` = 2·(W/2 + yaw) mod W) and the same v, its pixels in reverse order. Each
-//! full buffer goes to the row kernels (`kernel/row.rs`: x wrapped and y clamped in
-//! lanes, then the gather and blend), for the left half and then the right one.
+//! span). The left half is the right half mirrored: the same reads with Λ negated, so
+//! each span's mirror image has u = 2·(W/2 + yaw) − u (`Setup::mirror_fx`), the same v,
+//! and its pixels in reverse order. Each span is recorded and `kernel::expand` writes
+//! the floored Q.8 map positions of both (u wrapped once at the span's start, v = H/2 −
+//! V) into buffers of [`HALF_CHUNK`] pixels of the half; each full buffer goes to the
+//! row kernels (`kernel/row.rs`: x wrapped and y clamped in lanes, then the gather and
+//! blend), for the left half and then the right one.
 //!
 //! The pixels sample exactly the positions [`row_pass`] writes; `Renderer::positions`
 //! reads the same buffers, so the measured sampling error is this pass's.
