@@ -52,12 +52,12 @@ use cube::{render_cube, CubeRenderer};
 use exact::{render_exact, ExactFootprint};
 use frame::Frame;
 use grid::{Grid, GridStats};
-use kernel::{level_texels, sample_q8, texels};
-use rowpass::{row_pass, HalfRun};
+use kernel::{level_texels, texels};
+use rowpass::{pixel_row, position_row};
 use rows::{for_each_band_init, for_each_row, for_each_row_init, post_bands};
 use scanline::{render_row, RowScratch, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
-use sink::{Batch, PixelRows, PixelSink, PosRows, PosSink, RowSinks, Sink, TriRows, TriSink};
+use sink::{Batch, PixelRows, PosRows, RowSinks, Sink, TriRows, TriSink};
 use std::f64::consts::TAU;
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
@@ -586,11 +586,11 @@ impl Renderer {
             return Ok(match hook {
                 Some(post) => {
                     let (b, t) = (HOOK_BAND_ROWS, opts.threads);
-                    for_each_band_init(out, w, b, t, new_scratch, row, post);
+                    for_each_band_init(out, w, b, t, RowScratch::new, row, post);
                     (report, true)
                 }
                 None => {
-                    for_each_row_init(out, w, opts.threads, new_scratch, row);
+                    for_each_row_init(out, w, opts.threads, RowScratch::new, row);
                     (report, false)
                 }
             });
@@ -607,49 +607,15 @@ impl Renderer {
         ) {
             let (scans, table, setup, row_scale) = k;
             let t = texels(map);
-            let pass = rowpass::applies(setup);
-            let wq = (map.width() as i32) << 8;
             let row = |scratch: &mut RowScratch, y: usize, row: &mut [u32]| {
-                let mut s = PixelSink::<BILINEAR, CROP>::new(row, map);
-                if pass {
-                    // The row pass: positions, then the row kernels (left half, right half).
-                    let RowScratch { nodes, row: buf } = scratch;
-                    row_pass(&scans[y], table, setup, (nodes, buf), &mut s, |s, r| {
-                        let n = r.u.len();
-                        if CROP {
-                            // Partial maps: per pixel, at the same positions.
-                            let q = |u: i32| (u.rem_euclid(wq) as i64) << 8;
-                            for (j, (&v, (&u, &ul))) in
-                                r.v.iter().zip(r.u.iter().zip(r.ul)).enumerate()
-                            {
-                                let v = (v as i64) << 8;
-                                s.put(r.left_end - 1 - j, q(ul), v);
-                                s.put(r.right + j, q(u), v);
-                            }
-                            return;
-                        }
-                        let left = &mut s.row[r.left_end - n..r.left_end];
-                        sample_q8::<BILINEAR, true>(&t, r.ul, r.v, left);
-                        let right = &mut s.row[r.right..r.right + n];
-                        sample_q8::<BILINEAR, false>(&t, r.u, r.v, right);
-                    });
-                } else {
-                    render_row(
-                        &scans[y],
-                        table,
-                        setup,
-                        row_scale,
-                        &mut scratch.nodes,
-                        &mut s,
-                    );
-                    s.flush();
-                }
+                let lut = (&scans[y], table, setup, row_scale);
+                pixel_row::<BILINEAR, CROP>(lut, scratch, (map, &t), row);
             };
             match hook {
                 Some(post) => {
-                    for_each_band_init(out, w, HOOK_BAND_ROWS, threads, new_scratch, row, post)
+                    for_each_band_init(out, w, HOOK_BAND_ROWS, threads, RowScratch::new, row, post)
                 }
-                None => for_each_row_init(out, w, threads, new_scratch, row),
+                None => for_each_row_init(out, w, threads, RowScratch::new, row),
             }
         }
         let k = (&scans[..], table, &setup, row_scale);
@@ -776,46 +742,14 @@ impl Renderer {
             &mut out,
             width as usize,
             opts.threads,
-            new_scratch,
+            RowScratch::new,
             |scratch, y, row| {
-                let mut s = PosSink { row };
-                if pass {
-                    let RowScratch { nodes, row: buf } = scratch;
-                    let run = |s: &mut PosSink<'_>, r: HalfRun<'_>| pass_positions(s, r, wq);
-                    row_pass(&scans[y], table, &setup, (nodes, buf), &mut s, run);
-                    return;
-                }
-                render_row(
-                    &scans[y],
-                    table,
-                    &setup,
-                    row_scale,
-                    &mut scratch.nodes,
-                    &mut s,
-                );
+                let lut = (&scans[y], table, &setup, row_scale);
+                position_row(lut, scratch, pass.then_some(wq), row);
             },
         );
         Ok((out, report))
     }
-}
-
-/// The positions of a run of the row pass as its kernels sample them (Q.8, u wrapped into
-/// the map, `wq` = 256·W): the left half's pixels, then the right half's (the centre
-/// pixel of an odd width is the right half's).
-fn pass_positions(s: &mut PosSink<'_>, r: HalfRun<'_>, wq: i32) {
-    let px = |u: i32, v: i32| Some((u.rem_euclid(wq) as f64 / 256.0, v as f64 / 256.0));
-    for (j, (&u, &v)) in r.ul.iter().zip(r.v).enumerate() {
-        s.row[r.left_end - 1 - j] = px(u, v);
-    }
-    for (j, (&u, &v)) in r.u.iter().zip(r.v).enumerate() {
-        s.row[r.right + j] = px(u, v);
-    }
-}
-
-/// A row task's room for blended table nodes and a row's positions (on the stack: no
-/// allocation per frame).
-fn new_scratch() -> RowScratch {
-    RowScratch::new()
 }
 
 /// The map geometry the renderers use: (width, height, projection) of the full panorama.

@@ -16,13 +16,15 @@
 //! The pixels sample exactly the positions [`row_pass`] writes; `Renderer::positions`
 //! reads the same buffers, so the measured sampling error is this pass's.
 
-use super::kernel::{expand, Positions, SpanQ8};
-use super::scanline::{blend_pays, with_nodes, wrap_u, Half, RightSpans};
-use super::scanline::{Scratch, BLEND_NODES};
+use super::kernel::{expand, sample_q8, Positions, SpanQ8, Texels};
+use super::scanline::{blend_pays, render_row, with_nodes, wrap_u, Half, RightSpans};
+use super::scanline::{RowScratch, Scratch, BLEND_NODES};
 use super::setup::{Scan, Setup};
 use super::sink::Sink;
+use super::sink::{PixelSink, PosSink};
 use crate::geom::fixed::{Fx, FX_ONE};
 use crate::lut::{Blended, LutTable};
+use crate::map::envmap::EnvMap;
 
 /// Pixels of a half row whose positions are buffered before the row kernels run.
 pub(crate) const HALF_CHUNK: usize = 512;
@@ -173,4 +175,69 @@ fn fill(fr: &Setup, buf: &mut HalfBuf, k: usize, m: usize, (l, vv): (Fx, Fx), (d
         v += dv;
         ul -= dl;
     }
+}
+
+/// A scanline of the LUT renderer: its scan, the table, the frame's setup, the row scale.
+pub(crate) type LutRow<'a> = (&'a Scan, &'a LutTable, &'a Setup, &'a [i64]);
+
+/// Draw one LUT scanline of `map` (`t`: its texels) into `row`: the row pass where it
+/// applies ([`applies`]; partial maps take its positions with the per-pixel crop
+/// samplers), else span by span through the sink.
+#[inline]
+pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
+    (scan, table, fr, row_scale): LutRow<'_>,
+    scratch: &mut RowScratch,
+    (map, t): (&EnvMap, &Texels<'_>),
+    row: &mut [u32],
+) {
+    let mut s = PixelSink::<BILINEAR, CROP>::new(row, map);
+    if !applies(fr) {
+        render_row(scan, table, fr, row_scale, &mut scratch.nodes, &mut s);
+        s.flush();
+        return;
+    }
+    let wq = (map.width() as i32) << 8;
+    let RowScratch { nodes, row: buf } = scratch;
+    row_pass(scan, table, fr, (nodes, buf), &mut s, |s, r| {
+        let n = r.u.len();
+        if CROP {
+            let q = |u: i32| (u.rem_euclid(wq) as i64) << 8;
+            for (j, (&v, (&u, &ul))) in r.v.iter().zip(r.u.iter().zip(r.ul)).enumerate() {
+                let v = (v as i64) << 8;
+                s.put(r.left_end - 1 - j, q(ul), v);
+                s.put(r.right + j, q(u), v);
+            }
+            return;
+        }
+        sample_q8::<BILINEAR, true>(t, r.ul, r.v, &mut s.row[r.left_end - n..r.left_end]);
+        sample_q8::<BILINEAR, false>(t, r.u, r.v, &mut s.row[r.right..r.right + n]);
+    });
+}
+
+/// The sampling positions of one LUT scanline into `row`: the row pass's (`wq` = 256·W,
+/// when the row pass draws these pixels), else the span walk's.
+#[inline]
+pub(crate) fn position_row(
+    (scan, table, fr, row_scale): LutRow<'_>,
+    scratch: &mut RowScratch,
+    wq: Option<i32>,
+    row: &mut [Option<(f64, f64)>],
+) {
+    let mut s = PosSink { row };
+    let Some(wq) = wq else {
+        render_row(scan, table, fr, row_scale, &mut scratch.nodes, &mut s);
+        return;
+    };
+    let RowScratch { nodes, row: buf } = scratch;
+    row_pass(scan, table, fr, (nodes, buf), &mut s, |s, r| {
+        // As the row kernels sample them: Q.8, u wrapped into the map; the left half
+        // first (the centre pixel of an odd width is the right half's).
+        let px = |u: i32, v: i32| Some((u.rem_euclid(wq) as f64 / 256.0, v as f64 / 256.0));
+        for (j, (&u, &v)) in r.ul.iter().zip(r.v).enumerate() {
+            s.row[r.left_end - 1 - j] = px(u, v);
+        }
+        for (j, (&u, &v)) in r.u.iter().zip(r.v).enumerate() {
+            s.row[r.right + j] = px(u, v);
+        }
+    });
 }
