@@ -26,7 +26,7 @@ use super::paint::Compositor;
 use super::prefs::Prefs;
 use super::quality::{FrameTimes, Level};
 use super::OpenArgs;
-use crate::lighting::{LightsKey, LightsState, LitCache};
+use crate::lighting::{LightsKey, LightsState, LitCache, LitPanorama};
 use anyhow::{anyhow, Result};
 use lut_core::{CubeRenderer, IndexStep, LutChoice, RendererKind, Sampler};
 use std::collections::VecDeque;
@@ -122,6 +122,8 @@ struct App {
     lights: LightsState,
     /// Their illuminance map, rebuilt when they change.
     lit: LitCache,
+    /// The panorama lit once the lighting has settled, panned as an unlit one.
+    baked: LitPanorama,
     /// The luminaire being dragged in the view.
     light_drag: Option<usize>,
     /// The room edge being dragged (an index into `lut_core::Room::EDGES`).
@@ -193,6 +195,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         fatal: None,
         lights,
         lit: LitCache::default(),
+        baked: LitPanorama::default(),
         light_drag: None,
         edge_drag: None,
         corner_drag: None,
