@@ -43,7 +43,7 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 /// (96 MiB + 32 MiB). An 8192 × 4096 panorama is what today's 360° cameras and most
 /// stitched panoramas deliver; beyond it the copy would double a memory use that is
 /// already over half a gigabyte, and its bake (growing with the texels) would take
-/// over half a second, longer than lighting frames while the view is still.
+/// several hundred milliseconds.
 pub const BAKE_MAX_BYTES: usize = 192 << 20;
 
 /// The bytes a lit copy of `map` takes, its pyramid included (partial maps have none).
