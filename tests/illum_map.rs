@@ -20,7 +20,7 @@ use lut_core::{
     Room, RoomFace, ShadeOptions, TableOptions, View,
 };
 use std::sync::Arc;
-use test_support::light_fixtures::{bench_table, lum, ring, synth};
+use test_support::light_fixtures::{bench_table, lum, ring, synth, views};
 
 fn load(rel: &str) -> Arc<LightTable> {
     Arc::new(LightTable::load(&test_support::test_data(rel)).unwrap())
@@ -56,20 +56,6 @@ fn walls() -> LightScene {
         ],
     )
     .unwrap()
-}
-
-fn views() -> Vec<View> {
-    [
-        (0.0, -30.0, 100.0),
-        (90.0, -60.0, 90.0),
-        (200.0, 10.0, 120.0),
-        (-45.0, 45.0, 80.0),
-        (33.0, -89.0, 100.0),
-        (140.0, -5.0, 40.0),
-    ]
-    .iter()
-    .map(|&(y, p, f)| View::new(y, p, f).unwrap())
-    .collect()
 }
 
 const W: u32 = 480;

@@ -19,33 +19,13 @@ use lut_core::{
     Frame, IlluminanceMap, LightError, LightScene, MapOptions, Projection, RenderOptions, Renderer,
     Room, Sampler, Scene, ShadeOptions, View, BAKE_MAX_BYTES,
 };
-use test_support::light_fixtures::{bench_table, lum, ring};
-use test_support::pixels::max_channel_diff;
+use test_support::light_fixtures::{bench_table, lum, ring, views};
+use test_support::pixels::{linear_to_srgb, max_channel_diff, srgb_to_linear};
 
-/// sRGB byte → linear, in f64 (independent of lut-core's tables).
-fn decode(c: u32) -> f64 {
-    let c = c as f64 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Linear → sRGB byte, clamped.
-fn encode(l: f64) -> u32 {
-    let l = l.clamp(0.0, 1.0);
-    let s = if l <= 0.003_130_8 {
-        l * 12.92
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0).round().clamp(0.0, 255.0) as u32
-}
-
-/// Albedo `p` lit with light factor `k`, exactly.
+/// Albedo `p` lit with light factor `k`, exactly (in f64, independently of lut-core's
+/// tables).
 fn lit(p: u32, k: f64) -> u32 {
-    let ch = |s: u32| encode(decode((p >> s) & 0xff) * k) << s;
+    let ch = |s: u32| linear_to_srgb(srgb_to_linear((p >> s) & 0xff) * k) << s;
     ch(16) | ch(8) | ch(0)
 }
 
@@ -327,20 +307,6 @@ fn auto(map: &IlluminanceMap) -> ShadeOptions {
         exposure: 1.0 / map.quantile(0.95),
         ..opts()
     }
-}
-
-fn views() -> Vec<View> {
-    [
-        (0.0, -30.0, 100.0),
-        (90.0, -60.0, 90.0),
-        (200.0, 10.0, 120.0),
-        (-45.0, 45.0, 80.0),
-        (33.0, -89.0, 100.0),
-        (140.0, -5.0, 40.0),
-    ]
-    .iter()
-    .map(|&(y, p, f)| View::new(y, p, f).unwrap())
-    .collect()
 }
 
 /// The stated tolerance for frames of a lit copy against the per-pixel frames, per view:

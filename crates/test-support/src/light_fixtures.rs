@@ -2,7 +2,7 @@
 //! and directions spread over the sphere.
 
 use glam::DVec3;
-use lut_core::{IesFile, LightScene, LightTable, Luminaire, Room, TableOptions};
+use lut_core::{IesFile, LightScene, LightTable, Luminaire, Room, TableOptions, View};
 use std::sync::Arc;
 
 /// Directions spread evenly over the whole sphere (a Fibonacci spiral).
@@ -93,4 +93,20 @@ pub fn ring(table: &Arc<LightTable>) -> LightScene {
         })
         .collect();
     LightScene::new(Room::new(6.0, 5.0, 2.8, 1.5).expect("room"), lights).expect("ring scene")
+}
+
+/// Views for comparing lit frames: down at the floor, steep, wide, up at the ceiling,
+/// straight down (the nadir), narrow.
+pub fn views() -> Vec<View> {
+    [
+        (0.0, -30.0, 100.0),
+        (90.0, -60.0, 90.0),
+        (200.0, 10.0, 120.0),
+        (-45.0, 45.0, 80.0),
+        (33.0, -89.0, 100.0),
+        (140.0, -5.0, 40.0),
+    ]
+    .iter()
+    .map(|&(y, p, f)| View::new(y, p, f).expect("view"))
+    .collect()
 }

@@ -510,7 +510,7 @@ impl App {
         if self.print_view {
             let _ = crate::outln!(
                 "view yaw={:.4} pitch={:.4} hfov={:.4} path={path} sampler={} level={} fast={} \
-                 ms={ms:.2} size={}x{} lights={} proj={}",
+                 ms={ms:.2} size={}x{} lights={} proj={} lit={}",
                 look.yaw,
                 look.pitch,
                 look.hfov,
@@ -520,7 +520,12 @@ impl App {
                 rect.w,
                 rect.h,
                 self.lights.lights.len(),
-                look.projection.name()
+                look.projection.name(),
+                match (from_baked, &lit) {
+                    (true, _) => "baked",
+                    (false, Some(_)) => "frame",
+                    (false, None) => "none",
+                }
             );
         }
     }
