@@ -16,6 +16,8 @@ mod actions;
 mod frame;
 mod lights;
 
+use lights::SceneDrag;
+
 use super::dialogs::Dialogs;
 use super::document::{Document, LoadEvent, StartArgs};
 use super::input::{AutoRotate, Controller, Look};
@@ -124,12 +126,9 @@ struct App {
     lit: LitCache,
     /// The panorama lit once the lighting has settled, panned as an unlit one.
     baked: LitPanorama,
-    /// The luminaire being dragged in the view.
-    light_drag: Option<usize>,
-    /// The room edge being dragged (an index into `lut_core::Room::EDGES`).
-    edge_drag: Option<usize>,
-    /// The room corner being dragged (an index into `lut_core::Room::corners`).
-    corner_drag: Option<usize>,
+    /// What a drag in the view moves instead of the view (a luminaire, a room corner,
+    /// an edge, or with Shift an edge's floor or ceiling).
+    scene_drag: Option<SceneDrag>,
     /// The scene file opened or saved last.
     scene_file: Option<PathBuf>,
     /// The luminaires' marker positions as last printed (`--print-view`).
@@ -196,9 +195,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         lights,
         lit: LitCache::default(),
         baked: LitPanorama::default(),
-        light_drag: None,
-        edge_drag: None,
-        corner_drag: None,
+        scene_drag: None,
         scene_file: args.lights.room.scene.clone(),
         printed_markers: String::new(),
     };

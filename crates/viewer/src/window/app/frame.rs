@@ -92,12 +92,13 @@ impl App {
                 .or(resp.interact_pointer_pos());
             if let Some(o) = origin {
                 // On a luminaire's marker the drag moves the luminaire.
-                if !self.press_light(to_px(o), size) {
+                let shift = ui.input(|i| i.modifiers.shift);
+                if !self.press_light(to_px(o), size, shift) {
                     self.ctl.press(to_px(o), size, t);
                 }
             }
         }
-        if self.light_drag.is_some() || self.edge_drag.is_some() || self.corner_drag.is_some() {
+        if self.scene_drag.is_some() {
             match resp.interact_pointer_pos() {
                 Some(p) if resp.dragged_by(primary) => self.drag_light(to_px(p), size),
                 _ => self.end_light_drag(),
