@@ -207,6 +207,24 @@ fn the_bake_does_not_depend_on_the_number_of_threads() {
     assert!(px(&a.2) == px(&b.2), "false-colour bytes differ");
 }
 
+/// Lit frames to compare: the scene, the shading, the panorama and its lit copy.
+#[derive(Clone, Copy)]
+struct Case<'a> {
+    label: &'a str,
+    scene: &'a LightScene,
+    shade: &'a ShadeOptions,
+    unlit: Scene<'a>,
+    lit: Scene<'a>,
+}
+
+impl Case<'_> {
+    /// [`frames_against_per_pixel`], then [`check`] with `(share, mean)`.
+    fn check(&self, renderer: &mut Renderer, sampler: Sampler, views: &[View], tol: (f64, f64)) {
+        let frames = frames_against_per_pixel(self, renderer, sampler, views);
+        check(self.label, sampler, &frames, tol.0, tol.1);
+    }
+}
+
 /// One frame of the lit copy against the per-pixel frame.
 #[derive(Debug)]
 struct Frames {
@@ -224,14 +242,18 @@ struct Frames {
 /// Frames of `lit` against frames of `unlit` lit per pixel (`shade_frame`) with `shade`,
 /// for the views and sampler given (320 × 200 pixels).
 fn frames_against_per_pixel(
-    scene: &LightScene,
-    shade: &ShadeOptions,
-    unlit: Scene<'_>,
-    lit: Scene<'_>,
+    case: &Case<'_>,
     renderer: &mut Renderer,
     sampler: Sampler,
     views: &[View],
 ) -> Vec<Frames> {
+    let Case {
+        scene,
+        shade,
+        unlit,
+        lit,
+        ..
+    } = *case;
     let (w, h) = (320u32, 200u32);
     let ropts = RenderOptions {
         sampler,
@@ -359,21 +381,19 @@ fn frames_of_the_lit_map_match_frames_lit_per_pixel() {
         pano.pyramid();
         let shade = auto(&map);
         let baked = map.bake_map(&pano, &shade).unwrap();
+        let case = Case {
+            label,
+            scene: &scene,
+            shade: &shade,
+            unlit: Scene::Map(&pano),
+            lit: Scene::Map(&baked),
+        };
         for sampler in [Sampler::Bilinear, Sampler::Nearest, Sampler::Trilinear] {
-            let frames = frames_against_per_pixel(
-                &scene,
-                &shade,
-                Scene::Map(&pano),
-                Scene::Map(&baked),
-                &mut renderer,
-                sampler,
-                &views(),
-            );
-            let (share, mean) = match sampler {
+            let tol = match sampler {
                 Sampler::Trilinear => (0.985, 0.6),
                 _ => (0.99, 0.5),
             };
-            check(label, sampler, &frames, share, mean);
+            case.check(&mut renderer, sampler, &views(), tol);
         }
         // Curved view projections: a frame of the lit copy is an ordinary frame.
         let curved: Vec<View> = [
@@ -384,16 +404,7 @@ fn frames_of_the_lit_map_match_frames_lit_per_pixel() {
         .iter()
         .map(|&(y, p, f, proj)| View::with_projection(y, p, f, proj).unwrap())
         .collect();
-        let frames = frames_against_per_pixel(
-            &scene,
-            &shade,
-            Scene::Map(&pano),
-            Scene::Map(&baked),
-            &mut renderer,
-            Sampler::Bilinear,
-            &curved,
-        );
-        check(label, Sampler::Bilinear, &frames, 0.985, 0.6);
+        case.check(&mut renderer, Sampler::Bilinear, &curved, (0.985, 0.6));
     }
 }
 
@@ -416,16 +427,14 @@ fn cube_and_partial_maps() {
     let lit_cube = map.bake_cube(&cube, &shade).unwrap();
     let mut renderer = Renderer::default();
     for sampler in [Sampler::Bilinear, Sampler::Nearest] {
-        let frames = frames_against_per_pixel(
-            &scene,
-            &shade,
-            Scene::Cube(&cube),
-            Scene::Cube(&lit_cube),
-            &mut renderer,
-            sampler,
-            &views(),
-        );
-        check("cube", sampler, &frames, 0.99, 0.5);
+        Case {
+            label: "cube",
+            scene: &scene,
+            shade: &shade,
+            unlit: Scene::Cube(&cube),
+            lit: Scene::Cube(&lit_cube),
+        }
+        .check(&mut renderer, sampler, &views(), (0.99, 0.5));
     }
     // A partial map: 200° × 100° of the walls room, across the ±180° seam.
     let scene = walls();
@@ -448,16 +457,14 @@ fn cube_and_partial_maps() {
     .iter()
     .map(|&(y, p, f)| View::new(y, p, f).unwrap())
     .collect();
-    let frames = frames_against_per_pixel(
-        &scene,
-        &shade,
-        Scene::Map(&part),
-        Scene::Map(&lit_part),
-        &mut renderer,
-        Sampler::Bilinear,
-        &views,
-    );
-    check("partial", Sampler::Bilinear, &frames, 0.98, 0.7);
+    Case {
+        label: "partial",
+        scene: &scene,
+        shade: &shade,
+        unlit: Scene::Map(&part),
+        lit: Scene::Map(&lit_part),
+    }
+    .check(&mut renderer, Sampler::Bilinear, &views, (0.98, 0.7));
 }
 
 #[test]
