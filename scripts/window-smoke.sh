@@ -17,7 +17,9 @@
 # Run 3 (panel hidden): a scene file with --show-room opens its panorama at its view with
 #   its five luminaires; a click on a marker selects that light, dragging it moves it
 #   along the ceiling without turning the view; dragging a room edge resizes the room, and
-#   so does dragging a room corner (its two walls).
+#   so does dragging a room corner (its two walls), Shift-dragging a ceiling or floor
+#   edge changes the room's height or camera height; then, the lighting settled, a zoom
+#   draws the lit panorama (lit=baked).
 #
 # Screenshots and logs: target/window-smoke/ (kept as CI artifacts). The settings live
 # in a temporary config folder (LUTPANO_CONFIG_DIR), never the real home.
@@ -493,6 +495,13 @@ log "$ROOM2"
   fail "Shift-dragging a level changed the width or depth: $ROOM1 -> $ROOM2"
 [ "$(field yaw)" = "$YAW0" ] && [ "$(field pitch)" = "$PITCH0" ] ||
   fail "Shift-dragging a level turned the view"
+# The room and a light were dragged (each frame lit from the illuminance map); now the
+# lighting has settled: the panorama is lit once and a zoom draws the lit copy.
+N=$(lines)
+xdotool mousemove "$CX" "$CY"; sleep 0.2; xdotool click 4
+wait_for '^view .* lit=baked' "$N" 10
+settle
+log "after the lighting settled: lit=$(field lit)"
 sleep 0.3
 $IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/lights.png"
 quit_viewer

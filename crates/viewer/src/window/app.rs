@@ -28,7 +28,7 @@ use super::paint::Compositor;
 use super::prefs::Prefs;
 use super::quality::{FrameTimes, Level};
 use super::OpenArgs;
-use crate::lighting::{LightsKey, LightsState, LitCache};
+use crate::lighting::{LightsKey, LightsState, LitCache, LitPanorama};
 use anyhow::{anyhow, Result};
 use lut_core::{CubeRenderer, IndexStep, LutChoice, RendererKind, Sampler};
 use std::collections::VecDeque;
@@ -124,6 +124,8 @@ struct App {
     lights: LightsState,
     /// Their illuminance map, rebuilt when they change.
     lit: LitCache,
+    /// The panorama lit once the lighting has settled, panned as an unlit one.
+    baked: LitPanorama,
     /// What a drag in the view moves instead of the view (a luminaire, a room corner,
     /// an edge, or with Shift an edge's floor or ceiling).
     scene_drag: Option<SceneDrag>,
@@ -192,6 +194,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         fatal: None,
         lights,
         lit: LitCache::default(),
+        baked: LitPanorama::default(),
         scene_drag: None,
         scene_file: args.lights.room.scene.clone(),
         printed_markers: String::new(),

@@ -7,7 +7,7 @@ use crate::lighting::overlay::{
     drag_on_surface, drag_room_corner, drag_room_edge, drag_room_level, draw_room_and_lights,
     pick_light, pick_room_corner, pick_room_edge, project_point,
 };
-use crate::lighting::{legend::draw_legend, SceneFile, SceneView};
+use crate::lighting::{legend::draw_legend, BakeKey, SceneFile, SceneView};
 use crate::window::document::StartArgs;
 use crate::window::loader::Source;
 use crate::window::paint::SceneRect;
@@ -48,6 +48,25 @@ impl App {
                 None
             }
         }
+    }
+
+    /// Bake the lit panorama from `map` once the lighting has settled (the full map
+    /// built, nothing dragged, the same lighting as on the frame before: see
+    /// [`crate::lighting::LitPanorama`]), and show its state in the panel. True when this
+    /// frame pans the lit copy instead of lighting the frame.
+    pub(super) fn update_baked(&mut self, map: Option<&IlluminanceMap>) -> bool {
+        let settled = !self.lit.refining() && self.scene_drag.is_none();
+        let key = map.map(|_| BakeKey {
+            map_generation: self.lit.generation(),
+            scene_generation: self.doc.generation(),
+            shade: self.lights.shade_options(),
+        });
+        let Some(cur) = self.doc.current() else {
+            return false;
+        };
+        let on = self.baked.update(key, settled, map, &cur.scene);
+        self.lights.lit_panorama = self.baked.state().describe();
+        on
     }
 
     /// Light the freshly rendered scene from `unlit` (the map, when the render did not
