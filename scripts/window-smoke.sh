@@ -17,7 +17,9 @@
 # Run 3 (panel hidden): a scene file with --show-room opens its panorama at its view with
 #   its five luminaires; a click on a marker selects that light, dragging it moves it
 #   along the ceiling without turning the view; dragging a room edge resizes the room, and
-#   so does dragging a room corner (its two walls).
+#   so does dragging a room corner (its two walls), Shift-dragging a ceiling or floor
+#   edge changes the room's height or camera height; then, the lighting settled, a zoom
+#   draws the lit panorama (lit=baked).
 #
 # Screenshots and logs: target/window-smoke/ (kept as CI artifacts). The settings live
 # in a temporary config folder (LUTPANO_CONFIG_DIR), never the real home.
@@ -466,6 +468,40 @@ CORNER=$(grep '^corners ' "$VIEWLOG" | tail -n 1 | tr ' ' '\n' | grep '=' |
   [ "$(field yaw)" = "$YAW0" ] && [ "$(field pitch)" = "$PITCH0" ] ||
     fail "dragging a room corner turned the view"
 }
+# Shift-drag a floor or ceiling edge (Room::EDGES 0-3 and 8-11) up or down: the room's
+# height or camera height changes, its walls and the view stay.
+settle
+ROOM1=$(grep '^room ' "$VIEWLOG" | tail -n 1)
+LEVEL=$(grep '^edges ' "$VIEWLOG" | tail -n 1 | tr ' ' '\n' | grep '=' |
+  awk -F'[=,]' -v w="$SW" -v h="$SH" '($1 < 4 || $1 > 7) && $2 > 60 && $2 < w - 60 && $3 > 80 && $3 < h - 60 { print; exit }')
+[ -n "$LEVEL" ] || fail "no floor or ceiling edge inside the view: $(grep '^edges ' "$VIEWLOG" | tail -n 1)"
+LXY=${LEVEL#*=}; LX=$((X + ${LXY%,*})); LY=$((Y + ${LXY#*,}))
+log "level edge ${LEVEL%%=*} at $LX,$LY (Shift)"
+N=$(lines)
+# (Keys reach the window only with the keyboard focus: no window manager gives it.)
+xdotool windowfocus "$WID" 2>/dev/null || true
+xdotool mousemove "$LX" "$LY"; sleep 0.2; xdotool keydown Shift_L; sleep 0.1
+xdotool mousedown 1; sleep 0.1
+for i in 1 2 3 4 5 6; do xdotool mousemove "$LX" $((LY - 5 * i)); sleep 0.05; done
+sleep 0.2; xdotool mouseup 1; sleep 0.1; xdotool keyup Shift_L
+wait_for "^room " "$N" 5
+settle
+ROOM2=$(grep '^room ' "$VIEWLOG" | tail -n 1)
+log "$ROOM2"
+[ "$ROOM2" != "$ROOM1" ] || fail "Shift-dragging a floor or ceiling edge left the room as it was: $ROOM2"
+[ "$(echo "$ROOM2" | cut -d' ' -f3-4)" = "$(echo "$ROOM1" | cut -d' ' -f3-4)" ] ||
+  fail "Shift-dragging a level moved the walls: $ROOM1 -> $ROOM2"
+[ "$(echo "$ROOM2" | cut -d' ' -f2 | cut -dx -f1-2)" = "$(echo "$ROOM1" | cut -d' ' -f2 | cut -dx -f1-2)" ] ||
+  fail "Shift-dragging a level changed the width or depth: $ROOM1 -> $ROOM2"
+[ "$(field yaw)" = "$YAW0" ] && [ "$(field pitch)" = "$PITCH0" ] ||
+  fail "Shift-dragging a level turned the view"
+# The room and a light were dragged (each frame lit from the illuminance map); now the
+# lighting has settled: the panorama is lit once and a zoom draws the lit copy.
+N=$(lines)
+xdotool mousemove "$CX" "$CY"; sleep 0.2; xdotool click 4
+wait_for '^view .* lit=baked' "$N" 10
+settle
+log "after the lighting settled: lit=$(field lit)"
 sleep 0.3
 $IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/lights.png"
 quit_viewer

@@ -20,7 +20,7 @@ use lut_core::{
     View,
 };
 use test_support::golden::compare_to_truth;
-use test_support::pixels::{diff, psnr};
+use test_support::pixels::{diff, linear_to_srgb, psnr, srgb_to_linear};
 use test_support::render::{exact_frame, render_frame};
 
 /// The LUT render and the exact render (same sampler) of `view`, `w × h`.
@@ -230,27 +230,6 @@ fn golden_cube() {
     }
 }
 
-/// sRGB (8-bit) → linear.
-fn linear(c: u32) -> f64 {
-    let c = f64::from(c) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Linear → sRGB (8-bit, clamped).
-fn srgb(l: f64) -> u32 {
-    let l = l.clamp(0.0, 1.0);
-    let s = if l <= 0.003_130_8 {
-        l * 12.92
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0).round() as u32
-}
-
 /// A lit render: the grid map rendered by the LUT renderer as the room's albedo, lit by
 /// one isotropic light. Each pixel is checked against the analytic shading: the ray's
 /// hit on the room box (computed here), E = I·cos θ/d², colour = albedo · exposure · E in
@@ -301,9 +280,9 @@ fn golden_lit() {
             let e = 800.0 * (n.dot(to) / dist).max(0.0) / (dist * dist);
             let k = opts.ambient + opts.exposure * e;
             let a = albedo[(y * w + x) as usize];
-            let want = [16, 8, 0]
-                .iter()
-                .fold(0, |acc, s| acc | srgb(linear((a >> s) & 0xFF) * k) << s);
+            let want = [16, 8, 0].iter().fold(0, |acc, s| {
+                acc | linear_to_srgb(srgb_to_linear((a >> s) & 0xFF) * k) << s
+            });
             let got = img[(y * w + x) as usize];
             worst = worst.max(test_support::pixels::max_channel_diff(got, want));
         }

@@ -16,11 +16,11 @@
 
 use glam::DVec3;
 use lut_core::{
-    lux_at, shade_frame, Camera, IlluminanceMap, LightError, LightScene, LightTable, Luminaire,
-    MapOptions, Room, RoomFace, ShadeOptions, TableOptions, View,
+    lux_at, shade_frame, Camera, IlluminanceMap, LightError, LightScene, LightTable, MapOptions,
+    Room, RoomFace, ShadeOptions, TableOptions, View,
 };
 use std::sync::Arc;
-use test_support::light_fixtures::synth;
+use test_support::light_fixtures::{bench_table, lum, ring, synth, views};
 
 fn load(rel: &str) -> Arc<LightTable> {
     Arc::new(LightTable::load(&test_support::test_data(rel)).unwrap())
@@ -28,49 +28,6 @@ fn load(rel: &str) -> Arc<LightTable> {
 
 fn table_of(f: &lut_core::IesFile) -> Arc<LightTable> {
     Arc::new(LightTable::from_ies(f, &TableOptions::default()).unwrap())
-}
-
-/// The benchmark's luminaire: type C, bilateral, 5° steps, cut off at 80° (its planes
-/// agree at the nadir, as a measured luminaire's do).
-fn bench_table() -> Arc<LightTable> {
-    let v: Vec<f64> = (0..=36).map(|i| i as f64 * 5.0).collect();
-    let h: Vec<f64> = (0..=12).map(|i| i as f64 * 15.0).collect();
-    table_of(&synth(
-        1,
-        &v,
-        &h,
-        |hh, g| {
-            let (sg, cg) = g.to_radians().sin_cos();
-            if g >= 80.0 {
-                0.0
-            } else {
-                2000.0 * cg * cg * (1.0 + 0.2 * hh.to_radians().cos() * sg)
-            }
-        },
-        1.0,
-    ))
-}
-
-fn lum(t: &Arc<LightTable>, p: [f64; 3], yaw: f64, pitch: f64) -> Luminaire {
-    let mut l = Luminaire::new(t.clone(), DVec3::from(p));
-    l.yaw_deg = yaw;
-    l.pitch_deg = pitch;
-    l
-}
-
-fn ring(table: &Arc<LightTable>) -> LightScene {
-    let lights: Vec<Luminaire> = (0..8)
-        .map(|i| {
-            let a = i as f64 / 8.0 * std::f64::consts::TAU;
-            lum(
-                table,
-                [2.0 * a.cos(), 2.7, 1.8 * a.sin()],
-                i as f64 * 37.0,
-                -90.0,
-            )
-        })
-        .collect();
-    LightScene::new(Room::new(6.0, 5.0, 2.8, 1.5).unwrap(), lights).unwrap()
 }
 
 fn turned_room() -> Room {
@@ -99,20 +56,6 @@ fn walls() -> LightScene {
         ],
     )
     .unwrap()
-}
-
-fn views() -> Vec<View> {
-    [
-        (0.0, -30.0, 100.0),
-        (90.0, -60.0, 90.0),
-        (200.0, 10.0, 120.0),
-        (-45.0, 45.0, 80.0),
-        (33.0, -89.0, 100.0),
-        (140.0, -5.0, 40.0),
-    ]
-    .iter()
-    .map(|&(y, p, f)| View::new(y, p, f).unwrap())
-    .collect()
 }
 
 const W: u32 = 480;

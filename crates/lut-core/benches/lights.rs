@@ -5,18 +5,23 @@
 //!
 //! * `lights_pan`: whole frames of a pan (yaw +7.3° per frame, pitch −15°, hfov 100°) of a
 //!   4096×2048 equirectangular grid map with the default render options (LUT, bilinear,
-//!   adaptive step): `unlit`, then lit from the illuminance map with 0, 1 and 8 lights
-//!   (`map/N`: each band of rows lit as soon as it is drawn, `Renderer::render_with` with
-//!   `FrameShader::shade_band` as the hook, as the window and `viewer render` do; the
-//!   shading's cost is `map/N` − `unlit`), the same with 8 lights lit in a second pass over
-//!   the rendered frame (`map_second_pass/8`, what both did before), and lit per pixel
-//!   with 1 light (`per_pixel/1`).
+//!   adaptive step): `unlit`, then lit with 0, 1 and 8 lights (`map/N`: frames of the lit
+//!   panorama baked once from the illuminance map, `IlluminanceMap::bake_map`, as the
+//!   window pans once the lighting has settled; the shading's cost is `map/N` − `unlit`),
+//!   lit from the illuminance map frame by frame with 8 lights (`band/8`: each band of rows
+//!   lit as soon as it is drawn, `Renderer::render_with` with `FrameShader::shade_band` as
+//!   the hook, as the window does while the lighting changes and for panoramas too large
+//!   to bake, and `viewer render`), the same lit in a second pass over the rendered frame
+//!   (`band_second_pass/8`), and lit per pixel with 1 light (`per_pixel/1`).
 //! * `lights_shade`: the shading pass alone over a whole frame on a fixed view, each
 //!   iteration copying the unlit frame first (8 MB in, 8 MB out: the copy is in the time):
 //!   from the map (`map/N`) and per pixel with 1 and 8 lights,
 //!   linear and Catmull-Rom.
-//! * `lights_relight`: building the illuminance map (the cost of changing a light) with
-//!   0, 1 and 8 lights, default and preview spacing.
+//! * `lights_relight`: what a lighting change costs once it has settled, with 0, 1 and 8
+//!   lights (`map/N`: the illuminance map, then the lit 4096×2048 panorama baked from it,
+//!   its pyramid included, as the window does), the bake alone (`bake/8`), the bake of an
+//!   8192×4096 panorama (`bake_8192/8`, the largest [`lut_core::BAKE_MAX_BYTES`] allows),
+//!   and the coarse map the window shows while a value is being dragged (`preview/8`).
 //!
 //! The luminaire is a synthetic type C, bilateral (0-180) distribution with 5° steps and a
 //! cut-off at 80° (so the constant range is exercised), hung 10 cm below the ceiling of a
@@ -139,10 +144,28 @@ fn pan(c: &mut Criterion) {
         for n in [0usize, 1, 8] {
             let s = scene(n, &table);
             let lmap = IlluminanceMap::build(&s, &MapOptions::default()).expect("map");
+            let lit = pool.install(|| lmap.bake_map(&map, &shade).expect("bake"));
             g.bench_with_input(BenchmarkId::new("map", n), &n, |b, _| {
                 pool.install(|| {
                     b.iter(|| {
-                        // Lit as the rows are drawn, as the window and `viewer render` do.
+                        // A frame of the lit panorama, as the window pans a settled room.
+                        let view = pan_view(&mut k);
+                        let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
+                        renderer
+                            .render(Scene::Map(&lit), view, &opts, &mut frame)
+                            .expect("render");
+                        black_box(&pixels);
+                    })
+                })
+            });
+            if n < 8 {
+                continue;
+            }
+            g.bench_with_input(BenchmarkId::new("band", n), &n, |b, _| {
+                pool.install(|| {
+                    b.iter(|| {
+                        // Lit as the rows are drawn, as the window does while the lighting
+                        // changes (and `viewer render`).
                         let view = pan_view(&mut k);
                         let cam = Camera::new(view, W, H);
                         let shader = lmap.frame_shader(&cam, &shade).expect("shader");
@@ -155,24 +178,22 @@ fn pan(c: &mut Criterion) {
                     })
                 })
             });
-            if n == 8 {
-                // The same frames rendered, then lit in a second pass over the frame.
-                g.bench_function(BenchmarkId::new("map_second_pass", n), |b| {
-                    pool.install(|| {
-                        b.iter(|| {
-                            let view = pan_view(&mut k);
-                            let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
-                            renderer
-                                .render(Scene::Map(&map), view, &opts, &mut frame)
-                                .expect("render");
-                            let cam = Camera::new(view, W, H);
-                            lmap.shade_frame(&cam, &mut pixels, W, H, &shade)
-                                .expect("shade");
-                            black_box(&pixels);
-                        })
+            // The same frames rendered, then lit in a second pass over the frame.
+            g.bench_function(BenchmarkId::new("band_second_pass", n), |b| {
+                pool.install(|| {
+                    b.iter(|| {
+                        let view = pan_view(&mut k);
+                        let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
+                        renderer
+                            .render(Scene::Map(&map), view, &opts, &mut frame)
+                            .expect("render");
+                        let cam = Camera::new(view, W, H);
+                        lmap.shade_frame(&cam, &mut pixels, W, H, &shade)
+                            .expect("shade");
+                        black_box(&pixels);
                     })
-                });
-            }
+                })
+            });
         }
         let s = scene(1, &table);
         g.bench_function(BenchmarkId::new("per_pixel", 1), |b| {
@@ -243,10 +264,15 @@ fn shade_pass(c: &mut Criterion) {
     g.finish();
 }
 
-/// Building the illuminance map: what changing a light costs.
+/// What a settled lighting change costs: the illuminance map, then the lit panorama.
 fn relight(c: &mut Criterion) {
     let pool = pool();
     let table = Arc::new(synthetic_table(Interpolation::Linear));
+    let shade = ShadeOptions::default();
+    let pano = grid_map(4096, 2048, Projection::Equirect).expect("map");
+    // The window's panorama has its pyramid once the view has moved (moving frames read
+    // a level of it): the lit copy gets one too.
+    pano.pyramid();
     let mut g = c.benchmark_group("lights_relight");
     short(&mut g);
     {
@@ -254,13 +280,26 @@ fn relight(c: &mut Criterion) {
             let s = scene(n, &table);
             g.bench_with_input(BenchmarkId::new("map", n), &n, |b, _| {
                 pool.install(|| {
-                    b.iter(|| black_box(IlluminanceMap::build(&s, &MapOptions::default())))
+                    b.iter(|| {
+                        let lmap = IlluminanceMap::build(&s, &MapOptions::default()).expect("map");
+                        black_box(lmap.bake_map(&pano, &shade).expect("bake"))
+                    })
                 })
             });
         }
         let s = scene(8, &table);
+        let lmap = IlluminanceMap::build(&s, &MapOptions::default()).expect("map");
+        g.bench_function(BenchmarkId::new("bake", 8), |b| {
+            pool.install(|| b.iter(|| black_box(lmap.bake_map(&pano, &shade).expect("bake"))))
+        });
         g.bench_function(BenchmarkId::new("preview", 8), |b| {
             pool.install(|| b.iter(|| black_box(IlluminanceMap::build(&s, &MapOptions::preview()))))
+        });
+        drop(pano);
+        let big = grid_map(8192, 4096, Projection::Equirect).expect("map");
+        big.pyramid();
+        g.bench_function(BenchmarkId::new("bake_8192", 8), |b| {
+            pool.install(|| b.iter(|| black_box(lmap.bake_map(&big, &shade).expect("bake"))))
         });
     }
     g.finish();

@@ -159,11 +159,12 @@ pub use cube::{
 
 // Lights.
 pub use light::{
-    detect_format, false_color, false_color_position, lux_at, shade_frame, FrameShader, IesError,
-    IesFile, IesFormat, IlluminanceMap, Interpolation, LampSet, LdtError, LdtFile, LdtSymmetry,
-    LdtType, LightError, LightFileFormat, LightScene, LightTable, Luminaire, MapOptions,
-    PhotometricType, Photometry, PhotometrySource, Room, RoomFace, ShadeOptions, Symmetry,
-    TableOptions, Tilt, TiltData, MAP_SHADE_BLOCK, MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES,
+    detect_format, false_color, false_color_position, lit_cube_bytes, lit_map_bytes, lux_at,
+    shade_frame, FrameShader, IesError, IesFile, IesFormat, IlluminanceMap, Interpolation, LampSet,
+    LdtError, LdtFile, LdtSymmetry, LdtType, LightError, LightFileFormat, LightScene, LightTable,
+    Luminaire, MapOptions, PhotometricType, Photometry, PhotometrySource, Room, RoomFace,
+    ShadeOptions, Symmetry, TableOptions, Tilt, TiltData, BAKE_MAX_BYTES, MAP_SHADE_BLOCK,
+    MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES,
 };
 
 /// The module layout's rules, checked from the source: dependencies between the stages
@@ -184,7 +185,10 @@ mod layout {
         ("cube", &["geom", "map", "error", "named"]),
         ("render", &["geom", "map", "lut", "cube", "error", "named"]),
         ("file", &[]),
-        ("light", &["geom", "render", "error", "named", "file"]),
+        (
+            "light",
+            &["geom", "map", "cube", "render", "error", "named", "file"],
+        ),
         (
             "io",
             &["geom", "map", "lut", "cube", "render", "error", "file"],

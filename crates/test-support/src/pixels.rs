@@ -1,4 +1,26 @@
-//! Comparing 0RGB images: PSNR and per-channel differences.
+//! Comparing 0RGB images: PSNR and per-channel differences; the sRGB transfer function
+//! in f64 (an independent check of lut-core's tables).
+
+/// sRGB (8-bit) → linear.
+pub fn srgb_to_linear(c: u32) -> f64 {
+    let c = f64::from(c) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Linear → sRGB (8-bit, clamped).
+pub fn linear_to_srgb(l: f64) -> u32 {
+    let l = l.clamp(0.0, 1.0);
+    let s = if l <= 0.003_130_8 {
+        l * 12.92
+    } else {
+        1.055 * l.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0).round() as u32
+}
 
 /// The largest difference of one channel between two 0RGB pixels.
 pub fn max_channel_diff(a: u32, b: u32) -> u32 {

@@ -87,6 +87,14 @@ fn the_lights_section_shows_the_room_and_each_light() {
     assert_eq!(count(&t), 2, "{t:?}");
     lights.selected = Some(1);
     assert_eq!(count(&panel_texts(&mut lights)), 1);
+    // The lit panorama's state, as the window sets it.
+    lights.lit_panorama = "lit panorama: 43 MiB, baked in 41 ms".into();
+    let t = panel_texts(&mut lights);
+    assert!(
+        t.iter()
+            .any(|s| s == "lit panorama: 43 MiB, baked in 41 ms"),
+        "{t:?}"
+    );
 }
 
 #[test]

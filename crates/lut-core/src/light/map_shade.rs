@@ -11,6 +11,10 @@
 //! the view grazes the face). So a frame costs a few map lookups per block, whatever the
 //! number of lights, plus one table read per channel (`shade_table`: within a level of
 //! the exact path's linear-light multiply).
+//!
+//! The same blocks light the texels of a panorama once per lighting change (`bake.rs`):
+//! the block corners are then texels, whose directions come from the panorama's mapping
+//! instead of a camera ([`ProbeGrid`]).
 
 use super::illum::IlluminanceMap;
 use super::shade::{
@@ -25,7 +29,7 @@ use rayon::prelude::*;
 
 /// The illuminance seen at one pixel.
 #[derive(Clone, Copy)]
-struct Probe {
+pub(crate) struct Probe {
     face: usize,
     /// The hit point relative to the camera.
     p: DVec3,
@@ -49,9 +53,18 @@ const RAMP: [f32; BLOCK.0] = {
 /// Block size (columns, rows) between evaluations of the map, before splitting.
 pub const BLOCK: (usize, usize) = (32, 16);
 
+/// Where the pixels of an image (a frame, or a panorama's texels) look: the map's probe
+/// at pixel (x, y), through its centre (x + ½, y + ½); x and y may be one past the image
+/// (a block's far corner). [`IlluminanceMap::fill`] interpolates between these.
+pub(crate) trait ProbeGrid {
+    /// The probe at pixel (x, y).
+    fn probe(&self, map: &IlluminanceMap, x: usize, y: usize) -> Probe;
+}
+
 /// The camera rays of one frame in the room's frame: the ray through pixel centre
-/// (x + ½, y + ½) is `a + b·(x + ½) + c·(y + ½)` (linear in both, as the camera's is).
-struct Rays {
+/// (x + ½, y + ½) is `a + b·(x + ½) + c·(y + ½)` (linear in both, as the camera's is, and
+/// as a cube face's texels are).
+pub(crate) struct Rays {
     a: DVec3,
     b: DVec3,
     c: DVec3,
@@ -68,7 +81,13 @@ impl Rays {
         }
     }
 
-    /// The map's probe at pixel (x, y) (its centre; x, y may be one past the image).
+    /// The rays `a + b·x + c·y` at image point (x, y) (room frame).
+    pub(crate) fn linear(a: DVec3, b: DVec3, c: DVec3) -> Rays {
+        Rays { a, b, c }
+    }
+}
+
+impl ProbeGrid for Rays {
     #[inline]
     fn probe(&self, map: &IlluminanceMap, x: usize, y: usize) -> Probe {
         map.probe(self.a + self.b * (x as f64 + 0.5) + self.c * (y as f64 + 0.5))
@@ -83,7 +102,7 @@ impl IlluminanceMap {
     /// intersection of [`super::Room::hit_face`] (same arithmetic, same ties), then the
     /// face's bilinear value.
     #[inline]
-    fn probe(&self, d: DVec3) -> Probe {
+    pub(crate) fn probe(&self, d: DVec3) -> Probe {
         // Per axis, the plane ahead: the high one for a positive (or +0) component. The
         // camera is strictly inside, so a zero component gives +∞, never NaN.
         let pick = |c: f64, lo: f64, hi: f64| {
@@ -119,9 +138,9 @@ impl IlluminanceMap {
     /// corners (x1, y1 may be one past the image): bilinear between them when all four lie
     /// on one face within the tiles' `max_len` of each other, else split in four (or two),
     /// down to single pixels, which take their own probe.
-    fn fill(
+    fn fill<G: ProbeGrid>(
         &self,
-        rays: &Rays,
+        rays: &G,
         (x0, y0, x1, y1): (usize, usize, usize, usize),
         [tl, tr, bl, br]: [Probe; 4],
         out: &mut Lux<'_>,
@@ -189,7 +208,7 @@ impl IlluminanceMap {
 
     /// The illuminance of the band of rows starting at `band_y` (`es` holds whole rows of
     /// `w` values, at most [`BLOCK`]`.1` of them), block by block.
-    fn band_lux(&self, rays: &Rays, w: usize, band_y: usize, es: &mut [f32]) {
+    pub(crate) fn band_lux<G: ProbeGrid>(&self, rays: &G, w: usize, band_y: usize, es: &mut [f32]) {
         let rows = es.len() / w;
         debug_assert!(rows <= BLOCK.1);
         let y1 = band_y + rows;
@@ -343,24 +362,18 @@ impl FrameShader<'_> {
         let n = (rows.len() / w).min(h - y0);
         let rows = &mut rows[..n * w];
         let map = self.map;
-        let o = &self.opts;
-        let (ambient, exposure) = (o.ambient as f32, o.exposure as f32);
-        let dec = decode_lut();
-        let enc = encode_lut();
-        let false_colour = |px: &mut u32, e: f32| {
-            let shaded = shade_pixel(*px, ambient + exposure * e, dec, enc);
-            let c = false_color(false_color_position(e as f64, o.false_color_max_lux));
-            *px = blend(c, shaded, 0.65);
-        };
         let Some(rays) = &self.rays else {
             // Each pixel through its own ray; pixels with no direction stay as rendered.
+            let o = &self.opts;
+            let (ambient, exposure) = (o.ambient as f32, o.exposure as f32);
+            let (dec, enc) = (decode_lut(), encode_lut());
             for (j, row) in rows.chunks_mut(w).enumerate() {
                 for (x, px) in row.iter_mut().enumerate() {
                     let Some(e) = map.pixel_lux(self.cam, x, y0 + j) else {
                         continue;
                     };
                     if o.false_color {
-                        false_colour(px, e);
+                        colour_band(self.colour, o, std::slice::from_mut(px), &[e]);
                     } else {
                         *px = shade_pixel(*px, ambient + exposure * e, dec, enc);
                     }
@@ -381,16 +394,27 @@ impl FrameShader<'_> {
                 buf.resize(band.len(), 0.0);
                 let es = &mut buf[..band.len()];
                 map.band_lux(rays, w, y, es);
-                if o.false_color {
-                    band.iter_mut()
-                        .zip(es.iter())
-                        .for_each(|(p, &e)| false_colour(p, e));
-                } else {
-                    self.colour.run(band, es, ambient, exposure);
-                }
+                colour_band(self.colour, &self.opts, band, es);
                 y = y1;
             }
         });
+    }
+}
+
+/// Colour `pixels` (albedo) in place from their illuminance `es` (lux, lights only) with
+/// `o` (checked): the shading table's rows ([`ShadeRow`]), or the false-colour blend.
+/// What a frame's band and a baked panorama's texels both get.
+pub(crate) fn colour_band(colour: ShadeRow, o: &ShadeOptions, pixels: &mut [u32], es: &[f32]) {
+    let (ambient, exposure) = (o.ambient as f32, o.exposure as f32);
+    if !o.false_color {
+        colour.run(pixels, es, ambient, exposure);
+        return;
+    }
+    let (dec, enc) = (decode_lut(), encode_lut());
+    for (px, &e) in pixels.iter_mut().zip(es) {
+        let shaded = shade_pixel(*px, ambient + exposure * e, dec, enc);
+        let c = false_color(false_color_position(e as f64, o.false_color_max_lux));
+        *px = blend(c, shaded, 0.65);
     }
 }
 

@@ -18,11 +18,14 @@
 //!   (ambient + exposure · ΣE), with a false-colour illuminance overlay. The exact path.
 //! * [`illum`]: the illuminance map, E computed once per lighting change over the room's
 //!   faces, which frames sample (`map_shade`): the interactive path.
+//! * [`bake`]: the lit panorama, every texel lit once from the illuminance map, so a pan
+//!   of the lit room is an unlit frame of the lit copy.
 //!
 //! World frame (docs/conventions.md): X right, Y up, Z forward at yaw 0; metres. The origin is
 //! the floor point below the camera, so the camera sits at (0, camera height, 0).
 //! See `docs/lights.md` for the design.
 
+pub mod bake;
 pub mod ies;
 pub mod illum;
 pub mod ldt;
@@ -34,6 +37,7 @@ pub mod shade;
 mod shade_table;
 pub mod table;
 
+pub use bake::{lit_cube_bytes, lit_map_bytes, BAKE_MAX_BYTES};
 pub use ies::{IesError, IesFile, IesFormat, PhotometricType, Tilt, TiltData};
 pub use illum::{IlluminanceMap, MapOptions};
 pub use ldt::{LampSet, LdtError, LdtFile, LdtSymmetry, LdtType};
@@ -203,6 +207,18 @@ pub enum LightError {
         point: [f64; 3],
         /// Two of the faces meeting there.
         faces: (&'static str, &'static str),
+    },
+    /// A lit copy of the panorama would take more memory than a bake may use.
+    #[error(
+        "the lit panorama would take {} MiB, more than the {} MiB a bake may use: \
+         frames are lit one by one instead",
+        bytes.div_ceil(1 << 20), max >> 20
+    )]
+    BakeTooLarge {
+        /// The bytes the lit copy (and its pyramid) would take.
+        bytes: usize,
+        /// [`BAKE_MAX_BYTES`].
+        max: usize,
     },
     /// The frame buffer does not hold width × height pixels.
     #[error("frame holds {len} pixels but {width}x{height} needs {needed}")]

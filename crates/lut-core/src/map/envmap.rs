@@ -141,6 +141,34 @@ impl EnvMap {
         }
     }
 
+    /// A map like this one (size, projection, crop, background, pose, start view) holding
+    /// `data` instead, a padded buffer of the same size with its padding filled; its
+    /// pyramid is built on first use. (The lit copy of `light/bake.rs`.)
+    pub(crate) fn with_padded(&self, data: Vec<u32>) -> EnvMap {
+        debug_assert_eq!(data.len(), self.data.len());
+        EnvMap {
+            width: self.width,
+            height: self.height,
+            projection: self.projection,
+            data,
+            background: self.background,
+            crop: self.crop,
+            pose_heading: self.pose_heading,
+            start_view: self.start_view,
+            levels: std::sync::OnceLock::new(),
+            row_extent: self.row_extent.clone(),
+        }
+    }
+
+    /// Whether the padding column repeats column 0 (the stored pixels span 360°) rather
+    /// than the last column.
+    pub(crate) fn pads_by_wrapping(&self) -> bool {
+        match self.crop {
+            Some(c) => c.width() == c.full_width(),
+            None => self.projection.wraps(),
+        }
+    }
+
     /// The padded pixel buffer, `(stored width + 1) × (stored height + 1)` row-major, and
     /// its stride (stored width + 1): what the span kernels read.
     #[inline(always)]

@@ -2,6 +2,7 @@
 //! lux` and the window share, the light state ([`LightsState`]) they become, which the
 //! window's panel edits, and scene files ([`SceneFile`]) that save and reopen it.
 
+mod baked;
 mod files;
 pub mod legend;
 mod lit;
@@ -9,6 +10,7 @@ pub mod overlay;
 mod scene_file;
 mod state;
 
+pub use baked::{BakeKey, BakeState, LitPanorama};
 pub use files::{file_kind, FileKind};
 pub use lit::{LitCache, LitRenderError};
 pub use scene_file::{

@@ -300,7 +300,46 @@ pub fn drag_room_edge(
     Some(box_walls(lo, hi))
 }
 
-/// How close (metres) a dragged wall may come to the camera.
+/// The room's (height, camera height) after the floor or ceiling edge `edge` (an index
+/// into [`Room::EDGES`]) is lifted or lowered to (px, py) of a `cam` frame (the window's
+/// Shift-drag of an edge): the edge slides up or down its wall to where the cursor's ray
+/// meets that wall, taking the ceiling (a top edge: the height changes) or the floor (a
+/// bottom edge: the floor moves under the camera, so the camera height and the height
+/// change together and the ceiling stays). Walls, turn and centre stay; the camera
+/// stays at least 5 cm inside. `None` for a vertical edge or when the cursor's ray does
+/// not meet the wall in front of the camera.
+pub fn drag_room_level(
+    room: &Room,
+    cam: &Camera,
+    edge: usize,
+    at: (f64, f64),
+) -> Option<(f64, f64)> {
+    let (i, j) = *Room::EDGES.get(edge)?;
+    let axis = (i ^ j).trailing_zeros() as usize;
+    if axis == 1 {
+        return None;
+    }
+    // The wall that holds the edge: perpendicular to the other horizontal axis.
+    let wall = 2 - axis;
+    let plane = room.corners()[i][wall];
+    let o = room.camera_position();
+    let d = room.to_room(cam.ray(at.0, at.1)?);
+    let t = (plane - o[wall]) / d[wall];
+    if !(t > 0.0 && t.is_finite()) {
+        return None;
+    }
+    let y = o.y + d.y * t;
+    let (h, c) = (room.height(), o.y);
+    Some(if i & 2 != 0 {
+        (y.max(c + INSIDE), c)
+    } else {
+        // The floor at y (room coordinates, the old floor at 0): the ceiling stays.
+        let y = y.min(c - INSIDE);
+        (h - y, c - y)
+    })
+}
+
+/// How close (metres) a dragged wall, floor or ceiling may come to the camera.
 const INSIDE: f64 = 0.05;
 
 /// Move the wall on `axis` (0: X, 2: Z) at the box's `high` or low end to `v`, keeping
@@ -552,6 +591,81 @@ mod tests {
         let far = drag_room_edge(&room, &cam, k, (319.0, 100.0)).unwrap();
         let (lo3, hi3) = rebuilt(far).bounds();
         assert!(lo3.x <= -0.05 + 1e-12 && hi3.z >= 0.05 - 1e-12);
+    }
+
+    #[test]
+    fn lifted_edges_move_the_ceiling_or_the_floor() {
+        let room = Room::new(4.0, 6.0, 2.8, 1.5)
+            .unwrap()
+            .with_yaw(-35.0)
+            .unwrap()
+            .with_center(0.3, -0.4)
+            .unwrap();
+        let (lo, hi) = room.bounds();
+        let rebuilt = |(h, c): (f64, f64)| {
+            Room::new(4.0, 6.0, h, c)
+                .unwrap()
+                .with_yaw(-35.0)
+                .unwrap()
+                .with_center(0.3, -0.4)
+                .unwrap()
+        };
+        let edge = |a: usize, b: usize| Room::EDGES.iter().position(|&e| e == (a, b)).unwrap();
+        // The ceiling edge on the low-z wall raised to 3.4 m; the floor edge on the
+        // high-z wall lowered 0.3 m below the floor (and one on the low-x wall raised
+        // 0.2 m): each lands where the cursor is, on its own wall.
+        let xm = (lo.x + hi.x) / 2.0;
+        let zm = (lo.z + hi.z) / 2.0;
+        let view_of = |target: DVec3, pitch: f64| {
+            (0..36)
+                .map(|s| Camera::new(View::new(s as f64 * 10.0, pitch, 100.0).unwrap(), 320, 200))
+                .find(|cam| {
+                    project_point(&room, cam, target).is_some_and(|(x, y)| {
+                        (0.0..320.0).contains(&x) && (0.0..200.0).contains(&y)
+                    })
+                })
+                .expect("a view of the target")
+        };
+        for (k, target, want, pitch) in [
+            (edge(2, 3), DVec3::new(xm, 3.4, lo.z), (3.4, 1.5), 20.0),
+            (edge(4, 5), DVec3::new(xm, -0.3, hi.z), (3.1, 1.8), -30.0),
+            (edge(0, 4), DVec3::new(lo.x, 0.2, zm), (2.6, 1.3), -30.0),
+        ] {
+            let (i, _) = Room::EDGES[k];
+            let cam = view_of(target, pitch);
+            let at = project_point(&room, &cam, target).unwrap();
+            let got = drag_room_level(&room, &cam, k, at).unwrap();
+            assert!(
+                (got.0 - want.0).abs() < 1e-9 && (got.1 - want.1).abs() < 1e-9,
+                "edge {k}: {got:?} vs {want:?}"
+            );
+            // The rebuilt room's edge passes under the cursor: its corner's height is the
+            // target's, seen from the same camera.
+            let moved = rebuilt(got);
+            let mut p = target;
+            p.y = moved.corners()[i].y;
+            let seen = project_point(&moved, &cam, p).unwrap();
+            assert!((seen.0 - at.0).abs() < 1e-6 && (seen.1 - at.1).abs() < 1e-6);
+            assert_eq!(moved.bounds().0.x, lo.x);
+            assert_eq!(moved.bounds().1.z, hi.z);
+        }
+        // Never past the camera: the ceiling edge dragged below eye level stops 5 cm
+        // above it, the floor edge dragged above it 5 cm below.
+        let low = DVec3::new(xm, 1.0, lo.z);
+        let cam = view_of(low, -10.0);
+        let at = project_point(&room, &cam, low).unwrap();
+        let (h, c) = drag_room_level(&room, &cam, edge(2, 3), at).unwrap();
+        assert!((h - 1.55).abs() < 1e-12 && c == 1.5, "{h} {c}");
+        let high = DVec3::new(xm, 2.0, lo.z);
+        let cam = view_of(high, 10.0);
+        let at = project_point(&room, &cam, high).unwrap();
+        let (h, c) = drag_room_level(&room, &cam, edge(0, 1), at).unwrap();
+        assert!(
+            (c - 0.05).abs() < 1e-12 && (h - 1.35).abs() < 1e-12,
+            "{h} {c}"
+        );
+        // A vertical edge is not a level.
+        assert!(drag_room_level(&room, &cam, edge(0, 2), (160.0, 100.0)).is_none());
     }
 
     #[test]

@@ -82,6 +82,9 @@ pub struct LightsState {
     pub scene_error: Option<String>,
     /// Illuminance at the pointer (lights only), when the pointer is over the scene.
     pub lux_at_cursor: Option<f64>,
+    /// Where the window's lit panorama stands (`super::BakeState::describe`; empty
+    /// without luminaires).
+    pub lit_panorama: String,
     /// Draw the room box and the luminaires over the view (the window's "Show room").
     pub show_room: bool,
     /// The luminaire selected in the view or the panel.
@@ -108,6 +111,7 @@ impl Default for LightsState {
             error: None,
             scene_error: None,
             lux_at_cursor: None,
+            lit_panorama: String::new(),
             show_room: false,
             selected: None,
         }

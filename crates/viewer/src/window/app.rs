@@ -16,6 +16,8 @@ mod actions;
 mod frame;
 mod lights;
 
+use lights::SceneDrag;
+
 use super::dialogs::Dialogs;
 use super::document::{Document, LoadEvent, StartArgs};
 use super::input::{AutoRotate, Controller, Look};
@@ -26,7 +28,7 @@ use super::paint::Compositor;
 use super::prefs::Prefs;
 use super::quality::{FrameTimes, Level};
 use super::OpenArgs;
-use crate::lighting::{LightsKey, LightsState, LitCache};
+use crate::lighting::{LightsKey, LightsState, LitCache, LitPanorama};
 use anyhow::{anyhow, Result};
 use lut_core::{CubeRenderer, IndexStep, LutChoice, RendererKind, Sampler};
 use std::collections::VecDeque;
@@ -122,12 +124,11 @@ struct App {
     lights: LightsState,
     /// Their illuminance map, rebuilt when they change.
     lit: LitCache,
-    /// The luminaire being dragged in the view.
-    light_drag: Option<usize>,
-    /// The room edge being dragged (an index into `lut_core::Room::EDGES`).
-    edge_drag: Option<usize>,
-    /// The room corner being dragged (an index into `lut_core::Room::corners`).
-    corner_drag: Option<usize>,
+    /// The panorama lit once the lighting has settled, panned as an unlit one.
+    baked: LitPanorama,
+    /// What a drag in the view moves instead of the view (a luminaire, a room corner,
+    /// an edge, or with Shift an edge's floor or ceiling).
+    scene_drag: Option<SceneDrag>,
     /// The scene file opened or saved last.
     scene_file: Option<PathBuf>,
     /// The luminaires' marker positions as last printed (`--print-view`).
@@ -193,9 +194,8 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         fatal: None,
         lights,
         lit: LitCache::default(),
-        light_drag: None,
-        edge_drag: None,
-        corner_drag: None,
+        baked: LitPanorama::default(),
+        scene_drag: None,
         scene_file: args.lights.room.scene.clone(),
         printed_markers: String::new(),
     };

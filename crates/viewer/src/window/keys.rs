@@ -267,6 +267,11 @@ pub const MOUSE_HELP: &[(&str, &str)] = &[
         "drag a room edge",
         "move its walls to fit the photo (Show room on)",
     ),
+    ("drag a room corner", "move the two walls meeting there"),
+    (
+        "Shift-drag a floor/ceiling edge",
+        "raise or lower the ceiling or the floor (height, camera height)",
+    ),
     ("Tab, Enter", "focus and press the buttons"),
 ];
 

@@ -49,6 +49,12 @@ pub fn lights_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, out: &mut Panel
             for e in [&l.error, &l.scene_error].into_iter().flatten() {
                 ui.colored_label(ERROR, e);
             }
+            if !l.lit_panorama.is_empty() {
+                ui.label(&l.lit_panorama).on_hover_text(
+                    "Once the lighting has settled the panorama is lit once and panned \
+                     like an unlit one; while it changes each frame is lit",
+                );
+            }
             room_fields(ui, l);
             lights_list(ui, l);
             shading_fields(ui, l);

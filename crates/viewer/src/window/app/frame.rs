@@ -92,12 +92,13 @@ impl App {
                 .or(resp.interact_pointer_pos());
             if let Some(o) = origin {
                 // On a luminaire's marker the drag moves the luminaire.
-                if !self.press_light(to_px(o), size) {
+                let shift = ui.input(|i| i.modifiers.shift);
+                if !self.press_light(to_px(o), size, shift) {
                     self.ctl.press(to_px(o), size, t);
                 }
             }
         }
-        if self.light_drag.is_some() || self.edge_drag.is_some() || self.corner_drag.is_some() {
+        if self.scene_drag.is_some() {
             match resp.interact_pointer_pos() {
                 Some(p) if resp.dragged_by(primary) => self.drag_light(to_px(p), size),
                 _ => self.end_light_drag(),
@@ -328,8 +329,9 @@ impl App {
         if self.notices.expire(t) {
             want(now);
         }
-        if self.lit.refining() {
-            // The coarse illuminance map shown: the full one next.
+        if self.lit.refining() || self.baked.pending() {
+            // The coarse illuminance map shown: the full one next; or the lighting has
+            // settled: the lit panorama next.
             want(now);
         }
         if let Some(n) = next {
@@ -386,6 +388,9 @@ impl App {
         // level it shows. The still frame reads the map itself.
         let bilinear_level = fast && opts.sampler == Sampler::Bilinear;
         let lit = self.update_lit();
+        // Once the lighting has settled, frames pan the lit panorama (unlit frames of it);
+        // while it changes, each frame is lit from the illuminance map.
+        let from_baked = self.update_baked(lit.as_deref());
         let key = SceneKey {
             look,
             size: (rect.w, rect.h),
@@ -421,7 +426,7 @@ impl App {
         // A full-size frame is lit as its rows are drawn (no second pass over it); a
         // smaller one is lit after it is scaled up, in `light_scene`.
         let cam = Camera::new(view, rect.w, rect.h);
-        let shader = match (&lit, k == 1 && !s.heat_map) {
+        let shader = match (&lit, k == 1 && !s.heat_map && !from_baked) {
             (Some(map), true) => match map.frame_shader(&cam, &self.lights.shade_options()) {
                 Ok(shader) => Some(shader),
                 Err(e) => {
@@ -432,9 +437,13 @@ impl App {
             _ => None,
         };
         let lit_while_drawn = shader.is_some();
+        let scene = match self.baked.scene_ref(&mut cur.scene) {
+            Some(lit_copy) if from_baked => lit_copy,
+            _ => cur.scene.as_mut(),
+        };
         let result = if k == 1 {
             render_scene_lit(
-                cur.scene.as_mut(),
+                scene,
                 view,
                 &opts,
                 &mut self.scene,
@@ -445,7 +454,7 @@ impl App {
         } else {
             let (sw, sh) = (rect.w.div_ceil(k), rect.h.div_ceil(k));
             fit(&mut self.small, sw as usize * sh as usize);
-            let r = render_scene(cur.scene.as_mut(), view, &opts, &mut self.small, sw, sh);
+            let r = render_scene(scene, view, &opts, &mut self.small, sw, sh);
             crate::window::paint::upscale_bilinear(
                 &self.small,
                 sw,
@@ -468,7 +477,7 @@ impl App {
         if s.heat_map {
             self.show_heat_map(view, &opts, rect, k);
         } else {
-            let unlit = lit.as_deref().filter(|_| !lit_while_drawn);
+            let unlit = lit.as_deref().filter(|_| !lit_while_drawn && !from_baked);
             self.light_scene(lit.as_deref(), unlit, view, rect);
         }
         let ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -502,7 +511,7 @@ impl App {
         if self.print_view {
             let _ = crate::outln!(
                 "view yaw={:.4} pitch={:.4} hfov={:.4} path={path} sampler={} level={} fast={} \
-                 ms={ms:.2} size={}x{} lights={} proj={}",
+                 ms={ms:.2} size={}x{} lights={} proj={} lit={}",
                 look.yaw,
                 look.pitch,
                 look.hfov,
@@ -512,7 +521,12 @@ impl App {
                 rect.w,
                 rect.h,
                 self.lights.lights.len(),
-                look.projection.name()
+                look.projection.name(),
+                match (from_baked, &lit) {
+                    (true, _) => "baked",
+                    (false, Some(_)) => "frame",
+                    (false, None) => "none",
+                }
             );
         }
     }

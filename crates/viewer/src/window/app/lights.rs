@@ -4,10 +4,10 @@
 
 use super::App;
 use crate::lighting::overlay::{
-    drag_on_surface, drag_room_corner, drag_room_edge, draw_room_and_lights, pick_light,
-    pick_room_corner, pick_room_edge, project_point,
+    drag_on_surface, drag_room_corner, drag_room_edge, drag_room_level, draw_room_and_lights,
+    pick_light, pick_room_corner, pick_room_edge, project_point,
 };
-use crate::lighting::{legend::draw_legend, SceneFile, SceneView};
+use crate::lighting::{legend::draw_legend, BakeKey, SceneFile, SceneView};
 use crate::window::document::StartArgs;
 use crate::window::loader::Source;
 use crate::window::paint::SceneRect;
@@ -19,6 +19,19 @@ use std::sync::Arc;
 pub(super) const PICK_RADIUS: f64 = 12.0;
 /// How near (scene pixels) a press must be to a room edge to drag it.
 pub(super) const EDGE_RADIUS: f64 = 6.0;
+
+/// What a drag in the view moves instead of turning the view.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum SceneDrag {
+    /// A luminaire (its index), along the face it is nearest to.
+    Light(usize),
+    /// A room corner (an index into `lut_core::Room::corners`): its two walls.
+    Corner(usize),
+    /// A room edge (an index into `lut_core::Room::EDGES`): its walls.
+    Edge(usize),
+    /// A floor or ceiling edge taken with Shift: the floor or ceiling, up or down.
+    Level(usize),
+}
 
 impl App {
     /// The illuminance map for this frame (rebuilt, coarse first, when the lights
@@ -35,6 +48,25 @@ impl App {
                 None
             }
         }
+    }
+
+    /// Bake the lit panorama from `map` once the lighting has settled (the full map
+    /// built, nothing dragged, the same lighting as on the frame before: see
+    /// [`crate::lighting::LitPanorama`]), and show its state in the panel. True when this
+    /// frame pans the lit copy instead of lighting the frame.
+    pub(super) fn update_baked(&mut self, map: Option<&IlluminanceMap>) -> bool {
+        let settled = !self.lit.refining() && self.scene_drag.is_none();
+        let key = map.map(|_| BakeKey {
+            map_generation: self.lit.generation(),
+            scene_generation: self.doc.generation(),
+            shade: self.lights.shade_options(),
+        });
+        let Some(cur) = self.doc.current() else {
+            return false;
+        };
+        let on = self.baked.update(key, settled, map, &cur.scene);
+        self.lights.lit_panorama = self.baked.state().describe();
+        on
     }
 
     /// Light the freshly rendered scene from `unlit` (the map, when the render did not
@@ -151,77 +183,94 @@ impl App {
 
     /// A drag starts at `at`: on a luminaire's marker (the room shown) it moves that
     /// luminaire, on a corner of the room box the two walls meeting there, on an edge that
-    /// edge's walls, instead of turning the view. True when a luminaire, a corner or an
-    /// edge was taken.
-    pub(super) fn press_light(&mut self, at: (f64, f64), size: (u32, u32)) -> bool {
+    /// edge's walls, and with `shift` held on a floor or ceiling edge the floor or the
+    /// ceiling, instead of turning the view. True when one of them was taken.
+    pub(super) fn press_light(&mut self, at: (f64, f64), size: (u32, u32), shift: bool) -> bool {
+        self.scene_drag = self.pick_scene_drag(at, size, shift);
+        if let Some(SceneDrag::Light(i)) = self.scene_drag {
+            self.lights.selected = Some(i);
+            self.print_selection();
+        }
+        self.scene_drag.is_some()
+    }
+
+    /// What a press at `at` takes (see [`App::press_light`]).
+    fn pick_scene_drag(&self, at: (f64, f64), size: (u32, u32), shift: bool) -> Option<SceneDrag> {
         if !self.lights.show_room {
-            return false;
+            return None;
         }
         let view = self.ctl.look().view();
-        self.light_drag = pick_light(&self.lights, view, size.0, size.1, at, PICK_RADIUS);
-        if self.light_drag.is_some() {
-            self.lights.selected = self.light_drag;
-            self.print_selection();
-            return true;
+        if let Some(i) = pick_light(&self.lights, view, size.0, size.1, at, PICK_RADIUS) {
+            return Some(SceneDrag::Light(i));
         }
         let cam = Camera::new(view, size.0, size.1);
-        let Ok(room) = self.lights.room_box() else {
-            return false;
-        };
-        // A corner first (it lies on three edges), then an edge.
-        self.corner_drag = pick_room_corner(&room, &cam, at, EDGE_RADIUS);
-        if self.corner_drag.is_none() {
-            self.edge_drag = pick_room_edge(&room, &cam, at, EDGE_RADIUS);
+        let room = self.lights.room_box().ok()?;
+        if shift {
+            // Only the floor and ceiling edges have a level to take.
+            let e = pick_room_edge(&room, &cam, at, EDGE_RADIUS)?;
+            let (i, j) = lut_core::Room::EDGES[e];
+            return (i & 2 == j & 2).then_some(SceneDrag::Level(e));
         }
-        self.corner_drag.is_some() || self.edge_drag.is_some()
+        // A corner first (it lies on three edges), then an edge.
+        pick_room_corner(&room, &cam, at, EDGE_RADIUS)
+            .map(SceneDrag::Corner)
+            .or_else(|| pick_room_edge(&room, &cam, at, EDGE_RADIUS).map(SceneDrag::Edge))
     }
 
     /// The dragged luminaire follows the cursor along the face it is nearest to; a
-    /// dragged room corner or edge moves its walls to the cursor.
+    /// dragged room corner or edge moves its walls to the cursor, a dragged level its
+    /// floor or ceiling. Where the cursor's ray misses the plane the drag follows, the
+    /// room stays as it is.
     pub(super) fn drag_light(&mut self, at: (f64, f64), size: (u32, u32)) {
         let Ok(room) = self.lights.room_box() else {
             return;
         };
         let cam = Camera::new(self.ctl.look().view(), size.0, size.1);
-        let walls = match (self.corner_drag, self.edge_drag) {
-            (Some(c), _) => Some(drag_room_corner(&room, &cam, c, at)),
-            (None, Some(e)) => Some(drag_room_edge(&room, &cam, e, at)),
-            (None, None) => None,
-        };
-        match walls {
-            Some(Some((w, d, cx, cz))) => {
-                self.lights.room.0 = w;
-                self.lights.room.1 = d;
-                self.lights.room_center = (cx, cz);
+        let walls = match self.scene_drag {
+            Some(SceneDrag::Corner(c)) => drag_room_corner(&room, &cam, c, at),
+            Some(SceneDrag::Edge(e)) => drag_room_edge(&room, &cam, e, at),
+            Some(SceneDrag::Level(e)) => {
+                if let Some((h, c)) = drag_room_level(&room, &cam, e, at) {
+                    self.lights.room.2 = h;
+                    self.lights.camera_height = c;
+                }
                 return;
             }
-            // The cursor's ray misses the floor or ceiling: the room stays.
-            Some(None) => return,
-            None => {}
-        }
-        let Some(i) = self.light_drag else {
-            return;
-        };
-        if let Some(l) = self.lights.lights.get_mut(i) {
-            if let Some(p) = drag_on_surface(&room, &cam, l.position.into(), at) {
-                l.position = p.into();
+            Some(SceneDrag::Light(i)) => {
+                if let Some(l) = self.lights.lights.get_mut(i) {
+                    if let Some(p) = drag_on_surface(&room, &cam, l.position.into(), at) {
+                        l.position = p.into();
+                    }
+                }
+                return;
             }
+            None => return,
+        };
+        if let Some((w, d, cx, cz)) = walls {
+            self.lights.room.0 = w;
+            self.lights.room.1 = d;
+            self.lights.room_center = (cx, cz);
         }
     }
 
-    /// The drag of a luminaire ended (`--print-view`: where it is now).
+    /// The drag of a luminaire or of the room ended (`--print-view`: where it is now).
     pub(super) fn end_light_drag(&mut self) {
-        let room_dragged = self.edge_drag.take().is_some() | self.corner_drag.take().is_some();
-        if room_dragged && self.print_view {
-            let (w, d, h) = self.lights.room;
-            let (cx, cz) = self.lights.room_center;
-            let _ = crate::outln!("room {w:.3}x{d:.3}x{h:.3} centre {cx:.3},{cz:.3}");
+        let Some(drag) = self.scene_drag.take() else {
+            return;
+        };
+        if !self.print_view {
+            return;
         }
-        if let (Some(i), true) = (self.light_drag.take(), self.print_view) {
+        if let SceneDrag::Light(i) = drag {
             if let Some(l) = self.lights.lights.get(i) {
                 let [x, y, z] = l.position;
                 let _ = crate::outln!("light {} moved to {x:.3},{y:.3},{z:.3}", i + 1);
             }
+        } else {
+            let (w, d, h) = self.lights.room;
+            let (cx, cz) = self.lights.room_center;
+            let c = self.lights.camera_height;
+            let _ = crate::outln!("room {w:.3}x{d:.3}x{h:.3} centre {cx:.3},{cz:.3} camera {c:.3}");
         }
     }
 
