@@ -91,6 +91,46 @@ macro_rules! lanes {
     };
 }
 
+/// `expand` (see `row::expand_scalar`) for one instruction set, `$n` lanes: the three
+/// position lines of each span, a vector per step, stored whole (the next span overwrites
+/// what lies past a span).
+macro_rules! expand_kernel {
+    ($feature:literal, $n:literal, $shift:literal, $iota:expr, $set1:ident, $add:ident,
+     $sub:ident, $mullo:ident, $srai:ident, $slli:ident, $store:ident) => {
+        #[inline]
+        #[target_feature(enable = $feature)]
+        pub(super) fn expand(spans: &[SpanQ8], p: Positions<'_>) {
+            let iota = $iota;
+            for s in spans {
+                let (k, m) = (s.k as usize, s.m as usize);
+                let r = k..k + m.next_multiple_of($n);
+                let cu = p.u[r.clone()].chunks_exact_mut($n);
+                let out = cu.zip(p.v[r.clone()].chunks_exact_mut($n));
+                let (du, dv) = ($set1(s.du), $set1(s.dv));
+                let (iu, iv) = ($mullo(iota, du), $mullo(iota, dv));
+                let (mut lu, mut lv) = ($add($set1(s.lu), iu), $add($set1(s.lv), iv));
+                let mut ll = $sub($set1(s.ll), iu);
+                let (su, sv) = ($slli::<$shift>(du), $slli::<$shift>(dv));
+                let (hu, hv, hl) = ($set1(s.hu), $set1(s.hv), $set1(s.hl));
+                for ((cu, cv), cl) in out.zip(p.ul[r].chunks_exact_mut($n)) {
+                    let a = $add(hu, $srai::<8>(lu));
+                    let b = $add(hv, $srai::<8>(lv));
+                    let c = $add(hl, $srai::<8>(ll));
+                    // SAFETY: `cu`, `cv`, `cl` are $n writable i32 each; unaligned stores.
+                    unsafe {
+                        $store(cu.as_mut_ptr().cast(), a);
+                        $store(cv.as_mut_ptr().cast(), b);
+                        $store(cl.as_mut_ptr().cast(), c);
+                    }
+                    lu = $add(lu, su);
+                    lv = $add(lv, sv);
+                    ll = $sub(ll, su);
+                }
+            }
+        }
+    };
+}
+
 mod avx2 {
     use super::super::avx2::{lerp, merge, split};
     use super::*;
@@ -121,41 +161,19 @@ mod avx2 {
         (w, _mm256_sub_epi16(_mm256_set1_epi16(256), w))
     }
 
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    pub(super) fn expand(spans: &[SpanQ8], p: Positions<'_>) {
-        let iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-        for s in spans {
-            let (k, m) = (s.k as usize, s.m as usize);
-            let r = k..k + m.next_multiple_of(8);
-            let cu = p.u[r.clone()].chunks_exact_mut(8);
-            let out = cu.zip(p.v[r.clone()].chunks_exact_mut(8));
-            let set = _mm256_set1_epi32;
-            let (du, dv) = (set(s.du), set(s.dv));
-            let (iu, iv) = (_mm256_mullo_epi32(iota, du), _mm256_mullo_epi32(iota, dv));
-            let (mut lu, mut lv) = (
-                _mm256_add_epi32(set(s.lu), iu),
-                _mm256_add_epi32(set(s.lv), iv),
-            );
-            let mut ll = _mm256_sub_epi32(set(s.ll), iu);
-            let (su, sv) = (_mm256_slli_epi32::<3>(du), _mm256_slli_epi32::<3>(dv));
-            let (hu, hv, hl) = (set(s.hu), set(s.hv), set(s.hl));
-            for ((cu, cv), cl) in out.zip(p.ul[r].chunks_exact_mut(8)) {
-                let a = _mm256_add_epi32(hu, _mm256_srai_epi32::<8>(lu));
-                let b = _mm256_add_epi32(hv, _mm256_srai_epi32::<8>(lv));
-                let c = _mm256_add_epi32(hl, _mm256_srai_epi32::<8>(ll));
-                // SAFETY: `cu`, `cv`, `cl` are 8 writable i32 each; unaligned stores.
-                unsafe {
-                    _mm256_storeu_si256(cu.as_mut_ptr().cast(), a);
-                    _mm256_storeu_si256(cv.as_mut_ptr().cast(), b);
-                    _mm256_storeu_si256(cl.as_mut_ptr().cast(), c);
-                }
-                lu = _mm256_add_epi32(lu, su);
-                lv = _mm256_add_epi32(lv, sv);
-                ll = _mm256_sub_epi32(ll, su);
-            }
-        }
-    }
+    expand_kernel!(
+        "avx2",
+        8,
+        3,
+        _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
+        _mm256_set1_epi32,
+        _mm256_add_epi32,
+        _mm256_sub_epi32,
+        _mm256_mullo_epi32,
+        _mm256_srai_epi32,
+        _mm256_slli_epi32,
+        _mm256_storeu_si256
+    );
 
     #[inline]
     #[target_feature(enable = "avx2")]
@@ -268,38 +286,19 @@ mod sse41 {
         (w, _mm_sub_epi16(_mm_set1_epi16(256), w))
     }
 
-    #[inline]
-    #[target_feature(enable = "sse4.1")]
-    pub(super) fn expand(spans: &[SpanQ8], p: Positions<'_>) {
-        let iota = _mm_setr_epi32(0, 1, 2, 3);
-        for s in spans {
-            let (k, m) = (s.k as usize, s.m as usize);
-            let r = k..k + m.next_multiple_of(4);
-            let cu = p.u[r.clone()].chunks_exact_mut(4);
-            let out = cu.zip(p.v[r.clone()].chunks_exact_mut(4));
-            let set = _mm_set1_epi32;
-            let (du, dv) = (set(s.du), set(s.dv));
-            let (iu, iv) = (_mm_mullo_epi32(iota, du), _mm_mullo_epi32(iota, dv));
-            let (mut lu, mut lv) = (_mm_add_epi32(set(s.lu), iu), _mm_add_epi32(set(s.lv), iv));
-            let mut ll = _mm_sub_epi32(set(s.ll), iu);
-            let (su, sv) = (_mm_slli_epi32::<2>(du), _mm_slli_epi32::<2>(dv));
-            let (hu, hv, hl) = (set(s.hu), set(s.hv), set(s.hl));
-            for ((cu, cv), cl) in out.zip(p.ul[r].chunks_exact_mut(4)) {
-                let a = _mm_add_epi32(hu, _mm_srai_epi32::<8>(lu));
-                let b = _mm_add_epi32(hv, _mm_srai_epi32::<8>(lv));
-                let c = _mm_add_epi32(hl, _mm_srai_epi32::<8>(ll));
-                // SAFETY: `cu`, `cv`, `cl` are 4 writable i32 each; unaligned stores.
-                unsafe {
-                    _mm_storeu_si128(cu.as_mut_ptr().cast(), a);
-                    _mm_storeu_si128(cv.as_mut_ptr().cast(), b);
-                    _mm_storeu_si128(cl.as_mut_ptr().cast(), c);
-                }
-                lu = _mm_add_epi32(lu, su);
-                lv = _mm_add_epi32(lv, sv);
-                ll = _mm_sub_epi32(ll, su);
-            }
-        }
-    }
+    expand_kernel!(
+        "sse4.1",
+        4,
+        2,
+        _mm_setr_epi32(0, 1, 2, 3),
+        _mm_set1_epi32,
+        _mm_add_epi32,
+        _mm_sub_epi32,
+        _mm_mullo_epi32,
+        _mm_srai_epi32,
+        _mm_slli_epi32,
+        _mm_storeu_si128
+    );
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
