@@ -462,6 +462,10 @@ impl LutTable {
     pub fn col_max(&self) -> f64 {
         (self.cols - 1) as f64 / self.inv_step
     }
+    /// Table nodes per unit of the column (and row) coordinate.
+    pub(crate) fn nodes_per_unit(&self) -> f64 {
+        self.inv_step
+    }
     /// Largest row coordinate the table covers.
     pub fn row_max(&self) -> f64 {
         (self.rows - 1) as f64 / self.inv_step
@@ -525,7 +529,15 @@ impl Band<'_> {
     /// table clamp to its last node.
     #[inline(always)]
     pub(crate) fn lookup(&self, col: f64) -> (i64, i64) {
-        let (k, wk) = self.node(col);
+        // (col · inv_step) · 2^16 and col · (inv_step · 2^16) round alike (a power of two).
+        self.lookup_q(((col * self.scale) as i64) << 16)
+    }
+
+    /// [`Band::lookup`] at node coordinate `c` (column coordinate × nodes per unit, Q.32,
+    /// `c ≥ 0`): what the scanline walk reads, its coordinate stepped in integers.
+    #[inline(always)]
+    pub(crate) fn lookup_q(&self, c: i64) -> (i64, i64) {
+        let (k, wk) = self.node_q(c);
         let (a, b) = (self.top[k], self.top[k + 1]);
         let bot = &self.bot[k..k + 2];
         let (c, d) = (bot[0], bot[1]);
@@ -537,18 +549,16 @@ impl Band<'_> {
         (l0 + (((l1 - l0) * wk) >> 16), v0 + (((v1 - v0) * wk) >> 16))
     }
 
-    /// The node left of column coordinate `col ≥ 0` (at most the last but one) and the
+    /// The node left of node coordinate `c ≥ 0` (Q.32; at most the last but one) and the
     /// Q.16 weight of the next one.
     #[inline(always)]
-    pub(crate) fn node(&self, col: f64) -> (usize, i64) {
-        // (col · inv_step) · 2^16 and col · (inv_step · 2^16) round alike (a power of two).
-        let fc = (col * self.scale) as i64;
+    pub(crate) fn node_q(&self, c: i64) -> (usize, i64) {
         let n = self.top.len();
-        let k = (fc >> 16) as usize;
+        let k = (c >> 32) as usize;
         if k >= n - 1 {
             (n - 2, 1 << 16)
         } else {
-            (k, fc & 0xFFFF)
+            (k, (c >> 16) & 0xFFFF)
         }
     }
 
@@ -581,10 +591,10 @@ pub(crate) struct Blended<'a> {
 }
 
 impl Blended<'_> {
-    /// [`Band::lookup`]; `col`'s node and the next must be among the blended ones.
+    /// [`Band::lookup_q`]; `c`'s node and the next must be among the blended ones.
     #[inline(always)]
-    pub(crate) fn lookup(&self, col: f64) -> (i64, i64) {
-        let (k, wk) = self.band.node(col);
+    pub(crate) fn lookup_q(&self, c: i64) -> (i64, i64) {
+        let (k, wk) = self.band.node_q(c);
         let pair = &self.nodes[k - self.k0..k - self.k0 + 2];
         let (a, b) = (pair[0], pair[1]);
         let (l0, l1) = (a[0] as i64, b[0] as i64);
@@ -687,7 +697,9 @@ mod tests {
             };
             let mut col = k0 as f64 * step;
             while col < t.col_max() + 3.0 * step {
-                assert_eq!(blended.lookup(col), band.lookup(col), "row {row} col {col}");
+                let c = ((col * band.scale) as i64) << 16;
+                assert_eq!(blended.lookup_q(c), band.lookup(col), "row {row} col {col}");
+                assert_eq!(band.lookup_q(c), band.lookup(col), "row {row} col {col}");
                 assert_eq!(
                     band.lookup(col),
                     t.lookup(b, wa, col),

@@ -5,12 +5,15 @@
 //! * per frame, `setup.rs`: each scanline's table rows, column scale, index steps (from
 //!   the analytic bounds of `steps.rs`) and exact-pixel ranges; nothing else is
 //!   recomputed when the view turns;
-//! * per scanline, `scanline.rs`: the table read every Nth pixel, map coordinates stepped
-//!   in Q.16 fixed point between reads, longitude unwrapped across each span (a span over
-//!   the ±180° seam steps continuously and wraps per pixel instead of smearing across the
-//!   whole map); `rows.rs` runs the rows on one thread or in bands on rayon;
-//! * per pixel, `kernel/`: the span kernels, with the rules they keep;
-//! * `sink.rs`: where a scanline writes (pixels per sampler, or positions).
+//! * per scanline, `scanline.rs`: the table read every Nth pixel of the right half (the
+//!   left half is its mirror image), map coordinates stepped in Q.16 fixed point between
+//!   reads, longitude unwrapped across each span (a span over the ±180° seam steps
+//!   continuously and wraps per pixel instead of smearing across the whole map);
+//!   `rowpass.rs`, for full maps drawn nearest or bilinear: the walk's positions for a run
+//!   of the row at once, then one gather pass (`kernel/row.rs`); `rows.rs` runs the rows
+//!   on one thread or in bands on rayon;
+//! * per pixel, `kernel/`: the row and span kernels, with the rules they keep;
+//! * `sink.rs`: where a scanline's spans go otherwise (pixels per sampler, or positions).
 //!
 //! `exact.rs` is the per-pixel reference renderer, `cube.rs` the cube renderers,
 //! `heat.rs` the error heat map (per-pixel sampling-position error of a renderer),
@@ -28,6 +31,7 @@ pub(crate) mod grid;
 pub(crate) mod heat;
 pub(crate) mod kernel;
 pub(crate) mod projected;
+pub(crate) mod rowpass;
 pub(crate) mod rows;
 pub(crate) mod scanline;
 pub(crate) mod setup;
@@ -48,11 +52,12 @@ use cube::{render_cube, CubeRenderer};
 use exact::{render_exact, ExactFootprint};
 use frame::Frame;
 use grid::{Grid, GridStats};
-use kernel::level_texels;
+use kernel::{level_texels, texels};
+use rowpass::{pixel_row, position_row};
 use rows::{for_each_band_init, for_each_row, for_each_row_init, post_bands};
-use scanline::{render_row, Scratch, BLEND_NODES, ROW_SCALE_ONE};
+use scanline::{render_row, RowScratch, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
-use sink::{Batch, PixelRows, PixelSink, PosRows, PosSink, RowSinks, Sink, TriRows, TriSink};
+use sink::{Batch, PixelRows, PosRows, RowSinks, Sink, TriRows, TriSink};
 use std::f64::consts::TAU;
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
@@ -563,7 +568,7 @@ impl Renderer {
             let (levels, n) = level_texels(map);
             let levels = &levels[..n];
             let fp = ExactFootprint::new(view, width, height, geometry_of(map));
-            let row = |scratch: &mut Scratch, y: usize, row: &mut [u32]| {
+            let row = |scratch: &mut RowScratch, y: usize, row: &mut [u32]| {
                 let scan = &scans[y];
                 let mut s = TriSink {
                     row,
@@ -575,17 +580,17 @@ impl Renderer {
                     batch: Batch::new(),
                 };
                 s.set_lod(lod_q8(scan.fy[0] as f64));
-                render_row(scan, table, &setup, row_scale, scratch, &mut s);
+                render_row(scan, table, &setup, row_scale, &mut scratch.nodes, &mut s);
                 s.flush();
             };
             return Ok(match hook {
                 Some(post) => {
                     let (b, t) = (HOOK_BAND_ROWS, opts.threads);
-                    for_each_band_init(out, w, b, t, new_scratch, row, post);
+                    for_each_band_init(out, w, b, t, RowScratch::new, row, post);
                     (report, true)
                 }
                 None => {
-                    for_each_row_init(out, w, opts.threads, new_scratch, row);
+                    for_each_row_init(out, w, opts.threads, RowScratch::new, row);
                     (report, false)
                 }
             });
@@ -601,16 +606,16 @@ impl Renderer {
             hook: Option<BandHook<'_>>,
         ) {
             let (scans, table, setup, row_scale) = k;
-            let row = |scratch: &mut Scratch, y: usize, row: &mut [u32]| {
-                let mut s = PixelSink::<BILINEAR, CROP>::new(row, map);
-                render_row(&scans[y], table, setup, row_scale, scratch, &mut s);
-                s.flush();
+            let t = texels(map);
+            let row = |scratch: &mut RowScratch, y: usize, row: &mut [u32]| {
+                let lut = (&scans[y], table, setup, row_scale);
+                pixel_row::<BILINEAR, CROP>(lut, scratch, (map, &t), row);
             };
             match hook {
                 Some(post) => {
-                    for_each_band_init(out, w, HOOK_BAND_ROWS, threads, new_scratch, row, post)
+                    for_each_band_init(out, w, HOOK_BAND_ROWS, threads, RowScratch::new, row, post)
                 }
-                None => for_each_row_init(out, w, threads, new_scratch, row),
+                None => for_each_row_init(out, w, threads, RowScratch::new, row),
             }
         }
         let k = (&scans[..], table, &setup, row_scale);
@@ -730,23 +735,21 @@ impl Renderer {
         let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
+        // The pixels' path: the row pass for nearest and bilinear on full maps.
+        let pass = rowpass::applies(&setup) && opts.sampler != Sampler::Trilinear;
+        let wq = (map_w as i32) << 8;
         for_each_row_init(
             &mut out,
             width as usize,
             opts.threads,
-            new_scratch,
+            RowScratch::new,
             |scratch, y, row| {
-                let mut s = PosSink { row };
-                render_row(&scans[y], table, &setup, row_scale, scratch, &mut s);
+                let lut = (&scans[y], table, &setup, row_scale);
+                position_row(lut, scratch, pass.then_some(wq), row);
             },
         );
         Ok((out, report))
     }
-}
-
-/// A row task's room for blended table nodes (on the stack: no allocation per frame).
-fn new_scratch() -> Scratch {
-    [[0; 2]; BLEND_NODES]
 }
 
 /// The map geometry the renderers use: (width, height, projection) of the full panorama.

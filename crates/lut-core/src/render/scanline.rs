@@ -1,8 +1,11 @@
-//! The scanline walk: per output row, the pixels the table covers are stepped span by
-//! span (a table read every 2^shift pixels, Q.16 steps between, longitude unwrapped across
-//! each span so a span over the ±180° seam steps continuously), and the rest (pole zones,
-//! beyond the table) are evaluated exactly. Spans go to a [`Sink`].
+//! The scanline walk: per output row, the pixels the table covers are read every 2^shift
+//! pixels outward from the screen's centre column in both halves (the same reads for both:
+//! the one-eighth symmetry), the column coordinate stepped in whole numbers; Q.16 steps
+//! between reads, longitude unwrapped across each span so a span over the ±180° seam
+//! steps continuously. The rest (pole zones, beyond the table) is evaluated exactly.
+//! Spans go to a [`Sink`].
 
+use super::rowpass::HalfBuf;
 use super::setup::{Scan, Setup};
 use super::sink::Sink;
 use super::steps::STEP_REGIONS;
@@ -15,7 +18,32 @@ pub(crate) const BLEND_NODES: usize = 512;
 /// Room for a scanline's blended table nodes, kept from row to row (no allocation).
 pub(crate) type Scratch = [[i32; 2]; BLEND_NODES];
 
+/// What a row task keeps from row to row (made once per task: no allocation per frame):
+/// room for the blended table nodes and for a run of a row's positions (the row pass).
+pub(crate) struct RowScratch {
+    pub(crate) nodes: Scratch,
+    pub(crate) row: HalfBuf,
+}
+
+impl RowScratch {
+    pub(crate) fn new() -> RowScratch {
+        RowScratch {
+            nodes: [[0; 2]; BLEND_NODES],
+            row: HalfBuf::new(),
+        }
+    }
+}
+
 /// Render one scanline into `sink` (`scratch`: room for its blended table nodes).
+///
+/// The table covers a run of pixels symmetric about the screen's centre column (X = 0),
+/// less the exact zone around it near a pole: the *right half* from `xa` to `xe` and its
+/// mirror image, the *left half*. The table is read for the right half only, every
+/// 2^shift pixels outward from the centre (the shift of the region the span starts in,
+/// [`Half`]), the column coordinate a whole-number step per pixel
+/// (`Scan::node_per_2x`), no floating point per read; each span is emitted twice, for
+/// the left half mirrored (the one-eighth symmetry: X → −X negates Λ; see
+/// [`emit_mirror`]) and for the right half. The exact pixels go first.
 #[inline]
 pub(crate) fn render_row<S: Sink>(
     scan: &Scan,
@@ -26,45 +54,120 @@ pub(crate) fn render_row<S: Sink>(
     sink: &mut S,
 ) {
     let w = fr.w_out as i64;
-    if !scan.lut || scan.lut_lo > scan.lut_hi {
-        exact_run(scan, fr, 0, w - 1, sink);
+    let Some(h) = Half::exact_rest(scan, fr, sink) else {
         return;
+    };
+    with_nodes!(scan, table, &h, scratch, |nodes| {
+        let mut spans = RightSpans::new(scan, nodes, fr, &h);
+        while let Some((d, m, p0, step, r)) = spans.next(scan, fr) {
+            sink.footprint(step.0, step.1, r);
+            emit_mirror(fr, row_scale, w - h.xa - d - m, m, p0, step, sink);
+            emit(fr, row_scale, h.xa + d, m, p0, step, sink);
+        }
+    });
+}
+
+/// `$body` with `$nodes` bound to the half `$h`'s table nodes: blended once into
+/// `$scratch` when that pays ([`blend_pays`]; the right half's reads only), else read
+/// straight from the band (the body is compiled for both).
+macro_rules! with_nodes {
+    ($scan:expr, $table:expr, $h:expr, $scratch:expr, |$nodes:ident| $body:expr) => {{
+        let (scan, h) = ($scan, $h);
+        let band = $table.band(scan.band, scan.wa);
+        // From the smallest |X| to the largest, and the next node.
+        let k0 = band.node_q(h.a0 * scan.node_per_2x).0;
+        let k1 = band.node_q((h.a0 + 2 * h.dn) * scan.node_per_2x).0 + 1;
+        let count = k1 + 1 - k0;
+        if count <= BLEND_NODES && blend_pays(scan, count, (h.dn + 1) as usize) {
+            let nodes = &mut $scratch[..count];
+            band.blend_nodes(k0, nodes);
+            let $nodes = &Blended { band, k0, nodes };
+            $body
+        } else {
+            let $nodes = &band;
+            $body
+        }
+    }};
+}
+pub(super) use with_nodes;
+
+/// The right half of a scanline's table-covered pixels, `xa..=xe` (`xa` the first pixel
+/// right of the centre or of the exact zone), and where its table reads fall: at pixel
+/// offsets d from `xa`, from 0 on by the step of the region d lies in, and at `dn`.
+/// The reads of region r are `e[r] + k·2^shift[r]` below `e[r + 1]`, so both halves can
+/// walk them in either direction.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Half {
+    pub(super) xa: i64,
+    pub(super) xe: i64,
+    /// 2X at `xa` (≥ 0).
+    pub(super) a0: i64,
+    /// `xe − xa`.
+    pub(super) dn: i64,
+    /// The first read in each region (regions before `xa`'s: 0).
+    pub(super) e: [i64; STEP_REGIONS],
+    /// The region of `xa`.
+    pub(super) r0: usize,
+}
+
+impl Half {
+    /// The right half of `scan` (`None`: the table covers none of it).
+    #[inline]
+    fn of(scan: &Scan, fr: &Setup) -> Option<Half> {
+        if !scan.lut || scan.lut_lo > scan.lut_hi {
+            return None;
+        }
+        let w = fr.w_out as i64;
+        let mut xa = w / 2;
+        let (zl, zh) = (scan.zone_lo.max(scan.lut_lo), scan.zone_hi.min(scan.lut_hi));
+        if zl <= zh {
+            xa = xa.max(zh + 1);
+        }
+        let xe = scan.lut_hi.min(w - 1);
+        if xe < xa {
+            return None;
+        }
+        let a0 = 2 * xa + 1 - w;
+        let thr = &fr.region_2x;
+        let mut r0 = 0;
+        while r0 + 1 < STEP_REGIONS && a0 >= thr[r0 + 1] {
+            r0 += 1;
+        }
+        let mut e = [0i64; STEP_REGIONS];
+        for r in r0..STEP_REGIONS - 1 {
+            let n = 1i64 << scan.shifts[r];
+            // The first offset in region r + 1, then the first read there.
+            let t = (thr[r + 1] - a0 + 1).div_euclid(2);
+            let gap = (t - e[r]).max(0);
+            e[r + 1] = e[r] + (gap + n - 1) / n * n;
+        }
+        Some(Half {
+            xa,
+            xe,
+            a0,
+            dn: xe - xa,
+            e,
+            r0,
+        })
     }
-    exact_run(scan, fr, 0, scan.lut_lo - 1, sink);
-    let zl = scan.zone_lo.max(scan.lut_lo);
-    let zh = scan.zone_hi.min(scan.lut_hi);
-    if zl <= zh {
-        lut_run(
-            scan,
-            table,
-            fr,
-            row_scale,
-            (scan.lut_lo, zl - 1),
-            scratch,
-            sink,
-        );
-        exact_run(scan, fr, zl, zh, sink);
-        lut_run(
-            scan,
-            table,
-            fr,
-            row_scale,
-            (zh + 1, scan.lut_hi),
-            scratch,
-            sink,
-        );
-    } else {
-        lut_run(
-            scan,
-            table,
-            fr,
-            row_scale,
-            (scan.lut_lo, scan.lut_hi),
-            scratch,
-            sink,
-        );
+}
+
+impl Half {
+    /// The right half of `scan`, after evaluating exactly into `sink` the pixels neither
+    /// half covers (beyond the table, the pole zone between the halves; the whole row
+    /// when there is no half).
+    #[inline]
+    pub(super) fn exact_rest<S: Sink>(scan: &Scan, fr: &Setup, sink: &mut S) -> Option<Half> {
+        let w = fr.w_out as i64;
+        let Some(h) = Half::of(scan, fr) else {
+            exact_run(scan, fr, 0, w - 1, sink);
+            return None;
+        };
+        exact_run(scan, fr, 0, w - 2 - h.xe, sink);
+        exact_run(scan, fr, w - h.xa, h.xa - 1, sink);
+        exact_run(scan, fr, h.xe + 1, w - 1, sink);
+        Some(h)
     }
-    exact_run(scan, fr, scan.lut_hi + 1, w - 1, sink);
 }
 
 /// Exact evaluation of pixels x0..=x1 of a scanline (pole zones, beyond the table).
@@ -81,153 +184,182 @@ fn exact_run<S: Sink>(scan: &Scan, fr: &Setup, x0: i64, x1: i64, sink: &mut S) {
 }
 
 /// Unfolded table read at pixel x: (Λ, V) in Q.16 for the yaw-0 frame.
-#[inline(always)]
+#[inline]
 pub(crate) fn read(scan: &Scan, table: &LutTable, fr: &Setup, x: i64) -> (Fx, Fx) {
-    let big_x = x as f64 + 0.5 - fr.w_out as f64 * 0.5;
-    read_band(scan, &table.band(scan.band, scan.wa), fr, big_x)
+    let a = 2 * x + 1 - fr.w_out as i64;
+    let band = table.band(scan.band, scan.wa);
+    let u = Unfold::new(scan, fr, a < 0);
+    u.apply(band.lookup_q(a.abs() * scan.node_per_2x))
 }
 
 /// The table reads of a scanline: straight from its band, or from its nodes blended once.
-trait Nodes {
-    fn lookup(&self, col: f64) -> (Fx, Fx);
+pub(super) trait Nodes {
+    fn lookup_q(&self, c: i64) -> (Fx, Fx);
 }
 
 impl Nodes for Band<'_> {
     #[inline(always)]
-    fn lookup(&self, col: f64) -> (Fx, Fx) {
-        Band::lookup(self, col)
+    fn lookup_q(&self, c: i64) -> (Fx, Fx) {
+        Band::lookup_q(self, c)
     }
 }
 
 impl Nodes for Blended<'_> {
     #[inline(always)]
-    fn lookup(&self, col: f64) -> (Fx, Fx) {
-        Blended::lookup(self, col)
+    fn lookup_q(&self, c: i64) -> (Fx, Fx) {
+        Blended::lookup_q(self, c)
     }
 }
 
 /// Whether to blend a run's `nodes` once instead of two per read: when there are at
-/// most 2 nodes per read, the reads estimated from the run's length and the mean step of
-/// the regions. (Callgrind: about 20 instructions per blended node against 27 saved per
-/// read puts the break-even near 1.35; a limit of 1.25 and one of 2 measured alike on
-/// the benchmark views, docs/performance.md.) Only the cost depends on it, not the
-/// output.
+/// most 1.25 nodes per read, the reads estimated from the run's length and the mean step
+/// of the regions. (Callgrind: about 20 instructions per blended node against 27 saved
+/// per read puts the break-even near 1.35; with the row pass, which reads only the right
+/// half, a limit of 2 blended at about 1.9 nodes per read and cost 0.6 instructions per
+/// pixel at hfov 90, docs/performance.md.) Only the cost depends on it, not the output.
 #[inline(never)]
-fn blend_pays(scan: &Scan, nodes: usize, pixels: usize) -> bool {
+pub(super) fn blend_pays(scan: &Scan, nodes: usize, pixels: usize) -> bool {
     // Reads per 256 pixels, summed over the regions.
     let per_256: usize = scan.shifts.iter().map(|&s| 256 >> s).sum();
-    nodes * 256 * STEP_REGIONS <= 2 * pixels * per_256
+    4 * nodes * 256 * STEP_REGIONS <= 5 * pixels * per_256
 }
 
-/// [`read`] in the scanline's band, at X = x + ½ − W/2.
-#[inline(always)]
-fn read_band<N: Nodes>(scan: &Scan, band: &N, fr: &Setup, big_x: f64) -> (Fx, Fx) {
-    let (mut l, mut v) = band.lookup(big_x.abs() * scan.col_per_x);
-    if scan.back {
-        l = fr.half_map_w_fx - l;
-    }
-    if big_x < 0.0 {
-        l = -l;
-    }
-    if scan.neg_v {
-        v = -v;
-    }
-    (l, v)
+/// The one-eighth unfolding of one half of a scanline, hoisted out of its reads: Λ =
+/// ±Λ₈ + offset (behind the viewer W/2 − Λ₈, negated left of the centre), V = ±V₈ (negated
+/// below the horizon), as sign masks.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Unfold {
+    neg_l: i64,
+    off_l: i64,
+    neg_v: i64,
 }
 
-/// LUT evaluation of pixels x0..=x1: table reads every 2^shift pixels (the shift of the
-/// region the span starts in), fixed-point steps between.
+impl Unfold {
+    #[inline(always)]
+    pub(super) fn new(scan: &Scan, fr: &Setup, left: bool) -> Unfold {
+        let mask = |b: bool| -(b as i64);
+        let off = if scan.back { fr.half_map_w_fx } else { 0 };
+        Unfold {
+            neg_l: mask(scan.back != left),
+            off_l: if left { -off } else { off },
+            neg_v: mask(scan.neg_v),
+        }
+    }
+
+    #[inline(always)]
+    fn apply(&self, (l, v): (Fx, Fx)) -> (Fx, Fx) {
+        (
+            ((l ^ self.neg_l) - self.neg_l) + self.off_l,
+            (v ^ self.neg_v) - self.neg_v,
+        )
+    }
+}
+
+/// The unfolded read at offset d of the half `h`.
 #[inline(always)]
-fn lut_run<S: Sink>(
-    scan: &Scan,
-    table: &LutTable,
+pub(super) fn read_at<N: Nodes>(scan: &Scan, nodes: &N, h: &Half, u: &Unfold, d: i64) -> (Fx, Fx) {
+    u.apply(nodes.lookup_q((h.a0 + 2 * d) * scan.node_per_2x))
+}
+
+/// The span from (l0, v0) to the next read (l1, v1) over `m` pixels (`shift`: log2 of
+/// the region's step, used when m is the whole step): Λ unwrapped across the ±180° seam
+/// (a jump of one map width), and the per-pixel steps.
+#[inline(always)]
+pub(super) fn span_step(
     fr: &Setup,
-    row_scale: &[i64],
-    (x0, x1): (i64, i64),
-    scratch: &mut Scratch,
-    sink: &mut S,
-) {
-    if x0 > x1 {
-        return;
+    (l0, v0): (Fx, Fx),
+    (l1, v1): (Fx, Fx),
+    m: i64,
+    shift: u32,
+) -> (Fx, (Fx, Fx)) {
+    let d = l1 - l0;
+    let mut l1 = l1;
+    if d > fr.half_map_w_fx {
+        l1 -= fr.map_w_fx;
+    } else if d < -fr.half_map_w_fx {
+        l1 += fr.map_w_fx;
     }
-    let band = table.band(scan.band, scan.wa);
-    // The nodes the run reads: from the smallest |X| to the largest (the column and its
-    // node are monotonic in |X|), and the next node.
-    let half_w = fr.w_out as f64 * 0.5;
-    let (xa, xb) = (x0 as f64 + 0.5 - half_w, x1 as f64 + 0.5 - half_w);
-    let x_min = if xa < 0.0 && xb > 0.0 {
-        0.0
+    let step = if m == 1i64 << shift {
+        ((l1 - l0) >> shift, (v1 - v0) >> shift)
     } else {
-        xa.abs().min(xb.abs())
+        ((l1 - l0) / m, (v1 - v0) / m)
     };
-    let k0 = band.node(x_min * scan.col_per_x).0;
-    let k1 = band.node(xa.abs().max(xb.abs()) * scan.col_per_x).0 + 1;
-    let count = k1 + 1 - k0;
-    if count <= BLEND_NODES && blend_pays(scan, count, (x1 - x0 + 1) as usize) {
-        let nodes = &mut scratch[..count];
-        band.blend_nodes(k0, nodes);
-        let blended = Blended { band, k0, nodes };
-        lut_run_in(scan, &blended, fr, row_scale, x0, x1, sink);
-        return;
-    }
-    lut_run_in(scan, &band, fr, row_scale, x0, x1, sink);
+    (l1, step)
 }
 
-/// [`lut_run`] with the scanline's nodes read through `band`.
+/// The right half's spans, outward from its first pixel: [`RightSpans::next`] gives
+/// `(d, m, (Λ, V), (dΛ, dV), region)` for pixels `xa + d..xa + d + m` (Λ unwrapped
+/// from span to span), the last pixel as a span of one with no step. (An iterator the
+/// callers loop over, rather than a closure: it stays inlined.)
+pub(super) struct RightSpans<'n, N: Nodes> {
+    nodes: &'n N,
+    h: Half,
+    u: Unfold,
+    d: i64,
+    r: usize,
+    p0: (Fx, Fx),
+    done: bool,
+}
+
+impl<'n, N: Nodes> RightSpans<'n, N> {
+    #[inline(always)]
+    pub(super) fn new(scan: &Scan, nodes: &'n N, fr: &Setup, h: &Half) -> Self {
+        let u = Unfold::new(scan, fr, false);
+        RightSpans {
+            nodes,
+            h: *h,
+            u,
+            d: 0,
+            r: h.r0,
+            p0: read_at(scan, nodes, h, &u, 0),
+            done: false,
+        }
+    }
+
+    #[allow(clippy::type_complexity)]
+    #[inline(always)]
+    pub(super) fn next(
+        &mut self,
+        scan: &Scan,
+        fr: &Setup,
+    ) -> Option<(i64, i64, (Fx, Fx), (Fx, Fx), usize)> {
+        let (d, h) = (self.d, &self.h);
+        if d == h.dn {
+            if self.done {
+                return None;
+            }
+            self.done = true;
+            return Some((d, 1, self.p0, (0, 0), self.r));
+        }
+        while self.r + 1 < STEP_REGIONS && d >= h.e[self.r + 1] {
+            self.r += 1;
+        }
+        let shift = scan.shifts[self.r] as u32;
+        let d1 = (d + (1 << shift)).min(h.dn);
+        let p1 = read_at(scan, self.nodes, h, &self.u, d1);
+        let m = d1 - d;
+        let p0 = self.p0;
+        let (l1, step) = span_step(fr, p0, p1, m, shift);
+        self.d = d1;
+        self.p0 = (l1, p1.1);
+        Some((d, m, p0, step, self.r))
+    }
+}
+
+/// Emit the mirror image of the right-half span (Λ, V) + j·(dΛ, dV), j < m (X → −X
+/// negates Λ) as the `m` pixels from `x` on (left to right: j = m − 1 first).
 #[inline(always)]
-fn lut_run_in<S: Sink, N: Nodes>(
-    scan: &Scan,
-    band: &N,
+fn emit_mirror<S: Sink>(
     fr: &Setup,
     row_scale: &[i64],
-    x0: i64,
-    x1: i64,
+    x: i64,
+    m: i64,
+    (l, vv): (Fx, Fx),
+    (dl, dvv): (Fx, Fx),
     sink: &mut S,
 ) {
-    let half_w = fr.w_out as f64 * 0.5;
-    let last_region = STEP_REGIONS as i64 - 1;
-    let mut xs = x0;
-    // X of xs, carried from span to span (whole numbers plus ½: exact in f64).
-    let mut big_x = xs as f64 + 0.5 - half_w;
-    let (mut l0, mut v0) = read_band(scan, band, fr, big_x);
-    loop {
-        // Through i64 (as usize: the same value, as |X| ≥ 0, but a longer conversion).
-        let region = ((big_x.abs() * scan.region_per_x) as i64).min(last_region) as usize;
-        let shift = scan.shifts[region] as u32;
-        let n = 1i64 << shift;
-        let xe = (xs + n).min(x1);
-        if xe == xs {
-            emit(fr, row_scale, xs, 1, (l0, v0), (0, 0), sink);
-            return;
-        }
-        let big_xe = xe as f64 + 0.5 - half_w;
-        let (mut l1, v1) = read_band(scan, band, fr, big_xe);
-        // Unwrap longitude across the span: a ±180° seam is a jump of one map width.
-        let d = l1 - l0;
-        if d > fr.half_map_w_fx {
-            l1 -= fr.map_w_fx;
-        } else if d < -fr.half_map_w_fx {
-            l1 += fr.map_w_fx;
-        }
-        let m = xe - xs;
-        let (dl, dv) = if m == n {
-            ((l1 - l0) >> shift, (v1 - v0) >> shift)
-        } else {
-            ((l1 - l0) / m, (v1 - v0) / m)
-        };
-        sink.footprint(dl, dv, region);
-        if xe == x1 {
-            // Last span: emit through x1 inclusive, ending exactly on the read value.
-            emit(fr, row_scale, xs, m, (l0, v0), (dl, dv), sink);
-            emit(fr, row_scale, x1, 1, (l1, v1), (0, 0), sink);
-            return;
-        }
-        emit(fr, row_scale, xs, m, (l0, v0), (dl, dv), sink);
-        xs = xe;
-        big_x = big_xe;
-        l0 = l1;
-        v0 = v1;
-    }
+    let (l_end, v_end) = (l + (m - 1) * dl, vv + (m - 1) * dvv);
+    emit(fr, row_scale, x, m, (-l_end, v_end), (dl, -dvv), sink);
 }
 
 /// Emit `m` pixels from `x` on, starting at (Λ, V) and stepping by (dΛ, dV) (also the

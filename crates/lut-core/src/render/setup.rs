@@ -27,6 +27,9 @@ pub(crate) struct Scan {
     pub(crate) back: bool,
     /// Column coordinate per unit of X (X = x + ½ − W/2).
     pub(crate) col_per_x: f64,
+    /// Table node coordinate (Q.32) per unit of 2X (a whole number per pixel): the
+    /// scanline walk's integer column step.
+    pub(crate) node_per_2x: i64,
     /// t per unit of X (1/ρ).
     pub(crate) t_per_x: f64,
     /// sin and cos of the (unfolded) scanline angle.
@@ -34,8 +37,6 @@ pub(crate) struct Scan {
     pub(crate) ca: f64,
     /// log2 of the index step per region of |X| (see [`STEP_REGIONS`]).
     pub(crate) shifts: [u8; STEP_REGIONS],
-    /// Regions per unit of |X|.
-    pub(crate) region_per_x: f64,
     /// Angle between this scanline and the next at the centre column (radians).
     pub(crate) row_angle: f64,
     /// Vertical pixel footprint per region (level-0 map pixels; trilinear only): the
@@ -60,11 +61,17 @@ pub(crate) struct Setup {
     pub(crate) half_map_h_fx: Fx,
     /// W/2 + yaw, in map pixels, Q.16 (rectangular maps: u = Λ + off).
     pub(crate) off_fx: Fx,
+    /// 2·`off_fx` wrapped into [0, W): u of a pixel's mirror image (X → −X) is this
+    /// minus its u (modulo W).
+    pub(crate) mirror_fx: Fx,
     /// yaw in map pixels, Q.16 (scaled rows: u = W/2 + s · wrap(Λ + yaw)).
     pub(crate) yaw_fx: Fx,
     pub(crate) yaw: f64,
     pub(crate) coverage: bool,
     pub(crate) scaled: bool,
+    /// Where the step regions of a scanline start, in units of 2|X| (region r: 2|X| ≥
+    /// `region_2x[r]`, r < [`STEP_REGIONS`]; each region is W/16 pixels wide).
+    pub(crate) region_2x: [i64; STEP_REGIONS],
 }
 
 impl Setup {
@@ -83,10 +90,12 @@ impl Setup {
             map_h_fx: (mh as i64) << FX_BITS,
             half_map_h_fx: to_fx(mhf * 0.5),
             off_fx: to_fx(mwf * 0.5 + yaw_px),
+            mirror_fx: (2 * to_fx(mwf * 0.5 + yaw_px)).rem_euclid((mw as i64).max(1) << FX_BITS),
             yaw_fx: to_fx(yaw_px),
             yaw,
             coverage: !proj.full_sphere(),
             scaled: proj.scaled_rows(),
+            region_2x: std::array::from_fn(|r| (r * w_out as usize).div_ceil(STEP_REGIONS) as i64),
         }
     }
 }
@@ -175,6 +184,9 @@ pub(crate) fn prepare(
             scan.lut = true;
             scan.band = band;
             scan.wa = wa;
+            let q = scan.col_per_x * table.nodes_per_unit() * (1u64 << 31) as f64;
+            // (At most 2^47: times 2|X| ≤ 2^15 it cannot overflow; a column that far clamps.)
+            scan.node_per_2x = q.round().min((1u64 << 47) as f64) as i64;
             let xc = table.col_max() / scan.col_per_x;
             let (lo, hi) = x_range(half_w, xc, width);
             scan.lut_lo = lo;
@@ -190,7 +202,6 @@ pub(crate) fn prepare(
             }
             let (sn, c) = (a.sin().abs(), a.cos().abs());
             let reg_x = half_w / STEP_REGIONS as f64;
-            scan.region_per_x = 1.0 / reg_x;
             for (r, shift) in scan.shifts.iter_mut().enumerate() {
                 let (x_lo, x_hi) = (r as f64 * reg_x, (r + 1) as f64 * reg_x);
                 let n = step_for(&bounds, (sn, c), t_min, x_lo, x_hi, scan.t_per_x, nominal);

@@ -123,8 +123,10 @@ pub(crate) fn put_run<S: Sink + ?Sized>(
 /// Nearest spans shorter than this (the 8-pixel spans of hfov 90 and wider) are sampled
 /// at once by the scalar loop (`kernel::nearest_span_direct`), without the batch;
 /// longer ones go to the batch kernels, where the SIMD lane setup pays. Callgrind, 1080p
-/// from 8k, AVX2 (docs/performance.md): 45.8 → 44.0 instructions per pixel at hfov 90;
-/// with 16- and 32-pixel spans direct too, hfov 50 went from 25.5 to 28.4.
+/// from 8k, AVX2 (docs/performance.md), measured on the LUT frame before the row pass
+/// took its full-map rows (this sink now serves the grid renderer and the rows that go
+/// span by span): 45.8 → 44.0 instructions per pixel at hfov 90; with 16- and 32-pixel
+/// spans direct too, hfov 50 went from 25.5 to 28.4.
 const NEAREST_DIRECT: usize = 9;
 
 /// Writes sampled pixels. `CROP`: a partial map (see `map/crop.rs`): full-panorama

@@ -39,7 +39,11 @@
 //! portable kernels (the reference); `x86.rs`: SSE4.1 and AVX2 (the only module where
 //! `unsafe` is allowed; `x86/face.rs` is its child); `select.rs`: choosing the kernel;
 //! `tests.rs`: the property tests; `face.rs`: cube-face runs, whose positions are a
-//! projective line evaluated exactly per pixel (the cube scanline renderer's kernels).
+//! projective line evaluated exactly per pixel (the cube scanline renderer's kernels);
+//! `row.rs` (and `x86/row.rs`): the row pass's kernels (`render/rowpass.rs`), a run's
+//! Q.8 positions expanded from its spans and one gather-and-blend pass over them, with
+//! no per-span check (the LUT rows of full maps drawn nearest or bilinear; the span
+//! kernels draw the rest).
 //!
 //! # Batches
 //! Spans are short (8–16 pixels at hfov 90), so what a span costs besides its pixels
@@ -109,6 +113,7 @@
 
 mod face;
 mod jobs;
+mod row;
 mod scalar;
 mod select;
 #[cfg(test)]
@@ -122,6 +127,7 @@ pub use select::{
 };
 
 pub(crate) use face::{face_blend, face_span, FaceRun};
+pub(crate) use row::{expand, sample_q8, Positions, SpanQ8};
 
 use crate::geom::fixed::{Fx, FX_BITS};
 use crate::map::envmap::EnvMap;

@@ -1,0 +1,243 @@
+//! The row pass: a LUT scanline of a full 360° map (equirectangular, sine) drawn with
+//! nearest or bilinear sampling as a run of positions and one gather pass, instead of
+//! span by span through a [`Sink`].
+//!
+//! Only the right half of the table-covered pixels is walked (`scanline.rs`: reads every
+//! 2^shift pixels outward from the centre, the column coordinate stepped in whole
+//! numbers, one-eighth unfolding as sign masks hoisted per half, the seam unwrapped per
+//! span). The left half is the right half mirrored: the same reads with Λ negated, so
+//! each span's mirror image has u = 2·(W/2 + yaw) − u (`Setup::mirror_fx`), the same v,
+//! and its pixels in reverse order. Each span is recorded and `kernel::expand` writes
+//! the floored Q.8 map positions of both (u wrapped once at the span's start, v = H/2 −
+//! V) into buffers of [`HALF_CHUNK`] pixels of the half; each full buffer goes to the
+//! row kernels (`kernel/row.rs`: x wrapped and y clamped in lanes, then the gather and
+//! blend), for the left half and then the right one.
+//!
+//! The pixels sample exactly the positions [`row_pass`] writes; `Renderer::positions`
+//! reads the same buffers, so the measured sampling error is this pass's.
+
+use super::kernel::{expand, sample_q8, Positions, SpanQ8, Texels};
+use super::scanline::{blend_pays, render_row, with_nodes, wrap_u, Half, RightSpans};
+use super::scanline::{RowScratch, Scratch, BLEND_NODES};
+use super::setup::{Scan, Setup};
+use super::sink::Sink;
+use super::sink::{PixelSink, PosSink};
+use crate::geom::fixed::{Fx, FX_ONE};
+use crate::lut::{Blended, LutTable};
+use crate::map::envmap::EnvMap;
+
+/// Pixels of a half row whose positions are buffered before the row kernels run.
+pub(crate) const HALF_CHUNK: usize = 512;
+
+/// A buffer's room: a chunk, then up to one more span (64 pixels) and the last pixel.
+const ROOM: usize = HALF_CHUNK + 72;
+
+/// Room for a chunk of a half row's positions (Q.8) and its spans, kept from row to row.
+pub(crate) struct HalfBuf {
+    u: [i32; ROOM],
+    v: [i32; ROOM],
+    /// The left half's u (its v is the right half's).
+    ul: [i32; ROOM],
+    /// The spans not yet expanded into `u`, `v` (at most one per pixel of a chunk).
+    spans: [SpanQ8; HALF_CHUNK + 2],
+    n_spans: usize,
+}
+
+impl HalfBuf {
+    pub(crate) fn new() -> HalfBuf {
+        HalfBuf {
+            u: [0; ROOM],
+            v: [0; ROOM],
+            ul: [0; ROOM],
+            spans: [SpanQ8::default(); HALF_CHUNK + 2],
+            n_spans: 0,
+        }
+    }
+
+    /// Expand the recorded spans into the positions (`kernel::expand`).
+    #[inline]
+    fn expand(&mut self) {
+        let p = Positions {
+            u: &mut self.u,
+            v: &mut self.v,
+            ul: &mut self.ul,
+        };
+        expand(&self.spans[..self.n_spans], p);
+        self.n_spans = 0;
+    }
+}
+
+/// A run of positions of a scanline: pixel `right + j` samples (`u[j]`, `v[j]`) (Q.8 map
+/// coordinates), and pixel `left_end − 1 − j`, its mirror image, (`ul[j]`, `v[j]`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct HalfRun<'a> {
+    pub(crate) right: usize,
+    pub(crate) left_end: usize,
+    pub(crate) u: &'a [i32],
+    pub(crate) v: &'a [i32],
+    pub(crate) ul: &'a [i32],
+}
+
+/// Whether the row pass draws the LUT rows of `fr`'s map (full 360° maps whose rows do
+/// not scale: equirectangular and sine; the others go span by span).
+pub(crate) fn applies(fr: &Setup) -> bool {
+    !fr.scaled && !fr.coverage
+}
+
+/// One scanline: exact pixels to `sink`, the table-covered ones as runs to `run`.
+#[inline]
+pub(crate) fn row_pass<S: Sink>(
+    scan: &Scan,
+    table: &LutTable,
+    fr: &Setup,
+    (scratch, buf): (&mut Scratch, &mut HalfBuf),
+    sink: &mut S,
+    mut run: impl FnMut(&mut S, HalfRun<'_>),
+) {
+    let Some(h) = Half::exact_rest(scan, fr, sink) else {
+        return;
+    };
+    let (xa, w) = (h.xa as usize, fr.w_out);
+    let mut flush = |buf: &mut HalfBuf, sink: &mut S, c0: i64, n: i64| {
+        buf.expand();
+        let (c0, n) = (c0 as usize, n as usize);
+        let r = HalfRun {
+            right: xa + c0,
+            left_end: w - xa - c0,
+            u: &buf.u[..n],
+            v: &buf.v[..n],
+            ul: &buf.ul[..n],
+        };
+        run(sink, r);
+    };
+    // The first pixel in the buffer.
+    let mut c0 = 0i64;
+    with_nodes!(scan, table, &h, scratch, |nodes| {
+        let mut spans = RightSpans::new(scan, nodes, fr, &h);
+        while let Some((d, m, p0, step, _)) = spans.next(scan, fr) {
+            fill(fr, buf, (d - c0) as usize, m as usize, p0, step);
+            let end = d + m;
+            if end - c0 >= HALF_CHUNK as i64 || end > h.dn {
+                flush(buf, sink, c0, end - c0);
+                c0 = end;
+            }
+        }
+    });
+}
+
+/// Q.8 positions of `m` pixels from (Λ, V) by (dΛ, dV) (Q.16) at `k` of `buf`: u =
+/// Λ + W/2 + yaw wrapped into [0, W) at the start, v = H/2 − V, and the mirror image's
+/// u = W/2 + yaw − Λ (`Setup::mirror_fx` − u). Recorded as a span for
+/// `kernel::expand` (`i32` lanes relative to the starts' whole Q.8 values); a span that
+/// travels too far for them (a map width or more: far zoomed out on a tiny map) is
+/// written here, u wrapped per pixel.
+#[inline(always)]
+fn fill(fr: &Setup, buf: &mut HalfBuf, k: usize, m: usize, (l, vv): (Fx, Fx), (dl, dvv): (Fx, Fx)) {
+    let wfx = fr.map_w_fx;
+    let mut u = wrap_u(l + fr.off_fx, wfx);
+    if !(0..wfx).contains(&u) {
+        u = u.rem_euclid(wfx);
+    }
+    // In [0, W] (the kernels' common case: inside the map).
+    let mut ul = fr.mirror_fx - u;
+    if ul < 0 {
+        ul += wfx;
+    }
+    let v = fr.half_map_h_fx - vv;
+    let dv = -dvv;
+    // Lanes run up to 8 past the span. (|v| < 2³², as table entries and H/2 are i32:
+    // v >> 8 fits.)
+    let reach = dl.unsigned_abs().max(dv.unsigned_abs()) * (m as u64 + 8);
+    if reach + FX_ONE as u64 <= (wfx as u64).min(1 << 30) {
+        buf.spans[buf.n_spans] = SpanQ8 {
+            k: k as u32,
+            m: m as u32,
+            hu: (u >> 8) as i32,
+            lu: (u & 0xFF) as i32,
+            du: dl as i32,
+            hv: (v >> 8) as i32,
+            lv: (v & 0xFF) as i32,
+            dv: dv as i32,
+            hl: (ul >> 8) as i32,
+            ll: (ul & 0xFF) as i32,
+        };
+        buf.n_spans += 1;
+        return;
+    }
+    // The spans recorded before are expanded first (their last vector may reach here).
+    buf.expand();
+    let (mut u, mut v, mut ul) = (u, v, ul);
+    for j in k..k + m {
+        buf.u[j] = (u.rem_euclid(wfx) >> 8) as i32;
+        buf.v[j] = (v >> 8) as i32;
+        buf.ul[j] = (ul.rem_euclid(wfx) >> 8) as i32;
+        u += dl;
+        v += dv;
+        ul -= dl;
+    }
+}
+
+/// A scanline of the LUT renderer: its scan, the table, the frame's setup, the row scale.
+pub(crate) type LutRow<'a> = (&'a Scan, &'a LutTable, &'a Setup, &'a [i64]);
+
+/// Draw one LUT scanline of `map` (`t`: its texels) into `row`: the row pass where it
+/// applies ([`applies`]; partial maps take its positions with the per-pixel crop
+/// samplers), else span by span through the sink.
+#[inline]
+pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
+    (scan, table, fr, row_scale): LutRow<'_>,
+    scratch: &mut RowScratch,
+    (map, t): (&EnvMap, &Texels<'_>),
+    row: &mut [u32],
+) {
+    let mut s = PixelSink::<BILINEAR, CROP>::new(row, map);
+    if !applies(fr) {
+        render_row(scan, table, fr, row_scale, &mut scratch.nodes, &mut s);
+        s.flush();
+        return;
+    }
+    let wq = (map.width() as i32) << 8;
+    let RowScratch { nodes, row: buf } = scratch;
+    row_pass(scan, table, fr, (nodes, buf), &mut s, |s, r| {
+        let n = r.u.len();
+        if CROP {
+            let q = |u: i32| (u.rem_euclid(wq) as i64) << 8;
+            for (j, (&v, (&u, &ul))) in r.v.iter().zip(r.u.iter().zip(r.ul)).enumerate() {
+                let v = (v as i64) << 8;
+                s.put(r.left_end - 1 - j, q(ul), v);
+                s.put(r.right + j, q(u), v);
+            }
+            return;
+        }
+        sample_q8::<BILINEAR, true>(t, r.ul, r.v, &mut s.row[r.left_end - n..r.left_end]);
+        sample_q8::<BILINEAR, false>(t, r.u, r.v, &mut s.row[r.right..r.right + n]);
+    });
+}
+
+/// The sampling positions of one LUT scanline into `row`: the row pass's (`wq` = 256·W,
+/// when the row pass draws these pixels), else the span walk's.
+#[inline]
+pub(crate) fn position_row(
+    (scan, table, fr, row_scale): LutRow<'_>,
+    scratch: &mut RowScratch,
+    wq: Option<i32>,
+    row: &mut [Option<(f64, f64)>],
+) {
+    let mut s = PosSink { row };
+    let Some(wq) = wq else {
+        render_row(scan, table, fr, row_scale, &mut scratch.nodes, &mut s);
+        return;
+    };
+    let RowScratch { nodes, row: buf } = scratch;
+    row_pass(scan, table, fr, (nodes, buf), &mut s, |s, r| {
+        // As the row kernels sample them: Q.8, u wrapped into the map; the left half
+        // first (the centre pixel of an odd width is the right half's).
+        let px = |u: i32, v: i32| Some((u.rem_euclid(wq) as f64 / 256.0, v as f64 / 256.0));
+        for (j, (&u, &v)) in r.ul.iter().zip(r.v).enumerate() {
+            s.row[r.left_end - 1 - j] = px(u, v);
+        }
+        for (j, (&u, &v)) in r.u.iter().zip(r.v).enumerate() {
+            s.row[r.right + j] = px(u, v);
+        }
+    });
+}
