@@ -22,6 +22,8 @@
 //! `level` 0|1 (0; 1: bilinear reads the pyramid level matching the footprint,
 //! `Renderer::set_bilinear_level`, as the window does while moving; the pyramid is built
 //! before timing).
+//! `crop` WxH+LEFT+TOP: render a partial map holding only that rectangle of the map's
+//! pixels (the cropped kernels).
 //! `file` PATH: render that panorama instead of the generated map (e.g. `viewer
 //! bench-load`'s cached JPEGs; `map` is then ignored).
 
@@ -169,6 +171,7 @@ fn run() -> Result<(), String> {
     let mut cache = None;
     let mut level = false;
     let mut file = None;
+    let mut crop: Option<(u32, u32, u32, u32)> = None;
     for a in std::env::args().skip(1) {
         let (k, v) = a
             .split_once('=')
@@ -183,6 +186,14 @@ fn run() -> Result<(), String> {
             "frames" => frames = num(v)? as usize,
             "threads" => threads = num(v)? as usize,
             "map" => map_wh = size(v)?,
+            "crop" => {
+                let bad = || format!("crop={v}: not WxH+LEFT+TOP");
+                let (wh, rest) = v.split_once('+').ok_or_else(bad)?;
+                let (l, t) = rest.split_once('+').ok_or_else(bad)?;
+                let (cw, ch) = size(wh)?;
+                let n = |x: &str| x.parse::<u32>().map_err(|_| bad());
+                crop = Some((cw, ch, n(l)?, n(t)?));
+            }
             "size" => out_wh = size(v)?,
             "hfov" => hfov = num(v)?,
             "pitch" => pitch = num(v)?,
@@ -216,6 +227,22 @@ fn run() -> Result<(), String> {
         Some(p) => lut_core::load_map(p, &lut_core::LoadOptions::default(), &mut |_| {})
             .map_err(|e| e.to_string())?,
         None => load_map(map_wh, cache.as_deref())?,
+    };
+    // A partial map: the crop's pixels of the full map, placed where they were.
+    let map = match crop {
+        None => map,
+        Some((cw, ch, l, t)) => {
+            let px: Vec<u32> = (0..ch)
+                .flat_map(|y| (0..cw).map(move |x| (x, y)))
+                .map(|(x, y)| map.pixel((l + x) % map.width(), t + y))
+                .collect();
+            let c = lut_core::Crop::new(map.width(), map.height(), l, t, cw, ch)
+                .map_err(|e| e.to_string())?;
+            lut_core::EnvMap::from_pixels(cw, ch, &px, Projection::Equirect)
+                .map_err(|e| e.to_string())?
+                .into_partial(c)
+                .map_err(|e| e.to_string())?
+        }
     };
     let map_wh = (map.width(), map.height());
     eprintln!("map ready in {:.2} s", t_load.elapsed().as_secs_f64());

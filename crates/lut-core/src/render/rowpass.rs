@@ -201,17 +201,100 @@ pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
     row_pass(scan, table, fr, (nodes, buf), &mut s, |s, r| {
         let n = r.u.len();
         if CROP {
-            let q = |u: i32| (u.rem_euclid(wq) as i64) << 8;
-            for (j, (&v, (&u, &ul))) in r.v.iter().zip(r.u.iter().zip(r.ul)).enumerate() {
-                let v = (v as i64) << 8;
-                s.put(r.left_end - 1 - j, q(ul), v);
-                s.put(r.right + j, q(u), v);
-            }
+            crop_run(s, t, wq, r);
             return;
         }
         sample_q8::<BILINEAR, true>(t, r.ul, r.v, &mut s.row[r.left_end - n..r.left_end]);
         sample_q8::<BILINEAR, false>(t, r.u, r.v, &mut s.row[r.right..r.right + n]);
     });
+}
+
+/// Pixels of a partial map's run checked and sampled together by [`crop_run`].
+const CROP_CHUNK: usize = 64;
+
+/// A run of a partial map's scanline: each chunk of [`CROP_CHUNK`] pixels of a half whose
+/// positions all lie inside the stored pixels — away from their first and last row and
+/// column, where the crop samplers meet the background or the padding — is sampled by
+/// the row kernels on the stored texels at the positions moved onto them (the same
+/// texels and weights as `EnvMap::bilinear_cropped` / `nearest_cropped` there); a chunk
+/// whose pixels all fall on uncovered pixels (as `Crop::locate` decides, v clamped into
+/// the panorama first) is the background; the other chunks go pixel by pixel through
+/// the crop samplers. `wq`: the panorama's width, Q.8.
+#[inline]
+fn crop_run<const BILINEAR: bool, const CROP: bool>(
+    s: &mut PixelSink<'_, BILINEAR, CROP>,
+    t: &Texels<'_>,
+    wq: i32,
+    r: HalfRun<'_>,
+) {
+    let Some(c) = s.map.crop() else {
+        return;
+    };
+    // The stored pixels' interior, in Q.8 positions relative to their first pixel.
+    let (cw, ch) = ((c.width() as i32) << 8, (c.height() as i32) << 8);
+    let (lo, hi_u, hi_v) = if BILINEAR {
+        (128, cw - 128, ch - 128)
+    } else {
+        (0, cw, ch)
+    };
+    let (left, top) = ((c.left() as i32) << 8, (c.top() as i32) << 8);
+    let hq = (c.full_height() as i32) << 8;
+    let bg = s.map.background();
+    // Not covered: the pixel holding the position (v clamped into the panorama).
+    let outside = |x: i32, v: i32| {
+        let y = v.clamp(0, hq - 1) - top;
+        x >= cw || !(0..ch).contains(&y)
+    };
+    // u on the sheet [0, W) of the panorama, relative to the crop's first column (u lies
+    // within two widths of the map, as the row kernels take it).
+    let shift = |u: i32| {
+        let mut x = u - left;
+        while x < 0 {
+            x += wq;
+        }
+        while x >= wq {
+            x -= wq;
+        }
+        x
+    };
+    let q = |u: i32| (u.rem_euclid(wq) as i64) << 8;
+    let n = r.u.len();
+    let (mut su, mut sl, mut sv) = ([0i32; CROP_CHUNK], [0i32; CROP_CHUNK], [0i32; CROP_CHUNK]);
+    for j0 in (0..n).step_by(CROP_CHUNK) {
+        let m = CROP_CHUNK.min(n - j0);
+        let (mut right_in, mut left_in) = (true, true);
+        let (mut right_out, mut left_out) = (true, true);
+        for j in 0..m {
+            let v = r.v[j0 + j];
+            let (a, b) = (shift(r.u[j0 + j]), shift(r.ul[j0 + j]));
+            let v_in = (lo..hi_v).contains(&(v - top));
+            right_in &= v_in && (lo..hi_u).contains(&a);
+            left_in &= v_in && (lo..hi_u).contains(&b);
+            right_out &= outside(a, v);
+            left_out &= outside(b, v);
+            (su[j], sl[j], sv[j]) = (a, b, v - top);
+        }
+        let lend = r.left_end - j0;
+        if left_in {
+            sample_q8::<BILINEAR, true>(t, &sl[..m], &sv[..m], &mut s.row[lend - m..lend]);
+        } else if left_out {
+            s.row[lend - m..lend].fill(bg);
+        } else {
+            for j in j0..j0 + m {
+                s.put(r.left_end - 1 - j, q(r.ul[j]), (r.v[j] as i64) << 8);
+            }
+        }
+        let rs = r.right + j0;
+        if right_in {
+            sample_q8::<BILINEAR, false>(t, &su[..m], &sv[..m], &mut s.row[rs..rs + m]);
+        } else if right_out {
+            s.row[rs..rs + m].fill(bg);
+        } else {
+            for j in j0..j0 + m {
+                s.put(r.right + j, q(r.u[j]), (r.v[j] as i64) << 8);
+            }
+        }
+    }
 }
 
 /// The sampling positions of one LUT scanline into `row`: the row pass's (`wq` = 256·W,
