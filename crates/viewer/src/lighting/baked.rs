@@ -152,11 +152,13 @@ impl LitPanorama {
         map: Option<&Arc<IlluminanceMap>>,
         scene: &Scene,
     ) -> bool {
+        // First the bakes that have arrived (a stale one is freed before a new bake
+        // starts).
+        self.receive();
         let (Some(key), Some(map)) = (key, map) else {
             self.cancel();
             (self.seen, self.key, self.copy) = (None, None, None);
             (self.state, self.settled) = (BakeState::Off, false);
-            self.receive();
             return false;
         };
         self.settled = settled;
@@ -173,7 +175,6 @@ impl LitPanorama {
                 self.state = BakeState::Changing;
             }
         }
-        self.receive();
         self.copy.is_some()
     }
 
