@@ -7,8 +7,9 @@
 //! [`lut_core::IlluminanceMap::bake_map_cancellable`]) and starts once that one has
 //! stopped; requests queued behind a newer one are skipped. The bake's bands run on a
 //! rayon pool of its own: on the global pool, which draws the frames, a frame's bands
-//! would queue behind the bake's and the frame would wait for the whole bake. The two
-//! pools share the cores, so frames drawn during a bake take longer but are not held up.
+//! would queue behind the bake's (rayon's workers take their own queued work before work
+//! handed in from outside) and the frame would mostly wait for the bake. The two pools
+//! share the cores, so frames drawn during a bake take longer but are not held up.
 //! A finished bake is sent back with its request's number and the event loop is woken
 //! (no polling); a bake cancelled before it finished is dropped here.
 
