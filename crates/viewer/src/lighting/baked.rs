@@ -152,8 +152,8 @@ impl LitPanorama {
         map: Option<&Arc<IlluminanceMap>>,
         scene: &Scene,
     ) -> bool {
-        // First the bakes that have arrived (a stale one is freed before a new bake
-        // starts).
+        // First the bakes that have arrived (a stale one is freed before this frame
+        // requests another).
         self.receive();
         let (Some(key), Some(map)) = (key, map) else {
             self.cancel();
