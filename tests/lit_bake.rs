@@ -68,6 +68,14 @@ fn opts() -> ShadeOptions {
 }
 
 /// Share of `diffs` within `levels`, and their mean.
+/// The stored pixels of `m`, row by row.
+fn pixels(m: &EnvMap) -> Vec<u32> {
+    (0..m.height())
+        .flat_map(|y| (0..m.width()).map(move |x| (x, y)))
+        .map(|(x, y)| m.pixel(x, y))
+        .collect()
+}
+
 fn stats(diffs: &[u32], levels: u32) -> (f64, f64) {
     let within = diffs.iter().filter(|&&d| d <= levels).count() as f64 / diffs.len() as f64;
     let mean = diffs.iter().map(|&d| d as f64).sum::<f64>() / diffs.len() as f64;
@@ -196,15 +204,9 @@ fn the_bake_does_not_depend_on_the_number_of_threads() {
         })
     };
     let (a, b) = (run(1), run(2));
-    let px = |m: &EnvMap| -> Vec<u32> {
-        (0..m.height())
-            .flat_map(|y| (0..m.width()).map(move |x| (x, y)))
-            .map(|(x, y)| m.pixel(x, y))
-            .collect()
-    };
-    assert!(px(&a.0) == px(&b.0), "map bytes differ");
+    assert!(pixels(&a.0) == pixels(&b.0), "map bytes differ");
     assert!(a.1 == b.1, "cube bytes differ");
-    assert!(px(&a.2) == px(&b.2), "false-colour bytes differ");
+    assert!(pixels(&a.2) == pixels(&b.2), "false-colour bytes differ");
 }
 
 /// Lit frames to compare: the scene, the shading, the panorama and its lit copy.
@@ -503,4 +505,38 @@ fn memory_budget_and_bad_options() {
             Err(LightError::BadOption { .. })
         ));
     }
+}
+
+#[test]
+fn a_cancelled_bake_makes_nothing() {
+    // The window cancels a bake whose lighting has changed: with the flag set nothing is
+    // made (each band checks it before it starts); with it clear the bake is the plain
+    // one, byte for byte.
+    use std::sync::atomic::AtomicBool;
+    let pano = noise_map(300, 150);
+    let cube = CubeMap::from_envmap(&pano, 48, Sampler::Bilinear).unwrap();
+    let map = IlluminanceMap::build(&walls(), &MapOptions::preview()).unwrap();
+    let (stop, go) = (AtomicBool::new(true), AtomicBool::new(false));
+    assert!(matches!(
+        map.bake_map_cancellable(&pano, &opts(), &stop),
+        Err(LightError::Cancelled)
+    ));
+    assert!(matches!(
+        map.bake_cube_cancellable(&cube, &opts(), &stop),
+        Err(LightError::Cancelled)
+    ));
+    let a = map.bake_map_cancellable(&pano, &opts(), &go).unwrap();
+    let b = map.bake_map(&pano, &opts()).unwrap();
+    assert!(pixels(&a) == pixels(&b), "map bytes differ");
+    let a = map.bake_cube_cancellable(&cube, &opts(), &go).unwrap();
+    assert!(a == map.bake_cube(&cube, &opts()).unwrap());
+    // Bad options are reported before the flag is looked at.
+    let bad = ShadeOptions {
+        exposure: -1.0,
+        ..opts()
+    };
+    assert!(matches!(
+        map.bake_map_cancellable(&pano, &bad, &stop),
+        Err(LightError::BadOption { .. })
+    ));
 }

@@ -7,25 +7,36 @@ use lut_core::{
     CubeMap, EnvMap, ErrorMap, Frame, FrameShader, RenderOptions, RenderReport, Renderer, View,
     ViewError,
 };
+use std::sync::Arc;
 
-/// A panorama ready to render, owning its data (and, for a map, its tables).
+/// A panorama ready to render, owning its data (and, for a map, its tables). The pixels
+/// are shared (`Arc`), not copied, with the window's baking thread, which lights them
+/// while frames are drawn from them.
 pub enum Scene {
     /// A map on a surface of revolution, with its LUT renderer.
     Map {
         /// The map.
-        map: EnvMap,
+        map: Arc<EnvMap>,
         /// Its renderer (tables built on first use).
         renderer: Renderer,
     },
     /// A cube map.
-    Cube(CubeMap),
+    Cube(Arc<CubeMap>),
 }
 
 impl Scene {
     /// A map with a new renderer.
     pub fn map(map: EnvMap) -> Scene {
         let renderer = Renderer::new(&map);
-        Scene::Map { map, renderer }
+        Scene::Map {
+            map: Arc::new(map),
+            renderer,
+        }
+    }
+
+    /// A cube map.
+    pub fn cube(cube: CubeMap) -> Scene {
+        Scene::Cube(Arc::new(cube))
     }
 
     /// The scene to pass to [`render_scene`].
@@ -186,14 +197,14 @@ mod tests {
                     &mut Frame::new(&mut want, w, h).unwrap(),
                 )
                 .unwrap();
-            let mut scene = Scene::Cube(cube.clone());
+            let mut scene = Scene::cube(cube.clone());
             let report = render_scene(scene.as_mut(), view, &opts, &mut got, w, h).unwrap();
             assert_eq!(report.path, RenderPath::Cube(kind));
             assert_eq!(got, want);
             assert!(scene.env_map().is_none());
         }
         // A bad size is an error, not a panic.
-        let mut scene = Scene::Cube(cube);
+        let mut scene = Scene::cube(cube);
         assert!(render_scene(scene.as_mut(), view, &opts, &mut got, 0, h).is_err());
     }
 }

@@ -37,6 +37,7 @@ use crate::map::envmap::EnvMap;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The most memory a lit copy (with its pyramid) may take: 192 MiB, which holds an
 /// 8192 × 4096 map (128 MiB) and its pyramid (43 MiB), or a cube of 2048-texel faces
@@ -68,6 +69,14 @@ fn check_budget(bytes: usize) -> Result<(), LightError> {
             bytes,
             max: BAKE_MAX_BYTES,
         });
+    }
+    Ok(())
+}
+
+/// [`LightError::Cancelled`] when `cancel` is set (some bands were then skipped).
+fn cancelled(cancel: &AtomicBool) -> Result<(), LightError> {
+    if cancel.load(Ordering::Relaxed) {
+        return Err(LightError::Cancelled);
     }
     Ok(())
 }
@@ -164,6 +173,21 @@ impl IlluminanceMap {
     /// [`LightError::BakeTooLarge`] when the copy would take more than
     /// [`BAKE_MAX_BYTES`] ([`lit_map_bytes`]).
     pub fn bake_map(&self, map: &EnvMap, opts: &ShadeOptions) -> Result<EnvMap, LightError> {
+        self.bake_map_cancellable(map, opts, &AtomicBool::new(false))
+    }
+
+    /// [`IlluminanceMap::bake_map`], stopped when `cancel` is set: each band of rows
+    /// checks it before it starts, so a cancelled bake ends within one band per thread
+    /// (the window cancels a bake whose lighting has changed).
+    ///
+    /// # Errors
+    /// As [`IlluminanceMap::bake_map`]; [`LightError::Cancelled`] when `cancel` was set.
+    pub fn bake_map_cancellable(
+        &self,
+        map: &EnvMap,
+        opts: &ShadeOptions,
+        cancel: &AtomicBool,
+    ) -> Result<EnvMap, LightError> {
         opts.check()?;
         check_budget(lit_map_bytes(map))?;
         let grid = MapTexels::new(*self.room(), map);
@@ -176,6 +200,9 @@ impl IlluminanceMap {
         body.par_chunks_mut(band)
             .enumerate()
             .for_each_init(Vec::new, |buf, (i, rows)| {
+                if cancel.load(Ordering::Relaxed) {
+                    return;
+                }
                 let src = &src[i * band..i * band + rows.len()];
                 self.bake_rows(
                     &grid,
@@ -194,6 +221,7 @@ impl IlluminanceMap {
             row[w] = if wrap { row[0] } else { row[w - 1] };
         }
         pad.copy_from_slice(&body[(h - 1) * stride..]);
+        cancelled(cancel)?;
         let lit = map.with_padded(data);
         if map.pyramid_bytes() > 0 {
             lit.pyramid();
@@ -208,6 +236,20 @@ impl IlluminanceMap {
     /// # Errors
     /// As [`IlluminanceMap::bake_map`] ([`lit_cube_bytes`]).
     pub fn bake_cube(&self, cube: &CubeMap, opts: &ShadeOptions) -> Result<CubeMap, LightError> {
+        self.bake_cube_cancellable(cube, opts, &AtomicBool::new(false))
+    }
+
+    /// [`IlluminanceMap::bake_cube`], stopped when `cancel` is set (checked before each
+    /// band of rows, as [`IlluminanceMap::bake_map_cancellable`] does).
+    ///
+    /// # Errors
+    /// As [`IlluminanceMap::bake_cube`]; [`LightError::Cancelled`] when `cancel` was set.
+    pub fn bake_cube_cancellable(
+        &self,
+        cube: &CubeMap,
+        opts: &ShadeOptions,
+        cancel: &AtomicBool,
+    ) -> Result<CubeMap, LightError> {
         opts.check()?;
         check_budget(lit_cube_bytes(cube))?;
         let colour = ShadeRow::detect();
@@ -230,10 +272,14 @@ impl IlluminanceMap {
             out.par_chunks_mut(band)
                 .enumerate()
                 .for_each_init(Vec::new, |buf, (i, rows)| {
+                    if cancel.load(Ordering::Relaxed) {
+                        return;
+                    }
                     let src = &src[i * band..i * band + rows.len()];
                     self.bake_rows(&grid, colour, opts, (n, n), i * BLOCK.1, src, rows, buf);
                 });
         });
+        cancelled(cancel)?;
         let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
         let lit = CubeMap::from_faces(cube.face_size(), refs).map_err(|e| {
             // Cannot happen: the faces have the source's (valid) size.

@@ -220,6 +220,9 @@ pub enum LightError {
         /// [`BAKE_MAX_BYTES`].
         max: usize,
     },
+    /// A bake was cancelled (its lighting changed while it ran): nothing was made.
+    #[error("the bake was cancelled")]
+    Cancelled,
     /// The frame buffer does not hold width × height pixels.
     #[error("frame holds {len} pixels but {width}x{height} needs {needed}")]
     BufferSize {

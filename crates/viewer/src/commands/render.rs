@@ -180,7 +180,7 @@ impl RenderArgs {
                     "--coverage applies to equirectangular panoramas, not cube maps"
                 ));
             }
-            return Ok(Scene::Cube(load_cube(panorama, input.cube)?));
+            return Ok(Scene::cube(load_cube(panorama, input.cube)?));
         }
         if panorama.len() > 1 {
             return Err(usage!(

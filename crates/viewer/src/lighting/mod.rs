@@ -3,6 +3,7 @@
 //! window's panel edits, and scene files ([`SceneFile`]) that save and reopen it.
 
 mod baked;
+mod baker;
 mod files;
 pub mod legend;
 mod lit;
@@ -11,6 +12,7 @@ mod scene_file;
 mod state;
 
 pub use baked::{BakeKey, BakeState, LitPanorama};
+pub use baker::Wake;
 pub use files::{file_kind, FileKind};
 pub use lit::{LitCache, LitRenderError};
 pub use scene_file::{

@@ -60,6 +60,8 @@ struct SceneKey {
     lights: LightsKey,
     /// The illuminance map's generation, the room shown, the selected light.
     lit: (u64, bool, Option<usize>),
+    /// Drawn from the lit panorama (when its bake arrives, the view is drawn from it).
+    baked: bool,
 }
 
 /// Window, surface and egui-winit state: they exist between `resumed` and exit.
@@ -70,10 +72,18 @@ struct Gfx {
     surface_size: (u32, u32),
 }
 
+/// What other threads tell the event loop.
+enum AppEvent {
+    /// From the loading thread.
+    Load(LoadEvent),
+    /// The baking thread finished a lit panorama ([`LitPanorama`]).
+    Baked,
+}
+
 struct App {
     print_view: bool,
     initial_size: (u32, u32),
-    proxy: EventLoopProxy<LoadEvent>,
+    proxy: EventLoopProxy<AppEvent>,
     softbuffer: softbuffer::Context<OwnedDisplayHandle>,
     start: Instant,
     gfx: Option<Gfx>,
@@ -142,6 +152,13 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
     let softbuffer = softbuffer::Context::new(event_loop.owned_display_handle())
         .map_err(|e| anyhow!("cannot use the display for software drawing: {e}"))?;
     let proxy = event_loop.create_proxy();
+    // The baking thread wakes the event loop as the loading thread does (no polling).
+    let wake_on_bake: crate::lighting::Wake = {
+        let proxy = proxy.clone();
+        std::sync::Arc::new(move || {
+            let _ = proxy.send_event(AppEvent::Baked);
+        })
+    };
     let prefs_dir = super::prefs::config_dir();
     let mut notices = Notices::default();
     let prefs = match &prefs_dir {
@@ -194,7 +211,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         fatal: None,
         lights,
         lit: LitCache::default(),
-        baked: LitPanorama::default(),
+        baked: LitPanorama::new(rayon::current_num_threads(), wake_on_bake),
         scene_drag: None,
         scene_file: args.lights.room.scene.clone(),
         printed_markers: String::new(),
@@ -234,10 +251,10 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
 
 /// Create the event loop, turning a missing display (an error, or a panic deep in a
 /// platform backend) into a clear error.
-fn create_event_loop() -> Result<EventLoop<LoadEvent>> {
+fn create_event_loop() -> Result<EventLoop<AppEvent>> {
     let hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
-    let built = std::panic::catch_unwind(|| EventLoop::<LoadEvent>::with_user_event().build());
+    let built = std::panic::catch_unwind(|| EventLoop::<AppEvent>::with_user_event().build());
     std::panic::set_hook(hook);
     let no_display = "cannot open a window: no usable display (is DISPLAY or WAYLAND_DISPLAY set \
                       and the X11/Wayland libraries installed? `viewer render` works without one)";
@@ -323,7 +340,7 @@ impl App {
     }
 }
 
-impl ApplicationHandler<LoadEvent> for App {
+impl ApplicationHandler<AppEvent> for App {
     fn resumed(&mut self, el: &ActiveEventLoop) {
         if self.gfx.is_some() {
             return;
@@ -379,9 +396,15 @@ impl ApplicationHandler<LoadEvent> for App {
         });
     }
 
-    fn user_event(&mut self, _el: &ActiveEventLoop, ev: LoadEvent) {
-        let fx = self.doc.on_event(ev, self.ctl.settings.exposure_ev);
-        self.apply(fx);
+    fn user_event(&mut self, _el: &ActiveEventLoop, ev: AppEvent) {
+        match ev {
+            AppEvent::Load(ev) => {
+                let fx = self.doc.on_event(ev, self.ctl.settings.exposure_ev);
+                self.apply(fx);
+            }
+            // The next frame takes the bake (if it is still for the current lighting).
+            AppEvent::Baked => self.request_redraw(),
+        }
     }
 
     fn window_event(&mut self, el: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {

@@ -51,8 +51,9 @@ pub fn lights_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, out: &mut Panel
             }
             if !l.lit_panorama.is_empty() {
                 ui.label(&l.lit_panorama).on_hover_text(
-                    "Once the lighting has settled the panorama is lit once and panned \
-                     like an unlit one; while it changes each frame is lit",
+                    "Once the lighting has settled the panorama is lit once, on a thread \
+                     of its own, and panned like an unlit one; while it changes, and until \
+                     the bake is done, each frame is lit",
                 );
             }
             room_fields(ui, l);

@@ -201,7 +201,7 @@ pub fn load(
             cube.pyramid();
             progress(LoadStep::Tables, Some(1.0));
             return Ok(Box::new(Loaded {
-                scene: Scene::Cube(cube),
+                scene: Scene::cube(cube),
                 source,
                 projection: opts.projection,
                 hdr: false,

@@ -3,9 +3,9 @@
 //! previous) and saving the view.
 
 use super::frame::FrameRequests;
-use super::App;
+use super::{App, AppEvent};
 use crate::window::dialogs::Chosen;
-use crate::window::document::Effect;
+use crate::window::document::{Effect, LoadEvent};
 use crate::window::folder::{self, Step};
 use crate::window::input::{Look, HFOV_HOME};
 use crate::window::keys::{KeyAction, EXPOSURE_KEY_STEP_EV};
@@ -68,13 +68,13 @@ impl App {
             .name("viewer-load".into())
             .spawn(move || {
                 let result = crate::window::loader::load(req, &mut |step, fraction| {
-                    let _ = proxy.send_event(crate::window::document::LoadEvent::Progress {
+                    let _ = proxy.send_event(AppEvent::Load(LoadEvent::Progress {
                         id,
                         step,
                         fraction,
-                    });
+                    }));
                 });
-                let _ = proxy.send_event(crate::window::document::LoadEvent::Done { id, result });
+                let _ = proxy.send_event(AppEvent::Load(LoadEvent::Done { id, result }));
             });
         if let Err(e) = spawned {
             self.doc.load_not_started(id, &e.to_string());

@@ -390,7 +390,7 @@ impl App {
         let lit = self.update_lit();
         // Once the lighting has settled, frames pan the lit panorama (unlit frames of it);
         // while it changes, each frame is lit from the illuminance map.
-        let from_baked = self.update_baked(lit.as_deref());
+        let from_baked = self.update_baked(lit.as_ref());
         let key = SceneKey {
             look,
             size: (rect.w, rect.h),
@@ -409,6 +409,7 @@ impl App {
                 self.lights.show_room,
                 self.lights.selected,
             ),
+            baked: from_baked,
         };
         if self.scene_key.as_ref() == Some(&key) {
             return;

@@ -50,11 +50,12 @@ impl App {
         }
     }
 
-    /// Bake the lit panorama from `map` once the lighting has settled (the full map
-    /// built, nothing dragged, the same lighting as on the frame before: see
-    /// [`crate::lighting::LitPanorama`]), and show its state in the panel. True when this
-    /// frame pans the lit copy instead of lighting the frame.
-    pub(super) fn update_baked(&mut self, map: Option<&IlluminanceMap>) -> bool {
+    /// Request the lit panorama's bake from `map` once the lighting has settled (the full
+    /// map built, nothing dragged, the same lighting as on the frame before), take it when
+    /// it has arrived from the baking thread (see [`crate::lighting::LitPanorama`]), and
+    /// show its state in the panel. True when this frame pans the lit copy instead of
+    /// lighting the frame.
+    pub(super) fn update_baked(&mut self, map: Option<&Arc<IlluminanceMap>>) -> bool {
         let settled = !self.lit.refining() && self.scene_drag.is_none();
         let key = map.map(|_| BakeKey {
             map_generation: self.lit.generation(),

@@ -339,11 +339,13 @@ fn opened_files_start_at_their_own_view_reloads_keep_it() {
     // The file's own start view, partly overridden by the command line.
     let mut a = loaded(file("a.jpg"), 64, false, 0.0);
     if let Scene::Map { map, .. } = &mut a.scene {
-        map.set_start_view(Some(StartView {
-            yaw_deg: -100.0,
-            pitch_deg: 12.0,
-            hfov_deg: Some(70.0),
-        }));
+        std::sync::Arc::get_mut(map)
+            .unwrap()
+            .set_start_view(Some(StartView {
+                yaw_deg: -100.0,
+                pitch_deg: 12.0,
+                hfov_deg: Some(70.0),
+            }));
     }
     let fx = d.on_event(done(r.id, Ok(a)), 0.0);
     let want = StartView {
