@@ -41,12 +41,19 @@ const MIN_LEVEL_SIDE: u32 = 2;
 /// per pixel instead of two.
 pub const LOD_BIAS: f32 = -0.5;
 
+/// Footprints up to this have level of detail 0 ([`lod_q8`] skips the log2 there):
+/// up to 2^0.5, where log2 + [`LOD_BIAS`] ≤ 0 (and just above it, or after the f32
+/// rounding of the footprint, the Q.8 value truncates below 1/256 to 0 anyway). The LUT
+/// renderer's spans at the common zoom have footprints between 1 and 1.414.
+const LOD0_FOOTPRINT: f64 = std::f64::consts::SQRT_2;
+
 /// Level of detail in Q.8 (256 = one level) for a footprint of `footprint` level-0 map
 /// pixels per screen pixel: log2 of it plus [`LOD_BIAS`], and 0 (level 0, plain bilinear)
 /// below that.
 #[inline]
 pub fn lod_q8(footprint: f64) -> i32 {
-    if footprint > 1.0 {
+    // Up to LOD0_FOOTPRINT the answer is 0 (log2 + bias < 1/256): no log2.
+    if footprint > LOD0_FOOTPRINT {
         // f32 log2 is plenty: the blend weight has 8 bits.
         (((footprint as f32).log2() + LOD_BIAS) * 256.0).clamp(0.0, i32::MAX as f32 / 2.0) as i32
     } else {
@@ -192,6 +199,24 @@ mod tests {
     use super::*;
     use crate::geom::fixed::to_fx;
     use crate::geom::projection::Projection;
+
+    /// The log2-free range of `lod_q8` gives what the formula gives there (a sweep of
+    /// footprints from 1 to 1.5 in steps of 2⁻²⁰, and the first lod above 0).
+    #[test]
+    fn lod_without_log2_equals_the_formula() {
+        let formula = |f: f64| {
+            (((f as f32).log2() + LOD_BIAS) * 256.0).clamp(0.0, i32::MAX as f32 / 2.0) as i32
+        };
+        let mut first = None;
+        for i in 0..=(1 << 19) {
+            let f = 1.0 + i as f64 / (1 << 20) as f64;
+            assert_eq!(lod_q8(f), formula(f), "footprint {f}");
+            if first.is_none() && formula(f) > 0 {
+                first = Some(f);
+            }
+        }
+        assert!(first.is_some_and(|f| f > LOD0_FOOTPRINT), "{first:?}");
+    }
 
     fn checker(w: u32, h: u32) -> EnvMap {
         let px: Vec<u32> = (0..h)

@@ -53,11 +53,11 @@ use exact::{render_exact, ExactFootprint};
 use frame::Frame;
 use grid::{Grid, GridStats};
 use kernel::{level_texels, texels};
-use rowpass::{pixel_row, position_row};
+use rowpass::{pixel_row, position_row, tri_row};
 use rows::{for_each_band_init, for_each_row, for_each_row_init, post_bands};
-use scanline::{render_row, RowScratch, ROW_SCALE_ONE};
+use scanline::{RowScratch, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
-use sink::{Batch, PixelRows, PosRows, RowSinks, Sink, TriRows, TriSink};
+use sink::{Batch, PixelRows, PosRows, RowSinks, TriRows, TriSink};
 use std::f64::consts::TAU;
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
@@ -580,8 +580,7 @@ impl Renderer {
                     batch: Batch::new(),
                 };
                 s.set_lod(lod_q8(scan.fy[0] as f64));
-                render_row(scan, table, &setup, row_scale, &mut scratch.nodes, &mut s);
-                s.flush();
+                tri_row((scan, table, &setup, row_scale), scratch, &mut s);
             };
             return Ok(match hook {
                 Some(post) => {
@@ -735,8 +734,8 @@ impl Renderer {
         let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
-        // The pixels' path: the row pass for nearest and bilinear on full maps.
-        let pass = rowpass::applies(&setup) && opts.sampler != Sampler::Trilinear;
+        // The pixels' path: the row pass on full maps.
+        let pass = rowpass::applies(&setup);
         let wq = (map_w as i32) << 8;
         for_each_row_init(
             &mut out,

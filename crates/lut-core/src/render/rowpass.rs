@@ -16,12 +16,12 @@
 //! The pixels sample exactly the positions [`row_pass`] writes; `Renderer::positions`
 //! reads the same buffers, so the measured sampling error is this pass's.
 
-use super::kernel::{expand, sample_q8, Positions, SpanQ8, Texels};
+use super::kernel::{expand, sample_level, sample_q8, Level, Positions, SpanQ8, Texels};
 use super::scanline::{blend_pays, render_row, with_nodes, wrap_u, Half, RightSpans};
 use super::scanline::{RowScratch, Scratch, BLEND_NODES};
 use super::setup::{Scan, Setup};
 use super::sink::Sink;
-use super::sink::{PixelSink, PosSink};
+use super::sink::{PixelSink, PosSink, TriSink};
 use crate::geom::fixed::{Fx, FX_ONE};
 use crate::lut::{Blended, LutTable};
 use crate::map::envmap::EnvMap;
@@ -41,6 +41,19 @@ pub(crate) struct HalfBuf {
     /// The spans not yet expanded into `u`, `v` (at most one per pixel of a chunk).
     spans: [SpanQ8; HALF_CHUNK + 2],
     n_spans: usize,
+    /// The runs of equal level of detail (trilinear), in order: at most one per span.
+    segs: [Seg; HALF_CHUNK + 2],
+    n_segs: usize,
+    /// Room for per-position weights (trilinear: the second level's).
+    w: [u32; ROOM],
+}
+
+/// Positions from `start` (of a [`HalfRun`]) to the next `Seg`'s start (or the run's end)
+/// have the level of detail `lod` (Q.8, ≥ 0; 0: level 0 alone, plain bilinear).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct Seg {
+    pub(crate) start: u32,
+    pub(crate) lod: i32,
 }
 
 impl HalfBuf {
@@ -51,6 +64,20 @@ impl HalfBuf {
             ul: [0; ROOM],
             spans: [SpanQ8::default(); HALF_CHUNK + 2],
             n_spans: 0,
+            segs: [Seg::default(); HALF_CHUNK + 2],
+            n_segs: 0,
+            w: [0; ROOM],
+        }
+    }
+
+    /// The span from position `start` on has level of detail `lod` (a new [`Seg`]
+    /// unless it equals the last one's; below 0 is 0).
+    #[inline(always)]
+    fn push_lod(&mut self, start: u32, lod: i32) {
+        let lod = lod.max(0);
+        if self.n_segs == 0 || self.segs[self.n_segs - 1].lod != lod {
+            self.segs[self.n_segs] = Seg { start, lod };
+            self.n_segs += 1;
         }
     }
 
@@ -68,14 +95,18 @@ impl HalfBuf {
 }
 
 /// A run of positions of a scanline: pixel `right + j` samples (`u[j]`, `v[j]`) (Q.8 map
-/// coordinates), and pixel `left_end − 1 − j`, its mirror image, (`ul[j]`, `v[j]`).
-#[derive(Debug, Clone, Copy)]
+/// coordinates), and pixel `left_end − 1 − j`, its mirror image, (`ul[j]`, `v[j]`);
+/// for a sink that asks ([`Sink::LOD`]) the levels of detail of its positions (`segs`),
+/// and room for a weight per position (`w`).
+#[derive(Debug)]
 pub(crate) struct HalfRun<'a> {
     pub(crate) right: usize,
     pub(crate) left_end: usize,
     pub(crate) u: &'a [i32],
     pub(crate) v: &'a [i32],
     pub(crate) ul: &'a [i32],
+    pub(crate) segs: &'a [Seg],
+    pub(crate) w: &'a mut [u32],
 }
 
 /// Whether the row pass draws the LUT rows of `fr`'s map (full 360° maps whose rows do
@@ -107,14 +138,21 @@ pub(crate) fn row_pass<S: Sink>(
             u: &buf.u[..n],
             v: &buf.v[..n],
             ul: &buf.ul[..n],
+            segs: &buf.segs[..buf.n_segs],
+            w: &mut buf.w[..n],
         };
         run(sink, r);
+        buf.n_segs = 0;
     };
     // The first pixel in the buffer.
     let mut c0 = 0i64;
     with_nodes!(scan, table, &h, scratch, |nodes| {
         let mut spans = RightSpans::new(scan, nodes, fr, &h);
-        while let Some((d, m, p0, step, _)) = spans.next(scan, fr) {
+        while let Some((d, m, p0, step, r)) = spans.next(scan, fr) {
+            if S::LOD {
+                let lod = sink.span_lod(step.0, step.1, r);
+                buf.push_lod((d - c0) as u32, lod);
+            }
             fill(fr, buf, (d - c0) as usize, m as usize, p0, step);
             let end = d + m;
             if end - c0 >= HALF_CHUNK as i64 || end > h.dn {
@@ -207,6 +245,105 @@ pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
         sample_q8::<BILINEAR, true>(t, r.ul, r.v, &mut s.row[r.left_end - n..r.left_end]);
         sample_q8::<BILINEAR, false>(t, r.u, r.v, &mut s.row[r.right..r.right + n]);
     });
+}
+
+/// Draw one trilinear LUT scanline of a full map into `s` (its level of detail set for
+/// the scanline): the row pass where it applies ([`applies`]; [`tri_run`]), else span by
+/// span through the sink.
+#[inline]
+pub(crate) fn tri_row(
+    (scan, table, fr, row_scale): LutRow<'_>,
+    scratch: &mut RowScratch,
+    s: &mut TriSink<'_>,
+) {
+    if !applies(fr) {
+        render_row(scan, table, fr, row_scale, &mut scratch.nodes, s);
+        s.flush();
+        return;
+    }
+    let levels = s.levels;
+    let wq = (s.map.width() as i32) << 8;
+    let RowScratch { nodes, row: buf } = scratch;
+    row_pass(scan, table, fr, (nodes, buf), s, |s, r| {
+        tri_run(levels, wq, r, s.row);
+    });
+}
+
+/// The first pyramid level and the second level's weight of level of detail `lod` (Q.8)
+/// with levels `0..=last`, as `EnvMap::trilinear` resolves them: 0 and 0 for `lod` ≤ 0;
+/// else k = `lod >> 8` clamped to `last`, weight `lod & 0xFF` (the second level, k + 1,
+/// counts only below `last`).
+#[inline(always)]
+fn resolve(lod: i32, last: usize) -> (usize, u32) {
+    if lod <= 0 {
+        (0, 0)
+    } else {
+        (((lod >> 8) as usize).min(last), (lod & 0xFF) as u32)
+    }
+}
+
+/// A trilinear run (`levels`: level 0, the map `wq` / 256 wide, and its pyramid): the
+/// positions are grouped by their first level ka (consecutive [`Seg`]s); each group is
+/// sampled bilinearly on level ka (level 0: the bilinear row kernel, which is all of a
+/// magnified run), then, unless ka is the last level, level ka + 1 is blended in by each
+/// position's weight from the group's first segment with a weight not 0 to its last
+/// (the segments between with weight 0 are blended by 0: `lerp_px` by 0 is the
+/// identity). Per pixel that is
+/// `EnvMap::trilinear` at the position (u wrapped into the map) with the span's level of
+/// detail.
+fn tri_run(levels: &[Texels], wq: i32, r: HalfRun<'_>, row: &mut [u32]) {
+    let n = r.u.len();
+    let last = levels.len() - 1;
+    let segs = r.segs;
+    let end = |i: usize| segs.get(i).map_or(n, |s| s.start as usize);
+    let mut i = 0;
+    while i < segs.len() {
+        let ka = resolve(segs[i].lod, last).0;
+        let mut e = i + 1;
+        while e < segs.len() && resolve(segs[e].lod, last).0 == ka {
+            e += 1;
+        }
+        let (a, b) = (segs[i].start as usize, end(e));
+        let (u, ul, v) = (&r.u[a..b], &r.ul[a..b], &r.v[a..b]);
+        let (left, right) = (r.left_end - b..r.left_end - a, r.right + a..r.right + b);
+        if ka == 0 {
+            sample_q8::<true, true>(&levels[0], ul, v, &mut row[left]);
+            sample_q8::<true, false>(&levels[0], u, v, &mut row[right]);
+        } else {
+            let lv = Level {
+                k: ka as u32,
+                wq,
+                w: &[],
+            };
+            sample_level::<true, false>(&levels[ka], ul, v, &mut row[left], &lv);
+            sample_level::<false, false>(&levels[ka], u, v, &mut row[right], &lv);
+        }
+        // The second level over the segments from the first to the last with a weight.
+        let weighted = |j: &usize| resolve(segs[*j].lod, last).1 != 0;
+        let (Some(f), Some(l)) = ((i..e).find(weighted), (i..e).rev().find(weighted)) else {
+            i = e;
+            continue;
+        };
+        i = e;
+        if ka == last {
+            continue;
+        }
+        let (a, b) = (segs[f].start as usize, end(l + 1));
+        for (j, s) in segs.iter().enumerate().take(l + 1).skip(f) {
+            let w = resolve(s.lod, last).1;
+            r.w[s.start as usize - a..end(j + 1) - a].fill(w);
+        }
+        let lv = Level {
+            k: ka as u32 + 1,
+            wq,
+            w: &r.w[..b - a],
+        };
+        let (u, ul, v) = (&r.u[a..b], &r.ul[a..b], &r.v[a..b]);
+        let (left, right) = (r.left_end - b..r.left_end - a, r.right + a..r.right + b);
+        let kb = &levels[ka + 1];
+        sample_level::<true, true>(kb, ul, v, &mut row[left], &lv);
+        sample_level::<false, true>(kb, u, v, &mut row[right], &lv);
+    }
 }
 
 /// Pixels of a partial map's run checked and sampled together by [`crop_run`].
@@ -323,4 +460,97 @@ pub(crate) fn position_row(
             s.row[r.right + j] = px(u, v);
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::projection::Projection;
+    use crate::render::kernel::level_texels;
+
+    /// A trilinear run ([`tri_run`]: segments of levels of detail grouped by level, the
+    /// second level blended in over part of a group) writes, pixel by pixel on both
+    /// halves, `EnvMap::trilinear` at the position (u wrapped into the map) with its
+    /// segment's level of detail: random runs of 1..=600 positions within two map widths
+    /// of the map and v beyond the poles, 1..=40 segments of levels −1..9 (the last
+    /// levels clamped), on maps with even and odd level sides.
+    #[test]
+    fn tri_run_is_trilinear_per_pixel() {
+        let mut seed = 0x2545_F491_4F6C_DD1Du64;
+        let mut rnd = |n: u64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed % n
+        };
+        for (w, h) in [(64u32, 32u32), (300, 150), (96, 40), (6, 3)] {
+            let px: Vec<u32> = (0..w * h)
+                .map(|i| i.wrapping_mul(2_654_435_761) & 0xFF_FFFF)
+                .collect();
+            let m = EnvMap::from_pixels(w, h, &px, Projection::Equirect).unwrap();
+            let (levels, nl) = level_texels(&m);
+            let (wq, hq) = ((w as i64) << 8, (h as i64) << 8);
+            for _ in 0..60 {
+                let n = 1 + rnd(600) as usize;
+                let mut pos = |lo: i64, hi: i64| -> Vec<i32> {
+                    (0..n)
+                        .map(|_| (lo + rnd((hi - lo) as u64) as i64) as i32)
+                        .collect()
+                };
+                let (u, ul, v) = (
+                    pos(256 - wq, 2 * wq - 256),
+                    pos(256 - wq, 2 * wq - 256),
+                    pos(-hq / 2, hq + hq / 2),
+                );
+                let mut starts: Vec<u32> = (0..rnd(40)).map(|_| rnd(n as u64) as u32).collect();
+                starts.push(0);
+                starts.sort_unstable();
+                starts.dedup();
+                let segs: Vec<Seg> = starts
+                    .iter()
+                    .map(|&start| Seg {
+                        start,
+                        lod: rnd(10 * 256) as i32 - 256,
+                    })
+                    .collect();
+                let lod_at = |j: usize| {
+                    segs.iter()
+                        .rev()
+                        .find(|s| s.start as usize <= j)
+                        .unwrap()
+                        .lod
+                };
+                let mut wts = vec![0u32; n];
+                let mut row = vec![0u32; 2 * n + 2];
+                let r = HalfRun {
+                    right: n + 1,
+                    left_end: n,
+                    u: &u,
+                    v: &v,
+                    ul: &ul,
+                    segs: &segs,
+                    w: &mut wts,
+                };
+                tri_run(&levels[..nl], wq as i32, r, &mut row);
+                let at = |uq: i32, vq: i32, lod: i32| {
+                    let uu = ((uq as i64) << 8).rem_euclid((w as i64) << 16);
+                    m.trilinear(uu, (vq as i64) << 8, lod)
+                };
+                for j in 0..n {
+                    let lod = lod_at(j);
+                    assert_eq!(
+                        row[n + 1 + j],
+                        at(u[j], v[j], lod),
+                        "{w}x{h} right {j} lod {lod}"
+                    );
+                    assert_eq!(
+                        row[n - 1 - j],
+                        at(ul[j], v[j], lod),
+                        "{w}x{h} left {j} lod {lod}"
+                    );
+                }
+                assert_eq!(row[n], 0, "the pixel between the halves is not written");
+            }
+        }
+    }
 }

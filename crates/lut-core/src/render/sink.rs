@@ -31,6 +31,15 @@ pub(crate) trait Sink {
     /// footprint): the trilinear sink picks its pyramid level from it.
     #[inline(always)]
     fn footprint(&mut self, _dl: Fx, _dv: Fx, _region: usize) {}
+    /// Whether the row pass asks this sink for each span's level of detail
+    /// ([`Sink::span_lod`]: the trilinear sink).
+    const LOD: bool = false;
+    /// The level of detail (Q.8) of a span with step (dΛ, dV) in `region` (as
+    /// [`Sink::footprint`] sets it).
+    #[inline(always)]
+    fn span_lod(&mut self, _dl: Fx, _dv: Fx, _region: usize) -> i32 {
+        0
+    }
     /// The pixel footprint (level-0 map pixels) of the spans that follow, known as a whole
     /// (the grid renderer's cells): the trilinear sink picks its pyramid level from it.
     #[inline(always)]
@@ -260,6 +269,12 @@ impl Sink for TriSink<'_> {
     fn footprint(&mut self, dl: Fx, dv: Fx, region: usize) {
         let fx = dl.unsigned_abs().max(dv.unsigned_abs()) as f64 / FX_ONE as f64;
         self.set_lod(lod_q8(fx.max(self.fy[region] as f64)));
+    }
+    const LOD: bool = true;
+    #[inline(always)]
+    fn span_lod(&mut self, dl: Fx, dv: Fx, region: usize) -> i32 {
+        self.footprint(dl, dv, region);
+        self.lod
     }
     #[inline(always)]
     fn set_footprint(&mut self, footprint: f64) {

@@ -127,7 +127,7 @@ pub use select::{
 };
 
 pub(crate) use face::{face_blend, face_span, FaceRun};
-pub(crate) use row::{expand, sample_q8, Positions, SpanQ8};
+pub(crate) use row::{expand, sample_level, sample_q8, Level, Positions, SpanQ8};
 
 use crate::geom::fixed::{Fx, FX_BITS};
 use crate::map::envmap::EnvMap;

@@ -9,7 +9,7 @@
 //! clamps y at the poles (dropping the weight there as the per-pixel sampler does), and
 //! gathers: no span checks, no refusals, no per-span setup.
 //!
-//! [`sample_q8_scalar`] and [`expand_scalar`] are the reference: every SIMD kernel
+//! [`sample_lv_scalar`] and [`expand_scalar`] are the reference: every SIMD kernel
 //! (`x86/row.rs`) writes the same pixels and positions (`tests.rs`), and the pixels equal
 //! the per-pixel samplers' (`EnvMap::nearest` / `EnvMap::bilinear` at the wrapped
 //! position u/256, v/256).
@@ -79,23 +79,79 @@ fn wrap_x(mut x: i32, w: i32) -> i32 {
     x.clamp(0, w - 1)
 }
 
-/// The scalar kernel: `out[j]` = the sample at (`u[j]`, `v[j]`), or with `MIRROR` (the
-/// left half) `out[n − 1 − j]` (n = `out.len()` ≤ the positions).
+/// A pyramid level for the trilinear row kernels ([`sample_level`]): the level's index
+/// `k` (positions are level-0 Q.8: level k reads (u wrapped into the map) >> k and
+/// v >> k, as `EnvMap::trilinear` shifts its Q.16 positions), the level-0 map's width
+/// in Q.8 (`wq`), and with `BLEND` the weight of the level per position (`w[j]` for
+/// position j, 0..=255: `out = lerp(out, sample, w)`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Level<'a> {
+    pub(crate) k: u32,
+    pub(crate) wq: i32,
+    pub(crate) w: &'a [u32],
+}
+
+/// No level: the map itself (plain nearest or bilinear).
+const LEVEL0: Level<'static> = Level {
+    k: 0,
+    wq: 0,
+    w: &[],
+};
+
+/// u (within two map widths of the map, `wq` its width, Q.8) wrapped into `0..wq`.
 #[inline(always)]
-pub(super) fn sample_q8_scalar<const BILINEAR: bool, const MIRROR: bool>(
+pub(super) fn wrap_q8(mut u: i32, wq: i32) -> i32 {
+    if u < 0 {
+        u += wq;
+    }
+    if u < 0 {
+        u += wq;
+    }
+    if u >= wq {
+        u -= wq;
+    }
+    if u >= wq {
+        u -= wq;
+    }
+    u
+}
+
+/// The scalar kernel: `out[j]` = the sample at (`u[j]`, `v[j]`), or with `MIRROR` (the
+/// left half) `out[n − 1 − j]` (n = `out.len()` ≤ the positions); on a pyramid level
+/// with `LEVEL` (u wrapped into the level-0 map, then u and v shifted right by `lv.k`)
+/// and blended into `out` by the weights `lv.w` with `BLEND` (`lerp_px(out, sample,
+/// w[j])`).
+#[inline(always)]
+pub(super) fn sample_lv_scalar<
+    const BILINEAR: bool,
+    const MIRROR: bool,
+    const LEVEL: bool,
+    const BLEND: bool,
+>(
     t: &Texels,
     u: &[i32],
     v: &[i32],
     out: &mut [u32],
+    lv: &Level,
 ) {
     let n = out.len();
     for (j, (&uu, &vv)) in u[..n].iter().zip(&v[..n]).enumerate() {
         let at = if MIRROR { n - 1 - j } else { j };
-        out[at] = sample_at::<BILINEAR>(t, uu, vv);
+        let (uu, vv) = if LEVEL {
+            (wrap_q8(uu, lv.wq) >> lv.k, vv >> lv.k)
+        } else {
+            (uu, vv)
+        };
+        let s = sample_at::<BILINEAR>(t, uu, vv);
+        out[at] = if BLEND {
+            lerp_px(out[at], s, lv.w[j])
+        } else {
+            s
+        };
     }
 }
 
-/// [`sample_q8_scalar`] with kernel `k`.
+/// [`sample_lv_scalar`] (no level, no blend) with kernel `k`.
 #[inline]
 pub(super) fn sample_q8_with<const BILINEAR: bool, const MIRROR: bool>(
     k: Selected,
@@ -104,19 +160,62 @@ pub(super) fn sample_q8_with<const BILINEAR: bool, const MIRROR: bool>(
     v: &[i32],
     out: &mut [u32],
 ) {
+    sample_lv_with::<BILINEAR, MIRROR, false, false>(k, t, u, v, out, &LEVEL0);
+}
+
+/// [`sample_lv_scalar`] with kernel `k`.
+#[inline]
+pub(super) fn sample_lv_with<
+    const BILINEAR: bool,
+    const MIRROR: bool,
+    const LEVEL: bool,
+    const BLEND: bool,
+>(
+    k: Selected,
+    t: &Texels,
+    u: &[i32],
+    v: &[i32],
+    out: &mut [u32],
+    lv: &Level,
+) {
     assert!(
-        u.len() >= out.len() && v.len() >= out.len(),
-        "a position per pixel"
+        u.len() >= out.len() && v.len() >= out.len() && (!BLEND || lv.w.len() >= out.len()),
+        "a position (and a weight) per pixel"
+    );
+    assert!(
+        !LEVEL || (lv.k < 31 && lv.wq > 0),
+        "a level below 31 of a map"
     );
     #[cfg(target_arch = "x86_64")]
-    if x86::row::sample_q8::<BILINEAR, MIRROR>(k, t, u, v, out) {
+    if x86::row::sample_q8::<BILINEAR, MIRROR, LEVEL, BLEND>(k, t, u, v, out, lv) {
         return;
     }
     let _ = k;
-    sample_q8_scalar::<BILINEAR, MIRROR>(t, u, v, out);
+    sample_lv_scalar::<BILINEAR, MIRROR, LEVEL, BLEND>(t, u, v, out, lv);
 }
 
-/// [`sample_q8_scalar`] with the [`active_kernel`](super::active_kernel): the row pass's
+/// The trilinear row kernel: bilinear samples of pyramid level `t` (level `lv.k` of a
+/// map `lv.wq` / 256 wide) at level-0 Q.8 positions (`u` within two map widths of the
+/// map, as [`sample_q8`] takes them), into `out` (`BLEND` false) or blended into it by
+/// the weights `lv.w` (`BLEND` true: `out = lerp_px(out, sample, w[j])`, the blend of
+/// `EnvMap::trilinear`); `MIRROR` as [`sample_q8`], the weights indexed like the
+/// positions. With the [`active_kernel`](super::active_kernel).
+///
+/// # Panics
+/// When there are fewer positions (or weights, with `BLEND`) than pixels, `lv.k` ≥ 31
+/// or `lv.wq` ≤ 0.
+#[inline]
+pub(crate) fn sample_level<const MIRROR: bool, const BLEND: bool>(
+    t: &Texels,
+    u: &[i32],
+    v: &[i32],
+    out: &mut [u32],
+    lv: &Level,
+) {
+    sample_lv_with::<true, MIRROR, true, BLEND>(active(), t, u, v, out, lv);
+}
+
+/// [`sample_lv_scalar`] (no level, no blend) with the [`active_kernel`](super::active_kernel): the row pass's
 /// pixels. Positions u must lie within two map widths of the map, as the row pass's do
 /// (a span starts in the map and travels less than a width); outside, x is clamped
 /// (never a read outside the map). y is clamped.

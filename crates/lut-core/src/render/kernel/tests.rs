@@ -729,3 +729,117 @@ proptest! {
         }
     }
 }
+
+/// The trilinear row kernel `k` (`row::sample_lv_with` on a level, blended with `BLEND`)
+/// on case `c` (level-0 positions, the level `lk` below a map `wq` / 256 wide), written
+/// into `base` (the pixels it blends into) inside a sentinel-filled buffer.
+fn run_level<const M: bool, const BLEND: bool>(
+    k: Kernel,
+    t: &Texels,
+    c: &RowCase,
+    (lk, wq, w): (u32, i32, &[u32]),
+    base: &[u32],
+) -> Vec<u32> {
+    let n = c.u.len();
+    let mut buf = vec![SENTINEL; n + 16];
+    buf[c.off..c.off + n].copy_from_slice(&base[..n]);
+    let lv = row::Level { k: lk, wq, w };
+    let out = &mut buf[c.off..c.off + n];
+    row::sample_lv_with::<true, M, true, BLEND>(k.selected(), t, &c.u, &c.v, out, &lv);
+    buf
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// The trilinear row kernels (a pyramid level's bilinear samples at level-0
+    /// positions, written or blended in by per-position weights; in order and reversed):
+    /// every kernel writes the scalar one's pixels, and only its pixels. The level is
+    /// 0..=5 below the level-0 map (the test map's sides times 2^k: the level-0 positions
+    /// wrap by that width first), the weights 0..=255.
+    #[test]
+    fn level_kernels_equal_scalar(
+        (mi, lk, cases) in (0..maps().len() - 2, 0u32..=5).prop_flat_map(|(mi, lk)| {
+            let (w, h, _) = &maps()[mi];
+            let case = (row_case(*w << lk, *h << lk), prop::collection::vec(0u32..256, 64),
+                prop::collection::vec(any::<u32>(), 64));
+            (Just(mi), Just(lk), prop::collection::vec(case, 12))
+        })
+    ) {
+        let (w, h, px) = &maps()[mi];
+        let t = Texels::new(px, *w, *h, true).unwrap();
+        let wq = ((*w as i32) << lk) << 8;
+        for (c, wts, base) in &cases {
+            let base: Vec<u32> = base.iter().map(|p| p & 0xFF_FFFF).collect();
+            let a = (lk, wq, &wts[..]);
+            let want = [
+                run_level::<false, false>(Kernel::Scalar, &t, c, a, &base),
+                run_level::<true, false>(Kernel::Scalar, &t, c, a, &base),
+                run_level::<false, true>(Kernel::Scalar, &t, c, a, &base),
+                run_level::<true, true>(Kernel::Scalar, &t, c, a, &base),
+            ];
+            let n = c.u.len();
+            for x in &want {
+                prop_assert!(x[..c.off].iter().chain(&x[c.off + n..]).all(|&p| p == SENTINEL));
+            }
+            for k in others() {
+                let got = [
+                    run_level::<false, false>(k, &t, c, a, &base),
+                    run_level::<true, false>(k, &t, c, a, &base),
+                    run_level::<false, true>(k, &t, c, a, &base),
+                    run_level::<true, true>(k, &t, c, a, &base),
+                ];
+                prop_assert_eq!(&got, &want, "{} {}x{} level {} {:?}", k, w, h, lk, c);
+            }
+        }
+    }
+
+    /// The scalar trilinear row kernel equals `EnvMap::trilinear` per pixel: level ka
+    /// written, level ka + 1 blended in by the level of detail's weight (none on the
+    /// last level), at the Q.8 position with u wrapped into the map; maps with odd
+    /// sides on some levels (300×150: 75, 38, 19, …) included.
+    #[test]
+    fn level_scalar_equals_trilinear(
+        (wh, lod, cases) in prop::sample::select(vec![(4u32, 2u32), (64, 32), (300, 150), (96, 40)])
+            .prop_flat_map(|(w, h)| (Just((w, h)), 0i32..12 * 256,
+                prop::collection::vec(row_case(w, h), 8)))
+    ) {
+        let (w, h) = wh;
+        let px: Vec<u32> = (0..w * h).map(|i| i.wrapping_mul(2_654_435_761) & 0xFF_FFFF).collect();
+        let m = EnvMap::from_pixels(w, h, &px, Projection::Equirect).unwrap();
+        let (levels, nl) = level_texels(&m);
+        let last = nl - 1;
+        let (ka, frac) = (((lod >> 8) as usize).min(last), (lod & 0xFF) as u32);
+        let wq = (w as i32) << 8;
+        let wts = [frac; 64];
+        let wfx = (w as i64) << 16;
+        for c in &cases {
+            let n = c.u.len();
+            for rev in [false, true] {
+                let mut out = vec![0u32; n];
+                let a = row::Level { k: ka as u32, wq, w: &[] };
+                let b = row::Level { k: ka as u32 + 1, wq, w: &wts };
+                let s = Kernel::Scalar.selected();
+                if rev {
+                    row::sample_lv_with::<true, true, true, false>(s, &levels[ka], &c.u, &c.v, &mut out, &a);
+                } else {
+                    row::sample_lv_with::<true, false, true, false>(s, &levels[ka], &c.u, &c.v, &mut out, &a);
+                }
+                if ka < last {
+                    let t = &levels[ka + 1];
+                    if rev {
+                        row::sample_lv_with::<true, true, true, true>(s, t, &c.u, &c.v, &mut out, &b);
+                    } else {
+                        row::sample_lv_with::<true, false, true, true>(s, t, &c.u, &c.v, &mut out, &b);
+                    }
+                }
+                for j in 0..n {
+                    let at = if rev { n - 1 - j } else { j };
+                    let u = ((c.u[j] as i64) << 8).rem_euclid(wfx);
+                    let v = (c.v[j] as i64) << 8;
+                    prop_assert_eq!(out[at], m.trilinear(u, v, lod), "pixel {} lod {} reversed {} {:?}", j, lod, rev, c);
+                }
+            }
+        }
+    }
+}

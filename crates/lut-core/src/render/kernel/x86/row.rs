@@ -3,25 +3,35 @@
 //! them (two 64-bit loads per bilinear pixel) and blended with their `split`, `lerp` and
 //! `merge`; the left half's pixels reversed in the register before the store.
 
-use super::super::row::{sample_q8_scalar, Positions, SpanQ8};
+use super::super::row::{sample_lv_scalar, Level, Positions, SpanQ8};
 use super::{Kernel, Selected, Texels};
 use std::arch::x86_64::*;
 
-/// The row kernel with a SIMD kernel (see `row::sample_q8_scalar`); `false` (nothing
+/// The row kernel with a SIMD kernel (see `row::sample_lv_scalar`); `false` (nothing
 /// written) for the scalar one.
 #[inline(always)]
-pub(in super::super) fn sample_q8<const BILINEAR: bool, const MIRROR: bool>(
+pub(in super::super) fn sample_q8<
+    const BILINEAR: bool,
+    const MIRROR: bool,
+    const LEVEL: bool,
+    const BLEND: bool,
+>(
     k: Selected,
     t: &Texels,
     u: &[i32],
     v: &[i32],
     out: &mut [u32],
+    lv: &Level,
 ) -> bool {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        Kernel::Avx2 => unsafe { avx2::sample_q8::<BILINEAR, MIRROR>(t, u, v, out) },
+        Kernel::Avx2 => unsafe {
+            avx2::sample_q8::<BILINEAR, MIRROR, LEVEL, BLEND>(t, u, v, out, lv)
+        },
         // SAFETY: as above.
-        Kernel::Sse41 => unsafe { sse41::sample_q8::<BILINEAR, MIRROR>(t, u, v, out) },
+        Kernel::Sse41 => unsafe {
+            sse41::sample_q8::<BILINEAR, MIRROR, LEVEL, BLEND>(t, u, v, out, lv)
+        },
         Kernel::Scalar => return false,
     }
     true
@@ -56,7 +66,7 @@ fn last_index<const BILINEAR: bool>(t: &Texels) -> usize {
 macro_rules! lanes {
     ($feature:literal, $v:ty, $set1:ident, $add:ident, $sub:ident, $and:ident, $andnot:ident,
      $or:ident, $gt:ident, $min:ident, $max:ident, $minu:ident, $srai:ident, $mullo:ident,
-     $zero:ident) => {
+     $zero:ident, $sra:ident) => {
         /// (indices clamped to `last`, fx, fy) of positions (u, v), Q.8 (see
         /// `row::sample_at`: bilinear biased by −½, x wrapped, y clamped with fy dropped).
         #[inline]
@@ -87,6 +97,22 @@ macro_rules! lanes {
             let y = $min($max(y, zero), $set1(h1));
             let i = $add($mullo(y, $set1(t.stride() as i32)), x);
             ($minu(i, $set1(last as i32)), fx, fy)
+        }
+
+        /// Level-0 positions (u, v) on level `lv.k`: u wrapped into the level-0 map
+        /// (within two widths of it), both shifted right by k (see `row::wrap_q8`).
+        #[inline]
+        #[target_feature(enable = $feature)]
+        fn on_level(u: $v, v: $v, lv: &Level) -> ($v, $v) {
+            let zero = $zero();
+            let wv = $set1(lv.wq);
+            let u = $add(u, $and($gt(zero, u), wv));
+            let u = $add(u, $and($gt(zero, u), wv));
+            let top = $set1(lv.wq - 1);
+            let u = $sub(u, $and($gt(u, top), wv));
+            let u = $sub(u, $and($gt(u, top), wv));
+            let k = _mm_cvtsi32_si128(lv.k as i32);
+            ($sra(u, k), $sra(v, k))
         }
     };
 }
@@ -150,7 +176,8 @@ mod avx2 {
         _mm256_min_epu32,
         _mm256_srai_epi32,
         _mm256_mullo_epi32,
-        _mm256_setzero_si256
+        _mm256_setzero_si256,
+        _mm256_sra_epi32
     );
 
     /// An 8-bit weight per 32-bit lane as (w, 256 − w) in both 16-bit halves.
@@ -177,11 +204,17 @@ mod avx2 {
 
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn sample_q8<const BILINEAR: bool, const MIRROR: bool>(
+    pub(super) fn sample_q8<
+        const BILINEAR: bool,
+        const MIRROR: bool,
+        const LEVEL: bool,
+        const BLEND: bool,
+    >(
         t: &Texels,
         u: &[i32],
         v: &[i32],
         out: &mut [u32],
+        lv: &Level,
     ) {
         let n = out.len();
         let (u, v) = (&u[..n], &v[..n]);
@@ -201,6 +234,11 @@ mod avx2 {
                     _mm256_loadu_si256(cu.as_ptr().cast()),
                     _mm256_loadu_si256(cv.as_ptr().cast()),
                 )
+            };
+            let (uu, vv) = if LEVEL {
+                on_level(uu, vv, lv)
+            } else {
+                (uu, vv)
             };
             let (i, fx, fy) = lanes::<BILINEAR>(t, uu, vv, last);
             let mut a = [0u32; 8];
@@ -244,6 +282,24 @@ mod avx2 {
                 (c, j)
             };
             let o: &mut [u32; 8] = (&mut out[at..at + 8]).try_into().expect("8");
+            let c = if BLEND {
+                let cw: &[u32; 8] = lv.w[j..j + 8].try_into().expect("8");
+                // SAFETY: `cw` and `o` are 8 readable u32; the loads are unaligned.
+                let (f, prev) = unsafe {
+                    (
+                        _mm256_loadu_si256(cw.as_ptr().cast()),
+                        _mm256_loadu_si256(o.as_ptr().cast()),
+                    )
+                };
+                let f = if MIRROR {
+                    _mm256_permutevar8x32_epi32(f, rev)
+                } else {
+                    f
+                };
+                merge(lerp(split(prev), split(c), weight(f)))
+            } else {
+                c
+            };
             // SAFETY: `o` is 8 writable u32; the store is unaligned.
             unsafe { _mm256_storeu_si256(o.as_mut_ptr().cast(), c) };
             j += 8;
@@ -253,7 +309,11 @@ mod avx2 {
         } else {
             &mut out[j..]
         };
-        sample_q8_scalar::<BILINEAR, MIRROR>(t, &u[j..], &v[j..], rest);
+        let lv = Level {
+            w: if BLEND { &lv.w[j..] } else { lv.w },
+            ..*lv
+        };
+        sample_lv_scalar::<BILINEAR, MIRROR, LEVEL, BLEND>(t, &u[j..], &v[j..], rest, &lv);
     }
 }
 
@@ -276,7 +336,8 @@ mod sse41 {
         _mm_min_epu32,
         _mm_srai_epi32,
         _mm_mullo_epi32,
-        _mm_setzero_si128
+        _mm_setzero_si128,
+        _mm_sra_epi32
     );
 
     #[inline]
@@ -302,11 +363,17 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn sample_q8<const BILINEAR: bool, const MIRROR: bool>(
+    pub(super) fn sample_q8<
+        const BILINEAR: bool,
+        const MIRROR: bool,
+        const LEVEL: bool,
+        const BLEND: bool,
+    >(
         t: &Texels,
         u: &[i32],
         v: &[i32],
         out: &mut [u32],
+        lv: &Level,
     ) {
         let n = out.len();
         let (u, v) = (&u[..n], &v[..n]);
@@ -325,6 +392,11 @@ mod sse41 {
                     _mm_loadu_si128(cu.as_ptr().cast()),
                     _mm_loadu_si128(cv.as_ptr().cast()),
                 )
+            };
+            let (uu, vv) = if LEVEL {
+                on_level(uu, vv, lv)
+            } else {
+                (uu, vv)
             };
             let (i, fx, fy) = lanes::<BILINEAR>(t, uu, vv, last);
             let mut a = [0u32; 4];
@@ -363,6 +435,24 @@ mod sse41 {
                 (c, j)
             };
             let o: &mut [u32; 4] = (&mut out[at..at + 4]).try_into().expect("4");
+            let c = if BLEND {
+                let cw: &[u32; 4] = lv.w[j..j + 4].try_into().expect("4");
+                // SAFETY: `cw` and `o` are 4 readable u32; the loads are unaligned.
+                let (f, prev) = unsafe {
+                    (
+                        _mm_loadu_si128(cw.as_ptr().cast()),
+                        _mm_loadu_si128(o.as_ptr().cast()),
+                    )
+                };
+                let f = if MIRROR {
+                    _mm_shuffle_epi32::<0x1B>(f)
+                } else {
+                    f
+                };
+                merge(lerp(split(prev), split(c), weight(f)))
+            } else {
+                c
+            };
             // SAFETY: `o` is 4 writable u32; the store is unaligned.
             unsafe { _mm_storeu_si128(o.as_mut_ptr().cast(), c) };
             j += 4;
@@ -372,6 +462,10 @@ mod sse41 {
         } else {
             &mut out[j..]
         };
-        sample_q8_scalar::<BILINEAR, MIRROR>(t, &u[j..], &v[j..], rest);
+        let lv = Level {
+            w: if BLEND { &lv.w[j..] } else { lv.w },
+            ..*lv
+        };
+        sample_lv_scalar::<BILINEAR, MIRROR, LEVEL, BLEND>(t, &u[j..], &v[j..], rest, &lv);
     }
 }
