@@ -8,8 +8,12 @@
 //! hfov: however many the rows hold), the budget, the Pareto front (the configurations
 //! no other one beats on both time and mean error), the renderers without a position
 //! error (exact, cube, gather) as vertical lines, step labels placed where they overlap
-//! neither each other nor a point (dropped when there is no room), plain decimal ticks,
-//! and the legend in its own panel beside the plot.
+//! neither each other nor a point (dropped when there is no room), plain decimal ticks at
+//! 1, 2 and 5 times each power of ten, and the legend in its own panel beside the plot
+//! (its lines spaced to fit). `viewer bench --replot` draws it again from a `--json`
+//! file, with the peers of `scripts/peers.py` (no position error either: they remap along
+//! our exact maps) as dashed vertical lines numbered at the top, listed with their PSNR
+//! against the exact render.
 
 use super::report::{step_str, Row};
 use crate::output::write_png_atomic;
