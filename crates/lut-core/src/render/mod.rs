@@ -9,7 +9,7 @@
 //!   left half is its mirror image), map coordinates stepped in Q.16 fixed point between
 //!   reads, longitude unwrapped across each span (a span over the ±180° seam steps
 //!   continuously and wraps per pixel instead of smearing across the whole map);
-//!   `rowpass.rs`, for full maps drawn nearest or bilinear: the walk's positions for a run
+//!   `rowpass.rs`, for full maps (any sampler): the walk's positions for a run
 //!   of the row at once, then one gather pass (`kernel/row.rs`); `rows.rs` runs the rows
 //!   on one thread or in bands on rayon;
 //! * per pixel, `kernel/`: the row and span kernels, with the rules they keep;

@@ -1,6 +1,8 @@
-//! The row pass: a LUT scanline of a full 360° map (equirectangular, sine) drawn with
-//! nearest or bilinear sampling as a run of positions and one gather pass, instead of
-//! span by span through a [`Sink`].
+//! The row pass: a LUT scanline of a full 360° map (equirectangular, sine) drawn as a run
+//! of positions and one gather pass, instead of span by span through a [`Sink`]: nearest
+//! and bilinear ([`pixel_row`]), trilinear ([`tri_row`]: each span's level of detail
+//! recorded, runs on one level sampled together, the next level blended in), partial
+//! maps (`crop_run`).
 //!
 //! Only the right half of the table-covered pixels is walked (`scanline.rs`: reads every
 //! 2^shift pixels outward from the centre, the column coordinate stepped in whole

@@ -42,8 +42,8 @@
 //! projective line evaluated exactly per pixel (the cube scanline renderer's kernels);
 //! `row.rs` (and `x86/row.rs`): the row pass's kernels (`render/rowpass.rs`), a run's
 //! Q.8 positions expanded from its spans and one gather-and-blend pass over them, with
-//! no per-span check (the LUT rows of full maps drawn nearest or bilinear; the span
-//! kernels draw the rest).
+//! no per-span check (the LUT rows of full maps, trilinear's pyramid levels by
+//! `sample_level`; the span kernels draw the rest).
 //!
 //! # Batches
 //! Spans are short (8–16 pixels at hfov 90), so what a span costs besides its pixels
