@@ -19,7 +19,8 @@
 #   bench     scripts/peers.py: `viewer bench` (8192x4096 map, $THREADS threads; all
 #             configurations, the minification set, the chart docs/img/speed_error.png)
 #             and every peer (OpenCV remap, numpy+remap, ffmpeg v360, py360convert, nona)
-#             on the same views                                   -> main/{ours,peers}.json
+#             on the same views; then the chart redrawn with the peers (`viewer bench
+#             --replot main/ours.json --peers main/peers.json`)   -> main/{ours,peers}.json
 #   extra     the OpenCV remap peers again with 1 thread, and with the 4096x2048 map on
 #             1 and $THREADS threads (viewer bench without cube/minify rows)
 #                                                    -> t1/, map4k/, map4k-t1/ peers.json
@@ -63,6 +64,8 @@ if ! skip bench; then
   # shellcheck disable=SC2086 # main_peers is a list of flags
   python3 scripts/peers.py --size "$SIZE" --threads "$THREADS" --out "$OUT/main" --reps "$reps" $main_peers \
     --bench-args "--passes $passes --map-size $map8k --plot $plot" >"$OUT/main/peers.txt"
+  # The chart again, now with the peers of this run (measures nothing).
+  "$viewer" bench --replot "$OUT/main/ours.json" --peers "$OUT/main/peers.json" --plot "$plot"
 fi
 
 if ! skip extra; then

@@ -20,7 +20,8 @@
 //! * [`mod@configs`]: the view sets and the renderer configurations;
 //! * [`measure`]: the thread pool, errors, PSNR, timing;
 //! * [`report`]: the rows (`--json`) and the text table;
-//! * [`plot`]: `--plot`; [`export`]: `--export-maps`.
+//! * [`plot`]: `--plot` (and `--replot`: the chart again from a `--json` file, with the
+//!   peers of `scripts/peers.py`); [`export`]: `--export-maps`.
 
 pub mod configs;
 pub mod export;
@@ -71,6 +72,14 @@ pub struct BenchArgs {
     /// Also write the speed-against-error chart to this PNG.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Measure nothing: redraw the chart (`--plot`, required) from the rows a
+    /// `viewer bench --json` run wrote to this file.
+    #[arg(long, value_name = "OURS_JSON", requires = "plot", conflicts_with_all = ["json", "export_maps", "panorama"])]
+    pub replot: Option<PathBuf>,
+    /// With --replot: also draw the peers `scripts/peers.py` measured in the same run (its
+    /// peers.json), as dashed lines with their PSNR against the exact render.
+    #[arg(long, value_name = "PEERS_JSON", requires = "replot")]
+    pub peers: Option<PathBuf>,
     /// Also export, for the hfov-90 set, the source map (map.rgb, raw RGB24), the exact
     /// sampling maps in OpenCV's convention (mapx_NN.f32 / mapy_NN.f32 = u − ½, v − ½),
     /// the exact renders (exact_{bilinear,nearest}_NN.rgb) and views.json, for
@@ -119,10 +128,30 @@ pub fn run(a: BenchArgs) -> Result<()> {
     if a.passes == 0 {
         return Err(crate::usage!("--passes must be at least 1"));
     }
+    if let Some(ours) = &a.replot {
+        return replot(ours, a.peers.as_deref(), a.plot.as_deref());
+    }
     if let Some(KernelChoice(k)) = a.kernel {
         lut_core::set_kernel(k).map_err(|e| anyhow!("--kernel: {e}"))?;
     }
     in_pool(a.threads, |threads| run_in_pool(&a, threads))
+}
+
+/// `--replot`: the chart from the rows in `ours` and the peers in `peers`; both files
+/// are read before anything is drawn, so a bad one leaves no PNG.
+fn replot(
+    ours: &std::path::Path,
+    peers: Option<&std::path::Path>,
+    png: Option<&std::path::Path>,
+) -> Result<()> {
+    let png = png.ok_or_else(|| crate::usage!("--replot needs --plot PNG"))?;
+    let rows = plot::read_rows(ours)?;
+    let peers = match peers {
+        Some(p) => plot::read_peers(p)?,
+        None => Vec::new(),
+    };
+    plot::plot(png, &rows, &peers)
+        .with_context(|| format!("{}: cannot draw the chart", png.display()))
 }
 
 /// Progress goes to stderr (with --json, stdout is only the JSON array).
@@ -272,7 +301,8 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
     }
 
     if let Some(p) = &a.plot {
-        plot::plot(p, &rows).with_context(|| format!("{}: cannot draw the chart", p.display()))?;
+        plot::plot(p, &rows, &[])
+            .with_context(|| format!("{}: cannot draw the chart", p.display()))?;
     }
     if a.json {
         crate::outln!("{}", serde_json::to_string_pretty(&rows)?)?;
@@ -348,6 +378,34 @@ mod tests {
         ] {
             let e = bench_args(&[flag, bad]).unwrap_err().to_string();
             assert!(e.contains(bad), "{e}");
+        }
+    }
+
+    #[test]
+    fn replot_needs_plot_and_writes_nothing_from_a_bad_file() {
+        let e = bench_args(&["--replot", "ours.json"]).unwrap_err();
+        assert_eq!(e.kind(), clap::error::ErrorKind::MissingRequiredArgument);
+        assert!(e.to_string().contains("--plot"), "{e}");
+        let e = bench_args(&["--peers", "p.json", "--plot", "a.png"]).unwrap_err();
+        assert!(e.to_string().contains("--replot"), "{e}");
+        let tmp = tempfile::tempdir().unwrap();
+        let ours = tmp.path().join("ours.json");
+        let peers = tmp.path().join("peers.json");
+        std::fs::write(&ours, "[]").unwrap();
+        std::fs::write(&peers, r#"{"rows": [{"peer": "x"}]}"#).unwrap();
+        let png = tmp.path().join("chart.png");
+        let (o, p, g) = (
+            ours.to_str().unwrap(),
+            peers.to_str().unwrap(),
+            png.to_str().unwrap(),
+        );
+        for args in [
+            vec!["--replot", o, "--plot", g],
+            vec!["--replot", p, "--plot", g],
+        ] {
+            let e = super::run(bench_args(&args).unwrap()).unwrap_err();
+            assert!(format!("{e:#}").contains(args[1]), "{e:#}");
+            assert!(!png.exists());
         }
     }
 }

@@ -8,19 +8,24 @@
 //! hfov: however many the rows hold), the budget, the Pareto front (the configurations
 //! no other one beats on both time and mean error), the renderers without a position
 //! error (exact, cube, gather) as vertical lines, step labels placed where they overlap
-//! neither each other nor a point (dropped when there is no room), plain decimal ticks,
-//! and the legend in its own panel beside the plot.
+//! neither each other nor a point (dropped when there is no room), plain decimal ticks at
+//! 1, 2 and 5 times each power of ten, and the legend in its own panel beside the plot
+//! (its lines spaced to fit). `viewer bench --replot` draws it again from a `--json`
+//! file, with the peers of `scripts/peers.py` (no position error either: they remap along
+//! our exact maps) as dashed vertical lines numbered at the top, listed with their PSNR
+//! against the exact render.
 
 use super::report::{step_str, Row};
 use crate::output::write_png_atomic;
 use anyhow::{anyhow, Context, Result};
 use plotters::prelude::*;
+use serde::Deserialize;
 use std::path::Path;
 
 /// Image size.
-const SIZE: (u32, u32) = (1400, 800);
+const SIZE: (u32, u32) = (1600, 900);
 /// Width of the plot; the legend panel takes the rest.
-const PLOT_W: u32 = 1020;
+const PLOT_W: u32 = 1060;
 /// Lowest error drawn (log scale).
 const FLOOR: f64 = 1e-5;
 /// The error budget, source pixels.
@@ -41,6 +46,99 @@ const PALETTE: [RGBColor; 12] = [
     RGBColor(230, 70, 70),
     RGBColor(0, 0, 0),
 ];
+
+/// Colours of the peers' dashed lines: a dark family, apart from the series'.
+const PEER_PALETTE: [RGBColor; 6] = [
+    RGBColor(0, 0, 0),
+    RGBColor(110, 110, 110),
+    RGBColor(140, 70, 20),
+    RGBColor(90, 40, 130),
+    RGBColor(0, 90, 70),
+    RGBColor(150, 0, 50),
+];
+
+/// A peer of `scripts/peers.py` (one row of its `peers.json`): its name, median ms per
+/// frame on the same views, and its PSNR against our exact render (none: it makes no
+/// image, e.g. map building alone). Peers remap along our exact maps, so they have no
+/// sampling-position error: the chart draws them as dashed vertical lines.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Peer {
+    /// The peer's name as `peers.py` writes it.
+    pub name: String,
+    /// Median milliseconds per frame.
+    pub ms: f64,
+    /// PSNR against the exact render, dB.
+    pub psnr_db: Option<f64>,
+}
+
+#[derive(Deserialize)]
+struct PeersFile {
+    rows: Vec<PeerRow>,
+}
+
+#[derive(Deserialize)]
+struct PeerRow {
+    peer: String,
+    key: String,
+    ms_median: Option<f64>,
+    psnr_db_vs_exact: Option<f64>,
+}
+
+fn read_text(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))
+}
+
+/// The rows a `viewer bench --json` run wrote to `path`.
+///
+/// # Errors
+/// A file that cannot be read, is not such an array, or holds no row (one line naming
+/// the file and the reason).
+pub fn read_rows(path: &Path) -> Result<Vec<Row>> {
+    // Row's names are `&'static str` (so its derived Deserialize wants 'static input):
+    // the text is leaked, once per process.
+    let text: &'static str = Box::leak(read_text(path)?.into_boxed_str());
+    let rows: Vec<Row> = serde_json::from_str(text).map_err(|e| {
+        anyhow!(
+            "{}: not the rows of `viewer bench --json`: {e}",
+            path.display()
+        )
+    })?;
+    if rows.is_empty() {
+        return Err(anyhow!("{}: no rows", path.display()));
+    }
+    Ok(rows)
+}
+
+/// The peers `scripts/peers.py` wrote to `path` (`peers.json`), once per key (its last
+/// row repeats a peer against our gather), those without a time left out.
+///
+/// # Errors
+/// A file that cannot be read or is not such a file (one line naming the file and the
+/// reason).
+pub fn read_peers(path: &Path) -> Result<Vec<Peer>> {
+    let f: PeersFile = serde_json::from_str(&read_text(path)?).map_err(|e| {
+        anyhow!(
+            "{}: not a peers.json of scripts/peers.py: {e}",
+            path.display()
+        )
+    })?;
+    let mut keys: Vec<&str> = Vec::new();
+    let mut out = Vec::new();
+    for r in &f.rows {
+        if keys.contains(&r.key.as_str()) {
+            continue;
+        }
+        keys.push(&r.key);
+        if let Some(ms) = r.ms_median.filter(|m| m.is_finite() && *m > 0.0) {
+            out.push(Peer {
+                name: r.peer.clone(),
+                ms,
+                psnr_db: r.psnr_db_vs_exact,
+            });
+        }
+    }
+    Ok(out)
+}
 
 /// One series: the rows of one renderer, table, sampler and hfov with a measured error.
 struct Series<'a> {
@@ -178,6 +276,55 @@ pub fn tick(v: f64) -> String {
     }
 }
 
+/// The key points (labelled ticks) of a log axis over `lo..=hi`: 1, 2 and 5 times each
+/// power of ten inside the range; 1 to 9 times when fewer than two of those fall inside;
+/// powers of ten alone (every second, third … one) when more than `max` would.
+pub fn log_key_points(lo: f64, hi: f64, max: usize) -> Vec<f64> {
+    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi >= lo) {
+        return Vec::new();
+    }
+    let (d0, d1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let seq = |mults: &[u32], every: i32| -> Vec<f64> {
+        let mut out = Vec::new();
+        for d in (d0..=d1).filter(|d| d.rem_euclid(every) == 0) {
+            for m in mults {
+                // Parsed from decimal, so 2e-5 is the double nearest 0.00002.
+                let v: f64 = format!("{m}e{d}").parse().unwrap_or(f64::NAN);
+                if v >= lo && v <= hi {
+                    out.push(v);
+                }
+            }
+        }
+        out
+    };
+    let main = seq(&[1, 2, 5], 1);
+    if main.len() < 2 {
+        let all = seq(&[1, 2, 3, 4, 5, 6, 7, 8, 9], 1);
+        if all.len() <= max.max(2) {
+            return all;
+        }
+    }
+    if main.len() <= max {
+        return main;
+    }
+    let mut every = 1;
+    loop {
+        let p = seq(&[1], every);
+        if p.len() <= max.max(1) || every > 64 {
+            return p;
+        }
+        every += 1;
+    }
+}
+
+/// The light mesh lines of a log axis: 1 to 9 times each power of ten inside the range.
+fn log_light_points(lo: f64, hi: f64) -> Vec<f64> {
+    (lo.log10().floor() as i32..=hi.log10().ceil() as i32)
+        .flat_map(|d| (1..10).map(move |m| format!("{m}e{d}").parse::<f64>().unwrap_or(f64::NAN)))
+        .filter(|v| *v >= lo && *v <= hi)
+        .collect()
+}
+
 /// A row's mean and max error as drawn (at least [`FLOOR`]).
 fn mean_of(r: &Row) -> f64 {
     r.mean_err_px.or(r.max_err_px).unwrap_or(FLOOR).max(FLOOR)
@@ -191,8 +338,23 @@ fn err<E: std::fmt::Display>(e: E) -> anyhow::Error {
     anyhow!("{e}")
 }
 
-/// Draw the chart into `path` (see the module doc).
-pub fn plot(path: &Path, rows: &[Row]) -> Result<()> {
+/// One line of the legend.
+enum Entry {
+    /// A group's heading.
+    Head(String),
+    /// A series: its point's colour.
+    Point(RGBColor, String),
+    /// A solid line (references, budget, front).
+    Line(RGBColor, String),
+    /// A dashed line (peers).
+    Dashed(RGBColor, String),
+    /// A line of text.
+    Note(String),
+}
+
+/// Draw the chart into `path` (see the module doc), with `peers` (from `peers.json`,
+/// none when the bench draws the chart itself) as dashed vertical lines.
+pub fn plot(path: &Path, rows: &[Row], peers: &[Peer]) -> Result<()> {
     plotters::style::register_font(
         "sans-serif",
         FontStyle::Normal,
@@ -210,7 +372,8 @@ pub fn plot(path: &Path, rows: &[Row]) -> Result<()> {
         let times = all
             .iter()
             .flat_map(|s| s.rows.iter().map(|r| r.ms_median))
-            .chain(refs.iter().map(|r| r.ms_median));
+            .chain(refs.iter().map(|r| r.ms_median))
+            .chain(peers.iter().map(|p| p.ms));
         let (tmin, tmax) = times.fold((f64::INFINITY, 0.0f64), |(a, b), t| (a.min(t), b.max(t)));
         let (xmin, xmax) = if tmax > 0.0 {
             (tmin / 1.4, tmax * 1.4)
@@ -222,6 +385,15 @@ pub fn plot(path: &Path, rows: &[Row]) -> Result<()> {
             .flat_map(|s| s.rows.iter().filter_map(|r| r.max_err_px))
             .fold(0.1, f64::max)
             * 2.0;
+        // The bottom: a quarter of the lowest mean error drawn (at least [`FLOOR`]), so
+        // the points fill the height.
+        let ylo = all
+            .iter()
+            .flat_map(|s| s.rows.iter().map(|r| mean_of(r)))
+            .fold(ymax, f64::min)
+            .min(0.01)
+            / 4.0;
+        let ylo = ylo.max(FLOOR);
         let caption = rows.first().map_or(String::new(), |r| {
             format!(
                 "speed against error: {}x{} from {}x{}, {} threads, kernel {}",
@@ -238,7 +410,16 @@ pub fn plot(path: &Path, rows: &[Row]) -> Result<()> {
             .margin(16)
             .x_label_area_size(50)
             .y_label_area_size(80)
-            .build_cartesian_2d((xmin..xmax).log_scale(), (FLOOR..ymax).log_scale())
+            .build_cartesian_2d(
+                (xmin..xmax)
+                    .log_scale()
+                    .with_key_points(log_key_points(xmin, xmax, (PLOT_W / 80) as usize))
+                    .with_light_points(log_light_points(xmin, xmax)),
+                (ylo..ymax)
+                    .log_scale()
+                    .with_key_points(log_key_points(ylo, ymax, (SIZE.1 / 36) as usize))
+                    .with_light_points(log_light_points(ylo, ymax)),
+            )
             .map_err(err)?;
         chart
             .configure_mesh()
@@ -261,10 +442,39 @@ pub fn plot(path: &Path, rows: &[Row]) -> Result<()> {
         for (i, r) in refs.iter().enumerate() {
             chart
                 .draw_series(LineSeries::new(
-                    [(r.ms_median, FLOOR), (r.ms_median, ymax)],
+                    [(r.ms_median, ylo), (r.ms_median, ymax)],
                     ref_colour(i).stroke_width(2),
                 ))
                 .map_err(err)?;
+        }
+        // The peers: dashed, numbered at the top (a tag that would overlap the one
+        // beside it moves a row down).
+        let peer_colour = |i: usize| PEER_PALETTE[i % PEER_PALETTE.len()];
+        let (ax, ay) = chart.plotting_area().get_base_pixel();
+        let mut tags: Vec<Rect> = Vec::new();
+        for (i, p) in peers.iter().enumerate() {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(p.ms, ylo), (p.ms, ymax)],
+                    8,
+                    5,
+                    peer_colour(i).stroke_width(2),
+                ))
+                .map_err(err)?;
+            let (px, _) = chart.backend_coord(&(p.ms, ymax));
+            let t = format!("{}", i + 1);
+            let w = 8 * t.len() as i32 + 2;
+            let mut r = (px + 2, ay + 2, w, 14);
+            while tags.iter().any(|&q| overlaps(q, r)) {
+                r.1 += 15;
+            }
+            tags.push(r);
+            root.draw(&Text::new(
+                t,
+                (r.0, r.1),
+                ("sans-serif", 14).into_font().color(&peer_colour(i)),
+            ))
+            .map_err(err)?;
         }
         let points: Vec<(f64, f64)> = all
             .iter()
@@ -326,7 +536,6 @@ pub fn plot(path: &Path, rows: &[Row]) -> Result<()> {
             .iter()
             .map(|(t, _)| (8 * t.chars().count() as i32 + 2, 14))
             .collect();
-        let (ax, ay) = chart.plotting_area().get_base_pixel();
         let (aw, ah) = chart.plotting_area().dim_in_pixel();
         let area = (ax, ay, aw as i32, ah as i32);
         for (spot, (t, si)) in place_labels(&at, &sizes, 10, area).iter().zip(&texts) {
@@ -341,61 +550,108 @@ pub fn plot(path: &Path, rows: &[Row]) -> Result<()> {
                 .map_err(err)?;
             }
         }
-        // The legend panel.
-        let font = ("sans-serif", 15).into_font();
-        let mut y = 60;
-        let line = |y: i32, c: RGBColor| PathElement::new([(12, y), (36, y)], c.stroke_width(2));
+        // The legend panel: as many lines as there are, spaced to fit the panel (down
+        // to 12 px a line; series beyond that are counted, not listed).
+        let mut entries = vec![Entry::Head(
+            "configurations (point: mean error; whisker top: max)".into(),
+        )];
+        let fixed = refs.len() + peers.len() + 12;
+        let room = ((SIZE.1 as usize - 60) / 12).saturating_sub(fixed);
+        let listed = if all.len() > room {
+            room.saturating_sub(1)
+        } else {
+            all.len()
+        };
+        for (si, s) in all.iter().enumerate().take(listed) {
+            entries.push(Entry::Point(PALETTE[si % PALETTE.len()], s.label.clone()));
+        }
+        if listed < all.len() {
+            entries.push(Entry::Note(format!(
+                "... and {} more series",
+                all.len() - listed
+            )));
+        }
+        entries.push(Entry::Line(RED, "budget 0.05 px (max error)".into()));
+        entries.push(Entry::Line(
+            RGBColor(140, 140, 140),
+            "Pareto front (time, mean error)".into(),
+        ));
+        if !refs.is_empty() {
+            entries.push(Entry::Head("no position error (solid lines)".into()));
+        }
+        for (i, r) in refs.iter().enumerate() {
+            entries.push(Entry::Line(
+                ref_colour(i),
+                format!("{}, {}", r.renderer, r.sampler),
+            ));
+        }
+        if !peers.is_empty() {
+            entries.push(Entry::Head(
+                "peers, same run and views (dashed; PSNR vs exact render)".into(),
+            ));
+        }
+        for (i, p) in peers.iter().enumerate() {
+            let psnr = p
+                .psnr_db
+                .map_or("no image".to_string(), |d| format!("{d:.1} dB"));
+            entries.push(Entry::Dashed(
+                peer_colour(i),
+                format!("{} {}: {psnr}", i + 1, p.name),
+            ));
+        }
+        entries.push(Entry::Note(
+            "labels: index step (A = adaptive), where they fit".into(),
+        ));
+        let step = ((SIZE.1 as i32 - 60) / entries.len().max(1) as i32).clamp(12, 24);
+        let size = (step - 3).min(15);
+        let font = ("sans-serif", size).into_font();
+        let bold = ("sans-serif", size + 1).into_font().color(&BLACK);
         right
             .draw(&Text::new(
                 "legend",
-                (12, 30),
+                (12, 16),
                 ("sans-serif", 18).into_font(),
             ))
             .map_err(err)?;
-        for (si, s) in all.iter().enumerate() {
-            let c = PALETTE[si % PALETTE.len()];
-            right
-                .draw(&Circle::new((24, y), 5, c.filled()))
-                .map_err(err)?;
-            right
-                .draw(&Text::new(s.label.clone(), (44, y - 8), font.clone()))
-                .map_err(err)?;
-            y += 24;
-        }
-        for (i, r) in refs.iter().enumerate() {
-            right.draw(&line(y, ref_colour(i))).map_err(err)?;
-            let label = format!("{}, {} (no position error)", r.renderer, r.sampler);
-            right
-                .draw(&Text::new(label, (44, y - 8), font.clone()))
-                .map_err(err)?;
-            y += 24;
-        }
-        right.draw(&line(y, RED)).map_err(err)?;
-        right
-            .draw(&Text::new("budget 0.05 px", (44, y - 8), font.clone()))
-            .map_err(err)?;
-        y += 24;
-        right.draw(&line(y, RGBColor(140, 140, 140))).map_err(err)?;
-        right
-            .draw(&Text::new(
-                "Pareto front (time, mean error)",
-                (44, y - 8),
-                font.clone(),
-            ))
-            .map_err(err)?;
-        y += 36;
-        for note in [
-            "point: mean error; whisker top: max",
-            "error (the table sets it: the same",
-            "for most configurations)",
-            "labels: index step (A = adaptive);",
-            "where labels would overlap,",
-            "they are left out",
-        ] {
-            right
-                .draw(&Text::new(note, (12, y), font.clone()))
-                .map_err(err)?;
-            y += 20;
+        let mut y = 44 + step / 2;
+        let mid = size / 2;
+        for e in &entries {
+            match e {
+                Entry::Head(t) => {
+                    right
+                        .draw(&Text::new(t.clone(), (12, y - mid), bold.clone()))
+                        .map_err(err)?;
+                }
+                Entry::Note(t) => {
+                    right
+                        .draw(&Text::new(t.clone(), (12, y - mid), font.clone()))
+                        .map_err(err)?;
+                }
+                Entry::Point(c, t) | Entry::Line(c, t) | Entry::Dashed(c, t) => {
+                    match e {
+                        Entry::Point(..) => right
+                            .draw(&Circle::new((24, y), 4, c.filled()))
+                            .map_err(err)?,
+                        Entry::Line(..) => right
+                            .draw(&PathElement::new([(12, y), (36, y)], c.stroke_width(2)))
+                            .map_err(err)?,
+                        _ => {
+                            for x in [12, 22, 32] {
+                                right
+                                    .draw(&PathElement::new(
+                                        [(x, y), (x + 6, y)],
+                                        c.stroke_width(2),
+                                    ))
+                                    .map_err(err)?;
+                            }
+                        }
+                    }
+                    right
+                        .draw(&Text::new(t.clone(), (44, y - mid), font.clone()))
+                        .map_err(err)?;
+                }
+            }
+            y += step;
         }
         root.present().map_err(err)?;
     }
@@ -450,7 +706,7 @@ mod tests {
         ];
         let tmp = tempfile::tempdir().unwrap();
         let path = tmp.path().join("charts/speed.png");
-        plot(&path, &rows).unwrap();
+        plot(&path, &rows, &[]).unwrap();
         let img = image::open(&path).unwrap().to_rgb8();
         assert_eq!(img.dimensions(), SIZE);
         let white = image::Rgb([255u8, 255, 255]);
@@ -483,7 +739,7 @@ mod tests {
         assert_eq!(series(&rows).len(), 40);
         let tmp = tempfile::tempdir().unwrap();
         let path = tmp.path().join("many.png");
-        plot(&path, &rows).unwrap();
+        plot(&path, &rows, &[]).unwrap();
         let img = image::open(&path).unwrap().to_rgb8();
         let legend_ink = (PLOT_W..SIZE.0)
             .flat_map(|x| (0..SIZE.1).map(move |y| (x, y)))
@@ -533,6 +789,112 @@ mod tests {
                 );
             }
             assert!(a.0 >= 0 && a.1 >= 0 && a.0 + a.2 <= 600 && a.1 + a.3 <= 400);
+        }
+    }
+
+    #[test]
+    fn log_axes_have_a_one_two_five_key_point_in_every_decade() {
+        assert_eq!(
+            log_key_points(1.9, 160.0, 20),
+            vec![2.0, 5.0, 10.0, 20.0, 50.0, 100.0]
+        );
+        // Nothing outside the range.
+        assert_eq!(
+            log_key_points(2.1, 160.0, 20),
+            vec![5.0, 10.0, 20.0, 50.0, 100.0]
+        );
+        let y = log_key_points(1e-5, 0.2, 20);
+        assert_eq!(y.first(), Some(&0.00001));
+        assert_eq!(y.last(), Some(&0.2));
+        assert_eq!(y.len(), 14);
+        assert!(y.iter().map(|v| tick(*v)).all(|t| !t.contains('e')));
+        // A narrow range: 1 to 9 times; a crowded one: powers of ten, thinned.
+        assert_eq!(log_key_points(2.6, 4.5, 20), vec![3.0, 4.0]);
+        assert_eq!(
+            log_key_points(1e-6, 1e3, 5),
+            vec![1e-6, 1e-4, 0.01, 1.0, 100.0]
+        );
+        assert!(log_key_points(0.0, 1.0, 5).is_empty());
+    }
+
+    fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    const PEERS: &str = r#"{"threads": 1, "rows": [
+        {"peer": "OpenCV remap, float maps, bilinear", "key": "cv_float_bil", "ms_median": 0.8,
+         "ours_ms": 1.0, "ours": "lut bilinear adaptive", "ratio_ours_over_theirs": 1.25,
+         "psnr_db_vs_exact": 71.7},
+        {"peer": "OpenCV convertMaps (map building only)", "key": "cv_convert", "ms_median": 0.3,
+         "ours_ms": null, "ours": "-", "ratio_ours_over_theirs": null, "psnr_db_vs_exact": null},
+        {"peer": "again", "key": "cv_float_bil", "ms_median": 0.8, "psnr_db_vs_exact": 71.7}
+    ]}"#;
+
+    /// `--replot`: the rows of a `--json` run read back (the same rows), the peers read
+    /// once per key, and the chart drawn with them.
+    #[test]
+    fn replot_reads_the_json_files_and_draws_the_peers() {
+        let rows = vec![
+            lut(1.0, 0.01, 4, "wide"),
+            lut(0.5, 0.04, 8, "wide"),
+            Row::timed(&run(), "exact", Sampler::Bilinear, 90.0, 1, &[20.0]),
+        ];
+        let tmp = tempfile::tempdir().unwrap();
+        let ours = write(
+            tmp.path(),
+            "ours.json",
+            &serde_json::to_string(&rows).unwrap(),
+        );
+        assert_eq!(read_rows(&ours).unwrap(), rows);
+        let peers = read_peers(&write(tmp.path(), "peers.json", PEERS)).unwrap();
+        assert_eq!(
+            peers,
+            vec![
+                Peer {
+                    name: "OpenCV remap, float maps, bilinear".into(),
+                    ms: 0.8,
+                    psnr_db: Some(71.7)
+                },
+                Peer {
+                    name: "OpenCV convertMaps (map building only)".into(),
+                    ms: 0.3,
+                    psnr_db: None
+                },
+            ]
+        );
+        let png = tmp.path().join("replot.png");
+        plot(&png, &rows, &peers).unwrap();
+        let img = image::open(&png).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), SIZE);
+        // The first peer's dashed line is black, left of the plot's right edge.
+        let black = (0..PLOT_W)
+            .flat_map(|x| (0..SIZE.1).map(move |y| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0 == [0, 0, 0])
+            .count();
+        assert!(black > 200, "{black}");
+    }
+
+    #[test]
+    fn bad_json_files_are_named_in_one_line() {
+        let tmp = tempfile::tempdir().unwrap();
+        let bad_row = PEERS.replace(r#""ms_median": 0.3"#, r#""ms_median": "slow""#);
+        let peers = write(tmp.path(), "peers.json", &bad_row);
+        let e = read_peers(&peers).unwrap_err().to_string();
+        assert!(e.starts_with(&peers.display().to_string()), "{e}");
+        assert!(!e.contains('\n'), "{e}");
+        let missing = tmp.path().join("none.json");
+        let e = read_rows(&missing).unwrap_err().to_string();
+        assert!(e.contains("none.json: cannot read"), "{e}");
+        for (name, text) in [
+            ("a.json", "[{\"renderer\": 3}]"),
+            ("b.json", "[]"),
+            ("c.json", "{"),
+        ] {
+            let p = write(tmp.path(), name, text);
+            let e = read_rows(&p).unwrap_err().to_string();
+            assert!(e.starts_with(&p.display().to_string()), "{e}");
         }
     }
 

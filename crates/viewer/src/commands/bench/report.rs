@@ -3,11 +3,11 @@
 //! minification set's note.
 
 use lut_core::Sampler;
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 use std::io::Write;
 
 /// What every row of one run shares: output size, threads, the map.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RunInfo {
     /// Output width.
     pub width: u32,
@@ -20,21 +20,26 @@ pub struct RunInfo {
     /// Map height.
     pub map_height: u32,
     /// The map's projection name.
+    #[serde(deserialize_with = "static_str")]
     pub projection: &'static str,
     /// The span kernel that ran (`lut_core::Kernel` name: scalar, sse41, avx2).
+    #[serde(deserialize_with = "static_str")]
     pub kernel: &'static str,
 }
 
 /// One line of the report (one element of the `--json` array).
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Row {
     /// "exact", "lut", "grid", "cube-basic", "cube-scanline" or "gather".
+    #[serde(deserialize_with = "static_str")]
     pub renderer: &'static str,
     /// The sampler's name.
+    #[serde(deserialize_with = "static_str")]
     pub sampler: &'static str,
     /// A number, "adaptive", or null (not a LUT renderer).
     pub index_step: serde_json::Value,
     /// "wide", "high" or null.
+    #[serde(default, deserialize_with = "static_opt")]
     pub lut: Option<&'static str>,
     /// Output size, threads, the map (`width` … `projection` in the JSON).
     #[serde(flatten)]
@@ -70,7 +75,18 @@ pub struct Row {
     /// median milliseconds of the grid's per-view build alone (part of every frame).
     pub table_build_ms: Option<f64>,
     /// The table surface: "cylinder", "plane" or "diamond" (LUT rows), else null.
+    #[serde(default, deserialize_with = "static_opt")]
     pub surface: Option<&'static str>,
+}
+
+/// A name read back from a `--json` file (`viewer bench --replot`): the rows hold
+/// `&'static str`, so a name read back is leaked (a few bytes, once per process).
+fn static_str<'de, D: Deserializer<'de>>(d: D) -> Result<&'static str, D::Error> {
+    Ok(Box::leak(String::deserialize(d)?.into_boxed_str()))
+}
+
+fn static_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<&'static str>, D::Error> {
+    Ok(Option::<String>::deserialize(d)?.map(|s| &*Box::leak(s.into_boxed_str())))
 }
 
 impl Row {
