@@ -38,8 +38,9 @@
 //! [`EnvMap`]; `jobs.rs`: the span check, batches and the dispatch; `scalar.rs`: the
 //! portable kernels (the reference); `x86.rs`: SSE4.1 and AVX2 (the only module where
 //! `unsafe` is allowed; `x86/face.rs` is its child); `select.rs`: choosing the kernel;
-//! `tests.rs`: the property tests; `face.rs`: cube-face runs, whose positions are a
-//! projective line evaluated exactly per pixel (the cube scanline renderer's kernels);
+//! `tests/`: the property tests (`row_pass.rs`: the row kernels'); `face.rs`:
+//! cube-face runs, whose positions are a projective line evaluated exactly per pixel
+//! (the cube scanline renderer's kernels);
 //! `row.rs` (and `x86/row.rs`): the row pass's kernels (`render/rowpass.rs`), a run's
 //! Q.8 positions expanded from its spans and one gather-and-blend pass over them, with
 //! no per-span check (the LUT rows of full maps, trilinear's pyramid levels by
@@ -62,7 +63,7 @@
 //! Every SIMD kernel computes exactly what its scalar twin in `scalar.rs` computes: the
 //! same 8-bit weights, the same rounding (`(a·(256 − w) + b·w + 128) >> 8` per channel, in
 //! 16-bit lanes where it cannot overflow: at most 255·256 + 128), the same positions. The
-//! property tests in `tests.rs` compare the bytes of every available kernel with the
+//! property tests in `tests/` compare the bytes of every available kernel with the
 //! scalar one over random spans and batches (the seam, the last column and row, the
 //! poles, partial maps, lengths 1..=64, odd output offsets, negative and huge steps, 1×1
 //! and 2×1 maps, 65536-wide maps), and the scalar one with the per-pixel samplers. The
@@ -270,7 +271,7 @@ pub(crate) fn sample_span<const BILINEAR: bool>(
 /// nearest spans. At the 8 pixels of a span at hfov 90 the scalar loop costs less than
 /// queueing the span and setting up SIMD lanes for it (docs/performance.md, "Nearest
 /// without the batch"); the bytes are the scalar kernel's, which every SIMD kernel
-/// equals (`tests.rs`). `t` is [`texels`] of `map`, or `None` for
+/// equals (`tests/`). `t` is [`texels`] of `map`, or `None` for
 /// maps whose rows wrap within their own length (per pixel, as [`sample_spans`]).
 #[inline(always)]
 pub(crate) fn nearest_span_direct(

@@ -1,6 +1,7 @@
 //! Row kernels: a run of a scanline's positions expanded from its spans, and the gather
-//! (nearest) or gather-and-blend (bilinear) pass over them, for full 360° maps (the LUT
-//! renderer's rows, `render/rowpass.rs`).
+//! (nearest) or gather-and-blend (bilinear; trilinear: bilinear on a pyramid level,
+//! written or blended in by per-position weights, [`sample_level`]) pass over them, for
+//! full 360° maps (the LUT renderer's rows, `render/rowpass.rs`).
 //!
 //! The positions are `i32` Q.8 map coordinates (the 8 fraction bits are all the bilinear
 //! weights use), one per pixel, in the order of the right half of the scanline; the left
@@ -10,9 +11,9 @@
 //! gathers: no span checks, no refusals, no per-span setup.
 //!
 //! [`sample_lv_scalar`] and [`expand_scalar`] are the reference: every SIMD kernel
-//! (`x86/row.rs`) writes the same pixels and positions (`tests.rs`), and the pixels equal
-//! the per-pixel samplers' (`EnvMap::nearest` / `EnvMap::bilinear` at the wrapped
-//! position u/256, v/256).
+//! (`x86/row.rs`) writes the same pixels and positions (`tests/row_pass.rs`), and the
+//! pixels equal the per-pixel samplers' (`EnvMap::nearest` / `EnvMap::bilinear` at the
+//! wrapped position u/256, v/256; on pyramid levels `EnvMap::trilinear`).
 
 use super::select::{active, Selected};
 use super::Texels;
