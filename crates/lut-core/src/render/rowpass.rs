@@ -221,8 +221,8 @@ fn fill(fr: &Setup, buf: &mut HalfBuf, k: usize, m: usize, (l, vv): (Fx, Fx), (d
 pub(crate) type LutRow<'a> = (&'a Scan, &'a LutTable, &'a Setup, &'a [i64]);
 
 /// Draw one LUT scanline of `map` (`t`: its texels) into `row`: the row pass where it
-/// applies ([`applies`]; partial maps take its positions with the per-pixel crop
-/// samplers), else span by span through the sink.
+/// applies ([`applies`]; partial maps through [`crop_run`]), else span by span through
+/// the sink.
 #[inline]
 pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
     (scan, table, fr, row_scale): LutRow<'_>,
