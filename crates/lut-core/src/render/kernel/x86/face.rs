@@ -4,6 +4,7 @@
 //! (`bilinear8` / `bilinear4` on absolute positions: base 0) or a nearest fetch.
 
 use super::super::face::{face_side, FaceRun};
+use super::row::PREFETCH_AHEAD;
 use super::{padded, Kernel, Local, Selected, Texels};
 use crate::geom::fixed::{FX_HALF, FX_ONE};
 use std::arch::x86_64::*;
@@ -40,6 +41,45 @@ fn absolute(t: &Texels) -> Local {
         dv: 0,
         hi: (t.px.len() - t.stride() - 2) as i32,
         lo: 0,
+    }
+}
+
+/// Prefetch the cache lines pixel `i` of the run (of `m` pixels) will read, as the row
+/// kernels do ([`super::row::PREFETCH_AHEAD`] pixels ahead, see there why): its face
+/// position from the run's projective line (as the kernels compute it, without their
+/// rounding: a line off by one texel is prefetched at worst), its texel and for bilinear
+/// the one below. Pixels past the run or behind the face are skipped.
+#[inline(always)]
+fn prefetch<const BILINEAR: bool>(t: &Texels, r: &FaceRun, i: usize, m: usize) {
+    if i >= m {
+        return;
+    }
+    let dx = r.dx + i as f64;
+    let den = r.p[2] + dx * r.d[2];
+    if den.is_nan() || den <= 0.0 {
+        return;
+    }
+    let q = r.half / den;
+    let n = face_side(t) as f64;
+    let u = (r.half + (r.p[0] + dx * r.d[0]) * q).clamp(0.0, n);
+    let v = (r.half - (r.p[1] + dx * r.d[1]) * q).clamp(0.0, n);
+    let stride = t.stride();
+    let at = t.px.as_ptr().wrapping_add(v as usize * stride + u as usize);
+    // SAFETY: SSE is part of every x86-64 CPU; a prefetch reads nothing the program sees
+    // and never faults, whatever the address.
+    unsafe {
+        _mm_prefetch::<_MM_HINT_T0>(at.cast());
+        if BILINEAR {
+            _mm_prefetch::<_MM_HINT_T0>(at.wrapping_add(stride).cast());
+        }
+    }
+}
+
+/// [`prefetch`] the first [`PREFETCH_AHEAD`] pixels of a run before drawing it.
+#[inline(always)]
+fn prefetch_start<const BILINEAR: bool>(t: &Texels, r: &FaceRun, m: usize) {
+    for i in (0..PREFETCH_AHEAD.min(m)).step_by(8) {
+        prefetch::<BILINEAR>(t, r, i, m);
     }
 }
 
@@ -143,8 +183,10 @@ mod avx2 {
         let w = (fw, _mm256_sub_epi16(_mm256_set1_epi16(256), fw));
         let (four, eight) = (_mm256_set1_pd(4.0), _mm256_set1_pd(8.0));
         let mut fi = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
+        prefetch_start::<BILINEAR>(t, r, m);
         let mut i = 0;
         while i + 8 <= m {
+            prefetch::<BILINEAR>(t, r, i + PREFETCH_AHEAD, m);
             let q = out[i..i + 8].as_mut_ptr().cast::<__m256i>();
             let prev = if BLEND {
                 // SAFETY: `q` points at 8 u32 of `out` (the slice above); unaligned load.
@@ -268,8 +310,12 @@ mod sse41 {
         let w = (fw, _mm_sub_epi16(_mm_set1_epi16(256), fw));
         let (two, four) = (_mm_set1_pd(2.0), _mm_set1_pd(4.0));
         let mut fi = _mm_setr_pd(0.0, 1.0);
+        prefetch_start::<BILINEAR>(t, r, m);
         let mut i = 0;
         while i + 4 <= m {
+            if i % 8 == 0 {
+                prefetch::<BILINEAR>(t, r, i + PREFETCH_AHEAD, m);
+            }
             let q = out[i..i + 4].as_mut_ptr().cast::<__m128i>();
             let prev = if BLEND {
                 // SAFETY: `q` points at 4 u32 of `out` (the slice above); unaligned load.

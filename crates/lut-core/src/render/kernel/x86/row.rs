@@ -61,6 +61,47 @@ fn last_index<const BILINEAR: bool>(t: &Texels) -> usize {
     t.px.len() - if BILINEAR { t.stride() + 2 } else { 1 }
 }
 
+/// How many pixels ahead the row kernels prefetch the texels they will read.
+///
+/// Why: a frame reads the map along curves that cross map rows, and each map row the
+/// curve enters starts with cache misses the hardware prefetchers (which follow address
+/// streams) cannot foresee; the row's positions, already in the buffers, say where the
+/// reads will go. About 50 pixels is a few hundred nanoseconds of drawing, longer than a
+/// trip to memory; 32–64 measured alike (`docs/performance.md`, "Prefetching").
+pub(super) const PREFETCH_AHEAD: usize = 48;
+
+/// Prefetch the cache lines position `j` of (`u`, `v`) (Q.8, on level `k`) will read:
+/// its texel, and for bilinear the one below. Positions past the run are skipped;
+/// positions off the map (a seam not yet wrapped) prefetch a wrong line, which is
+/// harmless: a prefetch never faults and changes no result.
+#[inline(always)]
+fn prefetch<const BILINEAR: bool>(t: &Texels, (u, v): (&[i32], &[i32]), j: usize, k: u32) {
+    if let (Some(&u), Some(&v)) = (u.get(j), v.get(j)) {
+        let stride = t.stride() as isize;
+        let (x, y) = ((u >> (8 + k)) as isize, (v >> (8 + k)) as isize);
+        let at =
+            t.px.as_ptr()
+                .wrapping_offset(y.wrapping_mul(stride).wrapping_add(x));
+        // SAFETY: SSE is part of every x86-64 CPU; a prefetch reads nothing the program
+        // sees and never faults, whatever the address.
+        unsafe {
+            _mm_prefetch::<_MM_HINT_T0>(at.cast());
+            if BILINEAR {
+                _mm_prefetch::<_MM_HINT_T0>(at.wrapping_offset(stride).cast());
+            }
+        }
+    }
+}
+
+/// [`prefetch`] the first [`PREFETCH_AHEAD`] positions of a run, before drawing it (the
+/// kernel's loop prefetches the rest, each a vector's worth ahead).
+#[inline(always)]
+fn prefetch_start<const BILINEAR: bool>(t: &Texels, uv: (&[i32], &[i32]), k: u32) {
+    for j in (0..PREFETCH_AHEAD.min(uv.0.len())).step_by(8) {
+        prefetch::<BILINEAR>(t, uv, j, k);
+    }
+}
+
 /// One vector's texel indices and 8-bit fractions (x, y) from Q.8 positions, written once
 /// per instruction set: `$v` the vector type, `$p` the intrinsics' prefix.
 macro_rules! lanes {
@@ -222,8 +263,11 @@ mod avx2 {
         let stride = t.stride();
         let p = t.px.as_ptr();
         let rev = _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0);
+        let k = if LEVEL { lv.k } else { 0 };
+        prefetch_start::<BILINEAR>(t, (u, v), k);
         let mut j = 0;
         while j + 8 <= n {
+            prefetch::<BILINEAR>(t, (u, v), j + PREFETCH_AHEAD, k);
             let (cu, cv): (&[i32; 8], &[i32; 8]) = (
                 u[j..j + 8].try_into().expect("8"),
                 v[j..j + 8].try_into().expect("8"),
@@ -380,8 +424,13 @@ mod sse41 {
         let last = last_index::<BILINEAR>(t);
         let stride = t.stride();
         let p = t.px.as_ptr();
+        let k = if LEVEL { lv.k } else { 0 };
+        prefetch_start::<BILINEAR>(t, (u, v), k);
         let mut j = 0;
         while j + 4 <= n {
+            if j % 8 == 0 {
+                prefetch::<BILINEAR>(t, (u, v), j + PREFETCH_AHEAD, k);
+            }
             let (cu, cv): (&[i32; 4], &[i32; 4]) = (
                 u[j..j + 4].try_into().expect("4"),
                 v[j..j + 4].try_into().expect("4"),
