@@ -93,11 +93,22 @@ fn prefetch<const BILINEAR: bool>(t: &Texels, (u, v): (&[i32], &[i32]), j: usize
     }
 }
 
-/// [`prefetch`] the first [`PREFETCH_AHEAD`] positions of a run, before drawing it (the
-/// kernel's loop prefetches the rest, each a vector's worth ahead).
+/// The pixels between prefetches for a run of positions `u` (Q.8, on level `k`): 8, or
+/// 4 where the run steps more than 2 texels per pixel on average (zoomed out on the full
+/// resolution: 8 pixels then cross more than one 16-texel cache line).
 #[inline(always)]
-fn prefetch_start<const BILINEAR: bool>(t: &Texels, uv: (&[i32], &[i32]), k: u32) {
-    for j in (0..PREFETCH_AHEAD.min(uv.0.len())).step_by(8) {
+fn prefetch_every(u: &[i32], k: u32) -> usize {
+    match (u.first(), u.last()) {
+        (Some(&a), Some(&b)) if ((b - a).unsigned_abs() >> (8 + k)) as usize > 2 * u.len() => 4,
+        _ => 8,
+    }
+}
+
+/// [`prefetch`] the first [`PREFETCH_AHEAD`] positions of a run, every `every` pixels,
+/// before drawing it (the kernel's loop prefetches the rest as far ahead).
+#[inline(always)]
+fn prefetch_start<const BILINEAR: bool>(t: &Texels, uv: (&[i32], &[i32]), k: u32, every: usize) {
+    for j in (0..PREFETCH_AHEAD.min(uv.0.len())).step_by(every) {
         prefetch::<BILINEAR>(t, uv, j, k);
     }
 }
@@ -264,10 +275,14 @@ mod avx2 {
         let p = t.px.as_ptr();
         let rev = _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0);
         let k = if LEVEL { lv.k } else { 0 };
-        prefetch_start::<BILINEAR>(t, (u, v), k);
+        let every = prefetch_every(u, k);
+        prefetch_start::<BILINEAR>(t, (u, v), k, every);
         let mut j = 0;
         while j + 8 <= n {
             prefetch::<BILINEAR>(t, (u, v), j + PREFETCH_AHEAD, k);
+            if every < 8 {
+                prefetch::<BILINEAR>(t, (u, v), j + PREFETCH_AHEAD + 4, k);
+            }
             let (cu, cv): (&[i32; 8], &[i32; 8]) = (
                 u[j..j + 8].try_into().expect("8"),
                 v[j..j + 8].try_into().expect("8"),
@@ -425,10 +440,11 @@ mod sse41 {
         let stride = t.stride();
         let p = t.px.as_ptr();
         let k = if LEVEL { lv.k } else { 0 };
-        prefetch_start::<BILINEAR>(t, (u, v), k);
+        let every = prefetch_every(u, k);
+        prefetch_start::<BILINEAR>(t, (u, v), k, every);
         let mut j = 0;
         while j + 4 <= n {
-            if j % 8 == 0 {
+            if j & (every - 1) == 0 {
                 prefetch::<BILINEAR>(t, (u, v), j + PREFETCH_AHEAD, k);
             }
             let (cu, cv): (&[i32; 4], &[i32; 4]) = (
