@@ -244,9 +244,9 @@ macro_rules! row_kernels {
                 let o: &mut [u32; N] = (&mut out[at..at + N]).try_into().expect("N");
                 let c = if BLEND {
                     let cw: &[u32; N] = lv.w[j..j + N].try_into().expect("N");
+                    let (pw, po) = (cw.as_ptr().cast(), o.as_ptr().cast());
                     // SAFETY: `cw` and `o` are N readable u32; the loads are unaligned.
-                    let (f, prev) =
-                        unsafe { (loadu(cw.as_ptr().cast()), loadu(o.as_ptr().cast())) };
+                    let (f, prev) = unsafe { (loadu(pw), loadu(po)) };
                     let f = if MIRROR { reverse(f) } else { f };
                     merge(lerp(split(prev), split(c), weight(f)))
                 } else {
