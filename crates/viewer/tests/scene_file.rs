@@ -332,8 +332,9 @@ fn bad_scene_files_fail_with_one_line() {
             "--size",
             "8x8",
         ]);
-        assert!(!out.status.success(), "{name} should fail");
         let e = String::from_utf8_lossy(&out.stderr).to_string();
+        // A problem of the file, not of the command line (exit.rs): 1, not 2.
+        assert_eq!(out.status.code(), Some(1), "{name}: {e}");
         assert_eq!(e.trim_end().lines().count(), 1, "{name}: {e}");
         assert!(e.contains(name), "{name}: {e}");
         assert!(!dir.join("x.png").exists(), "{name}: an output was written");
@@ -355,4 +356,31 @@ fn bad_scene_files_fail_with_one_line() {
     assert!(e.contains("cubic") && e.contains("catmull-rom"), "{e}");
     let e = case("room.json", &|v| v["room"]["camera_height"] = 3.0.into());
     assert!(e.contains("camera height"), "{e}");
+    // The view's angles: an hfov no projection takes, and one the view projection of
+    // the command line (rectilinear) does not.
+    let view = |hfov: f64| {
+        move |v: &mut serde_json::Value| {
+            v["view"] = serde_json::json!({"yaw": 0.0, "pitch": 0.0, "hfov": hfov})
+        }
+    };
+    let e = case("hfov.json", &view(500.0));
+    assert!(e.contains("\"view\"") && e.contains("500"), "{e}");
+    let e = case("wide.json", &view(250.0));
+    assert!(e.contains("\"view\"") && e.contains("250"), "{e}");
+    assert!(e.contains("--view-projection"), "{e}");
+    // The same hfov given on the command line is a usage error (exit 2), file or not.
+    let out = viewer(&[
+        "render",
+        "--scene",
+        s(&dir.join("wide.json")),
+        "-o",
+        s(&dir.join("x.png")),
+        "--size",
+        "8x8",
+        "--hfov",
+        "250",
+    ]);
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{e}");
+    assert!(e.contains("invalid view"), "{e}");
 }

@@ -9,13 +9,13 @@ use crate::output::{check_not_input, output_kind, write_image};
 use crate::panorama::{coverage_text, heading_text, load_cube, load_panorama_partial};
 use crate::scene::{measure_errors, Scene};
 use crate::usage;
-use anyhow::{Context, Result};
+use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use lut_core::{
     IndexStep, LutChoice, RenderOptions, RenderReport, RendererKind, Sampler, Surface, View,
     ViewProjection, PANNINI_D_DEFAULT,
 };
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `viewer render`.
 #[derive(Args, Debug)]
@@ -134,21 +134,32 @@ impl RenderArgs {
         }
     }
 
-    /// The view these arguments select (angles not given: the scene file's view's).
+    /// The view these arguments select (angles not given: those of the scene file's view,
+    /// `scene`: the file and its view).
     ///
     /// # Errors
-    /// Bad angles, an hfov outside the projection's range, a bad Pannini d.
-    pub fn view(&self, scene: Option<crate::lighting::SceneView>) -> Result<View> {
+    /// Bad angles, an hfov outside the projection's range, a bad Pannini d: a usage error
+    /// (exit 2), unless the scene file's angles are to blame (the command line's own and
+    /// the defaults make a valid view): then a problem of that file (exit 1), named.
+    pub fn view(&self, scene: Option<(&Path, crate::lighting::SceneView)>) -> Result<View> {
         let p = self.view_projection()?;
-        let (yaw, pitch, hfov) = self.angles(scene);
-        View::with_projection(yaw, pitch, hfov, p).map_err(|e| {
+        let at = |s: Option<crate::lighting::SceneView>| {
+            let (yaw, pitch, hfov) = self.angles(s);
+            View::with_projection(yaw, pitch, hfov, p)
+        };
+        at(scene.map(|s| s.1)).map_err(|e| {
             let hint = match e {
                 lut_core::ViewError::HfovOutOfRange(h) if h >= 180.0 => {
                     " (wider views: --view-projection stereographic, fisheye, equisolid or pannini)"
                 }
                 _ => "",
             };
-            usage!("invalid view: {e}{hint}")
+            match scene {
+                Some((path, _)) if at(None).is_ok() => {
+                    anyhow!("{}: \"view\": {e}{hint}", path.display())
+                }
+                _ => usage!("invalid view: {e}{hint}"),
+            }
         })
     }
 
@@ -204,7 +215,7 @@ impl RenderArgs {
 /// Run `viewer render`.
 pub fn run(a: RenderArgs) -> Result<()> {
     let (scene_pano, scene_view) = a.lights.room.scene_panorama()?;
-    let mut view = a.view(scene_view)?;
+    let mut view = a.view(a.lights.room.scene.as_deref().zip(scene_view))?;
     if a.view_limit && !view.projection().is_rectilinear() {
         return Err(usage!(
             "--view-limit applies to rectilinear views, not --view-projection {}",

@@ -280,7 +280,7 @@ impl SceneFile {
     ///
     /// # Errors
     /// An unreadable file, bad JSON or an unknown key (with its line and column), a
-    /// format or version this viewer does not read.
+    /// format or version this viewer does not read, a view's hfov no projection takes.
     pub fn load(path: &Path) -> Result<SceneFile> {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("{}: cannot read", path.display()))?;
@@ -304,6 +304,14 @@ impl SceneFile {
                 "{}: scene file version {} (this viewer reads version {VERSION})",
                 path.display(),
                 scene.version
+            );
+        }
+        // No view projection takes more (its own range is checked where the view is made).
+        if let Some(v) = scene.view.filter(|v| !(v.hfov > 0.0 && v.hfov <= 360.0)) {
+            bail!(
+                "{}: \"view\": \"hfov\" is {}, expected more than 0 and at most 360 degrees",
+                path.display(),
+                v.hfov
             );
         }
         Ok(scene)

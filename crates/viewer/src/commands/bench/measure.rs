@@ -434,7 +434,7 @@ pub fn minify_set(
     let run = RunInfo {
         width: w,
         height: h,
-        ..*run
+        ..run.clone()
     };
     let mut rows = Vec::new();
     let mut out = vec![0u32; n];
@@ -456,7 +456,7 @@ pub fn minify_set(
         let mut row = Row::timed(&run, kind.name(), sampler, MINIFY_HFOV, views.len(), &times);
         if is_lut {
             row.index_step = super::configs::step_json(opts.index_step);
-            row.lut = Some(opts.lut.name());
+            row.lut = Some(opts.lut.name().into());
         }
         row.psnr_ss_db = psnr(err, (n * views.len() * 3) as u64);
         progress(&super::report::row_line(&row));

@@ -191,8 +191,8 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         threads,
         map_width: map.width(),
         map_height: map.height(),
-        projection: map.projection().name(),
-        kernel: kernel.active.name(),
+        projection: map.projection().name().into(),
+        kernel: kernel.active.name().into(),
     };
     let sets = view_sets(a.views)?;
     let mut renderer = Renderer::new(&map);
@@ -253,7 +253,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
             let (index_step, lut) = cfg.lut_fields(set.table);
             let mut row = Row {
                 index_step,
-                lut,
+                lut: lut.map(Into::into),
                 ..Row::timed(
                     &run,
                     cfg.renderer_name(),
@@ -264,7 +264,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
                 )
             };
             e.fill(&mut row);
-            row.surface = cfg.surface();
+            row.surface = cfg.surface().map(Into::into);
             match cfg {
                 configs::Config::Lut(..) => {
                     row.exact_fraction = Some(e.exact_fraction());

@@ -94,10 +94,8 @@ fn read_text(path: &Path) -> Result<String> {
 /// A file that cannot be read, is not such an array, or holds no row (one line naming
 /// the file and the reason).
 pub fn read_rows(path: &Path) -> Result<Vec<Row>> {
-    // Row's names are `&'static str` (so its derived Deserialize wants 'static input):
-    // the text is leaked, once per process.
-    let text: &'static str = Box::leak(read_text(path)?.into_boxed_str());
-    let rows: Vec<Row> = serde_json::from_str(text).map_err(|e| {
+    let text = read_text(path)?;
+    let rows: Vec<Row> = serde_json::from_str(&text).map_err(|e| {
         anyhow!(
             "{}: not the rows of `viewer bench --json`: {e}",
             path.display()
@@ -156,9 +154,10 @@ fn series(rows: &[Row]) -> Vec<Series<'_>> {
         // The table's surface when it is not the default cylinder (e.g. diamond).
         let surface = r
             .surface
+            .as_deref()
             .filter(|s| *s != "cylinder")
             .map_or(String::new(), |s| format!(" {s}"));
-        let label = match r.lut {
+        let label = match r.lut.as_deref() {
             Some(lut) => format!(
                 "{}{surface} {lut} (hfov {}), {}",
                 r.renderer, r.hfov, r.sampler
@@ -681,16 +680,16 @@ mod tests {
             threads: 1,
             map_width: 256,
             map_height: 128,
-            projection: "equirect",
-            kernel: "scalar",
+            projection: "equirect".into(),
+            kernel: "scalar".into(),
         }
     }
 
     fn lut(ms: f64, err: f64, step: i64, table: &'static str) -> Row {
         Row {
             index_step: serde_json::json!(step),
-            lut: Some(table),
-            surface: Some("cylinder"),
+            lut: Some(table.into()),
+            surface: Some("cylinder".into()),
             max_err_px: Some(err),
             mean_err_px: Some(err / 4.0),
             ..Row::timed(&run(), "lut", Sampler::Bilinear, 90.0, 1, &[ms])

@@ -3,11 +3,16 @@
 //! minification set's note.
 
 use lut_core::Sampler;
-use serde::{Deserialize, Deserializer, Serialize};
+use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 use std::io::Write;
 
+/// A name in a row: the program's own (`Cow::Borrowed`) or one read back from a `--json`
+/// file by `viewer bench --replot` (`Cow::Owned`); written the same either way.
+pub type Name = Cow<'static, str>;
+
 /// What every row of one run shares: output size, threads, the map.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunInfo {
     /// Output width.
     pub width: u32,
@@ -20,27 +25,23 @@ pub struct RunInfo {
     /// Map height.
     pub map_height: u32,
     /// The map's projection name.
-    #[serde(deserialize_with = "static_str")]
-    pub projection: &'static str,
+    pub projection: Name,
     /// The span kernel that ran (`lut_core::Kernel` name: scalar, sse41, avx2).
-    #[serde(deserialize_with = "static_str")]
-    pub kernel: &'static str,
+    pub kernel: Name,
 }
 
 /// One line of the report (one element of the `--json` array).
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Row {
     /// "exact", "lut", "grid", "cube-basic", "cube-scanline" or "gather".
-    #[serde(deserialize_with = "static_str")]
-    pub renderer: &'static str,
+    pub renderer: Name,
     /// The sampler's name.
-    #[serde(deserialize_with = "static_str")]
-    pub sampler: &'static str,
+    pub sampler: Name,
     /// A number, "adaptive", or null (not a LUT renderer).
     pub index_step: serde_json::Value,
     /// "wide", "high" or null.
-    #[serde(default, deserialize_with = "static_opt")]
-    pub lut: Option<&'static str>,
+    #[serde(default)]
+    pub lut: Option<Name>,
     /// Output size, threads, the map (`width` … `projection` in the JSON).
     #[serde(flatten)]
     pub run: RunInfo,
@@ -75,18 +76,8 @@ pub struct Row {
     /// median milliseconds of the grid's per-view build alone (part of every frame).
     pub table_build_ms: Option<f64>,
     /// The table surface: "cylinder", "plane" or "diamond" (LUT rows), else null.
-    #[serde(default, deserialize_with = "static_opt")]
-    pub surface: Option<&'static str>,
-}
-
-/// A name read back from a `--json` file (`viewer bench --replot`): the rows hold
-/// `&'static str`, so a name read back is leaked (a few bytes, once per process).
-fn static_str<'de, D: Deserializer<'de>>(d: D) -> Result<&'static str, D::Error> {
-    Ok(Box::leak(String::deserialize(d)?.into_boxed_str()))
-}
-
-fn static_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<&'static str>, D::Error> {
-    Ok(Option::<String>::deserialize(d)?.map(|s| &*Box::leak(s.into_boxed_str())))
+    #[serde(default)]
+    pub surface: Option<Name>,
 }
 
 impl Row {
@@ -102,11 +93,11 @@ impl Row {
     ) -> Row {
         let ms_median = super::measure::median(times);
         Row {
-            renderer,
-            sampler: sampler.name(),
+            renderer: renderer.into(),
+            sampler: sampler.name().into(),
             index_step: serde_json::Value::Null,
             lut: None,
-            run: *run,
+            run: run.clone(),
             hfov,
             frames,
             ms_median,
@@ -168,7 +159,7 @@ pub fn step_str(v: &serde_json::Value) -> String {
 
 /// One row as a line of the text table (also the progress line).
 pub fn row_line(r: &Row) -> String {
-    let renderer = match r.surface {
+    let renderer = match r.surface.as_deref() {
         Some(sf) if sf != "cylinder" => format!("{}/{sf}", r.renderer),
         _ => r.renderer.to_string(),
     };
@@ -177,7 +168,7 @@ pub fn row_line(r: &Row) -> String {
         renderer,
         r.sampler,
         step_str(&r.index_step),
-        r.lut.unwrap_or("-"),
+        r.lut.as_deref().unwrap_or("-"),
         r.hfov,
         r.ms_median,
         r.ms_min,
@@ -291,15 +282,15 @@ mod tests {
             threads: 2,
             map_width: 8192,
             map_height: 4096,
-            projection: "equirect",
-            kernel: "avx2",
+            projection: "equirect".into(),
+            kernel: "avx2".into(),
         }
     }
 
     fn lut_row() -> Row {
         Row {
             index_step: serde_json::json!(4),
-            lut: Some("wide"),
+            lut: Some("wide".into()),
             max_err_px: Some(0.01234),
             mean_err_px: Some(0.001),
             psnr_db: Some(48.25),
@@ -377,6 +368,30 @@ mod tests {
         assert!(exact["index_step"].is_null() && exact["lut"].is_null());
     }
 
+    /// Rows read back (`viewer bench --replot`) own their names (nothing is leaked) and
+    /// write the same JSON bytes as the rows that were written.
+    #[test]
+    fn rows_read_back_write_the_same_json() {
+        let rows = vec![
+            lut_row(),
+            Row {
+                surface: Some("diamond".into()),
+                psnr_ss_db: Some(30.0),
+                ..lut_row()
+            },
+            Row::timed(&run(), "exact", Sampler::Nearest, 50.0, 1, &[9.0]),
+        ];
+        let text = serde_json::to_string_pretty(&rows).unwrap();
+        let back: Vec<Row> = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, rows);
+        let owned = |n: &Name| matches!(n, Cow::Owned(_));
+        assert!(owned(&back[0].renderer) && owned(&back[0].sampler));
+        assert!(owned(&back[0].run.projection) && owned(&back[0].run.kernel));
+        assert!(back[1].lut.as_ref().is_some_and(owned));
+        assert!(back[1].surface.as_ref().is_some_and(owned));
+        assert_eq!(serde_json::to_string_pretty(&back).unwrap(), text);
+    }
+
     #[test]
     fn table_lines() {
         assert_eq!(
@@ -422,7 +437,7 @@ mod tests {
         assert!(lines[3].starts_with("renderer      sampler"));
         assert_eq!(lines[4], row_line(&lut_row()));
         let diamond = Row {
-            surface: Some("diamond"),
+            surface: Some("diamond".into()),
             ..lut_row()
         };
         assert!(row_line(&diamond).starts_with("lut/diamond   bilinear"));

@@ -2,6 +2,13 @@
 //! (SSE) pixels per `f64` vector, computed with the scalar twin's operations in its
 //! order, rounded to Q.16 as it rounds them, then the map kernels' gather and blend
 //! (`bilinear8` / `bilinear4` on absolute positions: base 0) or a nearest fetch.
+//!
+//! Written once (`face_kernels!`) as the row kernels are (`x86/row.rs`): each
+//! instruction set's module names its intrinsics with short aliases (`add_pd` is
+//! `_mm256_add_pd` in `avx2`, `_mm_add_pd` in `sse41`; `V` the i32 vector of `N` lanes,
+//! `D` the f64 vector of `N / 2`) and holds what differs in more than the prefix: joining
+//! two halves' coordinates (`join`), the nearest gather (`gather`), the lane offsets
+//! (`iota_pd`).
 
 use super::super::face::{face_side, FaceRun};
 use super::row::PREFETCH_AHEAD;
@@ -44,11 +51,13 @@ fn absolute(t: &Texels) -> Local {
     }
 }
 
+/// The face kernels of one instruction set (`$feature`), in terms of the names its
+/// module defines (see the module docs).
 /// Prefetch the cache lines pixel `i` of the run (of `m` pixels) will read, as the row
-/// kernels do ([`super::row::PREFETCH_AHEAD`] pixels ahead, see there why): its face
-/// position from the run's projective line (as the kernels compute it, without their
-/// rounding: a line off by one texel is prefetched at worst), its texel and for bilinear
-/// the one below. Pixels past the run or behind the face are skipped.
+/// kernels do ([`PREFETCH_AHEAD`] pixels ahead, see there why): its face position from
+/// the run's projective line (as the kernels compute it, without their rounding: a line
+/// off by one texel is prefetched at worst), its texel and for bilinear the one below.
+/// Pixels past the run or behind the face are skipped.
 #[inline(always)]
 fn prefetch<const BILINEAR: bool>(t: &Texels, r: &FaceRun, i: usize, m: usize) {
     if i >= m {
@@ -75,273 +84,211 @@ fn prefetch<const BILINEAR: bool>(t: &Texels, r: &FaceRun, i: usize, m: usize) {
     }
 }
 
-/// [`prefetch`] the first [`PREFETCH_AHEAD`] pixels of a run before drawing it.
-#[inline(always)]
-fn prefetch_start<const BILINEAR: bool>(t: &Texels, r: &FaceRun, m: usize) {
-    for i in (0..PREFETCH_AHEAD.min(m)).step_by(8) {
-        prefetch::<BILINEAR>(t, r, i, m);
-    }
+macro_rules! face_kernels {
+    ($feature:literal) => {
+        /// Face coordinates of the N / 2 pixels at lane offsets `i` (f64, from the run's
+        /// start), as the scalar twin rounds them: Q.16 (`BILINEAR`, not yet biased) or
+        /// whole texels; in the low lanes of the result.
+        #[inline]
+        #[target_feature(enable = $feature)]
+        fn uv<const BILINEAR: bool>(r: &FaceRun, n: f64, i: D) -> (__m128i, __m128i) {
+            let s = set1_pd;
+            let dx = add_pd(s(r.dx), i);
+            let a = add_pd(s(r.p[0]), mul_pd(dx, s(r.d[0])));
+            let b = add_pd(s(r.p[1]), mul_pd(dx, s(r.d[1])));
+            let m = add_pd(s(r.p[2]), mul_pd(dx, s(r.d[2])));
+            let half = s(r.half);
+            let q = div_pd(half, m);
+            let u = add_pd(half, mul_pd(a, q));
+            let v = sub_pd(half, mul_pd(b, q));
+            // max(x, 0) gives 0 for NaN (the second operand), as f64::max does.
+            let clamp = |x: D| min_pd(max_pd(x, zero_pd()), s(n));
+            let fx = |x: D| {
+                if BILINEAR {
+                    cvtt_pd(add_pd(mul_pd(clamp(x), s(FX_ONE as f64)), s(0.5)))
+                } else {
+                    cvtt_pd(clamp(x))
+                }
+            };
+            (fx(u), fx(v))
+        }
+
+        /// N pixels at lane offsets `lo` (lanes 0..N / 2) and `hi` (N / 2..N): bilinear
+        /// (merged 0RGB) or nearest.
+        #[inline]
+        #[target_feature(enable = $feature)]
+        #[allow(clippy::too_many_arguments)]
+        fn px<const BILINEAR: bool, const BLEND: bool>(
+            t: &Texels,
+            r: &FaceRun,
+            l: &Local,
+            prev: V,
+            w: (V, V),
+            lo: D,
+            hi: D,
+        ) -> V {
+            let n = face_side(t);
+            let stride = t.stride();
+            let (u0, v0) = uv::<BILINEAR>(r, n as f64, lo);
+            let (u1, v1) = uv::<BILINEAR>(r, n as f64, hi);
+            let (u, v) = (join(u0, u1), join(v0, v1));
+            if BILINEAR {
+                // + ½ texel: the border's +1 and the centres' −½ (CubeMap::bilinear).
+                let h = set1(FX_HALF as i32);
+                let c = bilinear(t.px, stride, l, add(u, h), add(v, h));
+                return if BLEND {
+                    merge(lerp(split(prev), c, w))
+                } else {
+                    merge(c)
+                };
+            }
+            let last = set1(n as i32 - 1);
+            let (x, y) = (min(u, last), min(v, last));
+            let k = add(
+                mullo(y, set1(stride as i32)),
+                add(x, set1(stride as i32 + 1)),
+            );
+            let k = min(max(k, zero()), set1(t.px.len() as i32 - 1));
+            let mut a = [0i32; N];
+            // SAFETY: `a` is N writable i32; the store is unaligned.
+            unsafe { storeu(a.as_mut_ptr().cast(), k) };
+            let p = t.px.as_ptr();
+            // SAFETY: each a[j] is clamped to [0, len − 1] just above.
+            let g = |j: usize| unsafe { p.add(a[j] as usize).read() } as i32;
+            gather(g)
+        }
+
+        /// The run, N pixels per step (`BLEND`: blended into `out` by `frac`); the tail's
+        /// lanes past the end repeat the last pixel.
+        #[target_feature(enable = $feature)]
+        pub(super) fn face<const BILINEAR: bool, const BLEND: bool>(
+            t: &Texels,
+            r: &FaceRun,
+            out: &mut [u32],
+            frac: u32,
+        ) {
+            let m = out.len();
+            let l = absolute(t);
+            let fw = set1((frac as i32) * 0x10001);
+            let w = (fw, sub16(set1_16(256), fw));
+            let (half, step) = (set1_pd((N / 2) as f64), set1_pd(N as f64));
+            let mut fi = iota_pd();
+            // Prefetched up to (not including) `ahead`, every 8 pixels.
+            let mut ahead = 0;
+            let mut i = 0;
+            while i + N <= m {
+                while ahead < (i + N + PREFETCH_AHEAD).min(m) {
+                    prefetch::<BILINEAR>(t, r, ahead, m);
+                    ahead += 8;
+                }
+                let q = out[i..i + N].as_mut_ptr().cast::<V>();
+                let prev = if BLEND {
+                    // SAFETY: `q` points at N u32 of `out` (the slice above); unaligned load.
+                    unsafe { loadu(q) }
+                } else {
+                    zero()
+                };
+                let c = px::<BILINEAR, BLEND>(t, r, &l, prev, w, fi, add_pd(fi, half));
+                // SAFETY: as above; unaligned store.
+                unsafe { storeu(q, c) };
+                fi = add_pd(fi, step);
+                i += N;
+            }
+            if i < m {
+                // Lane offsets past the end clamped to m − 1 (small whole numbers: exact).
+                let last = set1_pd((m - 1) as f64);
+                let (lo, hi) = (min_pd(fi, last), min_pd(add_pd(fi, half), last));
+                let tail = &mut out[i..];
+                let mut buf = padded::<N>(tail);
+                let q = buf.as_mut_ptr().cast::<V>();
+                // SAFETY: `buf` holds N u32; unaligned load.
+                let prev = unsafe { loadu(q) };
+                let c = px::<BILINEAR, BLEND>(t, r, &l, prev, w, lo, hi);
+                // SAFETY: as above; unaligned store.
+                unsafe { storeu(q, c) };
+                let n = tail.len();
+                tail.copy_from_slice(&buf[..n]);
+            }
+        }
+    };
 }
 
 mod avx2 {
-    use super::super::avx2::{bilinear8, lerp, merge, split};
+    use super::super::avx2::{bilinear8 as bilinear, lerp, merge, split};
     use super::*;
+    use std::arch::x86_64::{
+        __m256d as D, __m256i as V, _mm256_add_epi32 as add, _mm256_add_pd as add_pd,
+        _mm256_cvttpd_epi32 as cvtt_pd, _mm256_div_pd as div_pd, _mm256_loadu_si256 as loadu,
+        _mm256_max_epi32 as max, _mm256_max_pd as max_pd, _mm256_min_epi32 as min,
+        _mm256_min_pd as min_pd, _mm256_mul_pd as mul_pd, _mm256_mullo_epi32 as mullo,
+        _mm256_set1_epi16 as set1_16, _mm256_set1_epi32 as set1, _mm256_set1_pd as set1_pd,
+        _mm256_setzero_pd as zero_pd, _mm256_setzero_si256 as zero, _mm256_storeu_si256 as storeu,
+        _mm256_sub_epi16 as sub16, _mm256_sub_pd as sub_pd,
+    };
 
-    /// Face coordinates of the 4 pixels at lane offsets `i` (f64, from the run's start),
-    /// as the scalar twin rounds them: Q.16 (`BILINEAR`, not yet biased) or whole texels.
+    /// Pixels per step.
+    const N: usize = 8;
+
+    face_kernels!("avx2");
+
+    /// The lane offsets of the first half: 0, 1, 2, 3.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn uv4<const BILINEAR: bool>(r: &FaceRun, n: f64, i: __m256d) -> (__m128i, __m128i) {
-        let s = _mm256_set1_pd;
-        let dx = _mm256_add_pd(s(r.dx), i);
-        let a = _mm256_add_pd(s(r.p[0]), _mm256_mul_pd(dx, s(r.d[0])));
-        let b = _mm256_add_pd(s(r.p[1]), _mm256_mul_pd(dx, s(r.d[1])));
-        let m = _mm256_add_pd(s(r.p[2]), _mm256_mul_pd(dx, s(r.d[2])));
-        let half = s(r.half);
-        let q = _mm256_div_pd(half, m);
-        let u = _mm256_add_pd(half, _mm256_mul_pd(a, q));
-        let v = _mm256_sub_pd(half, _mm256_mul_pd(b, q));
-        // max(x, 0) gives 0 for NaN (the second operand), as f64::max does.
-        let clamp = |x: __m256d| _mm256_min_pd(_mm256_max_pd(x, _mm256_setzero_pd()), s(n));
-        let fx = |x: __m256d| {
-            if BILINEAR {
-                let y = _mm256_add_pd(_mm256_mul_pd(clamp(x), s(FX_ONE as f64)), s(0.5));
-                _mm256_cvttpd_epi32(y)
-            } else {
-                _mm256_cvttpd_epi32(clamp(x))
-            }
-        };
-        (fx(u), fx(v))
+    fn iota_pd() -> D {
+        _mm256_setr_pd(0.0, 1.0, 2.0, 3.0)
     }
 
-    /// 8 pixels at lane offsets `lo` (lanes 0..4) and `hi` (4..8): bilinear (merged
-    /// 0RGB) or nearest.
+    /// The two halves' coordinates (4 lanes each) as one vector.
     #[inline]
     #[target_feature(enable = "avx2")]
-    #[allow(clippy::too_many_arguments)]
-    fn px8<const BILINEAR: bool, const BLEND: bool>(
-        t: &Texels,
-        r: &FaceRun,
-        l: &Local,
-        prev: __m256i,
-        w: (__m256i, __m256i),
-        lo: __m256d,
-        hi: __m256d,
-    ) -> __m256i {
-        let n = face_side(t);
-        let stride = t.stride();
-        let (u0, v0) = uv4::<BILINEAR>(r, n as f64, lo);
-        let (u1, v1) = uv4::<BILINEAR>(r, n as f64, hi);
-        let (u, v) = (_mm256_set_m128i(u1, u0), _mm256_set_m128i(v1, v0));
-        if BILINEAR {
-            // + ½ texel: the border's +1 and the centres' −½ (CubeMap::bilinear).
-            let h = _mm256_set1_epi32(FX_HALF as i32);
-            let c = bilinear8(
-                t.px,
-                stride,
-                l,
-                _mm256_add_epi32(u, h),
-                _mm256_add_epi32(v, h),
-            );
-            return if BLEND {
-                merge(lerp(split(prev), c, w))
-            } else {
-                merge(c)
-            };
-        }
-        let last = _mm256_set1_epi32(n as i32 - 1);
-        let (x, y) = (_mm256_min_epi32(u, last), _mm256_min_epi32(v, last));
-        let k = _mm256_add_epi32(
-            _mm256_mullo_epi32(y, _mm256_set1_epi32(stride as i32)),
-            _mm256_add_epi32(x, _mm256_set1_epi32(stride as i32 + 1)),
-        );
-        let k = _mm256_min_epi32(
-            _mm256_max_epi32(k, _mm256_setzero_si256()),
-            _mm256_set1_epi32(t.px.len() as i32 - 1),
-        );
-        let mut a = [0i32; 8];
-        // SAFETY: `a` is 32 writable bytes; the store is unaligned.
-        unsafe { _mm256_storeu_si256(a.as_mut_ptr().cast(), k) };
-        let p = t.px.as_ptr();
-        // SAFETY: each a[j] is clamped to [0, len − 1] just above.
-        let g = |j: usize| unsafe { p.add(a[j] as usize).read() } as i32;
+    fn join(lo: __m128i, hi: __m128i) -> V {
+        _mm256_set_m128i(hi, lo)
+    }
+
+    /// Lanes 0..8 = `g(0..8)`.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn gather(g: impl Fn(usize) -> i32) -> V {
         _mm256_setr_epi32(g(0), g(1), g(2), g(3), g(4), g(5), g(6), g(7))
-    }
-
-    /// The run, 8 pixels per step (`BLEND`: blended into `out` by `frac`); the tail's
-    /// lanes past the end repeat the last pixel.
-    #[target_feature(enable = "avx2")]
-    pub(super) fn face<const BILINEAR: bool, const BLEND: bool>(
-        t: &Texels,
-        r: &FaceRun,
-        out: &mut [u32],
-        frac: u32,
-    ) {
-        let m = out.len();
-        let l = absolute(t);
-        let fw = _mm256_set1_epi32((frac as i32) * 0x10001);
-        let w = (fw, _mm256_sub_epi16(_mm256_set1_epi16(256), fw));
-        let (four, eight) = (_mm256_set1_pd(4.0), _mm256_set1_pd(8.0));
-        let mut fi = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
-        prefetch_start::<BILINEAR>(t, r, m);
-        let mut i = 0;
-        while i + 8 <= m {
-            prefetch::<BILINEAR>(t, r, i + PREFETCH_AHEAD, m);
-            let q = out[i..i + 8].as_mut_ptr().cast::<__m256i>();
-            let prev = if BLEND {
-                // SAFETY: `q` points at 8 u32 of `out` (the slice above); unaligned load.
-                unsafe { _mm256_loadu_si256(q) }
-            } else {
-                _mm256_setzero_si256()
-            };
-            let c = px8::<BILINEAR, BLEND>(t, r, &l, prev, w, fi, _mm256_add_pd(fi, four));
-            // SAFETY: as above; unaligned store.
-            unsafe { _mm256_storeu_si256(q, c) };
-            fi = _mm256_add_pd(fi, eight);
-            i += 8;
-        }
-        if i < m {
-            // Lane offsets past the end clamped to m − 1 (small whole numbers: exact).
-            let last = _mm256_set1_pd((m - 1) as f64);
-            let (lo, hi) = (
-                _mm256_min_pd(fi, last),
-                _mm256_min_pd(_mm256_add_pd(fi, four), last),
-            );
-            let tail = &mut out[i..];
-            let mut buf = padded::<8>(tail);
-            let q = buf.as_mut_ptr().cast::<__m256i>();
-            // SAFETY: `buf` holds 8 u32; unaligned load.
-            let prev = unsafe { _mm256_loadu_si256(q) };
-            let c = px8::<BILINEAR, BLEND>(t, r, &l, prev, w, lo, hi);
-            // SAFETY: as above; unaligned store.
-            unsafe { _mm256_storeu_si256(q, c) };
-            let n = tail.len();
-            tail.copy_from_slice(&buf[..n]);
-        }
     }
 }
 
 mod sse41 {
-    use super::super::sse41::{bilinear4, lerp, merge, split};
+    use super::super::sse41::{bilinear4 as bilinear, lerp, merge, split};
     use super::*;
+    use std::arch::x86_64::{
+        __m128d as D, __m128i as V, _mm_add_epi32 as add, _mm_add_pd as add_pd,
+        _mm_cvttpd_epi32 as cvtt_pd, _mm_div_pd as div_pd, _mm_loadu_si128 as loadu,
+        _mm_max_epi32 as max, _mm_max_pd as max_pd, _mm_min_epi32 as min, _mm_min_pd as min_pd,
+        _mm_mul_pd as mul_pd, _mm_mullo_epi32 as mullo, _mm_set1_epi16 as set1_16,
+        _mm_set1_epi32 as set1, _mm_set1_pd as set1_pd, _mm_setzero_pd as zero_pd,
+        _mm_setzero_si128 as zero, _mm_storeu_si128 as storeu, _mm_sub_epi16 as sub16,
+        _mm_sub_pd as sub_pd,
+    };
 
-    /// [`super::avx2`]'s `uv4` for 2 pixels.
+    /// Pixels per step.
+    const N: usize = 4;
+
+    face_kernels!("sse4.1");
+
+    /// The lane offsets of the first half: 0, 1.
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    fn uv2<const BILINEAR: bool>(r: &FaceRun, n: f64, i: __m128d) -> (__m128i, __m128i) {
-        let s = _mm_set1_pd;
-        let dx = _mm_add_pd(s(r.dx), i);
-        let a = _mm_add_pd(s(r.p[0]), _mm_mul_pd(dx, s(r.d[0])));
-        let b = _mm_add_pd(s(r.p[1]), _mm_mul_pd(dx, s(r.d[1])));
-        let m = _mm_add_pd(s(r.p[2]), _mm_mul_pd(dx, s(r.d[2])));
-        let half = s(r.half);
-        let q = _mm_div_pd(half, m);
-        let u = _mm_add_pd(half, _mm_mul_pd(a, q));
-        let v = _mm_sub_pd(half, _mm_mul_pd(b, q));
-        // max(x, 0) gives 0 for NaN (the second operand), as f64::max does.
-        let clamp = |x: __m128d| _mm_min_pd(_mm_max_pd(x, _mm_setzero_pd()), s(n));
-        let fx = |x: __m128d| {
-            if BILINEAR {
-                _mm_cvttpd_epi32(_mm_add_pd(_mm_mul_pd(clamp(x), s(FX_ONE as f64)), s(0.5)))
-            } else {
-                _mm_cvttpd_epi32(clamp(x))
-            }
-        };
-        (fx(u), fx(v))
+    fn iota_pd() -> D {
+        _mm_setr_pd(0.0, 1.0)
     }
 
-    /// 4 pixels at lane offsets `lo` (lanes 0..2) and `hi` (2..4).
+    /// The two halves' coordinates (2 low lanes each) as one vector.
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    #[allow(clippy::too_many_arguments)]
-    fn px4<const BILINEAR: bool, const BLEND: bool>(
-        t: &Texels,
-        r: &FaceRun,
-        l: &Local,
-        prev: __m128i,
-        w: (__m128i, __m128i),
-        lo: __m128d,
-        hi: __m128d,
-    ) -> __m128i {
-        let n = face_side(t);
-        let stride = t.stride();
-        let (u0, v0) = uv2::<BILINEAR>(r, n as f64, lo);
-        let (u1, v1) = uv2::<BILINEAR>(r, n as f64, hi);
-        let (u, v) = (_mm_unpacklo_epi64(u0, u1), _mm_unpacklo_epi64(v0, v1));
-        if BILINEAR {
-            let h = _mm_set1_epi32(FX_HALF as i32);
-            let c = bilinear4(t.px, stride, l, _mm_add_epi32(u, h), _mm_add_epi32(v, h));
-            return if BLEND {
-                merge(lerp(split(prev), c, w))
-            } else {
-                merge(c)
-            };
-        }
-        let last = _mm_set1_epi32(n as i32 - 1);
-        let (x, y) = (_mm_min_epi32(u, last), _mm_min_epi32(v, last));
-        let k = _mm_add_epi32(
-            _mm_mullo_epi32(y, _mm_set1_epi32(stride as i32)),
-            _mm_add_epi32(x, _mm_set1_epi32(stride as i32 + 1)),
-        );
-        let k = _mm_min_epi32(
-            _mm_max_epi32(k, _mm_setzero_si128()),
-            _mm_set1_epi32(t.px.len() as i32 - 1),
-        );
-        let mut a = [0i32; 4];
-        // SAFETY: `a` is 16 writable bytes; the store is unaligned.
-        unsafe { _mm_storeu_si128(a.as_mut_ptr().cast(), k) };
-        let p = t.px.as_ptr();
-        // SAFETY: each a[j] is clamped to [0, len − 1] just above.
-        let g = |j: usize| unsafe { p.add(a[j] as usize).read() } as i32;
+    fn join(lo: __m128i, hi: __m128i) -> V {
+        _mm_unpacklo_epi64(lo, hi)
+    }
+
+    /// Lanes 0..4 = `g(0..4)`.
+    #[inline]
+    #[target_feature(enable = "sse4.1")]
+    fn gather(g: impl Fn(usize) -> i32) -> V {
         _mm_setr_epi32(g(0), g(1), g(2), g(3))
-    }
-
-    /// The run, 4 pixels per step (see [`super::avx2`]'s `face`).
-    #[target_feature(enable = "sse4.1")]
-    pub(super) fn face<const BILINEAR: bool, const BLEND: bool>(
-        t: &Texels,
-        r: &FaceRun,
-        out: &mut [u32],
-        frac: u32,
-    ) {
-        let m = out.len();
-        let l = absolute(t);
-        let fw = _mm_set1_epi32((frac as i32) * 0x10001);
-        let w = (fw, _mm_sub_epi16(_mm_set1_epi16(256), fw));
-        let (two, four) = (_mm_set1_pd(2.0), _mm_set1_pd(4.0));
-        let mut fi = _mm_setr_pd(0.0, 1.0);
-        prefetch_start::<BILINEAR>(t, r, m);
-        let mut i = 0;
-        while i + 4 <= m {
-            if i % 8 == 0 {
-                prefetch::<BILINEAR>(t, r, i + PREFETCH_AHEAD, m);
-            }
-            let q = out[i..i + 4].as_mut_ptr().cast::<__m128i>();
-            let prev = if BLEND {
-                // SAFETY: `q` points at 4 u32 of `out` (the slice above); unaligned load.
-                unsafe { _mm_loadu_si128(q) }
-            } else {
-                _mm_setzero_si128()
-            };
-            let c = px4::<BILINEAR, BLEND>(t, r, &l, prev, w, fi, _mm_add_pd(fi, two));
-            // SAFETY: as above; unaligned store.
-            unsafe { _mm_storeu_si128(q, c) };
-            fi = _mm_add_pd(fi, four);
-            i += 4;
-        }
-        if i < m {
-            let last = _mm_set1_pd((m - 1) as f64);
-            let (lo, hi) = (_mm_min_pd(fi, last), _mm_min_pd(_mm_add_pd(fi, two), last));
-            let tail = &mut out[i..];
-            let mut buf = padded::<4>(tail);
-            let q = buf.as_mut_ptr().cast::<__m128i>();
-            // SAFETY: `buf` holds 4 u32; unaligned load.
-            let prev = unsafe { _mm_loadu_si128(q) };
-            let c = px4::<BILINEAR, BLEND>(t, r, &l, prev, w, lo, hi);
-            // SAFETY: as above; unaligned store.
-            unsafe { _mm_storeu_si128(q, c) };
-            let n = tail.len();
-            tail.copy_from_slice(&buf[..n]);
-        }
     }
 }

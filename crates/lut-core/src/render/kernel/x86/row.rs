@@ -2,6 +2,14 @@
 //! seam wrap and the pole clamp as lane compares, the texels read as the map kernels read
 //! them (two 64-bit loads per bilinear pixel) and blended with their `split`, `lerp` and
 //! `merge`; the left half's pixels reversed in the register before the store.
+//!
+//! The kernels are written once (`row_kernels!`) and expanded in each instruction set's
+//! module, where short names stand for that set's intrinsics (`add` is
+//! `_mm256_add_epi32` in `avx2`, `_mm_add_epi32` in `sse41`; `V` the vector type, `N` its
+//! lanes) and a few functions hold what differs in more than the prefix: the lane
+//! layout of the texel pairs (`pairs`), the nearest gather (`gather`), the reversal
+//! (`reverse`), `iota`. Every function is `#[target_feature]` and `#[inline]`, compiled
+//! into the entry points as before: the same code per set as when each was written out.
 
 use super::super::row::{sample_lv_scalar, Level, Positions, SpanQ8};
 use super::{Kernel, Selected, Texels};
@@ -104,107 +112,211 @@ fn prefetch_every(u: &[i32], k: u32) -> usize {
     }
 }
 
-/// [`prefetch`] the first [`PREFETCH_AHEAD`] positions of a run, every `every` pixels,
-/// before drawing it (the kernel's loop prefetches the rest as far ahead).
-#[inline(always)]
-fn prefetch_start<const BILINEAR: bool>(t: &Texels, uv: (&[i32], &[i32]), k: u32, every: usize) {
-    for j in (0..PREFETCH_AHEAD.min(uv.0.len())).step_by(every) {
-        prefetch::<BILINEAR>(t, uv, j, k);
-    }
-}
-
-/// One vector's texel indices and 8-bit fractions (x, y) from Q.8 positions, written once
-/// per instruction set: `$v` the vector type, `$p` the intrinsics' prefix.
-macro_rules! lanes {
-    ($feature:literal, $v:ty, $set1:ident, $add:ident, $sub:ident, $and:ident, $andnot:ident,
-     $or:ident, $gt:ident, $min:ident, $max:ident, $minu:ident, $srai:ident, $mullo:ident,
-     $zero:ident, $sra:ident) => {
+/// The row kernels of one instruction set (`$feature`), in terms of the names its module
+/// defines: `V` (the vector of `N` i32 lanes), `N`, `LOG2_N`, the intrinsic aliases
+/// (`add`, `sub`, `and`, `andnot`, `or`, `gt`, `min`, `max`, `minu`, `srai`, `slli`,
+/// `sra`, `mullo`, `set1`, `set1_16`, `sub16`, `zero`, `loadu`, `storeu`, `shuffle_ps`,
+/// `to_ps`, `from_ps`), `iota`, `pairs`, `gather` and `reverse`, and the map kernels'
+/// `split`, `lerp` and `merge`.
+macro_rules! row_kernels {
+    ($feature:literal) => {
         /// (indices clamped to `last`, fx, fy) of positions (u, v), Q.8 (see
         /// `row::sample_at`: bilinear biased by −½, x wrapped, y clamped with fy dropped).
         #[inline]
         #[target_feature(enable = $feature)]
-        fn lanes<const BILINEAR: bool>(t: &Texels, u: $v, v: $v, last: usize) -> ($v, $v, $v) {
+        fn lanes<const BILINEAR: bool>(t: &Texels, u: V, v: V, last: usize) -> (V, V, V) {
             let (w, h1) = (t.width as i32, t.height as i32 - 1);
-            let zero = $zero();
+            let zero = zero();
             let (u, v) = if BILINEAR {
-                ($sub(u, $set1(128)), $sub(v, $set1(128)))
+                (sub(u, set1(128)), sub(v, set1(128)))
             } else {
                 (u, v)
             };
-            let wv = $set1(w);
-            let x = $srai::<8>(u);
-            let x = $add(x, $and($gt(zero, x), wv));
-            let x = $add(x, $and($gt(zero, x), wv));
-            let x = $sub(x, $and($gt(x, $set1(w - 1)), wv));
-            let x = $sub(x, $and($gt(x, $set1(w - 1)), wv));
-            let x = $min($max(x, zero), $set1(w - 1));
-            let y = $srai::<8>(v);
-            let ff = $set1(0xFF);
+            let wv = set1(w);
+            let x = srai::<8>(u);
+            let x = add(x, and(gt(zero, x), wv));
+            let x = add(x, and(gt(zero, x), wv));
+            let x = sub(x, and(gt(x, set1(w - 1)), wv));
+            let x = sub(x, and(gt(x, set1(w - 1)), wv));
+            let x = min(max(x, zero), set1(w - 1));
+            let y = srai::<8>(v);
+            let ff = set1(0xFF);
             let (fx, fy) = if BILINEAR {
-                let off = $or($gt(zero, y), $gt(y, $set1(h1 - 1)));
-                ($and(u, ff), $andnot(off, $and(v, ff)))
+                let off = or(gt(zero, y), gt(y, set1(h1 - 1)));
+                (and(u, ff), andnot(off, and(v, ff)))
             } else {
                 (zero, zero)
             };
-            let y = $min($max(y, zero), $set1(h1));
-            let i = $add($mullo(y, $set1(t.stride() as i32)), x);
-            ($minu(i, $set1(last as i32)), fx, fy)
+            let y = min(max(y, zero), set1(h1));
+            let i = add(mullo(y, set1(t.stride() as i32)), x);
+            (minu(i, set1(last as i32)), fx, fy)
         }
 
         /// Level-0 positions (u, v) on level `lv.k`: u wrapped into the level-0 map
         /// (within two widths of it), both shifted right by k (see `row::wrap_q8`).
         #[inline]
         #[target_feature(enable = $feature)]
-        fn on_level(u: $v, v: $v, lv: &Level) -> ($v, $v) {
-            let zero = $zero();
-            let wv = $set1(lv.wq);
-            let u = $add(u, $and($gt(zero, u), wv));
-            let u = $add(u, $and($gt(zero, u), wv));
-            let top = $set1(lv.wq - 1);
-            let u = $sub(u, $and($gt(u, top), wv));
-            let u = $sub(u, $and($gt(u, top), wv));
+        fn on_level(u: V, v: V, lv: &Level) -> (V, V) {
+            let zero = zero();
+            let wv = set1(lv.wq);
+            let u = add(u, and(gt(zero, u), wv));
+            let u = add(u, and(gt(zero, u), wv));
+            let top = set1(lv.wq - 1);
+            let u = sub(u, and(gt(u, top), wv));
+            let u = sub(u, and(gt(u, top), wv));
             let k = _mm_cvtsi32_si128(lv.k as i32);
-            ($sra(u, k), $sra(v, k))
+            (sra(u, k), sra(v, k))
         }
-    };
-}
 
-/// `expand` (see `row::expand_scalar`) for one instruction set, `$n` lanes: the three
-/// position lines of each span, a vector per step, stored whole (the next span overwrites
-/// what lies past a span).
-macro_rules! expand_kernel {
-    ($feature:literal, $n:literal, $shift:literal, $iota:expr, $set1:ident, $add:ident,
-     $sub:ident, $mullo:ident, $srai:ident, $slli:ident, $store:ident) => {
+        /// An 8-bit weight per 32-bit lane as (w, 256 − w) in both 16-bit halves.
+        #[inline]
+        #[target_feature(enable = $feature)]
+        fn weight(f: V) -> (V, V) {
+            let w = or(f, slli::<16>(f));
+            (w, sub16(set1_16(256), w))
+        }
+
+        /// The left texels of the pixels whose pairs `pairs` laid out in `x`, `y`.
+        #[inline]
+        #[target_feature(enable = $feature)]
+        fn left(x: V, y: V) -> V {
+            from_ps(shuffle_ps::<0x88>(to_ps(x), to_ps(y)))
+        }
+
+        /// The right texels (see `left`).
+        #[inline]
+        #[target_feature(enable = $feature)]
+        fn right(x: V, y: V) -> V {
+            from_ps(shuffle_ps::<0xDD>(to_ps(x), to_ps(y)))
+        }
+
+        /// `expand` (see `row::expand_scalar`): the three position lines of each span, a
+        /// vector per step, stored whole (the next span overwrites what lies past a span).
         #[inline]
         #[target_feature(enable = $feature)]
         pub(super) fn expand(spans: &[SpanQ8], p: Positions<'_>) {
-            let iota = $iota;
+            let iota = iota();
             for s in spans {
                 let (k, m) = (s.k as usize, s.m as usize);
-                let r = k..k + m.next_multiple_of($n);
-                let cu = p.u[r.clone()].chunks_exact_mut($n);
-                let out = cu.zip(p.v[r.clone()].chunks_exact_mut($n));
-                let (du, dv) = ($set1(s.du), $set1(s.dv));
-                let (iu, iv) = ($mullo(iota, du), $mullo(iota, dv));
-                let (mut lu, mut lv) = ($add($set1(s.lu), iu), $add($set1(s.lv), iv));
-                let mut ll = $sub($set1(s.ll), iu);
-                let (su, sv) = ($slli::<$shift>(du), $slli::<$shift>(dv));
-                let (hu, hv, hl) = ($set1(s.hu), $set1(s.hv), $set1(s.hl));
-                for ((cu, cv), cl) in out.zip(p.ul[r].chunks_exact_mut($n)) {
-                    let a = $add(hu, $srai::<8>(lu));
-                    let b = $add(hv, $srai::<8>(lv));
-                    let c = $add(hl, $srai::<8>(ll));
-                    // SAFETY: `cu`, `cv`, `cl` are $n writable i32 each; unaligned stores.
+                let r = k..k + m.next_multiple_of(N);
+                let cu = p.u[r.clone()].chunks_exact_mut(N);
+                let out = cu.zip(p.v[r.clone()].chunks_exact_mut(N));
+                let (du, dv) = (set1(s.du), set1(s.dv));
+                let (iu, iv) = (mullo(iota, du), mullo(iota, dv));
+                let (mut lu, mut lv) = (add(set1(s.lu), iu), add(set1(s.lv), iv));
+                let mut ll = sub(set1(s.ll), iu);
+                let (su, sv) = (slli::<LOG2_N>(du), slli::<LOG2_N>(dv));
+                let (hu, hv, hl) = (set1(s.hu), set1(s.hv), set1(s.hl));
+                for ((cu, cv), cl) in out.zip(p.ul[r].chunks_exact_mut(N)) {
+                    let a = add(hu, srai::<8>(lu));
+                    let b = add(hv, srai::<8>(lv));
+                    let c = add(hl, srai::<8>(ll));
+                    // SAFETY: `cu`, `cv`, `cl` are N writable i32 each; unaligned stores.
                     unsafe {
-                        $store(cu.as_mut_ptr().cast(), a);
-                        $store(cv.as_mut_ptr().cast(), b);
-                        $store(cl.as_mut_ptr().cast(), c);
+                        storeu(cu.as_mut_ptr().cast(), a);
+                        storeu(cv.as_mut_ptr().cast(), b);
+                        storeu(cl.as_mut_ptr().cast(), c);
                     }
-                    lu = $add(lu, su);
-                    lv = $add(lv, sv);
-                    ll = $sub(ll, su);
+                    lu = add(lu, su);
+                    lv = add(lv, sv);
+                    ll = sub(ll, su);
                 }
             }
+        }
+
+        /// The row kernel (see `row::sample_lv_scalar`), N pixels per step, the rest
+        /// (fewer than N) with the scalar one.
+        #[inline]
+        #[target_feature(enable = $feature)]
+        pub(super) fn sample_q8<
+            const BILINEAR: bool,
+            const MIRROR: bool,
+            const LEVEL: bool,
+            const BLEND: bool,
+        >(
+            t: &Texels,
+            u: &[i32],
+            v: &[i32],
+            out: &mut [u32],
+            lv: &Level,
+        ) {
+            let n = out.len();
+            let (u, v) = (&u[..n], &v[..n]);
+            let last = last_index::<BILINEAR>(t);
+            let stride = t.stride();
+            let p = t.px.as_ptr();
+            // Prefetched up to (not including) `ahead`, every `every` positions.
+            let k = if LEVEL { lv.k } else { 0 };
+            let every = prefetch_every(u, k);
+            let mut ahead = 0;
+            let mut j = 0;
+            while j + N <= n {
+                while ahead < j + N + PREFETCH_AHEAD {
+                    prefetch::<BILINEAR>(t, (u, v), ahead, k);
+                    ahead += every;
+                }
+                let (cu, cv): (&[i32; N], &[i32; N]) = (
+                    u[j..j + N].try_into().expect("N"),
+                    v[j..j + N].try_into().expect("N"),
+                );
+                // SAFETY: `cu`, `cv` are N readable i32; the loads are unaligned.
+                let (uu, vv) = unsafe { (loadu(cu.as_ptr().cast()), loadu(cv.as_ptr().cast())) };
+                let (uu, vv) = if LEVEL {
+                    on_level(uu, vv, lv)
+                } else {
+                    (uu, vv)
+                };
+                let (i, fx, fy) = lanes::<BILINEAR>(t, uu, vv, last);
+                let mut a = [0u32; N];
+                // SAFETY: `a` is N writable u32; the store is unaligned.
+                unsafe { storeu(a.as_mut_ptr().cast(), i) };
+                let c = if BILINEAR {
+                    let pair = |k: usize, row: usize| -> i64 {
+                        // SAFETY: a[k] ≤ last = len − stride − 2 (clamped in `lanes`), so
+                        // the 8 bytes at a[k] + row (row ≤ stride) are inside `t.px`.
+                        unsafe { p.add(a[k] as usize + row).cast::<i64>().read_unaligned() }
+                    };
+                    let (ta, tb) = pairs(|k| pair(k, 0));
+                    let (ba, bb) = pairs(|k| pair(k, stride));
+                    let wx = weight(fx);
+                    let top = lerp(split(left(ta, tb)), split(right(ta, tb)), wx);
+                    let bot = lerp(split(left(ba, bb)), split(right(ba, bb)), wx);
+                    merge(lerp(top, bot, weight(fy)))
+                } else {
+                    // SAFETY: a[k] ≤ last = len − 1 (clamped in `lanes`).
+                    let g = |k: usize| unsafe { p.add(a[k] as usize).read() } as i32;
+                    gather(g)
+                };
+                let (c, at) = if MIRROR {
+                    (reverse(c), n - j - N)
+                } else {
+                    (c, j)
+                };
+                let o: &mut [u32; N] = (&mut out[at..at + N]).try_into().expect("N");
+                let c = if BLEND {
+                    let cw: &[u32; N] = lv.w[j..j + N].try_into().expect("N");
+                    let (pw, po) = (cw.as_ptr().cast(), o.as_ptr().cast());
+                    // SAFETY: `cw` and `o` are N readable u32; the loads are unaligned.
+                    let (f, prev) = unsafe { (loadu(pw), loadu(po)) };
+                    let f = if MIRROR { reverse(f) } else { f };
+                    merge(lerp(split(prev), split(c), weight(f)))
+                } else {
+                    c
+                };
+                // SAFETY: `o` is N writable u32; the store is unaligned.
+                unsafe { storeu(o.as_mut_ptr().cast(), c) };
+                j += N;
+            }
+            let rest = if MIRROR {
+                &mut out[..n - j]
+            } else {
+                &mut out[j..]
+            };
+            let lv = Level {
+                w: if BLEND { &lv.w[j..] } else { lv.w },
+                ..*lv
+            };
+            sample_lv_scalar::<BILINEAR, MIRROR, LEVEL, BLEND>(t, &u[j..], &v[j..], rest, &lv);
         }
     };
 }
@@ -212,325 +324,105 @@ macro_rules! expand_kernel {
 mod avx2 {
     use super::super::avx2::{lerp, merge, split};
     use super::*;
+    use std::arch::x86_64::{
+        __m256i as V, _mm256_add_epi32 as add, _mm256_and_si256 as and,
+        _mm256_andnot_si256 as andnot, _mm256_castps_si256 as from_ps,
+        _mm256_castsi256_ps as to_ps, _mm256_cmpgt_epi32 as gt, _mm256_loadu_si256 as loadu,
+        _mm256_max_epi32 as max, _mm256_min_epi32 as min, _mm256_min_epu32 as minu,
+        _mm256_mullo_epi32 as mullo, _mm256_or_si256 as or, _mm256_set1_epi16 as set1_16,
+        _mm256_set1_epi32 as set1, _mm256_setzero_si256 as zero, _mm256_shuffle_ps as shuffle_ps,
+        _mm256_slli_epi32 as slli, _mm256_sra_epi32 as sra, _mm256_srai_epi32 as srai,
+        _mm256_storeu_si256 as storeu, _mm256_sub_epi16 as sub16, _mm256_sub_epi32 as sub,
+    };
 
-    lanes!(
-        "avx2",
-        __m256i,
-        _mm256_set1_epi32,
-        _mm256_add_epi32,
-        _mm256_sub_epi32,
-        _mm256_and_si256,
-        _mm256_andnot_si256,
-        _mm256_or_si256,
-        _mm256_cmpgt_epi32,
-        _mm256_min_epi32,
-        _mm256_max_epi32,
-        _mm256_min_epu32,
-        _mm256_srai_epi32,
-        _mm256_mullo_epi32,
-        _mm256_setzero_si256,
-        _mm256_sra_epi32
-    );
+    /// Pixels per step, and its log2.
+    const N: usize = 8;
+    const LOG2_N: i32 = 3;
 
-    /// An 8-bit weight per 32-bit lane as (w, 256 − w) in both 16-bit halves.
+    row_kernels!("avx2");
+
+    /// The lane numbers.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn weight(f: __m256i) -> (__m256i, __m256i) {
-        let w = _mm256_or_si256(f, _mm256_slli_epi32::<16>(f));
-        (w, _mm256_sub_epi16(_mm256_set1_epi16(256), w))
+    fn iota() -> V {
+        _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)
     }
 
-    expand_kernel!(
-        "avx2",
-        8,
-        3,
-        _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
-        _mm256_set1_epi32,
-        _mm256_add_epi32,
-        _mm256_sub_epi32,
-        _mm256_mullo_epi32,
-        _mm256_srai_epi32,
-        _mm256_slli_epi32,
-        _mm256_storeu_si256
-    );
-
+    /// The 64-bit texel pairs of lanes 0..8 (`pair(k)`) as two vectors, (0, 1, 4, 5) and
+    /// (2, 3, 6, 7), so that `shufps` (within 128-bit halves) gives lanes 0..8 in order.
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn sample_q8<
-        const BILINEAR: bool,
-        const MIRROR: bool,
-        const LEVEL: bool,
-        const BLEND: bool,
-    >(
-        t: &Texels,
-        u: &[i32],
-        v: &[i32],
-        out: &mut [u32],
-        lv: &Level,
-    ) {
-        let n = out.len();
-        let (u, v) = (&u[..n], &v[..n]);
-        let last = last_index::<BILINEAR>(t);
-        let stride = t.stride();
-        let p = t.px.as_ptr();
-        let rev = _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0);
-        let k = if LEVEL { lv.k } else { 0 };
-        let every = prefetch_every(u, k);
-        prefetch_start::<BILINEAR>(t, (u, v), k, every);
-        let mut j = 0;
-        while j + 8 <= n {
-            prefetch::<BILINEAR>(t, (u, v), j + PREFETCH_AHEAD, k);
-            if every < 8 {
-                prefetch::<BILINEAR>(t, (u, v), j + PREFETCH_AHEAD + 4, k);
-            }
-            let (cu, cv): (&[i32; 8], &[i32; 8]) = (
-                u[j..j + 8].try_into().expect("8"),
-                v[j..j + 8].try_into().expect("8"),
-            );
-            // SAFETY: `cu`, `cv` are 8 readable i32; the loads are unaligned.
-            let (uu, vv) = unsafe {
-                (
-                    _mm256_loadu_si256(cu.as_ptr().cast()),
-                    _mm256_loadu_si256(cv.as_ptr().cast()),
-                )
-            };
-            let (uu, vv) = if LEVEL {
-                on_level(uu, vv, lv)
-            } else {
-                (uu, vv)
-            };
-            let (i, fx, fy) = lanes::<BILINEAR>(t, uu, vv, last);
-            let mut a = [0u32; 8];
-            // SAFETY: `a` is 32 writable bytes; the store is unaligned.
-            unsafe { _mm256_storeu_si256(a.as_mut_ptr().cast(), i) };
-            let c = if BILINEAR {
-                let pair = |k: usize, row: usize| -> i64 {
-                    // SAFETY: a[k] ≤ last = len − stride − 2 (clamped in `lanes`), so the
-                    // 8 bytes at a[k] + row (row ≤ stride) are inside `t.px`.
-                    unsafe { p.add(a[k] as usize + row).cast::<i64>().read_unaligned() }
-                };
-                let q = |row: usize, h: usize| {
-                    _mm256_set_epi64x(
-                        pair(5 + h, row),
-                        pair(4 + h, row),
-                        pair(1 + h, row),
-                        pair(h, row),
-                    )
-                };
-                let (ta, tb, ba, bb) = (q(0, 0), q(0, 2), q(stride, 0), q(stride, 2));
-                let shuf = |x: __m256i, y: __m256i, left: bool| {
-                    let (x, y) = (_mm256_castsi256_ps(x), _mm256_castsi256_ps(y));
-                    _mm256_castps_si256(if left {
-                        _mm256_shuffle_ps::<0x88>(x, y)
-                    } else {
-                        _mm256_shuffle_ps::<0xDD>(x, y)
-                    })
-                };
-                let wx = weight(fx);
-                let top = lerp(split(shuf(ta, tb, true)), split(shuf(ta, tb, false)), wx);
-                let bot = lerp(split(shuf(ba, bb, true)), split(shuf(ba, bb, false)), wx);
-                merge(lerp(top, bot, weight(fy)))
-            } else {
-                // SAFETY: a[k] ≤ last = len − 1 (clamped in `lanes`).
-                let g = |k: usize| unsafe { p.add(a[k] as usize).read() } as i32;
-                _mm256_setr_epi32(g(0), g(1), g(2), g(3), g(4), g(5), g(6), g(7))
-            };
-            let (c, at) = if MIRROR {
-                (_mm256_permutevar8x32_epi32(c, rev), n - j - 8)
-            } else {
-                (c, j)
-            };
-            let o: &mut [u32; 8] = (&mut out[at..at + 8]).try_into().expect("8");
-            let c = if BLEND {
-                let cw: &[u32; 8] = lv.w[j..j + 8].try_into().expect("8");
-                // SAFETY: `cw` and `o` are 8 readable u32; the loads are unaligned.
-                let (f, prev) = unsafe {
-                    (
-                        _mm256_loadu_si256(cw.as_ptr().cast()),
-                        _mm256_loadu_si256(o.as_ptr().cast()),
-                    )
-                };
-                let f = if MIRROR {
-                    _mm256_permutevar8x32_epi32(f, rev)
-                } else {
-                    f
-                };
-                merge(lerp(split(prev), split(c), weight(f)))
-            } else {
-                c
-            };
-            // SAFETY: `o` is 8 writable u32; the store is unaligned.
-            unsafe { _mm256_storeu_si256(o.as_mut_ptr().cast(), c) };
-            j += 8;
-        }
-        let rest = if MIRROR {
-            &mut out[..n - j]
-        } else {
-            &mut out[j..]
-        };
-        let lv = Level {
-            w: if BLEND { &lv.w[j..] } else { lv.w },
-            ..*lv
-        };
-        sample_lv_scalar::<BILINEAR, MIRROR, LEVEL, BLEND>(t, &u[j..], &v[j..], rest, &lv);
+    fn pairs(pair: impl Fn(usize) -> i64) -> (V, V) {
+        (
+            _mm256_set_epi64x(pair(5), pair(4), pair(1), pair(0)),
+            _mm256_set_epi64x(pair(7), pair(6), pair(3), pair(2)),
+        )
+    }
+
+    /// Lanes 0..8 = `g(0..8)`.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn gather(g: impl Fn(usize) -> i32) -> V {
+        _mm256_setr_epi32(g(0), g(1), g(2), g(3), g(4), g(5), g(6), g(7))
+    }
+
+    /// The lanes in reverse order.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn reverse(c: V) -> V {
+        _mm256_permutevar8x32_epi32(c, _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0))
     }
 }
 
 mod sse41 {
     use super::super::sse41::{lerp, merge, split};
     use super::*;
+    use std::arch::x86_64::{
+        __m128i as V, _mm_add_epi32 as add, _mm_and_si128 as and, _mm_andnot_si128 as andnot,
+        _mm_castps_si128 as from_ps, _mm_castsi128_ps as to_ps, _mm_cmpgt_epi32 as gt,
+        _mm_loadu_si128 as loadu, _mm_max_epi32 as max, _mm_min_epi32 as min,
+        _mm_min_epu32 as minu, _mm_mullo_epi32 as mullo, _mm_or_si128 as or,
+        _mm_set1_epi16 as set1_16, _mm_set1_epi32 as set1, _mm_setzero_si128 as zero,
+        _mm_shuffle_ps as shuffle_ps, _mm_slli_epi32 as slli, _mm_sra_epi32 as sra,
+        _mm_srai_epi32 as srai, _mm_storeu_si128 as storeu, _mm_sub_epi16 as sub16,
+        _mm_sub_epi32 as sub,
+    };
 
-    lanes!(
-        "sse4.1",
-        __m128i,
-        _mm_set1_epi32,
-        _mm_add_epi32,
-        _mm_sub_epi32,
-        _mm_and_si128,
-        _mm_andnot_si128,
-        _mm_or_si128,
-        _mm_cmpgt_epi32,
-        _mm_min_epi32,
-        _mm_max_epi32,
-        _mm_min_epu32,
-        _mm_srai_epi32,
-        _mm_mullo_epi32,
-        _mm_setzero_si128,
-        _mm_sra_epi32
-    );
+    /// Pixels per step, and its log2.
+    const N: usize = 4;
+    const LOG2_N: i32 = 2;
 
+    row_kernels!("sse4.1");
+
+    /// The lane numbers.
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    fn weight(f: __m128i) -> (__m128i, __m128i) {
-        let w = _mm_or_si128(f, _mm_slli_epi32::<16>(f));
-        (w, _mm_sub_epi16(_mm_set1_epi16(256), w))
+    fn iota() -> V {
+        _mm_setr_epi32(0, 1, 2, 3)
     }
 
-    expand_kernel!(
-        "sse4.1",
-        4,
-        2,
-        _mm_setr_epi32(0, 1, 2, 3),
-        _mm_set1_epi32,
-        _mm_add_epi32,
-        _mm_sub_epi32,
-        _mm_mullo_epi32,
-        _mm_srai_epi32,
-        _mm_slli_epi32,
-        _mm_storeu_si128
-    );
-
+    /// The 64-bit texel pairs of lanes 0..4 (`pair(k)`) as two vectors, (0, 1) and
+    /// (2, 3), so that `shufps` gives lanes 0..4 in order.
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn sample_q8<
-        const BILINEAR: bool,
-        const MIRROR: bool,
-        const LEVEL: bool,
-        const BLEND: bool,
-    >(
-        t: &Texels,
-        u: &[i32],
-        v: &[i32],
-        out: &mut [u32],
-        lv: &Level,
-    ) {
-        let n = out.len();
-        let (u, v) = (&u[..n], &v[..n]);
-        let last = last_index::<BILINEAR>(t);
-        let stride = t.stride();
-        let p = t.px.as_ptr();
-        let k = if LEVEL { lv.k } else { 0 };
-        let every = prefetch_every(u, k);
-        prefetch_start::<BILINEAR>(t, (u, v), k, every);
-        let mut j = 0;
-        while j + 4 <= n {
-            if j & (every - 1) == 0 {
-                prefetch::<BILINEAR>(t, (u, v), j + PREFETCH_AHEAD, k);
-            }
-            let (cu, cv): (&[i32; 4], &[i32; 4]) = (
-                u[j..j + 4].try_into().expect("4"),
-                v[j..j + 4].try_into().expect("4"),
-            );
-            // SAFETY: `cu`, `cv` are 4 readable i32; the loads are unaligned.
-            let (uu, vv) = unsafe {
-                (
-                    _mm_loadu_si128(cu.as_ptr().cast()),
-                    _mm_loadu_si128(cv.as_ptr().cast()),
-                )
-            };
-            let (uu, vv) = if LEVEL {
-                on_level(uu, vv, lv)
-            } else {
-                (uu, vv)
-            };
-            let (i, fx, fy) = lanes::<BILINEAR>(t, uu, vv, last);
-            let mut a = [0u32; 4];
-            // SAFETY: `a` is 16 writable bytes; the store is unaligned.
-            unsafe { _mm_storeu_si128(a.as_mut_ptr().cast(), i) };
-            let c = if BILINEAR {
-                let pair = |k: usize, row: usize| -> i64 {
-                    // SAFETY: a[k] ≤ last = len − stride − 2 (clamped in `lanes`), so the
-                    // 8 bytes at a[k] + row (row ≤ stride) are inside `t.px`.
-                    unsafe { p.add(a[k] as usize + row).cast::<i64>().read_unaligned() }
-                };
-                let ta = _mm_set_epi64x(pair(1, 0), pair(0, 0));
-                let tb = _mm_set_epi64x(pair(3, 0), pair(2, 0));
-                let ba = _mm_set_epi64x(pair(1, stride), pair(0, stride));
-                let bb = _mm_set_epi64x(pair(3, stride), pair(2, stride));
-                let shuf = |x: __m128i, y: __m128i, left: bool| {
-                    let (x, y) = (_mm_castsi128_ps(x), _mm_castsi128_ps(y));
-                    _mm_castps_si128(if left {
-                        _mm_shuffle_ps::<0x88>(x, y)
-                    } else {
-                        _mm_shuffle_ps::<0xDD>(x, y)
-                    })
-                };
-                let wx = weight(fx);
-                let top = lerp(split(shuf(ta, tb, true)), split(shuf(ta, tb, false)), wx);
-                let bot = lerp(split(shuf(ba, bb, true)), split(shuf(ba, bb, false)), wx);
-                merge(lerp(top, bot, weight(fy)))
-            } else {
-                // SAFETY: a[k] ≤ last = len − 1 (clamped in `lanes`).
-                let g = |k: usize| unsafe { p.add(a[k] as usize).read() } as i32;
-                _mm_setr_epi32(g(0), g(1), g(2), g(3))
-            };
-            let (c, at) = if MIRROR {
-                (_mm_shuffle_epi32::<0x1B>(c), n - j - 4)
-            } else {
-                (c, j)
-            };
-            let o: &mut [u32; 4] = (&mut out[at..at + 4]).try_into().expect("4");
-            let c = if BLEND {
-                let cw: &[u32; 4] = lv.w[j..j + 4].try_into().expect("4");
-                // SAFETY: `cw` and `o` are 4 readable u32; the loads are unaligned.
-                let (f, prev) = unsafe {
-                    (
-                        _mm_loadu_si128(cw.as_ptr().cast()),
-                        _mm_loadu_si128(o.as_ptr().cast()),
-                    )
-                };
-                let f = if MIRROR {
-                    _mm_shuffle_epi32::<0x1B>(f)
-                } else {
-                    f
-                };
-                merge(lerp(split(prev), split(c), weight(f)))
-            } else {
-                c
-            };
-            // SAFETY: `o` is 4 writable u32; the store is unaligned.
-            unsafe { _mm_storeu_si128(o.as_mut_ptr().cast(), c) };
-            j += 4;
-        }
-        let rest = if MIRROR {
-            &mut out[..n - j]
-        } else {
-            &mut out[j..]
-        };
-        let lv = Level {
-            w: if BLEND { &lv.w[j..] } else { lv.w },
-            ..*lv
-        };
-        sample_lv_scalar::<BILINEAR, MIRROR, LEVEL, BLEND>(t, &u[j..], &v[j..], rest, &lv);
+    fn pairs(pair: impl Fn(usize) -> i64) -> (V, V) {
+        (
+            _mm_set_epi64x(pair(1), pair(0)),
+            _mm_set_epi64x(pair(3), pair(2)),
+        )
+    }
+
+    /// Lanes 0..4 = `g(0..4)`.
+    #[inline]
+    #[target_feature(enable = "sse4.1")]
+    fn gather(g: impl Fn(usize) -> i32) -> V {
+        _mm_setr_epi32(g(0), g(1), g(2), g(3))
+    }
+
+    /// The lanes in reverse order.
+    #[inline]
+    #[target_feature(enable = "sse4.1")]
+    fn reverse(c: V) -> V {
+        _mm_shuffle_epi32::<0x1B>(c)
     }
 }
