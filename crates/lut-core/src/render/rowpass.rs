@@ -2,7 +2,8 @@
 //! of positions and one gather pass, instead of span by span through a [`Sink`]: nearest
 //! and bilinear ([`pixel_row`]), trilinear ([`tri_row`]: each span's level of detail
 //! recorded, runs on one level sampled together, the next level blended in), partial
-//! maps (`crop_run`).
+//! maps (`crop_run`; trilinear: `crop_tri_run`, the same grouping, each level's pass
+//! chunk by chunk as `crop_run`).
 //!
 //! Only the right half of the table-covered pixels is walked (`scanline.rs`: reads every
 //! 2^shift pixels outward from the centre, the column coordinate stepped in whole
@@ -250,9 +251,9 @@ pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
     });
 }
 
-/// Draw one trilinear LUT scanline of a full map into `s` (its level of detail set for
-/// the scanline): the row pass where it applies ([`applies`]; [`tri_run`]), else span by
-/// span through the sink.
+/// Draw one trilinear LUT scanline into `s` (its level of detail set for the
+/// scanline): the row pass where it applies ([`applies`]; [`tri_run`], partial maps
+/// [`crop_tri_run`]), else span by span through the sink.
 #[inline]
 pub(crate) fn tri_row(
     (scan, table, fr, row_scale): LutRow<'_>,
