@@ -174,7 +174,7 @@ fn depth_inside_at(
 ///   exact), background where it is at least 1 px outside; the 2 px band around the
 ///   edge differs by design (the crop clamps to its edge texels, the padded map blends
 ///   with background) and is not compared;
-/// * trilinear, on a smaller output (64 × 36: one pixel covers about two to eight map
+/// * trilinear (and the grid renderer's), on a smaller output (64 × 36: one pixel covers about two to eight map
 ///   pixels, so levels 1..3 are read): byte-identical where the exact position is at
 ///   least 1 px inside or outside the crop. The partial map's levels are the padded
 ///   map's levels (texels partly inside the crop included, `map/pyramid.rs`) and are read
@@ -243,7 +243,7 @@ fn check_trilinear(partial: &EnvMap, reference: &EnvMap, view: View, c: (u32, u3
     const SIZE: (u32, u32) = (64, 36);
     let depth = depth_inside_at(partial, view, c, SIZE);
     let (mut compared, mut minified) = (0, false);
-    for kind in [RendererKind::Lut, RendererKind::Exact] {
+    for kind in [RendererKind::Lut, RendererKind::Grid, RendererKind::Exact] {
         let a = render_at(partial, view, kind, Sampler::Trilinear, SIZE);
         let b = render_at(reference, view, kind, Sampler::Trilinear, SIZE);
         for i in 0..a.len() {
