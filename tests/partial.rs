@@ -98,31 +98,44 @@ fn decode(
 }
 
 fn render(map: &EnvMap, view: View, renderer: RendererKind, sampler: Sampler) -> Vec<u32> {
+    render_at(map, view, renderer, sampler, (160, 90))
+}
+
+/// [`render`] on a `w × h` output.
+fn render_at(
+    map: &EnvMap,
+    view: View,
+    renderer: RendererKind,
+    sampler: Sampler,
+    (w, h): (u32, u32),
+) -> Vec<u32> {
     let opts = RenderOptions {
         renderer,
         sampler,
         index_step: IndexStep::Fixed(4),
         ..RenderOptions::default()
     };
-    render_frame(
-        &mut Renderer::new(map),
-        Scene::Map(map),
-        view,
-        &opts,
-        160,
-        90,
-    )
-    .0
+    render_frame(&mut Renderer::new(map), Scene::Map(map), view, &opts, w, h).0
 }
 
 /// Where the exact position of each output pixel lies relative to the crop: its
 /// distance inside the crop's edge in full-panorama pixels (negative outside).
 fn depth_inside(map: &EnvMap, view: View, left: u32, top: u32, cw: u32, ch: u32) -> Vec<f64> {
-    let cam = Camera::new(view, 160, 90);
+    depth_inside_at(map, view, (left, top, cw, ch), (160, 90))
+}
+
+/// [`depth_inside`] on a `w × h` output.
+fn depth_inside_at(
+    map: &EnvMap,
+    view: View,
+    (left, top, cw, ch): (u32, u32, u32, u32),
+    (w, h): (u32, u32),
+) -> Vec<f64> {
+    let cam = Camera::new(view, w, h);
     let (mw, mh) = (map.width() as f64, map.height() as f64);
-    let mut d = Vec::with_capacity(160 * 90);
-    for y in 0..90 {
-        for x in 0..160 {
+    let mut d = Vec::with_capacity((w * h) as usize);
+    for y in 0..h {
+        for x in 0..w {
             let (u, v) = exact_uv(&cam, Projection::Equirect, mw, mh, x, y).unwrap();
             let su = (u - left as f64).rem_euclid(mw);
             // distance to the nearer horizontal edge, either way round the seam
@@ -160,7 +173,15 @@ fn depth_inside(map: &EnvMap, view: View, left: u32, top: u32, cw: u32, ch: u32)
 ///   (the four taps are crop pixels in both; the LUT's positions are within 0.05 px of
 ///   exact), background where it is at least 1 px outside; the 2 px band around the
 ///   edge differs by design (the crop clamps to its edge texels, the padded map blends
-///   with background) and is not compared.
+///   with background) and is not compared;
+/// * trilinear (and the grid renderer's), on a smaller output (64 × 36: one pixel covers about two to eight map
+///   pixels, so levels 1..3 are read): byte-identical where the exact position is at
+///   least 1 px inside or outside the crop. The partial map's levels are the padded
+///   map's levels (texels partly inside the crop included, `map/pyramid.rs`) and are read
+///   as the padded map reads them, so outside the crop a minified edge blends into the
+///   background there too; only level 0, weighing in at levels of detail below 1, keeps
+///   the bilinear band above, which is not compared. Where the view shows the crop, the
+///   partial map's trilinear frame also differs from its bilinear one (it minifies).
 fn check_case(left: u32, top: u32, cw: u32, ch: u32, views: &[(f64, f64, f64)]) {
     let jpeg = tagged_jpeg(left, top, cw, ch, None);
     let partial = load_partial(&jpeg);
@@ -213,7 +234,35 @@ fn check_case(left: u32, top: u32, cw: u32, ch: u32, views: &[(f64, f64, f64)]) 
             }
         }
         assert!(inside > 0 || outside > 0, "view {view:?} compared nothing");
+        check_trilinear(&partial, &reference, view, (left, top, cw, ch));
     }
+}
+
+/// The trilinear part of [`check_case`].
+fn check_trilinear(partial: &EnvMap, reference: &EnvMap, view: View, c: (u32, u32, u32, u32)) {
+    const SIZE: (u32, u32) = (64, 36);
+    let depth = depth_inside_at(partial, view, c, SIZE);
+    let (mut compared, mut minified) = (0, false);
+    for kind in [RendererKind::Lut, RendererKind::Grid, RendererKind::Exact] {
+        let a = render_at(partial, view, kind, Sampler::Trilinear, SIZE);
+        let b = render_at(reference, view, kind, Sampler::Trilinear, SIZE);
+        for i in 0..a.len() {
+            if depth[i].abs() >= 1.0 {
+                let (x, y) = (i % SIZE.0 as usize, i / SIZE.0 as usize);
+                assert_eq!(
+                    a[i], b[i],
+                    "{kind:?} trilinear, crop {c:?}, view {view:?}, pixel ({x}, {y}), depth {:.2}",
+                    depth[i]
+                );
+                compared += 1;
+            }
+        }
+        minified |= a != render_at(partial, view, kind, Sampler::Bilinear, SIZE);
+    }
+    assert!(compared > 0, "view {view:?} compared nothing");
+    // (Where the view shows some of the crop.)
+    let shows = depth.iter().any(|&d| d >= 1.0);
+    assert!(minified || !shows, "view {view:?}: trilinear is bilinear");
 }
 
 #[test]

@@ -47,14 +47,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// several hundred milliseconds.
 pub const BAKE_MAX_BYTES: usize = 192 << 20;
 
-/// The bytes a lit copy of `map` takes, its pyramid included (partial maps have none).
+/// The bytes a lit copy of `map` takes, its pyramid included (about a third more; a
+/// partial map's levels keep the texels its crop reaches, also about a third of its
+/// stored pixels, plus a row or column per level at the edges).
 pub fn lit_map_bytes(map: &EnvMap) -> usize {
     let base = map.bytes();
-    if map.crop().is_some() {
-        base
-    } else {
-        base + base / 3
-    }
+    base + base / 3
 }
 
 /// The bytes a lit copy of `cube` takes, its pyramid included.

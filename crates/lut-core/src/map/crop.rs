@@ -1,13 +1,14 @@
 //! Partial maps: an [`EnvMap`] that stores only the pixels of a [`Crop`] of the full
 //! panorama, and the cropped samplers (background outside the crop, the crop's edge
-//! texels clamped inside). The rules are in `geom/coverage.rs`.
+//! texels clamped inside; on pyramid levels the padded full map's bilinear,
+//! [`EnvMap::bilinear_padded`]). The rules are in `geom/coverage.rs`.
 
 use crate::error::CoverageError;
 use crate::geom::coverage::{Coverage, Crop, StartView};
-use crate::geom::fixed::{Fx, FX_HALF};
+use crate::geom::fixed::{Fx, FX_BITS, FX_HALF};
 use crate::geom::projection::Projection;
 use crate::map::envmap::EnvMap;
-use crate::map::sample::Sampler;
+use crate::map::sample::{lerp_px, Sampler};
 
 impl EnvMap {
     /// Where the stored pixels sit in the full panorama, for a partial map.
@@ -147,6 +148,44 @@ impl EnvMap {
         }
     }
 
+    /// Bilinear at a full-panorama position (Q.16) as the full map padded with the
+    /// background gives it (`EnvMap::bilinear` of that map: columns wrap round the
+    /// panorama, rows clamp, and a texel off the stored pixels is the background): how
+    /// the pyramid levels of a partial map are read (`map/pyramid.rs`), so a level blends
+    /// into the background across the crop's edge as the padded map's level does. For a
+    /// map without a crop it is [`EnvMap::bilinear`].
+    #[inline]
+    pub(crate) fn bilinear_padded(&self, u: Fx, v: Fx) -> u32 {
+        let Some(c) = self.crop else {
+            return self.bilinear(u, v);
+        };
+        let (w, h) = (c.full_width() as i64, c.full_height() as i64);
+        let (uu, vv) = (u - FX_HALF, v - FX_HALF);
+        let x0 = (uu >> FX_BITS).rem_euclid(w);
+        let fx = ((uu >> (FX_BITS - 8)) & 0xFF) as u32;
+        let x1 = if x0 + 1 < w { x0 + 1 } else { 0 };
+        let (mut y0, mut fy) = (vv >> FX_BITS, ((vv >> (FX_BITS - 8)) & 0xFF) as u32);
+        if y0 < 0 {
+            (y0, fy) = (0, 0);
+        } else if y0 >= h - 1 {
+            (y0, fy) = (h - 1, 0);
+        }
+        let y1 = (y0 + 1).min(h - 1);
+        let (left, top) = (c.left() as i64, c.top() as i64);
+        let (cw, ch) = (c.width() as i64, c.height() as i64);
+        let at = |x: i64, y: i64| {
+            let (sx, sy) = ((x - left).rem_euclid(w), y - top);
+            if sx < cw && (0..ch).contains(&sy) {
+                self.pixel(sx as u32, sy as u32)
+            } else {
+                self.background
+            }
+        };
+        let top = lerp_px(at(x0, y0), at(x1, y0), fx);
+        let bot = lerp_px(at(x0, y1), at(x1, y1), fx);
+        lerp_px(top, bot, fy)
+    }
+
     /// [`EnvMap::sample`] for a partial map.
     #[inline]
     pub(crate) fn sample_cropped(&self, sampler: Sampler, u: Fx, v: Fx) -> u32 {
@@ -161,7 +200,6 @@ impl EnvMap {
 mod tests {
     use super::*;
     use crate::geom::fixed::to_fx;
-    use crate::map::sample::lerp_px;
 
     fn partial(crop: Crop) -> EnvMap {
         let (w, h) = (crop.width(), crop.height());

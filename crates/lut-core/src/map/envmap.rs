@@ -195,7 +195,13 @@ impl EnvMap {
     }
     /// Set the background color (0RGB).
     pub fn set_background(&mut self, rgb: u32) {
-        self.background = rgb & 0x00FF_FFFF;
+        let rgb = rgb & 0x00FF_FFFF;
+        // A partial map's pyramid levels hold the background where they cross the crop's
+        // edge: built again (on first use) for a new one.
+        if self.crop.is_some() && rgb != self.background {
+            self.levels = std::sync::OnceLock::new();
+        }
+        self.background = rgb;
     }
     /// Memory held by the pixels, in bytes.
     pub fn bytes(&self) -> usize {

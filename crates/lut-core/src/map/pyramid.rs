@@ -24,10 +24,28 @@
 //! horizontal extent from each span's index-interpolation step and the vertical one per
 //! scanline from its angular row spacing (the LUT's per-scanline scale); the exact
 //! renderer differentiates the exact mapping per pixel. Memory: at most one third of the
-//! map more, built on first use. Partial (cropped) maps get no pyramid: they sample
-//! bilinearly.
+//! map more, built on first use.
+//!
+//! Partial maps (a crop of the panorama, `map/crop.rs`) get the pyramid of the full map
+//! padded with the background, kept only where the crop reaches: level k stores the
+//! texels of the full map's level k whose level-0 texels (by the rule above, odd sides
+//! and the seam included) hold a stored pixel — a rectangle of that level, taken round
+//! the seam like the crop, at least 2 × 2 — each the value the padded map's level has
+//! there. So a level texel wholly inside the crop averages stored pixels only, and one
+//! partly inside averages its stored pixels with the background, as the padded map's
+//! does (a minified crop edge blends into the background instead of ending in a hard
+//! step). The levels are read as the padded map reads them ([`EnvMap::bilinear_padded`]:
+//! a texel off the rectangle is the background), level 0 as the partial map always is
+//! ([`EnvMap::bilinear_cropped`]: background where the pixel is not covered, the edge
+//! texels clamped inside). Trilinear on a partial map is therefore trilinear on the
+//! padded full map, byte for byte, except where the level-0 sample is within half a
+//! pixel of the crop's edge and weighs in (`tests/partial.rs`). The crop's rectangles
+//! cost about a third of the stored pixels, plus a texel row or column on each side
+//! per level; a new background colour rebuilds them (`EnvMap::set_background`).
 
+use crate::geom::coverage::Crop;
 use crate::geom::fixed::Fx;
+use crate::geom::projection::Projection;
 use crate::map::envmap::EnvMap;
 use crate::map::sample::lerp_px;
 use rayon::prelude::*;
@@ -63,8 +81,9 @@ pub fn lod_q8(footprint: f64) -> i32 {
 
 impl EnvMap {
     /// The pyramid levels 1, 2, ... (level 0 is the map itself), built on first use
-    /// (rayon) and kept, down to a side of 2 (odd sides included). Empty for partial
-    /// maps.
+    /// (rayon) and kept, down to a side of 2 (odd sides included). For a partial map, the
+    /// padded full map's levels where its crop reaches (see the module docs); their
+    /// [`EnvMap::width`] and [`EnvMap::height`] are those of the full map's levels.
     pub fn pyramid(&self) -> &[EnvMap] {
         self.levels.get_or_init(|| build_levels(self))
     }
@@ -84,32 +103,47 @@ impl EnvMap {
 
     /// Trilinear sample at level-0 position (u, v) (Q.16; u in [0, W) for 360° maps) with
     /// level of detail `lod` (Q.8, see [`lod_q8`]): bilinear on the two levels around it,
-    /// blended. `lod` ≤ 0 is plain bilinear.
+    /// blended. `lod` ≤ 0 is plain bilinear. For a partial map (u, v) are
+    /// full-panorama coordinates; its level 0 is [`EnvMap::bilinear_cropped`], its other
+    /// levels the padded full map's (see the module docs).
     pub fn trilinear(&self, u: Fx, v: Fx, lod: i32) -> u32 {
-        if lod <= 0 || self.crop.is_some() {
-            return self.bilinear_any(u, v);
+        if lod <= 0 {
+            return self.level_bilinear(0, u, v);
         }
         let k = (lod >> 8) as usize;
         let frac = (lod & 0xFF) as u32;
-        let (a_map, ka) = self.level(k);
-        let a = a_map.bilinear(u >> ka, v >> ka);
-        let (b_map, kb) = self.level(k + 1);
+        let ka = self.level(k).1;
+        let a = self.level_bilinear(ka, u, v);
+        let kb = self.level(k + 1).1;
         if frac == 0 || kb == ka {
             return a;
         }
-        lerp_px(a, b_map.bilinear(u >> kb, v >> kb), frac)
+        lerp_px(a, self.level_bilinear(kb, u, v), frac)
     }
 
-    fn bilinear_any(&self, u: Fx, v: Fx) -> u32 {
-        if self.crop.is_some() {
-            self.bilinear_cropped(u, v)
+    /// The bilinear sample of pyramid level `k` (0 = this map; a level that is built) at
+    /// level-0 position (u, v) (Q.16), as [`EnvMap::trilinear`] reads its levels: level k
+    /// at (u >> k, v >> k). On a partial map level 0 is [`EnvMap::bilinear_cropped`] and
+    /// the other levels [`EnvMap::bilinear_padded`]: what the full map padded with the
+    /// background reads there.
+    #[inline]
+    pub(crate) fn level_bilinear(&self, k: u32, u: Fx, v: Fx) -> u32 {
+        if k == 0 {
+            return if self.crop.is_some() {
+                self.bilinear_cropped(u, v)
+            } else {
+                self.bilinear(u, v)
+            };
+        }
+        let level = &self.pyramid()[k as usize - 1];
+        if level.crop.is_some() {
+            level.bilinear_padded(u >> k, v >> k)
         } else {
-            self.bilinear(u, v)
+            level.bilinear(u >> k, v >> k)
         }
     }
 }
 
-/// Levels 1.. of `map` (empty for partial maps).
 /// Level `k` of `base`'s pyramid (0 = `base`; `levels` gives levels 1, 2, ..., built on
 /// first use) clamped to the last level, and its index. Shared by maps and cubes; level 0
 /// never builds the pyramid.
@@ -131,11 +165,12 @@ pub(crate) fn pick_level<'a, T>(
     }
 }
 
+/// Levels 1.. of `map`.
 fn build_levels(map: &EnvMap) -> Vec<EnvMap> {
-    let mut levels: Vec<EnvMap> = Vec::new();
-    if map.crop.is_some() {
-        return levels;
+    if let Some(crop) = map.crop {
+        return build_partial_levels(map, crop);
     }
+    let mut levels: Vec<EnvMap> = Vec::new();
     loop {
         let prev = levels.last().unwrap_or(map);
         let (w, h) = (prev.width, prev.height);
@@ -175,6 +210,148 @@ fn build_levels(map: &EnvMap) -> Vec<EnvMap> {
             // Cannot happen (sides ≥ 2 and below the map's); stop rather than panic.
             Err(_) => return levels,
         }
+    }
+}
+
+/// Levels 1.. of a partial map (see the module docs): level k stores the texels of the
+/// full map's level k that its crop touches, each the value the full map padded with
+/// the background has there, so a level texel partly inside the crop is the average of
+/// its stored texels and the background (exactly the padded map's texel).
+fn build_partial_levels(map: &EnvMap, crop: Crop) -> Vec<EnvMap> {
+    let mut levels: Vec<EnvMap> = Vec::new();
+    let bg = map.background;
+    let mut rect = Rect::of(&crop);
+    loop {
+        let prev = levels.last().unwrap_or(map);
+        let (fw, fh) = (rect.fw, rect.fh);
+        if fw.div_ceil(2) < MIN_LEVEL_SIDE || fh.div_ceil(2) < MIN_LEVEL_SIDE {
+            return levels;
+        }
+        let next = rect.next();
+        // Texel (x, y) of the padded full map's previous level: stored, or background.
+        let at = |x: u32, y: u32| rect.holds(x, y).map_or(bg, |(sx, sy)| prev.pixel(sx, sy));
+        // `build_levels`' neighbours: across the seam, and the last row again.
+        let right = |x: u32| if x + 1 < fw { x + 1 } else { 0 };
+        let below = |y: u32| (y + 1).min(fh - 1);
+        let (nw, nh) = (next.w as usize, next.h as usize);
+        let mut px = vec![0u32; nw * nh];
+        px.par_chunks_mut(nw).enumerate().for_each(|(j, row)| {
+            let y = 2 * (next.top + j as u32);
+            for (i, p) in row.iter_mut().enumerate() {
+                let x = 2 * ((next.left + i as u32) % next.fw);
+                let (x1, y1) = (right(x), below(y));
+                *p = average4(at(x, y), at(x1, y), at(x, y1), at(x1, y1));
+            }
+        });
+        // (The padding column repeats column 0 only when the level's texels span 360°.)
+        let pad_as = if next.w == next.fw {
+            Projection::Equirect
+        } else {
+            Projection::Elliptical
+        };
+        let level = Crop::new(next.fw, next.fh, next.left, next.top, next.w, next.h)
+            .ok()
+            .and_then(|c| {
+                let m = EnvMap::from_pixels(next.w, next.h, &px, pad_as).ok()?;
+                m.into_partial(c).ok()
+            });
+        match level {
+            Some(mut level) => {
+                level.background = bg;
+                levels.push(level);
+                rect = next;
+            }
+            // Cannot happen (sides ≥ 2 and at most the panorama's); stop rather than panic.
+            None => return levels,
+        }
+    }
+}
+
+/// The stored texels of a partial map's level in the padded full map's level: its sides
+/// `fw × fh` and the stored rectangle (`w × h` from column `left`, row `top`; the columns
+/// continue at 0 past the seam), as `Crop` has them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Rect {
+    fw: u32,
+    fh: u32,
+    left: u32,
+    top: u32,
+    w: u32,
+    h: u32,
+}
+
+impl Rect {
+    fn of(c: &Crop) -> Rect {
+        Rect {
+            fw: c.full_width(),
+            fh: c.full_height(),
+            left: c.left(),
+            top: c.top(),
+            w: c.width(),
+            h: c.height(),
+        }
+    }
+
+    /// The stored texel holding full-level texel (x, y) (`x < fw`), if any.
+    fn holds(&self, x: u32, y: u32) -> Option<(u32, u32)> {
+        let sx = (x + self.fw - self.left) % self.fw;
+        let sy = y.wrapping_sub(self.top);
+        (sx < self.w && sy < self.h).then_some((sx, sy))
+    }
+
+    /// The next level's rectangle: every texel whose 2×2 block (`build_levels`' rule:
+    /// the column after an odd side's last is column 0, the row below the last row is
+    /// the last row again) holds a stored texel of this level, and at least 2 × 2 (a
+    /// texel added to make up the size is the padded map's too: background, or the
+    /// average of what it covers). Full width starts at column 0.
+    fn next(&self) -> Rect {
+        let (fw, fh) = (self.fw.div_ceil(2), self.fh.div_ceil(2));
+        let right = |x: u32| if x + 1 < self.fw { x + 1 } else { 0 };
+        let col = |x: u32| (x + self.fw - self.left) % self.fw < self.w;
+        let mask: Vec<bool> = (0..fw).map(|i| col(2 * i) || col(right(2 * i))).collect();
+        let (mut left, mut w) = cyclic_hull(&mask);
+        w = w.max(2);
+        if w >= fw {
+            (left, w) = (0, fw);
+        }
+        let mut top = self.top / 2;
+        let h = ((self.top + self.h - 1) / 2 + 1 - top).max(2);
+        top = top.min(fh - h);
+        Rect {
+            fw,
+            fh,
+            left,
+            top,
+            w,
+            h,
+        }
+    }
+}
+
+/// The shortest run of columns round the circle `mask` holding every set one: (first
+/// column, length); (0, n) when all are set. (`mask` has one set.)
+fn cyclic_hull(mask: &[bool]) -> (u32, u32) {
+    let n = mask.len();
+    let Some(first) = mask.iter().position(|&b| b) else {
+        return (0, n as u32);
+    };
+    // The longest run of unset columns ends just before the hull's first column.
+    let (mut gap, mut start, mut run) = (0, 0, 0);
+    for s in 1..=n {
+        let i = (first + s) % n;
+        if mask[i] {
+            if run > gap {
+                (gap, start) = (run, i);
+            }
+            run = 0;
+        } else {
+            run += 1;
+        }
+    }
+    if gap == 0 {
+        (0, n as u32)
+    } else {
+        (start as u32, (n - gap) as u32)
     }
 }
 
@@ -339,6 +516,169 @@ mod tests {
             .pyramid()
             .iter()
             .all(|l| l.pixel(l.width() - 1, 0) == 0x123456));
+    }
+
+    const BG: u32 = 0x3366CC;
+
+    /// Crops (full sides, left, top, width, height) with odd and even sides and origins,
+    /// across the seam, 360° wide, at the corners, and tiny.
+    const CROPS: [(u32, u32, u32, u32, u32, u32); 10] = [
+        (30, 15, 7, 3, 11, 9),
+        (30, 15, 25, 0, 9, 15),
+        (37, 19, 36, 17, 2, 2),
+        (37, 19, 0, 5, 37, 7),
+        (37, 19, 0, 0, 3, 2),
+        (37, 19, 35, 4, 2, 3),
+        (64, 32, 1, 1, 62, 30),
+        (64, 32, 60, 10, 8, 4),
+        (301, 151, 150, 40, 77, 61),
+        (301, 151, 290, 149, 40, 2),
+    ];
+
+    /// The full map of random pixels inside `crop` and [`BG`] elsewhere (an ordinary
+    /// map: the padded reference), and the partial map of its crop.
+    fn padded_and_partial(c: (u32, u32, u32, u32, u32, u32)) -> (EnvMap, EnvMap) {
+        let crop = Crop::new(c.0, c.1, c.2, c.3, c.4, c.5).unwrap();
+        let (fw, fh) = (crop.full_width(), crop.full_height());
+        let inside = |x: u32, y: u32| {
+            (x + fw - crop.left()) % fw < crop.width() && y.wrapping_sub(crop.top()) < crop.height()
+        };
+        let px: Vec<u32> = (0..fw * fh)
+            .map(|i| match inside(i % fw, i / fw) {
+                true => (i ^ 0x5A5A).wrapping_mul(2_654_435_761) & 0xFF_FFFF,
+                false => BG,
+            })
+            .collect();
+        let mut full = EnvMap::from_pixels(fw, fh, &px, Projection::Equirect).unwrap();
+        full.set_background(BG);
+        let stored: Vec<u32> = (0..crop.height())
+            .flat_map(|y| (0..crop.width()).map(move |x| ((crop.left() + x) % fw, crop.top() + y)))
+            .map(|(x, y)| px[(y * fw + x) as usize])
+            .collect();
+        let m = EnvMap::from_pixels(crop.width(), crop.height(), &stored, Projection::Equirect);
+        let mut part = m.unwrap().into_partial(crop).unwrap();
+        part.set_background(BG);
+        assert!(part.crop().is_some());
+        (full, part)
+    }
+
+    /// A partial map's levels are the padded full map's levels where its crop reaches:
+    /// the same sides, every stored texel the padded level's texel (byte for byte, those
+    /// partly inside the crop included: their background share is the padded map's), and
+    /// every texel not stored the background in the padded level (nothing the crop
+    /// reaches is left out, odd sides and the seam included). The memory is the stored
+    /// texels'.
+    #[test]
+    fn partial_levels_are_the_padded_maps() {
+        for c in CROPS {
+            let (full, part) = padded_and_partial(c);
+            assert_eq!(part.pyramid_bytes(), 0, "built on first use");
+            let (fl, pl) = (full.pyramid(), part.pyramid());
+            assert_eq!(fl.len(), pl.len(), "{c:?}");
+            for (k, (f, p)) in fl.iter().zip(pl).enumerate() {
+                assert_eq!((p.width(), p.height()), (f.width(), f.height()), "{c:?}");
+                let r = p.crop().map_or(
+                    Rect {
+                        fw: f.width(),
+                        fh: f.height(),
+                        left: 0,
+                        top: 0,
+                        w: f.width(),
+                        h: f.height(),
+                    },
+                    |c| Rect::of(&c),
+                );
+                assert_eq!((p.stored_width(), p.stored_height()), (r.w, r.h));
+                for y in 0..f.height() {
+                    for x in 0..f.width() {
+                        let want = f.pixel(x, y);
+                        match r.holds(x, y) {
+                            Some((sx, sy)) => assert_eq!(
+                                p.pixel(sx, sy),
+                                want,
+                                "{c:?} level {} texel ({x}, {y})",
+                                k + 1
+                            ),
+                            None => assert_eq!(want, BG, "{c:?} level {} ({x}, {y})", k + 1),
+                        }
+                    }
+                }
+            }
+            let bytes: usize = pl.iter().map(EnvMap::bytes).sum();
+            assert_eq!(part.pyramid_bytes(), bytes);
+            assert!(bytes <= full.pyramid_bytes(), "{c:?}");
+        }
+    }
+
+    /// Trilinear on a partial map is trilinear on the padded full map: byte for byte
+    /// from level of detail 256 on (levels ≥ 1 only), and below it (level 0 blended with
+    /// level 1) the partial map's own level 0 (`bilinear_cropped`) blended with the
+    /// padded map's level 1 — so equal to the padded map's trilinear wherever the
+    /// level-0 samples agree (at least one pixel inside the crop, or outside it).
+    #[test]
+    fn partial_trilinear_is_the_padded_maps() {
+        for c in CROPS {
+            let (full, part) = padded_and_partial(c);
+            let crop = part.crop().unwrap();
+            let l1 = &full.pyramid()[0];
+            let (fw, fh) = (c.0 as i64, c.1 as i64);
+            let mut deep = 0;
+            for i in 0..fw * 3 {
+                for j in -2..fh * 3 + 2 {
+                    // Positions a third of a pixel apart, off the pixel grid.
+                    let (u, v) = (((i << 16) + 0x5432) / 3, ((j << 16) + 0x1234) / 3);
+                    for lod in [-5, 0, 1, 100, 255, 256, 300, 512, 700, 1000, 2000] {
+                        let got = part.trilinear(u, v, lod);
+                        let at = format!("{c:?} at ({u:#x}, {v:#x}) lod {lod}");
+                        if lod <= 0 {
+                            assert_eq!(got, part.bilinear_cropped(u, v), "{at}");
+                        } else if lod < 256 {
+                            let want = lerp_px(
+                                part.bilinear_cropped(u, v),
+                                l1.bilinear(u >> 1, v >> 1),
+                                lod as u32,
+                            );
+                            assert_eq!(got, want, "{at}");
+                        } else {
+                            assert_eq!(got, full.trilinear(u, v, lod), "{at}");
+                        }
+                        // At least a pixel inside the crop or outside it: the padded map's.
+                        let (su, sv) = (
+                            (u - ((crop.left() as i64) << 16)).rem_euclid(fw << 16),
+                            v - ((crop.top() as i64) << 16),
+                        );
+                        let d = |s: i64, n: u32| s.min(((n as i64) << 16) - s);
+                        let (du, dv) = (d(su, crop.width()), d(sv, crop.height()));
+                        let wrapped = crop.width() == crop.full_width();
+                        let du = if wrapped { i64::MAX } else { du };
+                        if du.min(dv) >= 1 << 16 {
+                            deep += 1;
+                            assert_eq!(got, full.trilinear(u, v, lod), "inside: {at}");
+                        }
+                    }
+                }
+            }
+            assert!(deep > 0 || c.4 <= 2 || c.5 <= 2, "{c:?}");
+        }
+    }
+
+    /// A new background colour rebuilds a partial map's pyramid (its edge texels hold
+    /// the background); a full map's is kept.
+    #[test]
+    fn new_background_rebuilds_a_partial_pyramid() {
+        let (mut full, mut part) = padded_and_partial(CROPS[0]);
+        let first = part.pyramid()[0].pixel(0, 0);
+        full.pyramid();
+        part.set_background(BG);
+        assert!(part.pyramid_bytes() > 0, "the same colour keeps it");
+        part.set_background(0xFFFFFF);
+        full.set_background(0xFFFFFF);
+        assert_eq!(part.pyramid_bytes(), 0);
+        assert!(full.pyramid_bytes() > 0);
+        // Crop column 7 (odd) and row 3 (odd): level-1 texel (0, 0) of the stored ones
+        // covers one stored pixel and three of the background.
+        assert_ne!(part.pyramid()[0].pixel(0, 0), first);
+        assert_eq!(part.pyramid()[0].background(), 0xFFFFFF);
     }
 
     #[test]

@@ -14,8 +14,9 @@ pub enum Sampler {
     /// The four pixel centers around (u − ½, v − ½), weighted by the fractions.
     Bilinear,
     /// Bilinear on the two pyramid levels around the pixel footprint, blended
-    /// (minification anti-aliasing, see [`crate::EnvMap::pyramid`]). Where no footprint is known
-    /// (single samples, cube maps, partial maps) it is bilinear.
+    /// (minification anti-aliasing, see [`crate::EnvMap::pyramid`]; partial maps and cube
+    /// faces have pyramids too). Where no footprint is known (single samples) it is
+    /// bilinear.
     Trilinear,
 }
 

@@ -119,7 +119,7 @@ pub fn render_exact(
     let cam = Camera::new(view, width, height);
     let (mw, mh) = (map.width() as f64, map.height() as f64);
     let proj = map.projection();
-    if sampler == Sampler::Trilinear && map.crop().is_none() {
+    if sampler == Sampler::Trilinear {
         map.pyramid();
         let fp = ExactFootprint { cam, proj, mw, mh };
         for_each_row(out, width as usize, threads, |y, line| {

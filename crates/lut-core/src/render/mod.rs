@@ -563,7 +563,7 @@ impl Renderer {
         let w = width as usize;
         let out = frame.pixels_mut();
         let bilinear = opts.sampler != Sampler::Nearest;
-        if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
+        if opts.sampler == Sampler::Trilinear {
             // The pyramid is built here once, before the rows run in parallel.
             let (levels, n) = level_texels(map);
             let levels = &levels[..n];
@@ -646,7 +646,7 @@ impl Renderer {
         fn px<R: RowSinks<Px = u32>>(g: &Grid, out: &mut [u32], r: &R, t: bool) -> GridStats {
             g.render(out, r, t, false)
         }
-        let stats = if opts.sampler == Sampler::Trilinear && map.crop().is_none() {
+        let stats = if opts.sampler == Sampler::Trilinear {
             let (levels, n) = level_texels(map); // builds the pyramid
             let exact = ExactFootprint::new(view, width, height, geometry);
             let rows = TriRows {

@@ -2,7 +2,8 @@
 //! of positions and one gather pass, instead of span by span through a [`Sink`]: nearest
 //! and bilinear ([`pixel_row`]), trilinear ([`tri_row`]: each span's level of detail
 //! recorded, runs on one level sampled together, the next level blended in), partial
-//! maps (`crop_run`).
+//! maps (`crop_run`; trilinear: `crop_tri_run`, the same grouping, each level's pass
+//! chunk by chunk as `crop_run`).
 //!
 //! Only the right half of the table-covered pixels is walked (`scanline.rs`: reads every
 //! 2^shift pixels outward from the centre, the column coordinate stepped in whole
@@ -18,7 +19,7 @@
 //! The pixels sample exactly the positions [`row_pass`] writes; `Renderer::positions`
 //! reads the same buffers, so the measured sampling error is this pass's.
 
-use super::kernel::{expand, sample_level, sample_q8, Level, Positions, SpanQ8, Texels};
+use super::kernel::{expand, sample_level, sample_q8, wrap_q8, Level, Positions, SpanQ8, Texels};
 use super::scanline::{blend_pays, render_row, with_nodes, wrap_u, Half, RightSpans};
 use super::scanline::{RowScratch, Scratch, BLEND_NODES};
 use super::setup::{Scan, Setup};
@@ -27,6 +28,7 @@ use super::sink::{PixelSink, PosSink, TriSink};
 use crate::geom::fixed::{Fx, FX_ONE};
 use crate::lut::{Blended, LutTable};
 use crate::map::envmap::EnvMap;
+use crate::map::sample::lerp_px;
 
 /// Pixels of a half row whose positions are buffered before the row kernels run.
 pub(crate) const HALF_CHUNK: usize = 512;
@@ -249,9 +251,9 @@ pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
     });
 }
 
-/// Draw one trilinear LUT scanline of a full map into `s` (its level of detail set for
-/// the scanline): the row pass where it applies ([`applies`]; [`tri_run`]), else span by
-/// span through the sink.
+/// Draw one trilinear LUT scanline into `s` (its level of detail set for the
+/// scanline): the row pass where it applies ([`applies`]; [`tri_run`], partial maps
+/// [`crop_tri_run`]), else span by span through the sink.
 #[inline]
 pub(crate) fn tri_row(
     (scan, table, fr, row_scale): LutRow<'_>,
@@ -266,6 +268,13 @@ pub(crate) fn tri_row(
     let levels = s.levels;
     let wq = (s.map.width() as i32) << 8;
     let RowScratch { nodes, row: buf } = scratch;
+    if s.map.crop().is_some() {
+        let (map, crop) = (s.map, crop_levels(s.map, levels));
+        row_pass(scan, table, fr, (nodes, buf), s, |s, r| {
+            crop_tri_run(map, &crop, wq, r, s.row);
+        });
+        return;
+    }
     row_pass(scan, table, fr, (nodes, buf), s, |s, r| {
         tri_run(levels, wq, r, s.row);
     });
@@ -294,8 +303,41 @@ fn resolve(lod: i32, last: usize) -> (usize, u32) {
 /// `EnvMap::trilinear` at the position (u wrapped into the map) with the span's level of
 /// detail.
 fn tri_run(levels: &[Texels], wq: i32, r: HalfRun<'_>, row: &mut [u32]) {
+    tri_groups(levels.len() - 1, r, row, |k, w, (u, v), out| {
+        let t = &levels[k];
+        let lv = Level {
+            k: k as u32,
+            wq,
+            w: w.unwrap_or(&[]),
+        };
+        match (k, w.is_some(), out) {
+            (0, false, Out::Left(o)) => sample_q8::<true, true>(t, u, v, o),
+            (0, false, Out::Right(o)) => sample_q8::<true, false>(t, u, v, o),
+            (_, false, Out::Left(o)) => sample_level::<true, false>(t, u, v, o, &lv),
+            (_, false, Out::Right(o)) => sample_level::<false, false>(t, u, v, o, &lv),
+            (_, true, Out::Left(o)) => sample_level::<true, true>(t, u, v, o, &lv),
+            (_, true, Out::Right(o)) => sample_level::<false, true>(t, u, v, o, &lv),
+        }
+    });
+}
+
+/// Where a pass of [`tri_groups`] writes: the left half's pixels (reversed: position j
+/// is `o[len − 1 − j]`) or the right half's (in order).
+enum Out<'a> {
+    Left(&'a mut [u32]),
+    Right(&'a mut [u32]),
+}
+
+/// The grouping of [`tri_run`] over levels `0..=last`: `pass(k, w, (u, v), out)` samples
+/// level k bilinearly at the level-0 positions (u, v) into `out`, written (`w` `None`)
+/// or blended in by the weights `w` (one per position).
+fn tri_groups(
+    last: usize,
+    r: HalfRun<'_>,
+    row: &mut [u32],
+    mut pass: impl FnMut(usize, Option<&[u32]>, (&[i32], &[i32]), Out<'_>),
+) {
     let n = r.u.len();
-    let last = levels.len() - 1;
     let segs = r.segs;
     let end = |i: usize| segs.get(i).map_or(n, |s| s.start as usize);
     let mut i = 0;
@@ -308,18 +350,8 @@ fn tri_run(levels: &[Texels], wq: i32, r: HalfRun<'_>, row: &mut [u32]) {
         let (a, b) = (segs[i].start as usize, end(e));
         let (u, ul, v) = (&r.u[a..b], &r.ul[a..b], &r.v[a..b]);
         let (left, right) = (r.left_end - b..r.left_end - a, r.right + a..r.right + b);
-        if ka == 0 {
-            sample_q8::<true, true>(&levels[0], ul, v, &mut row[left]);
-            sample_q8::<true, false>(&levels[0], u, v, &mut row[right]);
-        } else {
-            let lv = Level {
-                k: ka as u32,
-                wq,
-                w: &[],
-            };
-            sample_level::<true, false>(&levels[ka], ul, v, &mut row[left], &lv);
-            sample_level::<false, false>(&levels[ka], u, v, &mut row[right], &lv);
-        }
+        pass(ka, None, (ul, v), Out::Left(&mut row[left]));
+        pass(ka, None, (u, v), Out::Right(&mut row[right]));
         // The second level over the segments from the first to the last with a weight.
         let weighted = |j: &usize| resolve(segs[*j].lod, last).1 != 0;
         let (Some(f), Some(l)) = ((i..e).find(weighted), (i..e).rev().find(weighted)) else {
@@ -335,17 +367,155 @@ fn tri_run(levels: &[Texels], wq: i32, r: HalfRun<'_>, row: &mut [u32]) {
             let w = resolve(s.lod, last).1;
             r.w[s.start as usize - a..end(j + 1) - a].fill(w);
         }
-        let lv = Level {
-            k: ka as u32 + 1,
-            wq,
-            w: &r.w[..b - a],
-        };
+        let w = Some(&r.w[..b - a]);
         let (u, ul, v) = (&r.u[a..b], &r.ul[a..b], &r.v[a..b]);
         let (left, right) = (r.left_end - b..r.left_end - a, r.right + a..r.right + b);
-        let kb = &levels[ka + 1];
-        sample_level::<true, true>(kb, ul, v, &mut row[left], &lv);
-        sample_level::<false, true>(kb, u, v, &mut row[right], &lv);
+        pass(ka + 1, w, (ul, v), Out::Left(&mut row[left]));
+        pass(ka + 1, w, (u, v), Out::Right(&mut row[right]));
     }
+}
+
+/// A pyramid level of a partial map as [`crop_tri_run`] reads it: level `k`'s stored
+/// texels `t` and where they sit in the padded full map's level k (Q.8: the first column
+/// and row, the stored width and height, the level's full width and height; the columns
+/// continue at 0 past the seam).
+pub(crate) struct CropLevel<'a> {
+    k: u32,
+    t: &'a Texels<'a>,
+    left: i32,
+    top: i32,
+    cw: i32,
+    ch: i32,
+    fw: i32,
+    fh: i32,
+}
+
+/// The levels of partial map `map` for [`crop_tri_run`] (`levels`: its
+/// `kernel::level_texels`).
+pub(crate) fn crop_levels<'a>(map: &'a EnvMap, levels: &'a [Texels<'a>]) -> Vec<CropLevel<'a>> {
+    let pyramid = map.pyramid();
+    levels
+        .iter()
+        .enumerate()
+        .map(|(k, t)| {
+            let m = if k == 0 { map } else { &pyramid[k - 1] };
+            let (fw, fh) = (m.width() as i32, m.height() as i32);
+            let (left, top, cw, ch) = m.crop().map_or((0, 0, fw, fh), |c| {
+                let (l, t) = (c.left() as i32, c.top() as i32);
+                (l, t, c.width() as i32, c.height() as i32)
+            });
+            CropLevel {
+                k: k as u32,
+                t,
+                left: left << 8,
+                top: top << 8,
+                cw: cw << 8,
+                ch: ch << 8,
+                fw: fw << 8,
+                fh: fh << 8,
+            }
+        })
+        .collect()
+}
+
+impl CropLevel<'_> {
+    /// Whether the sample at (x, vk) (level-k Q.8: x relative to the stored first column,
+    /// in `0..fw`; vk absolute) is the background: level 0 where the pixel holding it is
+    /// not stored (v clamped into the panorama, as `Crop::locate`), the other levels
+    /// where none of its four texels is (`EnvMap::bilinear_padded`). May say no when
+    /// it is (the caller then samples per pixel), never yes when it is not.
+    #[inline(always)]
+    fn misses(&self, x: i32, vk: i32) -> bool {
+        let vc = vk.clamp(0, self.fh - 1) - self.top;
+        if self.k == 0 {
+            return x >= self.cw || !(0..self.ch).contains(&vc);
+        }
+        // Rows y0 and y0 + 1 (clamped into the level, which stays among them).
+        let y0 = (vc - 128) >> 8;
+        (self.cw + 128..self.fw - 128).contains(&x) || y0 + 1 < 0 || y0 >= self.ch >> 8
+    }
+}
+
+/// One level's pass of a partial map's trilinear run ([`crop_tri_run`]): level `lv.k`'s
+/// samples at level-0 positions (`u` within two panorama widths of it, `wq` its width,
+/// Q.8) written into `out` or, with `BLEND`, blended in by `w` (`MIRROR`: `out`
+/// reversed, as [`sample_level`]); per pixel `EnvMap::level_bilinear`. As [`crop_run`],
+/// chunk by chunk: a chunk whose samples all read stored texels away from the stored
+/// rectangle's edge goes to the row kernels at positions moved onto the texels, one
+/// wholly in the background is the background, the others go per pixel.
+#[allow(clippy::too_many_arguments)]
+fn crop_level_pass<const MIRROR: bool, const BLEND: bool>(
+    map: &EnvMap,
+    lv: &CropLevel<'_>,
+    wq: i32,
+    (u, v): (&[i32], &[i32]),
+    w: &[u32],
+    out: &mut [u32],
+) {
+    let n = out.len();
+    let bg = map.background();
+    let (mut su, mut sv) = ([0i32; CROP_CHUNK], [0i32; CROP_CHUNK]);
+    let (lo, hi_u, hi_v) = (128, lv.cw - 128, lv.ch - 128);
+    for j0 in (0..n).step_by(CROP_CHUNK) {
+        let m = CROP_CHUNK.min(n - j0);
+        let (mut inside, mut outside) = (true, true);
+        for j in 0..m {
+            let vk = v[j0 + j] >> lv.k;
+            let mut x = (wrap_q8(u[j0 + j], wq) >> lv.k) - lv.left;
+            if x < 0 {
+                x += lv.fw;
+            }
+            let y = vk - lv.top;
+            inside &= (lo..hi_u).contains(&x) && (lo..hi_v).contains(&y);
+            outside &= lv.misses(x, vk);
+            (su[j], sv[j]) = (x, y);
+        }
+        let o = if MIRROR {
+            &mut out[n - j0 - m..n - j0]
+        } else {
+            &mut out[j0..j0 + m]
+        };
+        let w = if BLEND { &w[j0..j0 + m] } else { &[][..] };
+        let at = |j: usize| if MIRROR { m - 1 - j } else { j };
+        if inside {
+            let (su, sv) = (&su[..m], &sv[..m]);
+            if BLEND {
+                // (Level 0 of the stored texels: u wrapped by the stored width, a no-op.)
+                let l = Level { k: 0, wq: lv.cw, w };
+                sample_level::<MIRROR, true>(lv.t, su, sv, o, &l);
+            } else {
+                sample_q8::<true, MIRROR>(lv.t, su, sv, o);
+            }
+        } else if outside {
+            for j in 0..m {
+                let p = &mut o[at(j)];
+                *p = if BLEND { lerp_px(*p, bg, w[j]) } else { bg };
+            }
+        } else {
+            for j in 0..m {
+                let uf = (wrap_q8(u[j0 + j], wq) as i64) << 8;
+                let s = map.level_bilinear(lv.k, uf, (v[j0 + j] as i64) << 8);
+                let p = &mut o[at(j)];
+                *p = if BLEND { lerp_px(*p, s, w[j]) } else { s };
+            }
+        }
+    }
+}
+
+/// A trilinear run of partial map `map` (the panorama `wq` / 256 wide; `levels`: its
+/// [`crop_levels`]): [`tri_run`]'s grouping, each level's pass by [`crop_level_pass`].
+/// Per pixel that is `EnvMap::trilinear` at the position (u wrapped into the panorama)
+/// with the span's level of detail.
+fn crop_tri_run(map: &EnvMap, levels: &[CropLevel], wq: i32, r: HalfRun<'_>, row: &mut [u32]) {
+    tri_groups(levels.len() - 1, r, row, |k, w, uv, out| {
+        let lv = &levels[k];
+        match (w, out) {
+            (None, Out::Left(o)) => crop_level_pass::<true, false>(map, lv, wq, uv, &[], o),
+            (None, Out::Right(o)) => crop_level_pass::<false, false>(map, lv, wq, uv, &[], o),
+            (Some(w), Out::Left(o)) => crop_level_pass::<true, true>(map, lv, wq, uv, w, o),
+            (Some(w), Out::Right(o)) => crop_level_pass::<false, true>(map, lv, wq, uv, w, o),
+        }
+    });
 }
 
 /// Pixels of a partial map's run checked and sampled together by [`crop_run`].
@@ -387,14 +557,12 @@ fn crop_run<const BILINEAR: bool, const CROP: bool>(
     // u on the sheet [0, W) of the panorama, relative to the crop's first column (u lies
     // within two widths of the map, as the row kernels take it).
     let shift = |u: i32| {
-        let mut x = u - left;
-        while x < 0 {
-            x += wq;
+        let x = wrap_q8(u, wq) - left;
+        if x < 0 {
+            x + wq
+        } else {
+            x
         }
-        while x >= wq {
-            x -= wq;
-        }
-        x
     };
     let q = |u: i32| (u.rem_euclid(wq) as i64) << 8;
     let n = r.u.len();
@@ -549,6 +717,110 @@ mod tests {
                         row[n - 1 - j],
                         at(ul[j], v[j], lod),
                         "{w}x{h} left {j} lod {lod}"
+                    );
+                }
+                assert_eq!(row[n], 0, "the pixel between the halves is not written");
+            }
+        }
+    }
+
+    /// A partial map's trilinear run ([`crop_tri_run`]: [`tri_run`]'s grouping, each
+    /// level's chunks on the row kernels inside the stored texels, the background
+    /// outside, per pixel over the edge) writes `EnvMap::trilinear` per pixel on both
+    /// halves: runs of 1..=600 positions walking a quarter pixel or less per pixel (so
+    /// whole chunks fall inside, outside and across the edges on every level) from
+    /// anywhere within two widths of the panorama and beyond the poles, with 1..=40
+    /// segments of levels −1..9, on crops with odd and even origins and sides, across
+    /// the seam and 360° wide.
+    #[test]
+    fn crop_tri_run_is_trilinear_per_pixel() {
+        use crate::geom::coverage::Crop;
+        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+        let mut rnd = |n: u64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed % n
+        };
+        for (fw, fh, left, top, cw, ch) in [
+            (300u32, 150u32, 101u32, 37u32, 123u32, 77u32),
+            (300, 150, 250, 0, 120, 90),
+            (300, 150, 0, 40, 300, 61),
+            (96, 40, 95, 3, 33, 36),
+            (64, 32, 10, 10, 2, 2),
+        ] {
+            let crop = Crop::new(fw, fh, left, top, cw, ch).unwrap();
+            let px: Vec<u32> = (0..cw * ch)
+                .map(|i| i.wrapping_mul(2_654_435_761) & 0xFF_FFFF)
+                .collect();
+            let m = EnvMap::from_pixels(cw, ch, &px, Projection::Equirect).unwrap();
+            let mut m = m.into_partial(crop).unwrap();
+            m.set_background(0x12_3456);
+            let (levels, nl) = level_texels(&m);
+            let crop_lv = crop_levels(&m, &levels[..nl]);
+            let (wq, hq) = ((fw as i64) << 8, (fh as i64) << 8);
+            for _ in 0..60 {
+                let n = 1 + rnd(600) as usize;
+                let mut walk = |lo: i64, hi: i64| -> Vec<i32> {
+                    let (mut p, d) = (lo + rnd((hi - lo) as u64) as i64, rnd(129) as i64 - 64);
+                    (0..n)
+                        .map(|_| {
+                            p = (p + d + rnd(9) as i64 - 4).clamp(lo, hi - 1);
+                            p as i32
+                        })
+                        .collect()
+                };
+                let (u, ul, v) = (
+                    walk(256 - wq, 2 * wq - 256),
+                    walk(256 - wq, 2 * wq - 256),
+                    walk(-hq / 2, hq + hq / 2),
+                );
+                let mut starts: Vec<u32> = (0..rnd(40)).map(|_| rnd(n as u64) as u32).collect();
+                starts.push(0);
+                starts.sort_unstable();
+                starts.dedup();
+                let segs: Vec<Seg> = starts
+                    .iter()
+                    .map(|&start| Seg {
+                        start,
+                        lod: rnd(10 * 256) as i32 - 256,
+                    })
+                    .collect();
+                let lod_at = |j: usize| {
+                    segs.iter()
+                        .rev()
+                        .find(|s| s.start as usize <= j)
+                        .unwrap()
+                        .lod
+                };
+                let mut wts = vec![0u32; n];
+                let mut row = vec![0u32; 2 * n + 2];
+                let r = HalfRun {
+                    right: n + 1,
+                    left_end: n,
+                    u: &u,
+                    v: &v,
+                    ul: &ul,
+                    segs: &segs,
+                    w: &mut wts,
+                };
+                crop_tri_run(&m, &crop_lv, wq as i32, r, &mut row);
+                let at = |uq: i32, vq: i32, lod: i32| {
+                    let uu = ((uq as i64) << 8).rem_euclid((fw as i64) << 16);
+                    m.trilinear(uu, (vq as i64) << 8, lod)
+                };
+                for j in 0..n {
+                    let lod = lod_at(j);
+                    let c = (fw, fh, left, top, cw, ch);
+                    assert_eq!(
+                        row[n + 1 + j],
+                        at(u[j], v[j], lod),
+                        "{c:?} right {j} lod {lod}"
+                    );
+                    assert_eq!(
+                        row[n - 1 - j],
+                        at(ul[j], v[j], lod),
+                        "{c:?} left {j} lod {lod}"
                     );
                 }
                 assert_eq!(row[n], 0, "the pixel between the halves is not written");

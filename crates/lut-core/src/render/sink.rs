@@ -243,7 +243,12 @@ impl Sink for TriSink<'_> {
         self.row[x] = self.map.trilinear(u, v, self.lod);
     }
     #[inline(always)]
-    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
+    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, w_fx: Fx) {
+        if self.map.crop.is_some() {
+            // A partial map: per pixel (`EnvMap::trilinear` reads its levels as the
+            // padded full map's; the span kernels know full maps only).
+            return put_run(self, x, m, (u, v), (du, dv), w_fx);
+        }
         if self.batch.push_lod(x, m, u, v, du, dv, self.lod) {
             self.batch.flush_trilinear(self.map, self.levels, self.row);
         }

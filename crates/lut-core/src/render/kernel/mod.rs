@@ -128,7 +128,7 @@ pub use select::{
 };
 
 pub(crate) use face::{face_blend, face_span, FaceRun};
-pub(crate) use row::{expand, sample_level, sample_q8, Level, Positions, SpanQ8};
+pub(crate) use row::{expand, sample_level, sample_q8, wrap_q8, Level, Positions, SpanQ8};
 
 use crate::geom::fixed::{Fx, FX_BITS};
 use crate::map::envmap::EnvMap;
@@ -344,14 +344,29 @@ pub(crate) fn trilinear_span(
     dv: Fx,
     lod: i32,
 ) {
-    if lod <= 0 || map.crop.is_some() {
+    if lod <= 0 {
         return sample_span::<true>(map, out, u, v, du, dv);
+    }
+    if map.crop.is_some() {
+        // Partial maps: per pixel (their levels are read as the padded map's).
+        return put_trilinear(map, out, (u, v), (du, dv), lod);
     }
     let (levels, n) = level_texels(map);
     if jobs::trilinear_span(&levels[..n], lod, out, u, v, du, dv) {
         return;
     }
     trilinear_span_slow(map, out, u, v, du, dv, lod);
+}
+
+/// [`trilinear_span`] pixel by pixel: [`EnvMap::trilinear`] at each position, u wrapped
+/// into the panorama.
+#[cfg(test)]
+fn put_trilinear(map: &EnvMap, out: &mut [u32], (u, v): (Fx, Fx), (du, dv): (Fx, Fx), lod: i32) {
+    let wfx = (map.width() as i64) << FX_BITS;
+    for (i, o) in out.iter_mut().enumerate() {
+        let i = i as i64;
+        *o = map.trilinear((u + i * du).rem_euclid(wfx), v + i * dv, lod);
+    }
 }
 
 /// [`trilinear_span`] where a level's span leaves its map: per level, with the per-pixel
@@ -381,8 +396,8 @@ fn trilinear_span_slow(map: &EnvMap, out: &mut [u32], u: Fx, v: Fx, du: Fx, dv: 
 
 /// [`trilinear_span`] for a batch of spans of one output row (`lods[i]` the level of
 /// detail of `spans[i]`): one kernel call for them all. `levels` is [`level_texels`]
-/// (taken once per frame). For the renderer's trilinear rows; partial maps are sampled
-/// bilinearly elsewhere.
+/// (taken once per frame). For the renderer's trilinear rows of full maps (a partial
+/// map's spans go pixel by pixel: `TriSink::span`).
 pub(crate) fn trilinear_spans(
     map: &EnvMap,
     levels: &[Texels],

@@ -101,7 +101,7 @@ const LEVEL0: Level<'static> = Level {
 
 /// u (within two map widths of the map, `wq` its width, Q.8) wrapped into `0..wq`.
 #[inline(always)]
-pub(super) fn wrap_q8(mut u: i32, wq: i32) -> i32 {
+pub(crate) fn wrap_q8(mut u: i32, wq: i32) -> i32 {
     if u < 0 {
         u += wq;
     }
