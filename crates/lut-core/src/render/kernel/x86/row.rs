@@ -1,7 +1,9 @@
 //! x86-64 row kernels (see `kernel/row.rs`): 8 (AVX2) or 4 (SSE4.1) pixels per step, the
 //! seam wrap and the pole clamp as lane compares, the texels read as the map kernels read
 //! them (two 64-bit loads per bilinear pixel) and blended with their `split`, `lerp` and
-//! `merge`; the left half's pixels reversed in the register before the store.
+//! `merge`; the left half's pixels reversed in the register before the store. Each
+//! kernel prefetches the texels of the position [`PREFETCH_AHEAD`] pixels ahead (the
+//! frame is bound by memory latency, not instructions: see there).
 //!
 //! The kernels are written once (`row_kernels!`) and expanded in each instruction set's
 //! module, where short names stand for that set's intrinsics (`add` is
