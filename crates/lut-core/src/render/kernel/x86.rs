@@ -8,8 +8,9 @@
 //! which is dropped at the end as `lerp_px` drops it).
 //!
 //! The only `unsafe` here: calling a `#[target_feature]` function (the CPU was checked:
-//! [`Selected`] is only made for a supported kernel) and the unaligned loads and stores,
-//! whose indices are clamped into the slices they read or bounded by the loop.
+//! [`Selected`] is only made for a supported kernel), the unaligned loads and stores,
+//! whose indices are clamped into the slices they read or bounded by the loop, and the
+//! prefetches of the row and face kernels ([`prefetch_texels`]), which read nothing.
 
 #![allow(unsafe_code)]
 
@@ -100,6 +101,30 @@ pub(super) fn tri_jobs(
         // SAFETY: as above.
         Kernel::Sse41 => Some(unsafe { sse41::tri_jobs(levels, row, jobs, lods) }),
         Kernel::Scalar => None,
+    }
+}
+
+/// How many pixels ahead the row kernels prefetch the texels they will read.
+///
+/// Why: a frame reads the map along curves that cross map rows, and each map row the
+/// curve enters starts with cache misses the hardware prefetchers (which follow address
+/// streams) cannot foresee; the row's positions, already in the buffers, say where the
+/// reads will go. About 50 pixels is a few hundred nanoseconds of drawing, longer than a
+/// trip to memory; 32–64 measured alike (`docs/performance.md`, "Prefetching").
+pub(super) const PREFETCH_AHEAD: usize = 48;
+
+/// Prefetch the cache line holding texel `at` and, for bilinear, the one `stride` texels
+/// below it (the row kernels' and the face kernels' look-ahead). `at` need not point
+/// into the map: a line off the map is a wasted prefetch, nothing more.
+#[inline(always)]
+fn prefetch_texels<const BILINEAR: bool>(at: *const u32, stride: usize) {
+    // SAFETY: SSE is part of every x86-64 CPU; a prefetch reads nothing the program sees
+    // and never faults, whatever the address.
+    unsafe {
+        _mm_prefetch::<_MM_HINT_T0>(at.cast());
+        if BILINEAR {
+            _mm_prefetch::<_MM_HINT_T0>(at.wrapping_add(stride).cast());
+        }
     }
 }
 

@@ -11,8 +11,7 @@
 //! (`iota_pd`).
 
 use super::super::face::{face_side, FaceRun};
-use super::row::PREFETCH_AHEAD;
-use super::{padded, Kernel, Local, Selected, Texels};
+use super::{padded, prefetch_texels, Kernel, Local, Selected, Texels, PREFETCH_AHEAD};
 use crate::geom::fixed::{FX_HALF, FX_ONE};
 use std::arch::x86_64::*;
 
@@ -74,14 +73,7 @@ fn prefetch<const BILINEAR: bool>(t: &Texels, r: &FaceRun, i: usize, m: usize) {
     let v = (r.half - (r.p[1] + dx * r.d[1]) * q).clamp(0.0, n);
     let stride = t.stride();
     let at = t.px.as_ptr().wrapping_add(v as usize * stride + u as usize);
-    // SAFETY: SSE is part of every x86-64 CPU; a prefetch reads nothing the program sees
-    // and never faults, whatever the address.
-    unsafe {
-        _mm_prefetch::<_MM_HINT_T0>(at.cast());
-        if BILINEAR {
-            _mm_prefetch::<_MM_HINT_T0>(at.wrapping_add(stride).cast());
-        }
-    }
+    prefetch_texels::<BILINEAR>(at, stride);
 }
 
 macro_rules! face_kernels {

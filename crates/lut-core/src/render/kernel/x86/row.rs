@@ -14,7 +14,7 @@
 //! into the entry points as before: the same code per set as when each was written out.
 
 use super::super::row::{sample_lv_scalar, Level, Positions, SpanQ8};
-use super::{Kernel, Selected, Texels};
+use super::{prefetch_texels, Kernel, Selected, Texels, PREFETCH_AHEAD};
 use std::arch::x86_64::*;
 
 /// The row kernel with a SIMD kernel (see `row::sample_lv_scalar`); `false` (nothing
@@ -71,15 +71,6 @@ fn last_index<const BILINEAR: bool>(t: &Texels) -> usize {
     t.px.len() - if BILINEAR { t.stride() + 2 } else { 1 }
 }
 
-/// How many pixels ahead the row kernels prefetch the texels they will read.
-///
-/// Why: a frame reads the map along curves that cross map rows, and each map row the
-/// curve enters starts with cache misses the hardware prefetchers (which follow address
-/// streams) cannot foresee; the row's positions, already in the buffers, say where the
-/// reads will go. About 50 pixels is a few hundred nanoseconds of drawing, longer than a
-/// trip to memory; 32–64 measured alike (`docs/performance.md`, "Prefetching").
-pub(super) const PREFETCH_AHEAD: usize = 48;
-
 /// Prefetch the cache lines position `j` of (`u`, `v`) (Q.8, on level `k`) will read:
 /// its texel, and for bilinear the one below. Positions past the run are skipped;
 /// positions off the map (a seam not yet wrapped) prefetch a wrong line, which is
@@ -92,14 +83,7 @@ fn prefetch<const BILINEAR: bool>(t: &Texels, (u, v): (&[i32], &[i32]), j: usize
         let at =
             t.px.as_ptr()
                 .wrapping_offset(y.wrapping_mul(stride).wrapping_add(x));
-        // SAFETY: SSE is part of every x86-64 CPU; a prefetch reads nothing the program
-        // sees and never faults, whatever the address.
-        unsafe {
-            _mm_prefetch::<_MM_HINT_T0>(at.cast());
-            if BILINEAR {
-                _mm_prefetch::<_MM_HINT_T0>(at.wrapping_offset(stride).cast());
-            }
-        }
+        prefetch_texels::<BILINEAR>(at, t.stride());
     }
 }
 
