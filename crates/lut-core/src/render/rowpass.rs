@@ -397,28 +397,44 @@ pub(crate) fn crop_levels<'a>(map: &'a EnvMap, levels: &'a [Texels<'a>]) -> Vec<
     levels
         .iter()
         .enumerate()
-        .map(|(k, t)| {
-            let m = if k == 0 { map } else { &pyramid[k - 1] };
-            let (fw, fh) = (m.width() as i32, m.height() as i32);
-            let (left, top, cw, ch) = m.crop().map_or((0, 0, fw, fh), |c| {
-                let (l, t) = (c.left() as i32, c.top() as i32);
-                (l, t, c.width() as i32, c.height() as i32)
-            });
-            CropLevel {
-                k: k as u32,
-                t,
-                left: left << 8,
-                top: top << 8,
-                cw: cw << 8,
-                ch: ch << 8,
-                fw: fw << 8,
-                fh: fh << 8,
-            }
-        })
+        .map(|(k, t)| CropLevel::new(k as u32, if k == 0 { map } else { &pyramid[k - 1] }, t))
         .collect()
 }
 
-impl CropLevel<'_> {
+impl<'a> CropLevel<'a> {
+    /// Level `k` of a partial map: `m` (the map itself for level 0, else its pyramid's
+    /// level k) and its stored texels `t`.
+    fn new(k: u32, m: &EnvMap, t: &'a Texels<'a>) -> CropLevel<'a> {
+        let (fw, fh) = (m.width() as i32, m.height() as i32);
+        let (left, top, cw, ch) = m.crop().map_or((0, 0, fw, fh), |c| {
+            let (l, t) = (c.left() as i32, c.top() as i32);
+            (l, t, c.width() as i32, c.height() as i32)
+        });
+        CropLevel {
+            k,
+            t,
+            left: left << 8,
+            top: top << 8,
+            cw: cw << 8,
+            ch: ch << 8,
+            fw: fw << 8,
+            fh: fh << 8,
+        }
+    }
+
+    /// The level-k Q.8 column of level-0 position `u` (within two panorama widths of it,
+    /// `wq` the panorama's width), relative to the first stored column: in `0..fw`, the
+    /// columns continuing at 0 past the seam.
+    #[inline(always)]
+    fn column(&self, u: i32, wq: i32) -> i32 {
+        let x = (wrap_q8(u, wq) >> self.k) - self.left;
+        if x < 0 {
+            x + self.fw
+        } else {
+            x
+        }
+    }
+
     /// Whether the sample at (x, vk) (level-k Q.8: x relative to the stored first column,
     /// in `0..fw`; vk absolute) is the background: level 0 where the pixel holding it is
     /// not stored (v clamped into the panorama, as `Crop::locate`), the other levels
@@ -461,10 +477,7 @@ fn crop_level_pass<const MIRROR: bool, const BLEND: bool>(
         let (mut inside, mut outside) = (true, true);
         for j in 0..m {
             let vk = v[j0 + j] >> lv.k;
-            let mut x = (wrap_q8(u[j0 + j], wq) >> lv.k) - lv.left;
-            if x < 0 {
-                x += lv.fw;
-            }
+            let x = lv.column(u[j0 + j], wq);
             let y = vk - lv.top;
             inside &= (lo..hi_u).contains(&x) && (lo..hi_v).contains(&y);
             outside &= lv.misses(x, vk);
@@ -536,34 +549,20 @@ fn crop_run<const BILINEAR: bool, const CROP: bool>(
     wq: i32,
     r: HalfRun<'_>,
 ) {
-    let Some(c) = s.map.crop() else {
+    if s.map.crop().is_none() {
         return;
-    };
+    }
+    // The stored pixels as level 0 of the partial map's pyramid sees them (the same
+    // column arithmetic, the same test for the background).
+    let lv = CropLevel::new(0, s.map, t);
+    let (cw, ch, top) = (lv.cw, lv.ch, lv.top);
     // The stored pixels' interior, in Q.8 positions relative to their first pixel.
-    let (cw, ch) = ((c.width() as i32) << 8, (c.height() as i32) << 8);
     let (lo, hi_u, hi_v) = if BILINEAR {
         (128, cw - 128, ch - 128)
     } else {
         (0, cw, ch)
     };
-    let (left, top) = ((c.left() as i32) << 8, (c.top() as i32) << 8);
-    let hq = (c.full_height() as i32) << 8;
     let bg = s.map.background();
-    // Not covered: the pixel holding the position (v clamped into the panorama).
-    let outside = |x: i32, v: i32| {
-        let y = v.clamp(0, hq - 1) - top;
-        x >= cw || !(0..ch).contains(&y)
-    };
-    // u on the sheet [0, W) of the panorama, relative to the crop's first column (u lies
-    // within two widths of the map, as the row kernels take it).
-    let shift = |u: i32| {
-        let x = wrap_q8(u, wq) - left;
-        if x < 0 {
-            x + wq
-        } else {
-            x
-        }
-    };
     let q = |u: i32| (u.rem_euclid(wq) as i64) << 8;
     let n = r.u.len();
     let (mut su, mut sl, mut sv) = ([0i32; CROP_CHUNK], [0i32; CROP_CHUNK], [0i32; CROP_CHUNK]);
@@ -573,12 +572,12 @@ fn crop_run<const BILINEAR: bool, const CROP: bool>(
         let (mut right_out, mut left_out) = (true, true);
         for j in 0..m {
             let v = r.v[j0 + j];
-            let (a, b) = (shift(r.u[j0 + j]), shift(r.ul[j0 + j]));
+            let (a, b) = (lv.column(r.u[j0 + j], wq), lv.column(r.ul[j0 + j], wq));
             let v_in = (lo..hi_v).contains(&(v - top));
             right_in &= v_in && (lo..hi_u).contains(&a);
             left_in &= v_in && (lo..hi_u).contains(&b);
-            right_out &= outside(a, v);
-            left_out &= outside(b, v);
+            right_out &= lv.misses(a, v);
+            left_out &= lv.misses(b, v);
             (su[j], sl[j], sv[j]) = (a, b, v - top);
         }
         let lend = r.left_end - j0;
@@ -638,6 +637,78 @@ mod tests {
     use crate::geom::projection::Projection;
     use crate::render::kernel::level_texels;
 
+    /// A xorshift generator: each call a number below its argument.
+    fn xorshift(mut seed: u64) -> impl FnMut(u64) -> u64 {
+        move |n| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed % n
+        }
+    }
+
+    /// Up to 40 segments over `n` positions (the first at 0) with levels of detail
+    /// −1..9 (Q.8).
+    fn random_segs(rnd: &mut impl FnMut(u64) -> u64, n: usize) -> Vec<Seg> {
+        let mut starts: Vec<u32> = (0..rnd(40)).map(|_| rnd(n as u64) as u32).collect();
+        starts.push(0);
+        starts.sort_unstable();
+        starts.dedup();
+        starts
+            .iter()
+            .map(|&start| Seg {
+                start,
+                lod: rnd(10 * 256) as i32 - 256,
+            })
+            .collect()
+    }
+
+    /// `draw` a run of positions (`u`, the left half's `ul`, `v`) with levels of detail
+    /// `segs` into a row of 2n + 2 pixels (the right half from n + 1, the left one
+    /// ending at n); every pixel must be `at(u, v, lod)` of its position and segment,
+    /// and the pixel between the halves unwritten (`what` names the case).
+    fn check_run(
+        (u, ul, v, segs): (&[i32], &[i32], &[i32], &[Seg]),
+        draw: impl FnOnce(HalfRun<'_>, &mut [u32]),
+        at: impl Fn(i32, i32, i32) -> u32,
+        what: &str,
+    ) {
+        let n = u.len();
+        let lod_at = |j: usize| {
+            segs.iter()
+                .rev()
+                .find(|s| s.start as usize <= j)
+                .unwrap()
+                .lod
+        };
+        let mut wts = vec![0u32; n];
+        let mut row = vec![0u32; 2 * n + 2];
+        let r = HalfRun {
+            right: n + 1,
+            left_end: n,
+            u,
+            v,
+            ul,
+            segs,
+            w: &mut wts,
+        };
+        draw(r, &mut row);
+        for j in 0..n {
+            let lod = lod_at(j);
+            assert_eq!(
+                row[n + 1 + j],
+                at(u[j], v[j], lod),
+                "{what} right {j} lod {lod}"
+            );
+            assert_eq!(
+                row[n - 1 - j],
+                at(ul[j], v[j], lod),
+                "{what} left {j} lod {lod}"
+            );
+        }
+        assert_eq!(row[n], 0, "the pixel between the halves is not written");
+    }
+
     /// A trilinear run ([`tri_run`]: segments of levels of detail grouped by level, the
     /// second level blended in over part of a group) writes, pixel by pixel on both
     /// halves, `EnvMap::trilinear` at the position (u wrapped into the map) with its
@@ -646,13 +717,7 @@ mod tests {
     /// levels clamped), on maps with even and odd level sides.
     #[test]
     fn tri_run_is_trilinear_per_pixel() {
-        let mut seed = 0x2545_F491_4F6C_DD1Du64;
-        let mut rnd = |n: u64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed % n
-        };
+        let mut rnd = xorshift(0x2545_F491_4F6C_DD1D);
         for (w, h) in [(64u32, 32u32), (300, 150), (96, 40), (6, 3)] {
             let px: Vec<u32> = (0..w * h)
                 .map(|i| i.wrapping_mul(2_654_435_761) & 0xFF_FFFF)
@@ -672,54 +737,17 @@ mod tests {
                     pos(256 - wq, 2 * wq - 256),
                     pos(-hq / 2, hq + hq / 2),
                 );
-                let mut starts: Vec<u32> = (0..rnd(40)).map(|_| rnd(n as u64) as u32).collect();
-                starts.push(0);
-                starts.sort_unstable();
-                starts.dedup();
-                let segs: Vec<Seg> = starts
-                    .iter()
-                    .map(|&start| Seg {
-                        start,
-                        lod: rnd(10 * 256) as i32 - 256,
-                    })
-                    .collect();
-                let lod_at = |j: usize| {
-                    segs.iter()
-                        .rev()
-                        .find(|s| s.start as usize <= j)
-                        .unwrap()
-                        .lod
-                };
-                let mut wts = vec![0u32; n];
-                let mut row = vec![0u32; 2 * n + 2];
-                let r = HalfRun {
-                    right: n + 1,
-                    left_end: n,
-                    u: &u,
-                    v: &v,
-                    ul: &ul,
-                    segs: &segs,
-                    w: &mut wts,
-                };
-                tri_run(&levels[..nl], wq as i32, r, &mut row);
+                let segs = random_segs(&mut rnd, n);
                 let at = |uq: i32, vq: i32, lod: i32| {
                     let uu = ((uq as i64) << 8).rem_euclid((w as i64) << 16);
                     m.trilinear(uu, (vq as i64) << 8, lod)
                 };
-                for j in 0..n {
-                    let lod = lod_at(j);
-                    assert_eq!(
-                        row[n + 1 + j],
-                        at(u[j], v[j], lod),
-                        "{w}x{h} right {j} lod {lod}"
-                    );
-                    assert_eq!(
-                        row[n - 1 - j],
-                        at(ul[j], v[j], lod),
-                        "{w}x{h} left {j} lod {lod}"
-                    );
-                }
-                assert_eq!(row[n], 0, "the pixel between the halves is not written");
+                check_run(
+                    (&u, &ul, &v, &segs),
+                    |r, row| tri_run(&levels[..nl], wq as i32, r, row),
+                    at,
+                    &format!("{w}x{h}"),
+                );
             }
         }
     }
@@ -735,13 +763,7 @@ mod tests {
     #[test]
     fn crop_tri_run_is_trilinear_per_pixel() {
         use crate::geom::coverage::Crop;
-        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
-        let mut rnd = |n: u64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed % n
-        };
+        let mut rnd = xorshift(0x9E37_79B9_7F4A_7C15);
         for (fw, fh, left, top, cw, ch) in [
             (300u32, 150u32, 101u32, 37u32, 123u32, 77u32),
             (300, 150, 250, 0, 120, 90),
@@ -775,55 +797,18 @@ mod tests {
                     walk(256 - wq, 2 * wq - 256),
                     walk(-hq / 2, hq + hq / 2),
                 );
-                let mut starts: Vec<u32> = (0..rnd(40)).map(|_| rnd(n as u64) as u32).collect();
-                starts.push(0);
-                starts.sort_unstable();
-                starts.dedup();
-                let segs: Vec<Seg> = starts
-                    .iter()
-                    .map(|&start| Seg {
-                        start,
-                        lod: rnd(10 * 256) as i32 - 256,
-                    })
-                    .collect();
-                let lod_at = |j: usize| {
-                    segs.iter()
-                        .rev()
-                        .find(|s| s.start as usize <= j)
-                        .unwrap()
-                        .lod
-                };
-                let mut wts = vec![0u32; n];
-                let mut row = vec![0u32; 2 * n + 2];
-                let r = HalfRun {
-                    right: n + 1,
-                    left_end: n,
-                    u: &u,
-                    v: &v,
-                    ul: &ul,
-                    segs: &segs,
-                    w: &mut wts,
-                };
-                crop_tri_run(&m, &crop_lv, wq as i32, r, &mut row);
+                let segs = random_segs(&mut rnd, n);
                 let at = |uq: i32, vq: i32, lod: i32| {
                     let uu = ((uq as i64) << 8).rem_euclid((fw as i64) << 16);
                     m.trilinear(uu, (vq as i64) << 8, lod)
                 };
-                for j in 0..n {
-                    let lod = lod_at(j);
-                    let c = (fw, fh, left, top, cw, ch);
-                    assert_eq!(
-                        row[n + 1 + j],
-                        at(u[j], v[j], lod),
-                        "{c:?} right {j} lod {lod}"
-                    );
-                    assert_eq!(
-                        row[n - 1 - j],
-                        at(ul[j], v[j], lod),
-                        "{c:?} left {j} lod {lod}"
-                    );
-                }
-                assert_eq!(row[n], 0, "the pixel between the halves is not written");
+                let c = (fw, fh, left, top, cw, ch);
+                check_run(
+                    (&u, &ul, &v, &segs),
+                    |r, row| crop_tri_run(&m, &crop_lv, wq as i32, r, row),
+                    at,
+                    &format!("{c:?}"),
+                );
             }
         }
     }
