@@ -13,7 +13,8 @@
 #   exits 0 and the recent files are in the settings file.
 # Run 2 (the settings written by run 1, panel hidden, default zoom limit): the panel
 #   stays hidden, the zoom stops where a map pixel covers two screen pixels, Ctrl+S
-#   saves the view where the settings say; docs/screenshot.png is taken here.
+#   saves the view where the settings say; the README's screenshot is taken here
+#   (into $OUT; copied to docs/screenshot.png only with SMOKE_UPDATE_SCREENSHOT=1).
 # Run 3 (panel hidden): a scene file with --show-room opens its panorama at its view with
 #   its five luminaires; a click on a marker selects that light, dragging it moves it
 #   along the ceiling without turning the view; dragging a room edge resizes the room, and
@@ -382,7 +383,8 @@ log "after scroll: hfov=$(field hfov)"
 awk -v a="$(field hfov)" -v l="$LIMIT" 'BEGIN { exit !(a > l - 0.01 && a < l + 0.01) }' ||
   fail "the zoom should stop at the resolution limit $LIMIT, got $(field hfov)"
 sleep 0.3
-$IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$ROOT/docs/screenshot.png"
+$IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/screenshot.png"
+if [ "${SMOKE_UPDATE_SCREENSHOT:-0}" = 1 ]; then cp "$OUT/screenshot.png" "$ROOT/docs/screenshot.png"; fi
 
 # Ctrl+S: the Save dialog opens in the folder of the settings, Enter saves view-1.png.
 N=$(lines)
@@ -505,4 +507,4 @@ log "after the lighting settled: lit=$(field lit)"
 sleep 0.3
 $IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/lights.png"
 quit_viewer
-log "PASS (screenshots in $OUT, docs/screenshot.png updated)"
+log "PASS (screenshots in $OUT$([ "${SMOKE_UPDATE_SCREENSHOT:-0}" = 1 ] && echo ", docs/screenshot.png updated"))"
