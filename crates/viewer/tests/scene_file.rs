@@ -363,6 +363,10 @@ fn bad_scene_files_fail_with_one_line() {
             v["view"] = serde_json::json!({"yaw": 0.0, "pitch": 0.0, "hfov": hfov})
         }
     };
+    let e = case("pitch.json", &|v| {
+        v["view"] = serde_json::json!({"yaw": 0.0, "pitch": 120.0, "hfov": 90.0})
+    });
+    assert!(e.contains("\"pitch\"") && e.contains("120"), "{e}");
     let e = case("hfov.json", &view(500.0));
     assert!(e.contains("\"view\"") && e.contains("500"), "{e}");
     let e = case("wide.json", &view(250.0));

@@ -280,7 +280,8 @@ impl SceneFile {
     ///
     /// # Errors
     /// An unreadable file, bad JSON or an unknown key (with its line and column), a
-    /// format or version this viewer does not read, a view's hfov no projection takes.
+    /// format or version this viewer does not read, a view's hfov no projection takes,
+    /// a view's pitch beyond ±90° or a yaw that is not finite.
     pub fn load(path: &Path) -> Result<SceneFile> {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("{}: cannot read", path.display()))?;
@@ -312,6 +313,21 @@ impl SceneFile {
                 "{}: \"view\": \"hfov\" is {}, expected more than 0 and at most 360 degrees",
                 path.display(),
                 v.hfov
+            );
+        }
+        // A pitch beyond the poles is not a view (the window would clamp it silently).
+        if let Some(v) = scene.view.filter(|v| !(-90.0..=90.0).contains(&v.pitch)) {
+            bail!(
+                "{}: \"view\": \"pitch\" is {}, expected -90 to 90 degrees",
+                path.display(),
+                v.pitch
+            );
+        }
+        if let Some(v) = scene.view.filter(|v| !v.yaw.is_finite()) {
+            bail!(
+                "{}: \"view\": \"yaw\" is {}, expected a finite number of degrees",
+                path.display(),
+                v.yaw
             );
         }
         Ok(scene)
