@@ -35,6 +35,10 @@ pub(in super::super) fn sample_q8<
 ) -> bool {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
+        Kernel::Avx512 => unsafe {
+            avx512::sample_q8::<BILINEAR, MIRROR, LEVEL, BLEND>(t, u, v, out, lv)
+        },
+        // SAFETY: as above.
         Kernel::Avx2 => unsafe {
             avx2::sample_q8::<BILINEAR, MIRROR, LEVEL, BLEND>(t, u, v, out, lv)
         },
@@ -57,6 +61,8 @@ pub(in super::super) fn expand<'a>(
 ) -> Option<Positions<'a>> {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
+        Kernel::Avx512 => unsafe { avx512::expand(spans, p) },
+        // SAFETY: as above.
         Kernel::Avx2 => unsafe { avx2::expand(spans, p) },
         // SAFETY: as above.
         Kernel::Sse41 => unsafe { sse41::expand(spans, p) },
@@ -357,6 +363,73 @@ mod avx2 {
     #[target_feature(enable = "avx2")]
     fn reverse(c: V) -> V {
         _mm256_permutevar8x32_epi32(c, _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0))
+    }
+}
+
+mod avx512 {
+    use super::super::avx512::{lerp, merge, pairs, split};
+    use super::*;
+    use std::arch::x86_64::{
+        __m512i as V, _mm512_add_epi32 as add, _mm512_and_si512 as and,
+        _mm512_andnot_si512 as andnot, _mm512_castps_si512 as from_ps,
+        _mm512_castsi512_ps as to_ps, _mm512_loadu_si512 as loadu, _mm512_max_epi32 as max,
+        _mm512_min_epi32 as min, _mm512_min_epu32 as minu, _mm512_mullo_epi32 as mullo,
+        _mm512_or_si512 as or, _mm512_set1_epi16 as set1_16, _mm512_set1_epi32 as set1,
+        _mm512_setzero_si512 as zero, _mm512_shuffle_ps as shuffle_ps, _mm512_slli_epi32 as slli,
+        _mm512_sra_epi32 as sra, _mm512_srai_epi32 as srai, _mm512_storeu_si512 as storeu,
+        _mm512_sub_epi16 as sub16, _mm512_sub_epi32 as sub,
+    };
+
+    /// Pixels per step, and its log2.
+    const N: usize = 16;
+    const LOG2_N: u32 = 4;
+
+    row_kernels!("avx2,avx512f,avx512bw,avx512vl,avx512dq");
+
+    /// `a > b` per lane as all-ones or zero (AVX-512 compares give a mask register).
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn gt(a: V, b: V) -> V {
+        _mm512_movm_epi32(_mm512_cmpgt_epi32_mask(a, b))
+    }
+
+    /// The lane numbers.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn iota() -> V {
+        _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
+    }
+
+    /// Lanes 0..16 = `g(0..16)`.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn gather(g: impl Fn(usize) -> i32) -> V {
+        _mm512_setr_epi32(
+            g(0),
+            g(1),
+            g(2),
+            g(3),
+            g(4),
+            g(5),
+            g(6),
+            g(7),
+            g(8),
+            g(9),
+            g(10),
+            g(11),
+            g(12),
+            g(13),
+            g(14),
+            g(15),
+        )
+    }
+
+    /// The lanes in reverse order.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn reverse(c: V) -> V {
+        let r = _mm512_setr_epi32(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
+        _mm512_permutexvar_epi32(r, c)
     }
 }
 
