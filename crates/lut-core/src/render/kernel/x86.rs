@@ -1,6 +1,10 @@
-//! x86-64 span kernels: SSE4.1 (4 pixels per step) and AVX2 (8 pixels per step).
+//! x86-64 span kernels: SSE4.1 (4 pixels per step) and AVX2 (8 pixels per step); the
+//! AVX-512 pieces (`avx512`: `split`, `lerp`, `merge`, the pair layout and `bilinear16`)
+//! that the AVX-512 row and face kernels (`x86/row.rs`, `x86/face.rs`) share. There are
+//! no AVX-512 span kernels: `Kernel::Avx512` runs the AVX2 ones here (an AVX-512 CPU
+//! runs AVX2), and so do the cropped kernels built on them.
 //!
-//! Both compute what `scalar.rs` computes, byte for byte (see the module docs of
+//! All compute what `scalar.rs` computes, byte for byte (see the module docs of
 //! [`super`]): positions in span-local `i32` lanes, lane indices stored to the stack and
 //! clamped into the pixel slice, two 64-bit loads per bilinear pixel (its top and bottom
 //! pairs), `shufps` to separate left and right texels, and the 8-bit blend in 16-bit

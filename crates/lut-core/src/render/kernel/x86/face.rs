@@ -1,13 +1,15 @@
-//! x86-64 cube-face runs (see `kernel/face.rs`): the face coordinates of 4 (AVX2) or 2
-//! (SSE) pixels per `f64` vector, computed with the scalar twin's operations in its
+//! x86-64 cube-face runs (see `kernel/face.rs`): the face coordinates of 8 (AVX-512), 4
+//! (AVX2) or 2 (SSE) pixels per `f64` vector, computed with the scalar twin's operations in its
 //! order, rounded to Q.16 as it rounds them, then the map kernels' gather and blend
-//! (`bilinear8` / `bilinear4` on absolute positions: base 0) or a nearest fetch.
+//! (`bilinear16` / `bilinear8` / `bilinear4` on absolute positions: base 0) or a nearest
+//! fetch. AVX-512 takes 16 pixels per step (two `f64` vectors, one 16-lane gather and
+//! blend); the division, the kernel's bottleneck, then runs 8 lanes wide.
 //!
 //! Written once (`face_kernels!`) as the row kernels are (`x86/row.rs`): each
 //! instruction set's module names its intrinsics with short aliases (`add_pd` is
 //! `_mm256_add_pd` in `avx2`, `_mm_add_pd` in `sse41`; `V` the i32 vector of `N` lanes,
-//! `D` the f64 vector of `N / 2`) and holds what differs in more than the prefix: joining
-//! two halves' coordinates (`join`), the nearest gather (`gather`), the lane offsets
+//! `D` the f64 vector of `N / 2`, `H` the rounded coordinates of one `D`) and holds what
+//! differs in more than the prefix: joining two halves' coordinates (`join`), the nearest gather (`gather`), the lane offsets
 //! (`iota_pd`).
 
 use super::super::face::{face_side, FaceRun};
