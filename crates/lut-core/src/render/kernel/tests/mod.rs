@@ -571,3 +571,17 @@ fn direct_nearest_spans_equal_per_pixel_samples() {
         }
     }
 }
+
+/// `LUTPANO_KERNEL` picks the active kernel (no test calls `set_kernel`): run the kernel
+/// tests with `LUTPANO_KERNEL=avx2` (or `scalar`, `avx512`) and the renderer uses it.
+#[test]
+fn env_chooses_the_active_kernel() {
+    let info = kernel_info();
+    match kernel_from_env() {
+        Ok(Some(k)) => {
+            assert_eq!(info.active, k);
+            assert_eq!(info.source, KernelSource::Env);
+        }
+        _ => assert_eq!(info.active, Kernel::best()),
+    }
+}
