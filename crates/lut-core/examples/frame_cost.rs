@@ -11,7 +11,7 @@
 //! ```
 //!
 //! Arguments (`key=value`, any order): `sampler` nearest|bilinear|trilinear (bilinear),
-//! `kernel` auto|scalar|sse41|avx2 (auto), `frames` (10), `threads` 1|2 (1), `map` WxH
+//! `kernel` auto|scalar|sse41|avx2|avx512 (auto), `frames` (10), `threads` 1|2 (1), `map` WxH
 //! (8192x4096), `size` WxH (1920x1080), `hfov` (90), `pitch` (10), `yaw` (start, 30; each
 //! frame turns 7.3°), `step` adaptive|1|2|4|8|16 (adaptive), `mode` lut|gather (lut:
 //! gather = a plain gather along the frame's precomputed nearest indices, the floor the

@@ -33,8 +33,9 @@ use crate::map::sample::lerp_px;
 /// Pixels of a half row whose positions are buffered before the row kernels run.
 pub(crate) const HALF_CHUNK: usize = 512;
 
-/// A buffer's room: a chunk, then up to one more span (64 pixels) and the last pixel.
-const ROOM: usize = HALF_CHUNK + 72;
+/// A buffer's room: a chunk, then up to one more span (64 pixels) and the last pixel,
+/// and the 15 positions past it a 16-lane `kernel::expand` writes.
+const ROOM: usize = HALF_CHUNK + 80;
 
 /// Room for a chunk of a half row's positions (Q.8) and its spans, kept from row to row.
 pub(crate) struct HalfBuf {
@@ -187,9 +188,9 @@ fn fill(fr: &Setup, buf: &mut HalfBuf, k: usize, m: usize, (l, vv): (Fx, Fx), (d
     }
     let v = fr.half_map_h_fx - vv;
     let dv = -dvv;
-    // Lanes run up to 8 past the span. (|v| < 2³², as table entries and H/2 are i32:
+    // Lanes run up to 16 past the span. (|v| < 2³², as table entries and H/2 are i32:
     // v >> 8 fits.)
-    let reach = dl.unsigned_abs().max(dv.unsigned_abs()) * (m as u64 + 8);
+    let reach = dl.unsigned_abs().max(dv.unsigned_abs()) * (m as u64 + 16);
     if reach + FX_ONE as u64 <= (wfx as u64).min(1 << 30) {
         buf.spans[buf.n_spans] = SpanQ8 {
             k: k as u32,

@@ -5,7 +5,7 @@
 //! with `a`, `b`, `m` linear in `dx`: a projective line, not a linear one. Stepping it
 //! linearly between exact points would need a bound on the curvature and would change
 //! bytes; these kernels instead evaluate the projective line *exactly* at every pixel, in
-//! `f64` SIMD lanes (4 per AVX2 vector, 2 per SSE vector: three multiply-adds, one
+//! `f64` SIMD lanes (8 per AVX-512 vector, 4 per AVX2 vector, 2 per SSE vector: three multiply-adds, one
 //! division, two multiply-adds per pixel), with the very operations, in the very order,
 //! of [`crate::cube::face_uv`] and [`crate::cube::CubeMap::bilinear`] /
 //! [`crate::cube::CubeMap::nearest`] (IEEE `f64` arithmetic is deterministic and

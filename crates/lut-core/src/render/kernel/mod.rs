@@ -1,5 +1,5 @@
 //! Span kernels: the LUT renderer's inner loops, in portable scalar code and in x86-64
-//! SIMD (SSE4.1, AVX2), chosen once per process.
+//! SIMD (SSE4.1, AVX2, AVX-512), chosen once per process.
 //!
 //! A *span* is a run of output pixels whose map positions step linearly in Q.16:
 //! pixel `i` samples (u + i·du, v + i·dv). The renderer reads its table every 8–64
@@ -36,8 +36,9 @@
 //! # Layout
 //! `mod.rs` (this file): the kernels' data types and the entries the renderer calls on an
 //! [`EnvMap`]; `jobs.rs`: the span check, batches and the dispatch; `scalar.rs`: the
-//! portable kernels (the reference); `x86.rs`: SSE4.1 and AVX2 (the only module where
-//! `unsafe` is allowed; `x86/face.rs` is its child); `select.rs`: choosing the kernel;
+//! portable kernels (the reference); `x86.rs`: SSE4.1 and AVX2, and the AVX-512 pieces
+//! (the only module where `unsafe` is allowed; `x86/face.rs` and `x86/row.rs` are its
+//! children); `select.rs`: choosing the kernel;
 //! `tests/`: the property tests (`row_pass.rs`: the row kernels'); `face.rs`:
 //! cube-face runs, whose positions are a projective line evaluated exactly per pixel
 //! (the cube scanline renderer's kernels);
@@ -90,12 +91,17 @@
 //!   gathering and blending all its pixels in one loop, took more instructions per pixel
 //!   (bilinear 67.6 against 62.8 per frame pixel, nearest 62.2 against 49.5): the fixed
 //!   cost of a span (checks, lane setup) stays, and the results must be copied back.
-//! - No AVX-512 kernel yet: at 8–16 pixels per span the per-span cost, not the blend,
-//!   dominates the kernel, and a 16-lane vector would be half empty on 8-pixel spans.
+//! - AVX-512 (`Kernel::Avx512`, 16 lanes) for the row kernels (`x86/row.rs`: runs of
+//!   hundreds of positions, no per-span cost) and the cube-face kernels (`x86/face.rs`:
+//!   the `f64` division 8 lanes wide), not for the span kernels: at 8–16 pixels per span
+//!   the per-span cost, not the blend, dominates them, and a 16-lane vector would be half
+//!   empty on 8-pixel spans; `Kernel::Avx512` runs their AVX2 code. On AMD Zen 5 plain
+//!   loads beat `vpgatherdq` / `vpgatherdd` in the AVX-512 row kernels too
+//!   (`docs/performance.md`, "AVX-512").
 //!
 //! # Choosing the kernel once
 //! [`active_kernel`] is decided on first use: the `LUTPANO_KERNEL` environment variable
-//! (`auto`, `scalar`, `sse41`, `avx2`; read once) or else the best kernel the CPU runs
+//! (`auto`, `scalar`, `sse41`, `avx2`, `avx512`; read once) or else the best kernel the CPU runs
 //! ([`Kernel::best`], from `is_x86_feature_detected!`). [`set_kernel`] changes it (the
 //! benchmarks compare kernels in one run); [`kernel_info`] tells what runs and which CPU
 //! features were detected. The choice costs one relaxed atomic load per batch, never a

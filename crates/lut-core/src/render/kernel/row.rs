@@ -278,12 +278,12 @@ pub(super) fn expand_scalar(spans: &[SpanQ8], p: Positions<'_>) {
 }
 
 /// Expand `spans` (in order of `k`, each starting where the one before ended) into the
-/// position buffers, which hold at least 8 entries past the last span (the SIMD kernels
+/// position buffers, which hold at least 16 entries past the last span (the SIMD kernels
 /// write whole vectors; the next span overwrites what lies past a span). The row pass's
 /// per-pixel positions, one kernel call per run.
 ///
 /// # Panics
-/// When a span (rounded up to 8 pixels) does not fit in the buffers.
+/// When a span (rounded up to 16 pixels) does not fit in the buffers.
 #[inline]
 pub(crate) fn expand(spans: &[SpanQ8], p: Positions<'_>) {
     expand_with(active(), spans, p);

@@ -19,18 +19,22 @@ pub enum Kernel {
     Sse41,
     /// x86-64 AVX2, 8 pixels per step.
     Avx2,
+    /// x86-64 AVX-512 (F, BW, VL, DQ), 16 pixels per step: the row and cube-face
+    /// kernels; the span kernels, which have no AVX-512 version, run the AVX2 code.
+    Avx512,
 }
 
 /// The kernels in order, slowest first; the names `LUTPANO_KERNEL`, `viewer bench
 /// --kernel` and the reports use.
 impl Named for Kernel {
-    const ALL: &'static [Kernel] = &[Kernel::Scalar, Kernel::Sse41, Kernel::Avx2];
+    const ALL: &'static [Kernel] = &[Kernel::Scalar, Kernel::Sse41, Kernel::Avx2, Kernel::Avx512];
 
     fn name(self) -> &'static str {
         match self {
             Kernel::Scalar => "scalar",
             Kernel::Sse41 => "sse41",
             Kernel::Avx2 => "avx2",
+            Kernel::Avx512 => "avx512",
         }
     }
 
@@ -39,6 +43,7 @@ impl Named for Kernel {
             Kernel::Scalar => "Portable scalar code (the reference)",
             Kernel::Sse41 => "x86-64 SSE4.1, 4 pixels per step",
             Kernel::Avx2 => "x86-64 AVX2, 8 pixels per step",
+            Kernel::Avx512 => "x86-64 AVX-512 (F, BW, VL, DQ), 16 pixels per step",
         }
     }
 }
@@ -57,8 +62,17 @@ impl Kernel {
             Kernel::Sse41 => std::arch::is_x86_feature_detected!("sse4.1"),
             #[cfg(target_arch = "x86_64")]
             Kernel::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+            // AVX2 too: where no AVX-512 version exists, this kernel runs the AVX2 code.
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx512 => {
+                std::arch::is_x86_feature_detected!("avx2")
+                    && std::arch::is_x86_feature_detected!("avx512f")
+                    && std::arch::is_x86_feature_detected!("avx512bw")
+                    && std::arch::is_x86_feature_detected!("avx512vl")
+                    && std::arch::is_x86_feature_detected!("avx512dq")
+            }
             #[cfg(not(target_arch = "x86_64"))]
-            Kernel::Sse41 | Kernel::Avx2 => false,
+            Kernel::Sse41 | Kernel::Avx2 | Kernel::Avx512 => false,
         }
     }
 
@@ -213,7 +227,7 @@ impl std::fmt::Display for Kernel {
 #[non_exhaustive]
 pub enum KernelError {
     /// A name that is not a kernel.
-    #[error("{KERNEL_ENV}={value}: unknown kernel (expected auto, scalar, sse41 or avx2)")]
+    #[error("{KERNEL_ENV}={value}: unknown kernel (expected auto, scalar, sse41, avx2 or avx512)")]
     Unknown {
         /// The value given.
         value: String,
@@ -339,7 +353,7 @@ pub fn cpu_features() -> Vec<&'static str> {
                 }
             )*};
         }
-        probe!("sse4.1", "avx2", "fma", "avx512f", "avx512bw", "avx512vl");
+        probe!("sse4.1", "avx2", "fma", "avx512f", "avx512bw", "avx512vl", "avx512dq");
     }
     #[cfg(target_arch = "aarch64")]
     {

@@ -1,6 +1,10 @@
-//! x86-64 span kernels: SSE4.1 (4 pixels per step) and AVX2 (8 pixels per step).
+//! x86-64 span kernels: SSE4.1 (4 pixels per step) and AVX2 (8 pixels per step); the
+//! AVX-512 pieces (`avx512`: `split`, `lerp`, `merge`, the pair layout and `bilinear16`)
+//! that the AVX-512 row and face kernels (`x86/row.rs`, `x86/face.rs`) share. There are
+//! no AVX-512 span kernels: `Kernel::Avx512` runs the AVX2 ones here (an AVX-512 CPU
+//! runs AVX2), and so do the cropped kernels built on them.
 //!
-//! Both compute what `scalar.rs` computes, byte for byte (see the module docs of
+//! All compute what `scalar.rs` computes, byte for byte (see the module docs of
 //! [`super`]): positions in span-local `i32` lanes, lane indices stored to the stack and
 //! clamped into the pixel slice, two 64-bit loads per bilinear pixel (its top and bottom
 //! pairs), `shufps` to separate left and right texels, and the 8-bit blend in 16-bit
@@ -78,7 +82,8 @@ pub(super) fn jobs<const BILINEAR: bool>(
 ) -> Option<u64> {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        Kernel::Avx2 => Some(unsafe { avx2::jobs::<BILINEAR>(t, row, jobs) }),
+        // (No AVX-512 span kernels: AVX-512 CPUs run AVX2, see `Kernel::Avx512`.)
+        Kernel::Avx2 | Kernel::Avx512 => Some(unsafe { avx2::jobs::<BILINEAR>(t, row, jobs) }),
         // SAFETY: as above.
         Kernel::Sse41 => Some(unsafe { sse41::jobs::<BILINEAR>(t, row, jobs) }),
         Kernel::Scalar => None,
@@ -97,7 +102,8 @@ pub(super) fn tri_jobs(
 ) -> Option<u64> {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        Kernel::Avx2 => Some(unsafe { avx2::tri_jobs(levels, row, jobs, lods) }),
+        // (No AVX-512 span kernels: AVX-512 CPUs run AVX2, see `Kernel::Avx512`.)
+        Kernel::Avx2 | Kernel::Avx512 => Some(unsafe { avx2::tri_jobs(levels, row, jobs, lods) }),
         // SAFETY: as above.
         Kernel::Sse41 => Some(unsafe { sse41::tri_jobs(levels, row, jobs, lods) }),
         Kernel::Scalar => None,
@@ -429,6 +435,149 @@ mod avx2 {
                 *o = fetch(&a, j);
             }
         }
+    }
+}
+
+/// The AVX-512 pieces the row and face kernels share (`x86/row.rs`, `x86/face.rs`): the
+/// AVX2 ones on 16 lanes, the same arithmetic. There are no AVX-512 span kernels (the
+/// batch entry points above): `Kernel::Avx512` runs the AVX2 ones.
+///
+/// Every function is `#[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,
+/// avx512dq")]` (a list: `Kernel::Avx512` checks each).
+mod avx512 {
+    use super::*;
+
+    /// Per 32-bit lane: the fraction byte (bits 8..16) in both 16-bit halves.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn weights(r: __m512i) -> (__m512i, __m512i) {
+        let m = _mm512_set4_epi32(
+            0x800D_800D_u32 as i32,
+            0x8009_8009_u32 as i32,
+            0x8005_8005_u32 as i32,
+            0x8001_8001_u32 as i32,
+        );
+        let w = _mm512_shuffle_epi8(r, m);
+        (w, _mm512_sub_epi16(_mm512_set1_epi16(256), w))
+    }
+
+    /// 0RGB pixels → (blue and red, green and top byte), one channel per 16-bit lane.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    pub(super) fn split(p: __m512i) -> (__m512i, __m512i) {
+        (
+            _mm512_and_si512(p, _mm512_set1_epi32(0x00FF_00FF)),
+            _mm512_srli_epi16::<8>(p),
+        )
+    }
+
+    /// Per channel `(a·iw + b·w + 128) >> 8` (at most 255·256 + 128: no 16-bit overflow).
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    pub(super) fn lerp(
+        a: (__m512i, __m512i),
+        b: (__m512i, __m512i),
+        w: (__m512i, __m512i),
+    ) -> (__m512i, __m512i) {
+        let r = _mm512_set1_epi16(128);
+        let f = |x: __m512i, y: __m512i| {
+            let s = _mm512_add_epi16(_mm512_mullo_epi16(x, w.1), _mm512_mullo_epi16(y, w.0));
+            _mm512_srli_epi16::<8>(_mm512_add_epi16(s, r))
+        };
+        (f(a.0, b.0), f(a.1, b.1))
+    }
+
+    /// Split channels back to 0RGB (the top byte dropped).
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    pub(super) fn merge(c: (__m512i, __m512i)) -> __m512i {
+        let g = _mm512_and_si512(_mm512_slli_epi32::<8>(c.1), _mm512_set1_epi32(0xFF00));
+        _mm512_or_si512(c.0, g)
+    }
+
+    /// The 64-bit texel pairs of lanes 0..16 (`pair(k)`) as two vectors, (0, 1, 4, 5, 8,
+    /// 9, 12, 13) and (2, 3, 6, 7, 10, 11, 14, 15), so that `shufps` (within 128-bit
+    /// quarters) gives lanes 0..16 in order.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    pub(super) fn pairs(pair: impl Fn(usize) -> i64) -> (__m512i, __m512i) {
+        (
+            _mm512_set_epi64(
+                pair(13),
+                pair(12),
+                pair(9),
+                pair(8),
+                pair(5),
+                pair(4),
+                pair(1),
+                pair(0),
+            ),
+            _mm512_set_epi64(
+                pair(15),
+                pair(14),
+                pair(11),
+                pair(10),
+                pair(7),
+                pair(6),
+                pair(3),
+                pair(2),
+            ),
+        )
+    }
+
+    /// The left texels of the pixels whose pairs [`pairs`] laid out in `x`, `y`.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    pub(super) fn left(x: __m512i, y: __m512i) -> __m512i {
+        _mm512_castps_si512(_mm512_shuffle_ps::<0x88>(
+            _mm512_castsi512_ps(x),
+            _mm512_castsi512_ps(y),
+        ))
+    }
+
+    /// The right texels (see [`left`]).
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    pub(super) fn right(x: __m512i, y: __m512i) -> __m512i {
+        _mm512_castps_si512(_mm512_shuffle_ps::<0xDD>(
+            _mm512_castsi512_ps(x),
+            _mm512_castsi512_ps(y),
+        ))
+    }
+
+    /// Bilinear samples at 16 lane positions (split channels; see `avx2::bilinear8`).
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    pub(super) fn bilinear16(
+        px: &[u32],
+        stride: usize,
+        l: &Local,
+        ru: __m512i,
+        rv: __m512i,
+    ) -> (__m512i, __m512i) {
+        let x = _mm512_srai_epi32::<16>(ru);
+        let y = _mm512_srai_epi32::<16>(rv);
+        let i = _mm512_add_epi32(_mm512_mullo_epi32(y, _mm512_set1_epi32(stride as i32)), x);
+        let i = _mm512_max_epi32(
+            _mm512_min_epi32(i, _mm512_set1_epi32(l.hi)),
+            _mm512_set1_epi32(l.lo),
+        );
+        let mut a = [0i32; 16];
+        // SAFETY: `a` is 64 writable bytes; the store is unaligned.
+        unsafe { _mm512_storeu_si512(a.as_mut_ptr().cast(), i) };
+        let p = px.as_ptr();
+        let pair = |j: usize, row: usize| -> i64 {
+            let k = (l.base as isize + a[j] as isize) as usize + row;
+            // SAFETY: a[j] is clamped to [−base, last − base], so k ≤ last + row where
+            // last + stride + 1 < px.len() (Local::new): the 8 bytes at k are in `px`.
+            unsafe { p.add(k).cast::<i64>().read_unaligned() }
+        };
+        let (ta, tb) = pairs(|j| pair(j, 0));
+        let (ba, bb) = pairs(|j| pair(j, stride));
+        let wx = weights(ru);
+        let top = lerp(split(left(ta, tb)), split(right(ta, tb)), wx);
+        let bot = lerp(split(left(ba, bb)), split(right(ba, bb)), wx);
+        lerp(top, bot, weights(rv))
     }
 }
 

@@ -93,7 +93,7 @@ pub struct BenchArgs {
     /// render supersampled 8x8, which takes a while).
     #[arg(long)]
     pub no_minify: bool,
-    /// The span kernel: auto (the best this CPU runs), scalar, sse41 or avx2 (default:
+    /// The span kernel: auto (the best this CPU runs), scalar, sse41, avx2 or avx512 (default:
     /// LUTPANO_KERNEL, else auto). The kernel that ran and the CPU features detected are
     /// printed with the results.
     #[arg(long, value_parser = parse_kernel_choice)]

@@ -26,7 +26,7 @@ pub struct RunInfo {
     pub map_height: u32,
     /// The map's projection name.
     pub projection: Name,
-    /// The span kernel that ran (`lut_core::Kernel` name: scalar, sse41, avx2).
+    /// The span kernel that ran (`lut_core::Kernel` name: scalar, sse41, avx2, avx512).
     pub kernel: Name,
 }
 

@@ -463,7 +463,11 @@ fn names_parse_and_selection() {
     assert_eq!(Kernel::available().first(), Some(&Kernel::Scalar));
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
-        assert_eq!(Kernel::best(), Kernel::Avx2);
+        let avx512 = ["avx512f", "avx512bw", "avx512vl", "avx512dq"]
+            .iter()
+            .all(|f| cpu_features().contains(f));
+        let best = if avx512 { Kernel::Avx512 } else { Kernel::Avx2 };
+        assert_eq!(Kernel::best(), best);
         assert!(cpu_features().contains(&"avx2"));
     }
     let info = kernel_info();
@@ -565,5 +569,19 @@ fn direct_nearest_spans_equal_per_pixel_samples() {
                 }
             }
         }
+    }
+}
+
+/// `LUTPANO_KERNEL` picks the active kernel (no test calls `set_kernel`): run the kernel
+/// tests with `LUTPANO_KERNEL=avx2` (or `scalar`, `avx512`) and the renderer uses it.
+#[test]
+fn env_chooses_the_active_kernel() {
+    let info = kernel_info();
+    match kernel_from_env() {
+        Ok(Some(k)) => {
+            assert_eq!(info.active, k);
+            assert_eq!(info.source, KernelSource::Env);
+        }
+        _ => assert_eq!(info.active, Kernel::best()),
     }
 }

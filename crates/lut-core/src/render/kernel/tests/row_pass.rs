@@ -142,7 +142,7 @@ proptest! {
                 s
             })
             .collect();
-        let room = k as usize + 8;
+        let room = k as usize + 16;
         let run = |kern: Kernel| {
             let mut b = [vec![0i32; room], vec![0i32; room], vec![0i32; room]];
             let [u, v, ul] = &mut b;

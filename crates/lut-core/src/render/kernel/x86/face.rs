@@ -1,13 +1,15 @@
-//! x86-64 cube-face runs (see `kernel/face.rs`): the face coordinates of 4 (AVX2) or 2
-//! (SSE) pixels per `f64` vector, computed with the scalar twin's operations in its
+//! x86-64 cube-face runs (see `kernel/face.rs`): the face coordinates of 8 (AVX-512), 4
+//! (AVX2) or 2 (SSE) pixels per `f64` vector, computed with the scalar twin's operations in its
 //! order, rounded to Q.16 as it rounds them, then the map kernels' gather and blend
-//! (`bilinear8` / `bilinear4` on absolute positions: base 0) or a nearest fetch.
+//! (`bilinear16` / `bilinear8` / `bilinear4` on absolute positions: base 0) or a nearest
+//! fetch. AVX-512 takes 16 pixels per step (two `f64` vectors, one 16-lane gather and
+//! blend); the division, the kernel's bottleneck, then runs 8 lanes wide.
 //!
 //! Written once (`face_kernels!`) as the row kernels are (`x86/row.rs`): each
 //! instruction set's module names its intrinsics with short aliases (`add_pd` is
 //! `_mm256_add_pd` in `avx2`, `_mm_add_pd` in `sse41`; `V` the i32 vector of `N` lanes,
-//! `D` the f64 vector of `N / 2`) and holds what differs in more than the prefix: joining
-//! two halves' coordinates (`join`), the nearest gather (`gather`), the lane offsets
+//! `D` the f64 vector of `N / 2`, `H` the rounded coordinates of one `D`) and holds what
+//! differs in more than the prefix: joining two halves' coordinates (`join`), the nearest gather (`gather`), the lane offsets
 //! (`iota_pd`).
 
 use super::super::face::{face_side, FaceRun};
@@ -27,6 +29,8 @@ pub(in super::super) fn face_span<const BILINEAR: bool, const BLEND: bool>(
 ) -> bool {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
+        Kernel::Avx512 => unsafe { avx512::face::<BILINEAR, BLEND>(t, r, out, frac) },
+        // SAFETY: as above.
         Kernel::Avx2 => unsafe { avx2::face::<BILINEAR, BLEND>(t, r, out, frac) },
         // SAFETY: as above.
         Kernel::Sse41 => unsafe { sse41::face::<BILINEAR, BLEND>(t, r, out, frac) },
@@ -83,7 +87,7 @@ macro_rules! face_kernels {
         /// whole texels; in the low lanes of the result.
         #[inline]
         #[target_feature(enable = $feature)]
-        fn uv<const BILINEAR: bool>(r: &FaceRun, n: f64, i: D) -> (__m128i, __m128i) {
+        fn uv<const BILINEAR: bool>(r: &FaceRun, n: f64, i: D) -> (H, H) {
             let s = set1_pd;
             let dx = add_pd(s(r.dx), i);
             let a = add_pd(s(r.p[0]), mul_pd(dx, s(r.d[0])));
@@ -220,6 +224,8 @@ mod avx2 {
 
     /// Pixels per step.
     const N: usize = 8;
+    /// The rounded coordinates of one `D` (4 lanes).
+    type H = __m128i;
 
     face_kernels!("avx2");
 
@@ -245,6 +251,65 @@ mod avx2 {
     }
 }
 
+mod avx512 {
+    use super::super::avx512::{bilinear16 as bilinear, lerp, merge, split};
+    use super::*;
+    use std::arch::x86_64::{
+        __m512d as D, __m512i as V, _mm512_add_epi32 as add, _mm512_add_pd as add_pd,
+        _mm512_cvttpd_epi32 as cvtt_pd, _mm512_div_pd as div_pd, _mm512_loadu_si512 as loadu,
+        _mm512_max_epi32 as max, _mm512_max_pd as max_pd, _mm512_min_epi32 as min,
+        _mm512_min_pd as min_pd, _mm512_mul_pd as mul_pd, _mm512_mullo_epi32 as mullo,
+        _mm512_set1_epi16 as set1_16, _mm512_set1_epi32 as set1, _mm512_set1_pd as set1_pd,
+        _mm512_setzero_pd as zero_pd, _mm512_setzero_si512 as zero, _mm512_storeu_si512 as storeu,
+        _mm512_sub_epi16 as sub16, _mm512_sub_pd as sub_pd,
+    };
+
+    /// Pixels per step.
+    const N: usize = 16;
+    /// The rounded coordinates of one `D` (8 lanes).
+    type H = __m256i;
+
+    face_kernels!("avx2,avx512f,avx512bw,avx512vl,avx512dq");
+
+    /// The lane offsets of the first half: 0..8.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn iota_pd() -> D {
+        _mm512_setr_pd(0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
+    }
+
+    /// The two halves' coordinates (8 lanes each) as one vector.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn join(lo: __m256i, hi: __m256i) -> V {
+        _mm512_inserti64x4::<1>(_mm512_castsi256_si512(lo), hi)
+    }
+
+    /// Lanes 0..16 = `g(0..16)`.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn gather(g: impl Fn(usize) -> i32) -> V {
+        _mm512_setr_epi32(
+            g(0),
+            g(1),
+            g(2),
+            g(3),
+            g(4),
+            g(5),
+            g(6),
+            g(7),
+            g(8),
+            g(9),
+            g(10),
+            g(11),
+            g(12),
+            g(13),
+            g(14),
+            g(15),
+        )
+    }
+}
+
 mod sse41 {
     use super::super::sse41::{bilinear4 as bilinear, lerp, merge, split};
     use super::*;
@@ -260,6 +325,8 @@ mod sse41 {
 
     /// Pixels per step.
     const N: usize = 4;
+    /// The rounded coordinates of one `D` (2 low lanes).
+    type H = __m128i;
 
     face_kernels!("sse4.1");
 

@@ -1,5 +1,5 @@
-//! x86-64 row kernels (see `kernel/row.rs`): 8 (AVX2) or 4 (SSE4.1) pixels per step, the
-//! seam wrap and the pole clamp as lane compares, the texels read as the map kernels read
+//! x86-64 row kernels (see `kernel/row.rs`): 16 (AVX-512), 8 (AVX2) or 4 (SSE4.1) pixels
+//! per step, the seam wrap and the pole clamp as lane compares, the texels read as the map kernels read
 //! them (two 64-bit loads per bilinear pixel) and blended with their `split`, `lerp` and
 //! `merge`; the left half's pixels reversed in the register before the store. Each
 //! kernel prefetches the texels of the position [`PREFETCH_AHEAD`] pixels ahead (the
@@ -10,8 +10,19 @@
 //! `_mm256_add_epi32` in `avx2`, `_mm_add_epi32` in `sse41`; `V` the vector type, `N` its
 //! lanes) and a few functions hold what differs in more than the prefix: the lane
 //! layout of the texel pairs (`pairs`), the nearest gather (`gather`), the reversal
-//! (`reverse`), `iota`. Every function is `#[target_feature]` and `#[inline]`, compiled
-//! into the entry points as before: the same code per set as when each was written out.
+//! (`reverse`), `iota`, the compares (`add_if_below`, `sub_if_above`, `zero_outside`:
+//! vector compares and masks in AVX2 and SSE4.1, `vector_compares!`; mask registers and
+//! masked adds in AVX-512), and the kernel for the last pixels of a run (`tail`: the
+//! scalar one, or for AVX-512 the AVX2 one, so that a run of 8–15 pixels, common in the
+//! trilinear level runs, still goes 8 at a time). Every function is `#[target_feature]`
+//! and `#[inline]`, compiled into the entry points as before: the same code per set as
+//! when each was written out.
+//!
+//! AVX-512 (`avx512`, 16 `i32` lanes): `shufps` works within 128-bit quarters there too,
+//! so `pairs` lays the pairs out as (0, 1, 4, 5, 8, 9, 12, 13) and (2, 3, …, 15). Plain
+//! 64-bit loads, as AVX2 does, measured faster than `vpgatherdq` for the pairs (and
+//! scalar loads faster than `vpgatherdd` for nearest) on AMD Zen 5: see
+//! `docs/performance.md`, "AVX-512".
 
 use super::super::row::{sample_lv_scalar, Level, Positions, SpanQ8};
 use super::{prefetch_texels, Kernel, Selected, Texels, PREFETCH_AHEAD};
@@ -35,6 +46,10 @@ pub(in super::super) fn sample_q8<
 ) -> bool {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
+        Kernel::Avx512 => unsafe {
+            avx512::sample_q8::<BILINEAR, MIRROR, LEVEL, BLEND>(t, u, v, out, lv)
+        },
+        // SAFETY: as above.
         Kernel::Avx2 => unsafe {
             avx2::sample_q8::<BILINEAR, MIRROR, LEVEL, BLEND>(t, u, v, out, lv)
         },
@@ -57,6 +72,8 @@ pub(in super::super) fn expand<'a>(
 ) -> Option<Positions<'a>> {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
+        Kernel::Avx512 => unsafe { avx512::expand(spans, p) },
+        // SAFETY: as above.
         Kernel::Avx2 => unsafe { avx2::expand(spans, p) },
         // SAFETY: as above.
         Kernel::Sse41 => unsafe { sse41::expand(spans, p) },
@@ -100,10 +117,10 @@ fn prefetch_every(u: &[i32], k: u32) -> usize {
 
 /// The row kernels of one instruction set (`$feature`), in terms of the names its module
 /// defines: `V` (the vector of `N` i32 lanes), `N`, `LOG2_N`, the intrinsic aliases
-/// (`add`, `sub`, `and`, `andnot`, `or`, `gt`, `min`, `max`, `minu`, `srai`, `slli`,
-/// `sra`, `mullo`, `set1`, `set1_16`, `sub16`, `zero`, `loadu`, `storeu`, `shuffle_ps`,
-/// `to_ps`, `from_ps`), `iota`, `pairs`, `gather` and `reverse`, and the map kernels'
-/// `split`, `lerp` and `merge`.
+/// (`add`, `sub`, `and`, `or`, `min`, `max`, `minu`, `srai`, `slli`, `sra`, `mullo`,
+/// `set1`, `set1_16`, `sub16`, `zero`, `loadu`, `storeu`, `shuffle_ps`, `to_ps`,
+/// `from_ps`), `iota`, `pairs`, `gather`, `reverse`, `add_if_below`, `sub_if_above`,
+/// `zero_outside` and `tail`, and the map kernels' `split`, `lerp` and `merge`.
 macro_rules! row_kernels {
     ($feature:literal) => {
         /// (indices clamped to `last`, fx, fy) of positions (u, v), Q.8 (see
@@ -120,16 +137,15 @@ macro_rules! row_kernels {
             };
             let wv = set1(w);
             let x = srai::<8>(u);
-            let x = add(x, and(gt(zero, x), wv));
-            let x = add(x, and(gt(zero, x), wv));
-            let x = sub(x, and(gt(x, set1(w - 1)), wv));
-            let x = sub(x, and(gt(x, set1(w - 1)), wv));
+            let x = add_if_below(x, zero, wv);
+            let x = add_if_below(x, zero, wv);
+            let x = sub_if_above(x, set1(w - 1), wv);
+            let x = sub_if_above(x, set1(w - 1), wv);
             let x = min(max(x, zero), set1(w - 1));
             let y = srai::<8>(v);
             let ff = set1(0xFF);
             let (fx, fy) = if BILINEAR {
-                let off = or(gt(zero, y), gt(y, set1(h1 - 1)));
-                (and(u, ff), andnot(off, and(v, ff)))
+                (and(u, ff), zero_outside(y, set1(h1 - 1), and(v, ff)))
             } else {
                 (zero, zero)
             };
@@ -145,11 +161,11 @@ macro_rules! row_kernels {
         fn on_level(u: V, v: V, lv: &Level) -> (V, V) {
             let zero = zero();
             let wv = set1(lv.wq);
-            let u = add(u, and(gt(zero, u), wv));
-            let u = add(u, and(gt(zero, u), wv));
+            let u = add_if_below(u, zero, wv);
+            let u = add_if_below(u, zero, wv);
             let top = set1(lv.wq - 1);
-            let u = sub(u, and(gt(u, top), wv));
-            let u = sub(u, and(gt(u, top), wv));
+            let u = sub_if_above(u, top, wv);
+            let u = sub_if_above(u, top, wv);
             let k = _mm_cvtsi32_si128(lv.k as i32);
             (sra(u, k), sra(v, k))
         }
@@ -211,7 +227,7 @@ macro_rules! row_kernels {
         }
 
         /// The row kernel (see `row::sample_lv_scalar`), N pixels per step, the rest
-        /// (fewer than N) with the scalar one.
+        /// (fewer than N) with `tail` (the scalar one, or for AVX-512 the AVX2 one).
         #[inline]
         #[target_feature(enable = $feature)]
         pub(super) fn sample_q8<
@@ -302,13 +318,41 @@ macro_rules! row_kernels {
                 w: if BLEND { &lv.w[j..] } else { lv.w },
                 ..*lv
             };
-            sample_lv_scalar::<BILINEAR, MIRROR, LEVEL, BLEND>(t, &u[j..], &v[j..], rest, &lv);
+            tail::<BILINEAR, MIRROR, LEVEL, BLEND>(t, &u[j..], &v[j..], rest, &lv);
+        }
+    };
+}
+
+/// The lane compares of `lanes` and `on_level` for a set whose compares give vectors
+/// (`gt`: all-ones or zero per lane), in terms of its aliases.
+macro_rules! vector_compares {
+    ($feature:literal) => {
+        /// `x + w` where `x < lo`, else `x`.
+        #[inline]
+        #[target_feature(enable = $feature)]
+        fn add_if_below(x: V, lo: V, w: V) -> V {
+            add(x, and(gt(lo, x), w))
+        }
+
+        /// `x − w` where `x > hi`, else `x`.
+        #[inline]
+        #[target_feature(enable = $feature)]
+        fn sub_if_above(x: V, hi: V, w: V) -> V {
+            sub(x, and(gt(x, hi), w))
+        }
+
+        /// `f` where 0 ≤ `y` ≤ `hi`, else 0.
+        #[inline]
+        #[target_feature(enable = $feature)]
+        fn zero_outside(y: V, hi: V, f: V) -> V {
+            andnot(or(gt(zero(), y), gt(y, hi)), f)
         }
     };
 }
 
 mod avx2 {
     use super::super::avx2::{lerp, merge, split};
+    use super::sample_lv_scalar as tail;
     use super::*;
     use std::arch::x86_64::{
         __m256i as V, _mm256_add_epi32 as add, _mm256_and_si256 as and,
@@ -326,6 +370,7 @@ mod avx2 {
     const LOG2_N: i32 = 3;
 
     row_kernels!("avx2");
+    vector_compares!("avx2");
 
     /// The lane numbers.
     #[inline]
@@ -360,8 +405,91 @@ mod avx2 {
     }
 }
 
+mod avx512 {
+    use super::super::avx512::{lerp, merge, pairs, split};
+    use super::avx2::sample_q8 as tail;
+    use super::*;
+    use std::arch::x86_64::{
+        __m512i as V, _mm512_add_epi32 as add, _mm512_and_si512 as and,
+        _mm512_castps_si512 as from_ps, _mm512_castsi512_ps as to_ps, _mm512_loadu_si512 as loadu,
+        _mm512_max_epi32 as max, _mm512_min_epi32 as min, _mm512_min_epu32 as minu,
+        _mm512_mullo_epi32 as mullo, _mm512_or_si512 as or, _mm512_set1_epi16 as set1_16,
+        _mm512_set1_epi32 as set1, _mm512_setzero_si512 as zero, _mm512_shuffle_ps as shuffle_ps,
+        _mm512_slli_epi32 as slli, _mm512_sra_epi32 as sra, _mm512_srai_epi32 as srai,
+        _mm512_storeu_si512 as storeu, _mm512_sub_epi16 as sub16, _mm512_sub_epi32 as sub,
+    };
+
+    /// Pixels per step, and its log2.
+    const N: usize = 16;
+    const LOG2_N: u32 = 4;
+
+    row_kernels!("avx2,avx512f,avx512bw,avx512vl,avx512dq");
+
+    /// `x + w` where `x < lo`, else `x` (a masked add).
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn add_if_below(x: V, lo: V, w: V) -> V {
+        _mm512_mask_add_epi32(x, _mm512_cmplt_epi32_mask(x, lo), x, w)
+    }
+
+    /// `x − w` where `x > hi`, else `x` (a masked subtract).
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn sub_if_above(x: V, hi: V, w: V) -> V {
+        _mm512_mask_sub_epi32(x, _mm512_cmpgt_epi32_mask(x, hi), x, w)
+    }
+
+    /// `f` where 0 ≤ `y` ≤ `hi`, else 0.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn zero_outside(y: V, hi: V, f: V) -> V {
+        let inside = _mm512_mask_cmple_epi32_mask(_mm512_cmpge_epi32_mask(y, zero()), y, hi);
+        _mm512_maskz_mov_epi32(inside, f)
+    }
+
+    /// The lane numbers.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn iota() -> V {
+        _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
+    }
+
+    /// Lanes 0..16 = `g(0..16)`.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn gather(g: impl Fn(usize) -> i32) -> V {
+        _mm512_setr_epi32(
+            g(0),
+            g(1),
+            g(2),
+            g(3),
+            g(4),
+            g(5),
+            g(6),
+            g(7),
+            g(8),
+            g(9),
+            g(10),
+            g(11),
+            g(12),
+            g(13),
+            g(14),
+            g(15),
+        )
+    }
+
+    /// The lanes in reverse order.
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn reverse(c: V) -> V {
+        let r = _mm512_setr_epi32(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
+        _mm512_permutexvar_epi32(r, c)
+    }
+}
+
 mod sse41 {
     use super::super::sse41::{lerp, merge, split};
+    use super::sample_lv_scalar as tail;
     use super::*;
     use std::arch::x86_64::{
         __m128i as V, _mm_add_epi32 as add, _mm_and_si128 as and, _mm_andnot_si128 as andnot,
@@ -379,6 +507,7 @@ mod sse41 {
     const LOG2_N: i32 = 2;
 
     row_kernels!("sse4.1");
+    vector_compares!("sse4.1");
 
     /// The lane numbers.
     #[inline]
