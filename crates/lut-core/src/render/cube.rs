@@ -37,7 +37,7 @@
 
 use super::exact::render_exact;
 use super::frame::Frame;
-use super::kernel::{face_blend, face_span, FaceRun, Texels};
+use super::kernel::{face_blend, face_span, face_steps, FaceRun, StepBuf, Texels};
 use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
     check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
@@ -180,8 +180,17 @@ fn face_texels(cube: &CubeMap, face: Face) -> Texels<'_> {
 trait Fetch: Copy + Send + Sync {
     /// The sample of ray `d` on `face` (the face of `d`), per pixel.
     fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32;
-    /// A verified run on `face` (`run`: its projective line), with the span kernels.
-    fn span(self, cube: &CubeMap, frame: &Rays, face: Face, run: &FaceRun, out: &mut [u32]);
+    /// A verified run on `face` (`run`: its projective line), with the span kernels
+    /// (`buf`: the band's scratch for the stepped runs).
+    fn span(
+        self,
+        cube: &CubeMap,
+        frame: &Rays,
+        face: Face,
+        run: &FaceRun,
+        out: &mut [u32],
+        buf: &mut StepBuf,
+    );
 }
 
 #[derive(Clone, Copy)]
@@ -198,8 +207,8 @@ impl Fetch for NearestFetch {
         cube.nearest(face, u, v)
     }
     #[inline(always)]
-    fn span(self, cube: &CubeMap, _: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
-        face_span::<false>(&face_texels(cube, face), run, out)
+    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut StepBuf) {
+        face_steps::<false>(&face_texels(c, f), r, o, b)
     }
 }
 
@@ -210,8 +219,8 @@ impl Fetch for BilinearFetch {
         cube.bilinear(face, u, v)
     }
     #[inline(always)]
-    fn span(self, cube: &CubeMap, _: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
-        face_span::<true>(&face_texels(cube, face), run, out)
+    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut StepBuf) {
+        face_steps::<true>(&face_texels(c, f), r, o, b)
     }
 }
 
@@ -226,7 +235,15 @@ impl Fetch for TrilinearFetch {
         cube.trilinear_dir(face, d, lod)
     }
 
-    fn span(self, cube: &CubeMap, frame: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
+    fn span(
+        self,
+        cube: &CubeMap,
+        frame: &Rays,
+        face: Face,
+        run: &FaceRun,
+        out: &mut [u32],
+        _: &mut StepBuf,
+    ) {
         // The image's x and y steps on the face's axes (y: −R₁ per row; the sign does not
         // change the footprint).
         let (sx, sy) = (face_axes(face, frame.b), face_axes(face, frame.r1));
@@ -296,11 +313,14 @@ fn render_with<S: Fetch>(
     let rows_per_band = (16384 / w).clamp(1, frame.h as usize);
     let band = |(bi, chunk): (usize, &mut [u32])| {
         let mut segs = Vec::with_capacity(16);
+        let mut buf = StepBuf::default();
         for (r, line) in chunk.chunks_exact_mut(w).enumerate() {
             let y = bi * rows_per_band + r;
             match renderer {
                 CubeRenderer::Basic => basic_row(cube, frame, s, y, line),
-                CubeRenderer::Accelerated => accel_row(cube, frame, s, y, line, &mut segs),
+                CubeRenderer::Accelerated => {
+                    accel_row(cube, frame, s, y, line, (&mut segs, &mut buf))
+                }
             }
         }
     };
@@ -391,7 +411,7 @@ fn accel_row<S: Fetch>(
     s: S,
     y: usize,
     line: &mut [u32],
-    segs: &mut Vec<Seg>,
+    (segs, buf): (&mut Vec<Seg>, &mut StepBuf),
 ) {
     let w = line.len();
     let p = frame.row(frame.dy(y));
@@ -432,7 +452,7 @@ fn accel_row<S: Fetch>(
             dx: frame.dx(a),
             half: frame.half_face,
         };
-        s.span(cube, frame, seg.face, &run, &mut line[a..e]);
+        s.span(cube, frame, seg.face, &run, &mut line[a..e], buf);
     }
 }
 

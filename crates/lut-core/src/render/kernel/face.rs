@@ -156,7 +156,7 @@ impl Kernel {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::cube::{face_axes, face_of, CubeMap, Face};
     use glam::DVec3;
@@ -180,7 +180,7 @@ mod tests {
         CubeMap::from_faces(n, refs).unwrap()
     }
 
-    fn cubes() -> &'static [CubeMap] {
+    pub(in crate::render::kernel) fn cubes() -> &'static [CubeMap] {
         static C: std::sync::OnceLock<Vec<CubeMap>> = std::sync::OnceLock::new();
         C.get_or_init(|| {
             [1, 2, 3, 16, 61]
@@ -191,7 +191,7 @@ mod tests {
         })
     }
 
-    fn face_texels(c: &CubeMap, f: Face) -> Texels<'_> {
+    pub(in crate::render::kernel) fn face_texels(c: &CubeMap, f: Face) -> Texels<'_> {
         let s = c.face_size() + 1;
         Texels::new(c.bordered_face(f), s, s, false).unwrap()
     }
@@ -282,7 +282,7 @@ mod tests {
 
     /// A face run of a view's scanline as the renderer builds it: `P`, `B` of
     /// `render/cube.rs` on the axes of the face of the run's first pixel.
-    fn view_run(
+    pub(in crate::render::kernel) fn view_run(
         (yaw, pitch, hfov): (f64, f64, f64),
         (w, h): (u32, u32),
         (x, y): (u32, u32),

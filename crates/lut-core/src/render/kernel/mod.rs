@@ -113,6 +113,7 @@
 //! aarch64 and x86 CPUs without SSE4.1 run the scalar kernel.
 
 mod face;
+mod face_step;
 mod jobs;
 mod row;
 mod scalar;
@@ -128,6 +129,8 @@ pub use select::{
 };
 
 pub(crate) use face::{face_blend, face_span, FaceRun};
+pub(crate) use face_step::{face_steps, StepBuf};
+pub use face_step::{FACE_STEP_BOUND, FACE_STEP_ERROR, FACE_STEP_MAX};
 pub(crate) use row::{expand, sample_level, sample_q8, wrap_q8, Level, Positions, SpanQ8};
 
 use crate::geom::fixed::{Fx, FX_BITS};
