@@ -25,7 +25,9 @@
 //!
 //! Each sub-span takes the largest power of two `d` ≤ [`FACE_STEP_MAX`] (or the rest of
 //! the run) with `E(d)` ≤ [`FACE_STEP_ERROR`] (0.02 face texels, the LUT's own sampling
-//! error; the project's budget is 0.05); `d` = 1 is exact. The fixed point adds less than
+//! error; the project's budget is 0.05), taking for `min m` the smaller of `m` at the
+//! sub-span's start and `FACE_STEP_MAX` pixels on (or at the run's last pixel), which
+//! is no larger (m is linear) and costs no division; `d` = 1 is exact. The fixed point adds less than
 //! `d` Q.16 units per axis (the ends' rounding, ≤ 1 unit with nearest's clamp below the
 //! face's last texel edge, and the truncated step, < 1 unit per pixel), so every position
 //! is within [`FACE_STEP_BOUND`] = 0.02 + √2·32/65536 ≈ 0.0207 face texels of the exact
@@ -80,7 +82,8 @@ pub(crate) struct StepBuf {
 /// `m`.
 #[inline(always)]
 fn exact(r: &FaceRun, i: usize) -> (f64, f64, f64) {
-    let dx = r.dx + i as f64;
+    // (Runs are shorter than 2³² pixels: u32 converts to f64 in one instruction.)
+    let dx = r.dx + f64::from(i as u32);
     let a = r.p[0] + dx * r.d[0];
     let b = r.p[1] + dx * r.d[1];
     let m = r.p[2] + dx * r.d[2];
@@ -109,8 +112,10 @@ pub(super) fn plan<const BILINEAR: bool>(
     let q16 = |x: f64| ((x.max(0.0).min(nf) * FX_ONE as f64 + 0.5) as i64).min(top) + FX_ONE;
     let ka = r.d[0] * r.p[2] - r.p[0] * r.d[2];
     let kb = r.d[1] * r.p[2] - r.p[1] * r.d[2];
-    // E(d) = c·d² / min(m)³.
+    // E(d) = c·d² / min(m)³ ≤ FACE_STEP_ERROR ⟺ d² ≤ lim·min(m)³.
     let c = 0.25 * r.half * r.d[2].abs() * ka.hypot(kb);
+    let lim = FACE_STEP_ERROR / c;
+    let m_at = |i: usize| r.p[2] + (r.dx + f64::from(i as u32)) * r.d[2];
     // The row (bordered, with bilinear's −½) at which the map kernels clamp.
     let last_row = (n as i64) << FX_BITS;
     let mut low = false;
@@ -119,23 +124,25 @@ pub(super) fn plan<const BILINEAR: bool>(
     let mut i0 = 0;
     while i0 < len {
         let rest = len - 1 - i0;
-        let mut l = FACE_STEP_MAX;
-        let (d, (u, v, m1)) = loop {
-            let d = l.min(rest);
-            let e = exact(r, i0 + d);
-            let mm = m0.min(e.2);
-            if l <= 1 || c * (d * d) as f64 <= FACE_STEP_ERROR * mm * mm * mm {
-                break (d, e);
-            }
+        // m is linear: its minimum over any sub-span from i0 of up to FACE_STEP_MAX
+        // pixels (all on the run) is at least the smaller of these two.
+        let mm = m0.min(m_at(i0 + FACE_STEP_MAX.min(rest)));
+        // (NaN → 0, as m ≤ 0 off a verified run: one pixel per step, exact.)
+        let most = (lim * mm * mm * mm).max(0.0);
+        let (mut l, mut l2) = (FACE_STEP_MAX, (FACE_STEP_MAX * FACE_STEP_MAX) as f64);
+        while l > 1 && l2 > most {
             l /= 2;
-        };
+            l2 *= 0.25;
+        }
+        let d = l.min(rest);
+        let (u, v, m1) = exact(r, i0 + d);
         let (u1, v1) = (q16(u), q16(v));
         // The run's last sub-span draws its far end too.
         let count = if d == rest { d + 1 } else { d };
         let (du, dv) = if d == 0 {
             (0, 0)
         } else {
-            ((u1 - u0) / d as i64, (v1 - v0) / d as i64)
+            (toward_zero(u1 - u0, d), toward_zero(v1 - v0, d))
         };
         spans.push(SpanQ8 {
             k: i0 as u32,
@@ -154,6 +161,17 @@ pub(super) fn plan<const BILINEAR: bool>(
         (u0, v0, m0) = (u1, v1, m1);
     }
     low
+}
+
+/// `x / d` rounded towards zero (`d` > 0), a shift for powers of two.
+#[inline(always)]
+fn toward_zero(x: i64, d: usize) -> i64 {
+    if d.is_power_of_two() {
+        let k = d.trailing_zeros();
+        (x + ((x >> 63) & ((1 << k) - 1))) >> k
+    } else {
+        x / d as i64
+    }
 }
 
 /// The bilinear sample at bordered Q.8 position (`u`, `v`) reading the rows `y` and
