@@ -22,18 +22,25 @@
 //! scanline lying in an edge plane) are peeled off and handled per pixel; a run that still
 //! fails is done per pixel.
 //!
-//! # Runs on the span kernels
+//! # Runs stepped like spans
 //! On a verified run's face the ray's axes `(a, b, m)` are linear in `dx` and the face
-//! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line. The run goes to
-//! the span kernels (`render/kernel/face.rs`: AVX2, SSE4.1 or the scalar twin, chosen
-//! once per process as for the map's spans, `LUTPANO_KERNEL=scalar` forcing the portable
-//! one), which evaluate that line exactly at every pixel in `f64` SIMD lanes with the
-//! arithmetic of [`face_uv`] (one division per pixel) and gather and blend with the map
-//! kernels' code. No position is interpolated: the per-pixel path's face coordinates
-//! come from [`face_uv`] on the bit-identical ray, the kernels' from the same operations,
-//! so the two renderers' images are byte-identical (tested over sweeps of views, sizes
-//! and both samplers in `tests/cube.rs`, with every kernel), and the sampling-position
-//! error of the cube renderers is zero.
+//! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line. Nearest and
+//! bilinear runs are stepped like the LUT's spans (`render/kernel/face_step.rs`): the line
+//! is evaluated exactly (with the arithmetic of [`face_uv`]) every 1–32 pixels, the
+//! sub-span length chosen from a proven bound on the interpolation error (the curvature
+//! of the projective line, largest where `m` is smallest), and stepped linearly in Q.16
+//! between; the positions are then gathered and blended by the row kernels
+//! (`render/kernel/row.rs`: AVX2, SSE4.1 or the scalar twin, chosen once per process,
+//! `LUTPANO_KERNEL=scalar` forcing the portable one) on the face's bordered texels. Every
+//! stepped position is within [`crate::FACE_STEP_BOUND`] (0.0207) face texels of the
+//! exact one (0.0201 the largest measured over a sweep of views); the per-pixel
+//! (`Basic`) renderer stays exact, so the two renderers' images now differ by that much
+//! in position: bilinear pixels by at most (bound + 1/256) × the local texel gradient
+//! + 2 levels, nearest pixels only at texel edges (`tests/cube.rs`).
+//!
+//! Trilinear runs still evaluate the line exactly per pixel (`render/kernel/face.rs`, in
+//! `f64` SIMD lanes, one division per pixel) on the two pyramid levels of each
+//! [`TRILINEAR_RUN_CHUNK`].
 
 use super::exact::render_exact;
 use super::frame::Frame;
@@ -50,9 +57,11 @@ use crate::named::{parse_name, unknown_name, Named};
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// Which of the paper's renderers to use. Both give byte-identical images with nearest
-/// and bilinear sampling; with trilinear the scanline renderer takes the level of detail
-/// per 16 pixels of a face run, the basic one per pixel (`cube/pyramid.rs`).
+/// Which of the paper's renderers to use. With nearest and bilinear sampling their images
+/// differ only by the scanline renderer's stepped positions (within
+/// [`crate::FACE_STEP_BOUND`] face texels, see `render/cube.rs`); with trilinear the
+/// scanline renderer also takes the level of detail per 16 pixels of a face run, the basic
+/// one per pixel (`cube/pyramid.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum CubeRenderer {
     /// Section 1: per pixel, ray → face by the largest |coordinate| → face coordinates.
@@ -277,9 +286,8 @@ impl Fetch for TrilinearFetch {
 
 /// Render `view` of `cube` into `frame` with the chosen renderer (the entry is
 /// [`crate::Renderer::render`] of a [`crate::Scene::Cube`]). `threads` splits rows into
-/// bands across the rayon pool; the output is identical either way, and identical between
-/// the two renderers (nearest, bilinear; see [`CubeRenderer`] for trilinear, which builds
-/// the face pyramid on first use).
+/// bands across the rayon pool; the output is identical either way (the renderers differ
+/// as [`CubeRenderer`] says; trilinear builds the face pyramid on first use).
 pub(crate) fn render_cube(
     cube: &CubeMap,
     view: View,
@@ -442,8 +450,9 @@ fn accel_row<S: Fetch>(
             continue;
         }
         // A verified run: the ray's coordinates on the face's axes are linear in dx,
-        // the face coordinates a projective line, evaluated exactly per pixel by the
-        // span kernel (render/kernel/face.rs) with the per-pixel path's arithmetic.
+        // the face coordinates a projective line, stepped like a span (nearest,
+        // bilinear: render/kernel/face_step.rs) or evaluated exactly per pixel
+        // (trilinear: render/kernel/face.rs).
         let (pa, pb, pm) = face_axes(seg.face, p);
         let (ba, bb, bm) = face_axes(seg.face, b);
         let run = FaceRun {

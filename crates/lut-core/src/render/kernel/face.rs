@@ -1,10 +1,14 @@
-//! Cube-face runs: the span kernels' gather and blend fed by a projective line.
+//! Cube-face runs evaluated exactly: the span kernels' gather and blend fed by a
+//! projective line, one division per pixel. The cube scanline renderer's trilinear runs
+//! (both pyramid levels of each chunk); its nearest and bilinear runs are stepped
+//! (`face_step.rs`). The nearest kernel is kept with its tests (the AVX-512 work on
+//! `x86/face.rs` is under way elsewhere).
 //!
 //! Along a scanline the cube renderer's ray is `P + dx · B` (`render/cube.rs`), so on a
 //! face with axes `(a, b, m)` the face coordinates are `u = h + h·a/m`, `v = h − h·b/m`
 //! with `a`, `b`, `m` linear in `dx`: a projective line, not a linear one. Stepping it
-//! linearly between exact points would need a bound on the curvature and would change
-//! bytes; these kernels instead evaluate the projective line *exactly* at every pixel, in
+//! linearly between exact points needs a bound on the curvature (`face_step.rs`) and
+//! changes bytes; these kernels instead evaluate the projective line *exactly* at every pixel, in
 //! `f64` SIMD lanes (4 per AVX2 vector, 2 per SSE vector: three multiply-adds, one
 //! division, two multiply-adds per pixel), with the very operations, in the very order,
 //! of [`crate::cube::face_uv`] and [`crate::cube::CubeMap::bilinear`] /
