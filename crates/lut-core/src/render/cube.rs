@@ -33,7 +33,7 @@
 //! (`render/kernel/row.rs`: AVX2, SSE4.1 or the scalar twin, chosen once per process,
 //! `LUTPANO_KERNEL=scalar` forcing the portable one) on the face's bordered texels. Every
 //! stepped position is within [`crate::FACE_STEP_BOUND`] (0.0207) face texels of the
-//! exact one (0.0201 the largest measured over a sweep of views); the per-pixel
+//! exact one (0.0200 the largest measured over a sweep of views); the per-pixel
 //! (`Basic`) renderer stays exact, so the two renderers' images now differ by that much
 //! in position: bilinear pixels by at most (bound + 1/256) × the local texel gradient
 //! + 2 levels, nearest pixels only at texel edges (`tests/cube.rs`).
@@ -216,8 +216,8 @@ impl Fetch for NearestFetch {
         cube.nearest(face, u, v)
     }
     #[inline(always)]
-    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut StepBuf) {
-        face_steps::<false>(&face_texels(c, f), r, o, b)
+    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], _: &mut StepBuf) {
+        face_span::<false>(&face_texels(c, f), r, o)
     }
 }
 
@@ -229,7 +229,7 @@ impl Fetch for BilinearFetch {
     }
     #[inline(always)]
     fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut StepBuf) {
-        face_steps::<true>(&face_texels(c, f), r, o, b)
+        face_steps(&face_texels(c, f), r, o, b)
     }
 }
 

@@ -1,8 +1,7 @@
 //! Cube-face runs evaluated exactly: the span kernels' gather and blend fed by a
-//! projective line, one division per pixel. The cube scanline renderer's trilinear runs
-//! (both pyramid levels of each chunk); its nearest and bilinear runs are stepped
-//! (`face_step.rs`). The nearest kernel is kept with its tests (the AVX-512 work on
-//! `x86/face.rs` is under way elsewhere).
+//! projective line, one division per pixel. The cube scanline renderer's nearest runs
+//! and trilinear runs (both pyramid levels of each chunk); its bilinear runs are stepped
+//! (`face_step.rs`).
 //!
 //! Along a scanline the cube renderer's ray is `P + dx · B` (`render/cube.rs`), so on a
 //! face with axes `(a, b, m)` the face coordinates are `u = h + h·a/m`, `v = h − h·b/m`

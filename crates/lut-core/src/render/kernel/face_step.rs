@@ -1,8 +1,10 @@
 //! Cube-face runs stepped like spans: the face's projective line evaluated exactly every
 //! few pixels and interpolated linearly in fixed point between, then drawn by the row
 //! kernels (`kernel/row.rs`: the positions expanded from [`SpanQ8`]s, one gather-and-blend
-//! pass over them, AVX2 / SSE4.1 / the scalar twin). The cube scanline renderer's nearest
-//! and bilinear runs (`render/cube.rs`).
+//! pass over them, AVX2 / SSE4.1 / the scalar twin). The cube scanline renderer's
+//! bilinear runs (`render/cube.rs`). Its nearest runs stay on the exact kernel
+//! (`face.rs`): stepped, nearest took 36.8 instead of 20.4 instructions per pixel and
+//! was no faster (one thread 9.53 against 8.90 ms, two 5.25 against 5.17 ms).
 //!
 //! # Positions
 //! On a verified run ([`FaceRun`]) the face coordinates are `u(t) = h + h·a(t)/m(t)`,
@@ -23,17 +25,21 @@
 //!
 //! `E(d) = d²/8 · 2h·|m₁|·√((a₁m₀ − a₀m₁)² + (b₁m₀ − b₀m₁)²) / min(m(t), m(t + d))³`.
 //!
-//! Each sub-span takes the largest power of two `d` ≤ [`FACE_STEP_MAX`] (or the rest of
-//! the run) with `E(d)` ≤ [`FACE_STEP_ERROR`] (0.02 face texels, the LUT's own sampling
+//! Each sub-span takes the largest length `d` ≤ [`FACE_STEP_MAX`] (or the rest of the
+//! run) with `E(d)` ≤ [`FACE_STEP_ERROR`] (0.02 face texels, the LUT's own sampling
 //! error; the project's budget is 0.05), taking for `min m` the smaller of `m` at the
 //! sub-span's start and `FACE_STEP_MAX` pixels on (or at the run's last pixel), which
-//! is no larger (m is linear) and costs no division; `d` = 1 is exact. The fixed point adds less than
-//! `d` Q.16 units per axis (the ends' rounding, ≤ 1 unit with nearest's clamp below the
-//! face's last texel edge, and the truncated step, < 1 unit per pixel), so every position
+//! is no larger (m is linear) and costs no division: `d = ⌊√(0.02·min m³ / c)⌋`, checked
+//! once against the rounding of the square root; `d` = 1 is exact. (Any length, not
+//! only powers of two: the sub-spans are 1.4x longer on average at the cost of an
+//! `i32` division for the step, 48.2 instead of 54.2 instructions per pixel.) The fixed
+//! point adds less than `d` Q.16 units per axis (the ends' rounding, ≤ ½ unit, and the
+//! truncated step, < 1 unit per pixel), so every position
 //! is within [`FACE_STEP_BOUND`] = 0.02 + √2·32/65536 ≈ 0.0207 face texels of the exact
-//! one (tested over random views' runs; the largest error measured is in
-//! `docs/performance.md`). At hfov 90 on 2048² faces a sub-span is 4–32 pixels (short
-//! near a face edge seen obliquely, where `m` is small), one division per sub-span.
+//! one (tested over random views' runs; the largest error measured, 0.0200 texels, is in
+//! `docs/performance.md`). At hfov 90 on 2048² faces a sub-span is 9.4 pixels on average
+//! (short near a face edge seen obliquely, where `m` is small), one division per
+//! sub-span.
 //!
 //! # Texels
 //! The positions are bordered-face coordinates (the face's `(n + 2)²` texels as a
@@ -93,23 +99,17 @@ fn exact(r: &FaceRun, i: usize) -> (f64, f64, f64) {
 
 /// Cut a run of `len` pixels on a face of side `n` into sub-spans (see the module docs):
 /// their [`SpanQ8`]s into `spans` (positions in bordered-face Q.16, `k` from 0; the
-/// mirror line unused). Returns whether a bilinear run reaches the lower half of the
-/// face's last texel row (see [`bottom`]).
-pub(super) fn plan<const BILINEAR: bool>(
-    n: usize,
-    r: &FaceRun,
-    len: usize,
-    spans: &mut Vec<SpanQ8>,
-) -> bool {
+/// mirror line unused). Returns whether the run reaches the lower half of the face's
+/// last texel row (see [`bottom`]).
+pub(super) fn plan(n: usize, r: &FaceRun, len: usize, spans: &mut Vec<SpanQ8>) -> bool {
     spans.clear();
     if len == 0 {
         return false;
     }
-    let nf = n as f64;
-    // Clamped into the face as `CubeMap::bilinear` clamps (NaN → 0); nearest below the
-    // last texel edge (a position at n would be read as the next texel).
-    let top = ((n as i64) << FX_BITS) - i64::from(!BILINEAR);
-    let q16 = |x: f64| ((x.max(0.0).min(nf) * FX_ONE as f64 + 0.5) as i64).min(top) + FX_ONE;
+    // Clamped into the face as `CubeMap::bilinear` clamps (the same Q.16 values: `as`
+    // saturates and maps NaN to 0).
+    let top = (n as i64) << FX_BITS;
+    let q16 = |x: f64| ((x * FX_ONE as f64 + 0.5) as i64).clamp(0, top) + FX_ONE;
     let ka = r.d[0] * r.p[2] - r.p[0] * r.d[2];
     let kb = r.d[1] * r.p[2] - r.p[1] * r.d[2];
     // E(d) = c·d² / min(m)³ ≤ FACE_STEP_ERROR ⟺ d² ≤ lim·min(m)³.
@@ -129,10 +129,11 @@ pub(super) fn plan<const BILINEAR: bool>(
         let mm = m0.min(m_at(i0 + FACE_STEP_MAX.min(rest)));
         // (NaN → 0, as m ≤ 0 off a verified run: one pixel per step, exact.)
         let most = (lim * mm * mm * mm).max(0.0);
-        let (mut l, mut l2) = (FACE_STEP_MAX, (FACE_STEP_MAX * FACE_STEP_MAX) as f64);
-        while l > 1 && l2 > most {
-            l /= 2;
-            l2 *= 0.25;
+        // The largest l with l² ≤ most (`as` saturates: ∞ → the cap); the square root is
+        // correctly rounded, so one check makes it exact.
+        let mut l = (most.sqrt() as usize).clamp(1, FACE_STEP_MAX);
+        if l > 1 && (l * l) as f64 > most {
+            l -= 1;
         }
         let d = l.min(rest);
         let (u, v, m1) = exact(r, i0 + d);
@@ -156,22 +157,18 @@ pub(super) fn plan<const BILINEAR: bool>(
             hl: 0,
             ll: 0,
         });
-        low |= BILINEAR && v0.max(v1) - FX_HALF >= last_row;
+        low |= v0.max(v1) - FX_HALF >= last_row;
         i0 += count;
         (u0, v0, m0) = (u1, v1, m1);
     }
     low
 }
 
-/// `x / d` rounded towards zero (`d` > 0), a shift for powers of two.
+/// `x / d` rounded towards zero (`d` > 0): `x` is a difference of two positions in one
+/// face (|x| ≤ 8192 · 2¹⁶ < 2³¹), so in `i32`.
 #[inline(always)]
 fn toward_zero(x: i64, d: usize) -> i64 {
-    if d.is_power_of_two() {
-        let k = d.trailing_zeros();
-        (x + ((x >> 63) & ((1 << k) - 1))) >> k
-    } else {
-        x / d as i64
-    }
+    i64::from(x as i32 / d as i32)
 }
 
 /// The bilinear sample at bordered Q.8 position (`u`, `v`) reading the rows `y` and
@@ -194,17 +191,11 @@ fn bottom(t: &Texels, u: i32, v: i32) -> u32 {
 
 /// A stepped face run with kernel `k`.
 #[inline]
-fn run<const BILINEAR: bool>(
-    k: Selected,
-    t: &Texels,
-    r: &FaceRun,
-    out: &mut [u32],
-    buf: &mut StepBuf,
-) {
+fn run(k: Selected, t: &Texels, r: &FaceRun, out: &mut [u32], buf: &mut StepBuf) {
     debug_assert!(t.width == t.height && t.width >= 2, "bordered face texels");
     let len = out.len();
     let n = face_side(t);
-    let low = plan::<BILINEAR>(n, r, len, &mut buf.spans);
+    let low = plan(n, r, len, &mut buf.spans);
     for b in [&mut buf.u, &mut buf.v, &mut buf.ul] {
         if b.len() < len + SLACK {
             b.resize(len + SLACK, 0);
@@ -217,7 +208,7 @@ fn run<const BILINEAR: bool>(
     };
     expand_with(k, &buf.spans, p);
     let (u, v) = (&buf.u[..len], &buf.v[..len]);
-    sample_q8_with::<BILINEAR, false>(k, t, u, v, out);
+    sample_q8_with::<true, false>(k, t, u, v, out);
     if low {
         let last = n as i32;
         for ((o, &u), &v) in out.iter_mut().zip(u).zip(v) {
@@ -228,18 +219,12 @@ fn run<const BILINEAR: bool>(
     }
 }
 
-/// Nearest (`BILINEAR` false) or bilinear samples of one cube face along a verified run,
-/// stepped (see the module docs), with the [`active_kernel`](super::active_kernel). `t`
+/// Bilinear samples of one cube face along a verified run, stepped (see the module docs), with the [`active_kernel`](super::active_kernel). `t`
 /// is the face's bordered texels. Every pixel of `out` is written; positions are clamped
 /// into the face, so any run is safe (only verified runs meet the bound).
 #[inline]
-pub(crate) fn face_steps<const BILINEAR: bool>(
-    t: &Texels,
-    r: &FaceRun,
-    out: &mut [u32],
-    buf: &mut StepBuf,
-) {
-    run::<BILINEAR>(active(), t, r, out, buf)
+pub(crate) fn face_steps(t: &Texels, r: &FaceRun, out: &mut [u32], buf: &mut StepBuf) {
+    run(active(), t, r, out, buf)
 }
 
 #[cfg(test)]
@@ -248,15 +233,9 @@ impl Kernel {
     ///
     /// # Panics
     /// When the CPU does not run this kernel, or `t` is not a face's bordered texels.
-    pub(crate) fn face_steps<const BILINEAR: bool>(
-        self,
-        t: &Texels,
-        r: &FaceRun,
-        out: &mut [u32],
-        buf: &mut StepBuf,
-    ) {
+    pub(crate) fn face_steps(self, t: &Texels, r: &FaceRun, out: &mut [u32], buf: &mut StepBuf) {
         assert!(t.width == t.height && t.width >= 2, "bordered face texels");
-        run::<BILINEAR>(self.selected(), t, r, out, buf)
+        run(self.selected(), t, r, out, buf)
     }
 }
 
@@ -296,22 +275,16 @@ mod tests {
                 let (f, r) = view_run(view, (w, h), (a, y), n);
                 assert_eq!(f, face);
                 let len = (e - a) as usize;
-                for bilinear in [false, true] {
-                    if bilinear {
-                        plan::<true>(n as usize, &r, len, &mut spans);
-                    } else {
-                        plan::<false>(n as usize, &r, len, &mut spans);
-                    }
-                    let p = stepped(&spans, len);
-                    for (i, &(su, sv)) in p.iter().enumerate() {
-                        assert!(su != i64::MIN, "pixel {i} of {len} not planned");
-                        let (u, v, m) = exact(&r, i);
-                        assert!(m > 0.0);
-                        let one = FX_ONE as f64;
-                        let du = (su as f64 - one) / one - u;
-                        let dv = (sv as f64 - one) / one - v;
-                        worst = worst.max(du.hypot(dv));
-                    }
+                plan(n as usize, &r, len, &mut spans);
+                let p = stepped(&spans, len);
+                for (i, &(su, sv)) in p.iter().enumerate() {
+                    assert!(su != i64::MIN, "pixel {i} of {len} not planned");
+                    let (u, v, m) = exact(&r, i);
+                    assert!(m > 0.0);
+                    let one = FX_ONE as f64;
+                    let du = (su as f64 - one) / one - u;
+                    let dv = (sv as f64 - one) / one - v;
+                    worst = worst.max(du.hypot(dv));
                 }
             }
         }
@@ -382,33 +355,26 @@ mod tests {
         }
     }
 
-    /// Every kernel against the scalar one, both samplers, with sentinels around `out`.
+    /// Every kernel against the scalar one, with sentinels around `out`.
     fn check(ci: usize, f: Face, r: &FaceRun, len: usize, off: usize) {
         let c = &cubes()[ci];
         let t = face_texels(c, f);
         let mut buf = StepBuf::default();
-        for bilinear in [false, true] {
-            let mut want = Vec::new();
-            for k in Kernel::available() {
-                let mut o = vec![0xDEAD_BEEFu32; off + len + 3];
-                let out = &mut o[off..off + len];
-                if bilinear {
-                    k.face_steps::<true>(&t, r, out, &mut buf);
-                } else {
-                    k.face_steps::<false>(&t, r, out, &mut buf);
-                }
-                let outside = o[..off].iter().chain(&o[off + len..]);
-                assert!(
-                    outside.into_iter().all(|&x| x == 0xDEAD_BEEF),
-                    "{}",
-                    k.name()
-                );
-                let got = o[off..off + len].to_vec();
-                if k == Kernel::Scalar {
-                    want = got;
-                } else {
-                    assert_eq!(got, want, "{} bilinear={bilinear} {f:?} {r:?}", k.name());
-                }
+        let mut want = Vec::new();
+        for k in Kernel::available() {
+            let mut o = vec![0xDEAD_BEEFu32; off + len + 3];
+            k.face_steps(&t, r, &mut o[off..off + len], &mut buf);
+            let outside = o[..off].iter().chain(&o[off + len..]);
+            assert!(
+                outside.into_iter().all(|&x| x == 0xDEAD_BEEF),
+                "{}",
+                k.name()
+            );
+            let got = o[off..off + len].to_vec();
+            if k == Kernel::Scalar {
+                want = got;
+            } else {
+                assert_eq!(got, want, "{} {f:?} {r:?}", k.name());
             }
         }
     }
@@ -454,7 +420,7 @@ mod tests {
         let mut buf = StepBuf::default();
         for k in Kernel::available() {
             let mut out = vec![0; 54];
-            k.face_steps::<true>(&t, &r, &mut out, &mut buf);
+            k.face_steps(&t, &r, &mut out, &mut buf);
             for (i, &o) in out.iter().enumerate() {
                 let (u, v, _) = exact(&r, i);
                 assert_eq!(o, c.bilinear(Face::Front, u, v), "{} pixel {i}", k.name());
