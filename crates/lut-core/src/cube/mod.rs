@@ -32,9 +32,10 @@
 //! a 3-D line, cut into face segments found by binary search, stepped inside each segment
 //! without choosing a face). Both compute every ray with the same expression, and the
 //! accelerated path *proves* each segment's face before using it (falling back to the
-//! per-pixel choice where it cannot), so the faces agree; inside a segment the face
+//! per-pixel choice where it cannot), so the faces agree; inside a segment bilinear face
 //! coordinates are stepped linearly between exact ones, within [`crate::FACE_STEP_BOUND`]
-//! (0.0207) face texels of the basic renderer's exact coordinates. Trilinear sampling
+//! (0.0207) face texels of the basic renderer's exact coordinates (nearest ones are
+//! exact: byte-identical images). Trilinear sampling
 //! reads a face pyramid (`cube/pyramid.rs`). See `docs/cube.md`.
 //!
 //! Loading from files is `io/cube.rs`; layouts and namings are `cube/layout.rs`.

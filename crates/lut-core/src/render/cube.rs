@@ -24,9 +24,9 @@
 //!
 //! # Runs stepped like spans
 //! On a verified run's face the ray's axes `(a, b, m)` are linear in `dx` and the face
-//! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line. Nearest and
-//! bilinear runs are stepped like the LUT's spans (`render/kernel/face_step.rs`): the line
-//! is evaluated exactly (with the arithmetic of [`face_uv`]) every 1–32 pixels, the
+//! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line. Bilinear runs
+//! are stepped like the LUT's spans (`render/kernel/face_step.rs`): the line is evaluated
+//! exactly (with the arithmetic of [`face_uv`]) every 1–32 pixels, the
 //! sub-span length chosen from a proven bound on the interpolation error (the curvature
 //! of the projective line, largest where `m` is smallest), and stepped linearly in Q.16
 //! between; the positions are then gathered and blended by the row kernels
@@ -34,13 +34,16 @@
 //! `LUTPANO_KERNEL=scalar` forcing the portable one) on the face's bordered texels. Every
 //! stepped position is within [`crate::FACE_STEP_BOUND`] (0.0207) face texels of the
 //! exact one (0.0200 the largest measured over a sweep of views); the per-pixel
-//! (`Basic`) renderer stays exact, so the two renderers' images now differ by that much
-//! in position: bilinear pixels by at most (bound + 1/256) × the local texel gradient
-//! + 2 levels, nearest pixels only at texel edges (`tests/cube.rs`).
+//! (`Basic`) renderer stays exact, so the two renderers' bilinear images now differ by
+//! that much in position: per pixel by at most (bound + 1/256) × the local texel
+//! gradient + 2 levels (`tests/cube.rs`).
 //!
-//! Trilinear runs still evaluate the line exactly per pixel (`render/kernel/face.rs`, in
-//! `f64` SIMD lanes, one division per pixel) on the two pyramid levels of each
-//! [`TRILINEAR_RUN_CHUNK`].
+//! Nearest runs, and trilinear runs on the two pyramid levels of each
+//! [`TRILINEAR_RUN_CHUNK`], still evaluate the line exactly at every pixel
+//! (`render/kernel/face.rs`: `f64` SIMD lanes, one division per pixel, with the
+//! per-pixel path's arithmetic), so nearest images stay byte-identical to the basic
+//! renderer's. (Stepped, nearest took 36.8 instead of 20.4 instructions per pixel and was
+//! no faster.)
 
 use super::exact::render_exact;
 use super::frame::Frame;
@@ -57,11 +60,11 @@ use crate::named::{parse_name, unknown_name, Named};
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// Which of the paper's renderers to use. With nearest and bilinear sampling their images
-/// differ only by the scanline renderer's stepped positions (within
+/// Which of the paper's renderers to use. With nearest sampling both give byte-identical
+/// images; with bilinear they differ by the scanline renderer's stepped positions (within
 /// [`crate::FACE_STEP_BOUND`] face texels, see `render/cube.rs`); with trilinear the
-/// scanline renderer also takes the level of detail per 16 pixels of a face run, the basic
-/// one per pixel (`cube/pyramid.rs`).
+/// scanline renderer takes the level of detail per 16 pixels of a face run, the basic one
+/// per pixel (`cube/pyramid.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum CubeRenderer {
     /// Section 1: per pixel, ray → face by the largest |coordinate| → face coordinates.
@@ -450,9 +453,9 @@ fn accel_row<S: Fetch>(
             continue;
         }
         // A verified run: the ray's coordinates on the face's axes are linear in dx,
-        // the face coordinates a projective line, stepped like a span (nearest,
-        // bilinear: render/kernel/face_step.rs) or evaluated exactly per pixel
-        // (trilinear: render/kernel/face.rs).
+        // the face coordinates a projective line, stepped like a span (bilinear:
+        // render/kernel/face_step.rs) or evaluated exactly per pixel (nearest,
+        // trilinear: render/kernel/face.rs).
         let (pa, pb, pm) = face_axes(seg.face, p);
         let (ba, bb, bm) = face_axes(seg.face, b);
         let run = FaceRun {

@@ -40,9 +40,9 @@
 //! `unsafe` is allowed; `x86/face.rs` is its child); `select.rs`: choosing the kernel;
 //! `tests/`: the property tests (`row_pass.rs`: the row kernels'); `face.rs`:
 //! cube-face runs, whose positions are a projective line evaluated exactly per pixel
-//! (the cube scanline renderer's trilinear runs); `face_step.rs`: cube-face runs stepped
-//! like spans (exact every 1–32 pixels by a proven error bound, Q.16 steps between) and
-//! drawn by the row kernels (the scanline renderer's nearest and bilinear runs);
+//! (the cube scanline renderer's nearest and trilinear runs); `face_step.rs`: cube-face
+//! runs stepped like spans (exact every 1–32 pixels by a proven error bound, Q.16 steps
+//! between) and drawn by the row kernels (the scanline renderer's bilinear runs);
 //! `row.rs` (and `x86/row.rs`): the row pass's kernels (`render/rowpass.rs`), a run's
 //! Q.8 positions expanded from its spans and one gather-and-blend pass over them, with
 //! no per-span check (the LUT rows of full maps, trilinear's pyramid levels by
