@@ -32,7 +32,7 @@
 //! is no larger (m is linear) and costs no division: `d = ⌊√(0.02·min m³ / c)⌋`, checked
 //! once against the rounding of the square root; `d` = 1 is exact. (Any length, not
 //! only powers of two: the sub-spans are 1.4x longer on average at the cost of an
-//! `i32` division for the step, 48.2 instead of 54.2 instructions per pixel.) The fixed
+//! `i32` division for the step, 47.3 instead of 54.2 instructions per pixel.) The fixed
 //! point adds less than `d` Q.16 units per axis (the ends' rounding, ≤ ½ unit, and the
 //! truncated step, < 1 unit per pixel), so every position
 //! is within [`FACE_STEP_BOUND`] = 0.02 + √2·32/65536 ≈ 0.0207 face texels of the exact
