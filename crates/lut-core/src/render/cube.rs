@@ -22,22 +22,32 @@
 //! scanline lying in an edge plane) are peeled off and handled per pixel; a run that still
 //! fails is done per pixel.
 //!
-//! # Runs on the span kernels
+//! # Runs stepped like spans
 //! On a verified run's face the ray's axes `(a, b, m)` are linear in `dx` and the face
-//! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line. The run goes to
-//! the span kernels (`render/kernel/face.rs`: AVX2, SSE4.1 or the scalar twin, chosen
-//! once per process as for the map's spans, `LUTPANO_KERNEL=scalar` forcing the portable
-//! one), which evaluate that line exactly at every pixel in `f64` SIMD lanes with the
-//! arithmetic of [`face_uv`] (one division per pixel) and gather and blend with the map
-//! kernels' code. No position is interpolated: the per-pixel path's face coordinates
-//! come from [`face_uv`] on the bit-identical ray, the kernels' from the same operations,
-//! so the two renderers' images are byte-identical (tested over sweeps of views, sizes
-//! and both samplers in `tests/cube.rs`, with every kernel), and the sampling-position
-//! error of the cube renderers is zero.
+//! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line. Bilinear runs
+//! are stepped like the LUT's spans (`render/kernel/face_step.rs`): the line is evaluated
+//! exactly (with the arithmetic of [`face_uv`]) every 1–32 pixels, the
+//! sub-span length chosen from a proven bound on the interpolation error (the curvature
+//! of the projective line, largest where `m` is smallest), and stepped linearly in Q.16
+//! between; the positions are then gathered and blended by the row kernels
+//! (`render/kernel/row.rs`: AVX2, SSE4.1 or the scalar twin, chosen once per process,
+//! `LUTPANO_KERNEL=scalar` forcing the portable one) on the face's bordered texels. Every
+//! stepped position is within [`crate::FACE_STEP_BOUND`] (0.0207) face texels of the
+//! exact one (0.0200 the largest measured over a sweep of views); the per-pixel
+//! (`Basic`) renderer stays exact, so the two renderers' bilinear images now differ by
+//! that much in position: per pixel by at most (bound + 1/256) × the local texel
+//! gradient + 2 levels (`tests/cube.rs`).
+//!
+//! Nearest runs, and trilinear runs on the two pyramid levels of each
+//! [`TRILINEAR_RUN_CHUNK`], still evaluate the line exactly at every pixel
+//! (`render/kernel/face.rs`: `f64` SIMD lanes, one division per pixel, with the
+//! per-pixel path's arithmetic), so nearest images stay byte-identical to the basic
+//! renderer's. (Stepped, nearest took 36.8 instead of 20.4 instructions per pixel and was
+//! no faster.)
 
 use super::exact::render_exact;
 use super::frame::Frame;
-use super::kernel::{face_blend, face_span, FaceRun, Texels};
+use super::kernel::{face_blend, face_span, face_steps, FaceRun, StepBuf, Texels};
 use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
     check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
@@ -50,9 +60,11 @@ use crate::named::{parse_name, unknown_name, Named};
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// Which of the paper's renderers to use. Both give byte-identical images with nearest
-/// and bilinear sampling; with trilinear the scanline renderer takes the level of detail
-/// per 16 pixels of a face run, the basic one per pixel (`cube/pyramid.rs`).
+/// Which of the paper's renderers to use. With nearest sampling both give byte-identical
+/// images; with bilinear they differ by the scanline renderer's stepped positions (within
+/// [`crate::FACE_STEP_BOUND`] face texels, see `render/cube.rs`); with trilinear the
+/// scanline renderer takes the level of detail per 16 pixels of a face run, the basic one
+/// per pixel (`cube/pyramid.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum CubeRenderer {
     /// Section 1: per pixel, ray → face by the largest |coordinate| → face coordinates.
@@ -180,8 +192,17 @@ fn face_texels(cube: &CubeMap, face: Face) -> Texels<'_> {
 trait Fetch: Copy + Send + Sync {
     /// The sample of ray `d` on `face` (the face of `d`), per pixel.
     fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32;
-    /// A verified run on `face` (`run`: its projective line), with the span kernels.
-    fn span(self, cube: &CubeMap, frame: &Rays, face: Face, run: &FaceRun, out: &mut [u32]);
+    /// A verified run on `face` (`run`: its projective line), with the span kernels
+    /// (`buf`: the band's scratch for the stepped runs).
+    fn span(
+        self,
+        cube: &CubeMap,
+        frame: &Rays,
+        face: Face,
+        run: &FaceRun,
+        out: &mut [u32],
+        buf: &mut StepBuf,
+    );
 }
 
 #[derive(Clone, Copy)]
@@ -198,8 +219,8 @@ impl Fetch for NearestFetch {
         cube.nearest(face, u, v)
     }
     #[inline(always)]
-    fn span(self, cube: &CubeMap, _: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
-        face_span::<false>(&face_texels(cube, face), run, out)
+    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], _: &mut StepBuf) {
+        face_span::<false>(&face_texels(c, f), r, o)
     }
 }
 
@@ -210,8 +231,8 @@ impl Fetch for BilinearFetch {
         cube.bilinear(face, u, v)
     }
     #[inline(always)]
-    fn span(self, cube: &CubeMap, _: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
-        face_span::<true>(&face_texels(cube, face), run, out)
+    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut StepBuf) {
+        face_steps(&face_texels(c, f), r, o, b)
     }
 }
 
@@ -226,7 +247,15 @@ impl Fetch for TrilinearFetch {
         cube.trilinear_dir(face, d, lod)
     }
 
-    fn span(self, cube: &CubeMap, frame: &Rays, face: Face, run: &FaceRun, out: &mut [u32]) {
+    fn span(
+        self,
+        cube: &CubeMap,
+        frame: &Rays,
+        face: Face,
+        run: &FaceRun,
+        out: &mut [u32],
+        _: &mut StepBuf,
+    ) {
         // The image's x and y steps on the face's axes (y: −R₁ per row; the sign does not
         // change the footprint).
         let (sx, sy) = (face_axes(face, frame.b), face_axes(face, frame.r1));
@@ -260,9 +289,8 @@ impl Fetch for TrilinearFetch {
 
 /// Render `view` of `cube` into `frame` with the chosen renderer (the entry is
 /// [`crate::Renderer::render`] of a [`crate::Scene::Cube`]). `threads` splits rows into
-/// bands across the rayon pool; the output is identical either way, and identical between
-/// the two renderers (nearest, bilinear; see [`CubeRenderer`] for trilinear, which builds
-/// the face pyramid on first use).
+/// bands across the rayon pool; the output is identical either way (the renderers differ
+/// as [`CubeRenderer`] says; trilinear builds the face pyramid on first use).
 pub(crate) fn render_cube(
     cube: &CubeMap,
     view: View,
@@ -296,11 +324,14 @@ fn render_with<S: Fetch>(
     let rows_per_band = (16384 / w).clamp(1, frame.h as usize);
     let band = |(bi, chunk): (usize, &mut [u32])| {
         let mut segs = Vec::with_capacity(16);
+        let mut buf = StepBuf::default();
         for (r, line) in chunk.chunks_exact_mut(w).enumerate() {
             let y = bi * rows_per_band + r;
             match renderer {
                 CubeRenderer::Basic => basic_row(cube, frame, s, y, line),
-                CubeRenderer::Accelerated => accel_row(cube, frame, s, y, line, &mut segs),
+                CubeRenderer::Accelerated => {
+                    accel_row(cube, frame, s, y, line, (&mut segs, &mut buf))
+                }
             }
         }
     };
@@ -391,7 +422,7 @@ fn accel_row<S: Fetch>(
     s: S,
     y: usize,
     line: &mut [u32],
-    segs: &mut Vec<Seg>,
+    (segs, buf): (&mut Vec<Seg>, &mut StepBuf),
 ) {
     let w = line.len();
     let p = frame.row(frame.dy(y));
@@ -422,8 +453,9 @@ fn accel_row<S: Fetch>(
             continue;
         }
         // A verified run: the ray's coordinates on the face's axes are linear in dx,
-        // the face coordinates a projective line, evaluated exactly per pixel by the
-        // span kernel (render/kernel/face.rs) with the per-pixel path's arithmetic.
+        // the face coordinates a projective line, stepped like a span (bilinear:
+        // render/kernel/face_step.rs) or evaluated exactly per pixel (nearest,
+        // trilinear: render/kernel/face.rs).
         let (pa, pb, pm) = face_axes(seg.face, p);
         let (ba, bb, bm) = face_axes(seg.face, b);
         let run = FaceRun {
@@ -432,7 +464,7 @@ fn accel_row<S: Fetch>(
             dx: frame.dx(a),
             half: frame.half_face,
         };
-        s.span(cube, frame, seg.face, &run, &mut line[a..e]);
+        s.span(cube, frame, seg.face, &run, &mut line[a..e], buf);
     }
 }
 

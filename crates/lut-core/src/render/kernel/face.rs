@@ -1,12 +1,16 @@
-//! Cube-face runs: the span kernels' gather and blend fed by a projective line.
+//! Cube-face runs evaluated exactly: the span kernels' gather and blend fed by a
+//! projective line, one division per pixel. The cube scanline renderer's nearest runs
+//! and trilinear runs (both pyramid levels of each chunk); its bilinear runs are stepped
+//! (`face_step.rs`).
 //!
 //! Along a scanline the cube renderer's ray is `P + dx · B` (`render/cube.rs`), so on a
 //! face with axes `(a, b, m)` the face coordinates are `u = h + h·a/m`, `v = h − h·b/m`
 //! with `a`, `b`, `m` linear in `dx`: a projective line, not a linear one. Stepping it
-//! linearly between exact points would need a bound on the curvature and would change
-//! bytes; these kernels instead evaluate the projective line *exactly* at every pixel, in
-//! `f64` SIMD lanes (8 per AVX-512 vector, 4 per AVX2 vector, 2 per SSE vector: three multiply-adds, one
-//! division, two multiply-adds per pixel), with the very operations, in the very order,
+//! linearly between exact points needs a bound on the curvature (`face_step.rs`) and
+//! changes bytes; these kernels instead evaluate the projective line *exactly* at every
+//! pixel, in `f64` SIMD lanes (8 per AVX-512 vector, 4 per AVX2 vector, 2 per SSE
+//! vector: three multiply-adds, one division, two multiply-adds per pixel), with the
+//! very operations, in the very order,
 //! of [`crate::cube::face_uv`] and [`crate::cube::CubeMap::bilinear`] /
 //! [`crate::cube::CubeMap::nearest`] (IEEE `f64` arithmetic is deterministic and
 //! correctly rounded, and rounding is symmetric in sign, so a negated axis is computed
@@ -156,7 +160,7 @@ impl Kernel {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::cube::{face_axes, face_of, CubeMap, Face};
     use glam::DVec3;
@@ -180,7 +184,7 @@ mod tests {
         CubeMap::from_faces(n, refs).unwrap()
     }
 
-    fn cubes() -> &'static [CubeMap] {
+    pub(in crate::render::kernel) fn cubes() -> &'static [CubeMap] {
         static C: std::sync::OnceLock<Vec<CubeMap>> = std::sync::OnceLock::new();
         C.get_or_init(|| {
             [1, 2, 3, 16, 61]
@@ -191,7 +195,7 @@ mod tests {
         })
     }
 
-    fn face_texels(c: &CubeMap, f: Face) -> Texels<'_> {
+    pub(in crate::render::kernel) fn face_texels(c: &CubeMap, f: Face) -> Texels<'_> {
         let s = c.face_size() + 1;
         Texels::new(c.bordered_face(f), s, s, false).unwrap()
     }
@@ -282,7 +286,7 @@ mod tests {
 
     /// A face run of a view's scanline as the renderer builds it: `P`, `B` of
     /// `render/cube.rs` on the axes of the face of the run's first pixel.
-    fn view_run(
+    pub(in crate::render::kernel) fn view_run(
         (yaw, pitch, hfov): (f64, f64, f64),
         (w, h): (u32, u32),
         (x, y): (u32, u32),

@@ -41,7 +41,9 @@
 //! children); `select.rs`: choosing the kernel;
 //! `tests/`: the property tests (`row_pass.rs`: the row kernels'); `face.rs`:
 //! cube-face runs, whose positions are a projective line evaluated exactly per pixel
-//! (the cube scanline renderer's kernels);
+//! (the cube scanline renderer's nearest and trilinear runs); `face_step.rs`: cube-face
+//! runs stepped like spans (exact every 1–32 pixels by a proven error bound, Q.16 steps
+//! between) and drawn by the row kernels (the scanline renderer's bilinear runs);
 //! `row.rs` (and `x86/row.rs`): the row pass's kernels (`render/rowpass.rs`), a run's
 //! Q.8 positions expanded from its spans and one gather-and-blend pass over them, with
 //! no per-span check (the LUT rows of full maps, trilinear's pyramid levels by
@@ -119,6 +121,7 @@
 //! aarch64 and x86 CPUs without SSE4.1 run the scalar kernel.
 
 mod face;
+mod face_step;
 mod jobs;
 mod row;
 mod scalar;
@@ -134,6 +137,8 @@ pub use select::{
 };
 
 pub(crate) use face::{face_blend, face_span, FaceRun};
+pub(crate) use face_step::{face_steps, StepBuf};
+pub use face_step::{FACE_STEP_BOUND, FACE_STEP_ERROR, FACE_STEP_MAX};
 pub(crate) use row::{expand, sample_level, sample_q8, wrap_q8, Level, Positions, SpanQ8};
 
 use crate::geom::fixed::{Fx, FX_BITS};
