@@ -175,8 +175,25 @@ fn series(rows: &[Row]) -> Vec<Series<'_>> {
     out
 }
 
-/// Renderers drawn as vertical lines (no position error: exact, cube, gather), at the
-/// first set's hfov.
+/// A vertical line's legend: the renderer and sampler, and for the one that has a
+/// position error by construction, its bound (the cube scanline renderer's bilinear runs
+/// step the face's projective line, `lut_core::FACE_STEP_BOUND`; the others sample the
+/// exact positions).
+fn reference_label(r: &Row) -> String {
+    let label = format!("{}, {}", r.renderer, r.sampler);
+    if r.renderer == "cube-scanline" && r.sampler == "bilinear" {
+        format!(
+            "{label} (stepped: max error <= {:.4} face texel, bound)",
+            lut_core::FACE_STEP_BOUND
+        )
+    } else {
+        label
+    }
+}
+
+/// Renderers drawn as vertical lines (no position error measured: exact, cube, gather;
+/// the cube scanline renderer's bilinear runs are within a bound, [`reference_label`]),
+/// at the first set's hfov.
 fn references(rows: &[Row]) -> Vec<&Row> {
     let Some(hfov) = rows.first().map(|r| r.hfov) else {
         return Vec::new();
@@ -576,13 +593,12 @@ pub fn plot(path: &Path, rows: &[Row], peers: &[Peer]) -> Result<()> {
             "Pareto front (time, mean error)".into(),
         ));
         if !refs.is_empty() {
-            entries.push(Entry::Head("no position error (solid lines)".into()));
+            entries.push(Entry::Head(
+                "no position error measured (solid lines)".into(),
+            ));
         }
         for (i, r) in refs.iter().enumerate() {
-            entries.push(Entry::Line(
-                ref_colour(i),
-                format!("{}, {}", r.renderer, r.sampler),
-            ));
+            entries.push(Entry::Line(ref_colour(i), reference_label(r)));
         }
         if !peers.is_empty() {
             entries.push(Entry::Head(
