@@ -1,7 +1,7 @@
 //! Cube-face runs stepped like spans: the face's projective line evaluated exactly every
 //! few pixels and interpolated linearly in fixed point between, then drawn by the row
 //! kernels (`kernel/row.rs`: the positions expanded from [`SpanQ8`]s, one gather-and-blend
-//! pass over them, AVX2 / SSE4.1 / the scalar twin). The cube scanline renderer's
+//! pass over them, AVX-512 / AVX2 / SSE4.1 / the scalar twin). The cube scanline renderer's
 //! bilinear runs (`render/cube.rs`). Its nearest runs stay on the exact kernel
 //! (`face.rs`): stepped, nearest took 36.8 instead of 20.4 instructions per pixel and
 //! was no faster (one thread 9.53 against 8.90 ms, two 5.25 against 5.17 ms).

@@ -247,6 +247,14 @@ mod avx2 {
         _mm256_or_si256(c.0, g)
     }
 
+    /// A vector whose lanes 0..8 are `g(0..8)`: the nearest texels, read one by one
+    /// (the row and face kernels' nearest; hardware gathers measured slower).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) fn gather(g: impl Fn(usize) -> i32) -> __m256i {
+        _mm256_setr_epi32(g(0), g(1), g(2), g(3), g(4), g(5), g(6), g(7))
+    }
+
     /// `d · [0, 1, …, 7]` per lane without `vpmulld` (10 cycles of latency on the
     /// span's critical path): each lane adds d, 2d and 4d by the bits of its index.
     #[inline]
@@ -495,6 +503,31 @@ mod avx512 {
         _mm512_or_si512(c.0, g)
     }
 
+    /// A vector whose lanes 0..16 are `g(0..16)`: the nearest texels, read one by one
+    /// (`vpgatherdd` measured slower, docs/performance.md "AVX-512").
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    pub(super) fn gather(g: impl Fn(usize) -> i32) -> __m512i {
+        _mm512_setr_epi32(
+            g(0),
+            g(1),
+            g(2),
+            g(3),
+            g(4),
+            g(5),
+            g(6),
+            g(7),
+            g(8),
+            g(9),
+            g(10),
+            g(11),
+            g(12),
+            g(13),
+            g(14),
+            g(15),
+        )
+    }
+
     /// The 64-bit texel pairs of lanes 0..16 (`pair(k)`) as two vectors, (0, 1, 4, 5, 8,
     /// 9, 12, 13) and (2, 3, 6, 7, 10, 11, 14, 15), so that `shufps` (within 128-bit
     /// quarters) gives lanes 0..16 in order.
@@ -625,6 +658,13 @@ mod sse41 {
     pub(super) fn merge(c: (__m128i, __m128i)) -> __m128i {
         let g = _mm_and_si128(_mm_slli_epi32::<8>(c.1), _mm_set1_epi32(0xFF00));
         _mm_or_si128(c.0, g)
+    }
+
+    /// A vector whose lanes 0..4 are `g(0..4)`: the nearest texels, read one by one.
+    #[inline]
+    #[target_feature(enable = "sse4.1")]
+    pub(super) fn gather(g: impl Fn(usize) -> i32) -> __m128i {
+        _mm_setr_epi32(g(0), g(1), g(2), g(3))
     }
 
     #[inline]

@@ -210,7 +210,7 @@ macro_rules! face_kernels {
 }
 
 mod avx2 {
-    use super::super::avx2::{bilinear8 as bilinear, lerp, merge, split};
+    use super::super::avx2::{bilinear8 as bilinear, gather, lerp, merge, split};
     use super::*;
     use std::arch::x86_64::{
         __m256d as D, __m256i as V, _mm256_add_epi32 as add, _mm256_add_pd as add_pd,
@@ -242,17 +242,10 @@ mod avx2 {
     fn join(lo: __m128i, hi: __m128i) -> V {
         _mm256_set_m128i(hi, lo)
     }
-
-    /// Lanes 0..8 = `g(0..8)`.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn gather(g: impl Fn(usize) -> i32) -> V {
-        _mm256_setr_epi32(g(0), g(1), g(2), g(3), g(4), g(5), g(6), g(7))
-    }
 }
 
 mod avx512 {
-    use super::super::avx512::{bilinear16 as bilinear, lerp, merge, split};
+    use super::super::avx512::{bilinear16 as bilinear, gather, lerp, merge, split};
     use super::*;
     use std::arch::x86_64::{
         __m512d as D, __m512i as V, _mm512_add_epi32 as add, _mm512_add_pd as add_pd,
@@ -284,34 +277,10 @@ mod avx512 {
     fn join(lo: __m256i, hi: __m256i) -> V {
         _mm512_inserti64x4::<1>(_mm512_castsi256_si512(lo), hi)
     }
-
-    /// Lanes 0..16 = `g(0..16)`.
-    #[inline]
-    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
-    fn gather(g: impl Fn(usize) -> i32) -> V {
-        _mm512_setr_epi32(
-            g(0),
-            g(1),
-            g(2),
-            g(3),
-            g(4),
-            g(5),
-            g(6),
-            g(7),
-            g(8),
-            g(9),
-            g(10),
-            g(11),
-            g(12),
-            g(13),
-            g(14),
-            g(15),
-        )
-    }
 }
 
 mod sse41 {
-    use super::super::sse41::{bilinear4 as bilinear, lerp, merge, split};
+    use super::super::sse41::{bilinear4 as bilinear, gather, lerp, merge, split};
     use super::*;
     use std::arch::x86_64::{
         __m128d as D, __m128i as V, _mm_add_epi32 as add, _mm_add_pd as add_pd,
@@ -342,12 +311,5 @@ mod sse41 {
     #[target_feature(enable = "sse4.1")]
     fn join(lo: __m128i, hi: __m128i) -> V {
         _mm_unpacklo_epi64(lo, hi)
-    }
-
-    /// Lanes 0..4 = `g(0..4)`.
-    #[inline]
-    #[target_feature(enable = "sse4.1")]
-    fn gather(g: impl Fn(usize) -> i32) -> V {
-        _mm_setr_epi32(g(0), g(1), g(2), g(3))
     }
 }

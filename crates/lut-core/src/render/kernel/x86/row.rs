@@ -9,7 +9,8 @@
 //! module, where short names stand for that set's intrinsics (`add` is
 //! `_mm256_add_epi32` in `avx2`, `_mm_add_epi32` in `sse41`; `V` the vector type, `N` its
 //! lanes) and a few functions hold what differs in more than the prefix: the lane
-//! layout of the texel pairs (`pairs`), the nearest gather (`gather`), the reversal
+//! layout of the texel pairs (`pairs`), the nearest gather (`gather`, in `x86.rs` beside
+//! `split`, `lerp` and `merge`, shared with the face kernels), the reversal
 //! (`reverse`), `iota`, the compares (`add_if_below`, `sub_if_above`, `zero_outside`:
 //! vector compares and masks in AVX2 and SSE4.1, `vector_compares!`; mask registers and
 //! masked adds in AVX-512), and the kernel for the last pixels of a run (`tail`: the
@@ -120,7 +121,7 @@ fn prefetch_every(u: &[i32], k: u32) -> usize {
 /// (`add`, `sub`, `and`, `or`, `min`, `max`, `minu`, `srai`, `slli`, `sra`, `mullo`,
 /// `set1`, `set1_16`, `sub16`, `zero`, `loadu`, `storeu`, `shuffle_ps`, `to_ps`,
 /// `from_ps`), `iota`, `pairs`, `gather`, `reverse`, `add_if_below`, `sub_if_above`,
-/// `zero_outside` and `tail`, and the map kernels' `split`, `lerp` and `merge`.
+/// `zero_outside` and `tail`, and the map kernels' `split`, `lerp`, `merge` and `gather`.
 macro_rules! row_kernels {
     ($feature:literal) => {
         /// (indices clamped to `last`, fx, fy) of positions (u, v), Q.8 (see
@@ -351,7 +352,7 @@ macro_rules! vector_compares {
 }
 
 mod avx2 {
-    use super::super::avx2::{lerp, merge, split};
+    use super::super::avx2::{gather, lerp, merge, split};
     use super::sample_lv_scalar as tail;
     use super::*;
     use std::arch::x86_64::{
@@ -390,13 +391,6 @@ mod avx2 {
         )
     }
 
-    /// Lanes 0..8 = `g(0..8)`.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn gather(g: impl Fn(usize) -> i32) -> V {
-        _mm256_setr_epi32(g(0), g(1), g(2), g(3), g(4), g(5), g(6), g(7))
-    }
-
     /// The lanes in reverse order.
     #[inline]
     #[target_feature(enable = "avx2")]
@@ -406,7 +400,7 @@ mod avx2 {
 }
 
 mod avx512 {
-    use super::super::avx512::{lerp, merge, pairs, split};
+    use super::super::avx512::{gather, lerp, merge, pairs, split};
     use super::avx2::sample_q8 as tail;
     use super::*;
     use std::arch::x86_64::{
@@ -454,30 +448,6 @@ mod avx512 {
         _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
     }
 
-    /// Lanes 0..16 = `g(0..16)`.
-    #[inline]
-    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
-    fn gather(g: impl Fn(usize) -> i32) -> V {
-        _mm512_setr_epi32(
-            g(0),
-            g(1),
-            g(2),
-            g(3),
-            g(4),
-            g(5),
-            g(6),
-            g(7),
-            g(8),
-            g(9),
-            g(10),
-            g(11),
-            g(12),
-            g(13),
-            g(14),
-            g(15),
-        )
-    }
-
     /// The lanes in reverse order.
     #[inline]
     #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
@@ -488,7 +458,7 @@ mod avx512 {
 }
 
 mod sse41 {
-    use super::super::sse41::{lerp, merge, split};
+    use super::super::sse41::{gather, lerp, merge, split};
     use super::sample_lv_scalar as tail;
     use super::*;
     use std::arch::x86_64::{
@@ -525,13 +495,6 @@ mod sse41 {
             _mm_set_epi64x(pair(1), pair(0)),
             _mm_set_epi64x(pair(3), pair(2)),
         )
-    }
-
-    /// Lanes 0..4 = `g(0..4)`.
-    #[inline]
-    #[target_feature(enable = "sse4.1")]
-    fn gather(g: impl Fn(usize) -> i32) -> V {
-        _mm_setr_epi32(g(0), g(1), g(2), g(3))
     }
 
     /// The lanes in reverse order.
