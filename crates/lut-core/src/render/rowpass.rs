@@ -20,9 +20,10 @@
 //! reads the same buffers, so the measured sampling error is this pass's.
 
 use super::kernel::{expand, sample_level, sample_q8, wrap_q8, Level, Positions, SpanQ8, Texels};
-use super::scanline::{blend_pays, render_row, with_nodes, wrap_u, Half, RightSpans};
+use super::scanline::{blend_pays, read_at, render_row, span_step, with_nodes, wrap_u, Half, Unfold};
 use super::scanline::{RowScratch, Scratch, BLEND_NODES};
 use super::setup::{Scan, Setup};
+use super::steps::STEP_REGIONS;
 use super::sink::Sink;
 use super::sink::{PixelSink, PosSink, TriSink};
 use crate::geom::fixed::{Fx, FX_ONE};
@@ -152,19 +153,66 @@ pub(crate) fn row_pass<S: Sink>(
     // The first pixel in the buffer.
     let mut c0 = 0i64;
     with_nodes!(scan, table, &h, scratch, |nodes| {
-        let mut spans = RightSpans::new(scan, nodes, fr, &h);
-        while let Some((d, m, p0, step, r)) = spans.next(scan, fr) {
-            if S::LOD {
-                let lod = sink.span_lod(step.0, step.1, r);
-                buf.push_lod((d - c0) as u32, lod);
+        // The spans of `RightSpans`, walked region by region: inside a region every span
+        // is the region's whole step (its reads lie a whole number of steps apart,
+        // `Half`), so the tight loop below needs no region lookup, no clamp to the half's
+        // end and no division; the one span that ends the half short goes through
+        // `span_step` as in `RightSpans::next`.
+        let un = Unfold::new(scan, fr, false);
+        let (dn, npx) = (h.dn, scan.node_per_2x);
+        let mut p0 = read_at(scan, nodes, &h, &un, 0);
+        let (mut d, mut r) = (0i64, h.r0);
+        while d < dn {
+            while r + 1 < STEP_REGIONS && d >= h.e[r + 1] {
+                r += 1;
             }
-            fill(fr, buf, (d - c0) as usize, m as usize, p0, step);
-            let end = d + m;
-            if end - c0 >= HALF_CHUNK as i64 || end > h.dn {
-                flush(buf, sink, c0, end - c0);
-                c0 = end;
+            let shift = scan.shifts[r] as u32;
+            let n = 1i64 << shift;
+            let stop = h.region_end(r).min(dn);
+            let mut c = (h.a0 + 2 * d) * npx;
+            let dc = 2 * n * npx;
+            while d + n <= stop {
+                c += dc;
+                let p1 = un.apply(nodes.lookup_q(c));
+                let (l1, step) = span_step(fr, p0, p1, n, shift);
+                if S::LOD {
+                    let lod = sink.span_lod(step.0, step.1, r);
+                    buf.push_lod((d - c0) as u32, lod);
+                }
+                fill(fr, buf, (d - c0) as usize, n as usize, p0, step);
+                p0 = (l1, p1.1);
+                d += n;
+                if d - c0 >= HALF_CHUNK as i64 {
+                    flush(buf, sink, c0, d - c0);
+                    c0 = d;
+                }
+            }
+            if d < dn && d < h.region_end(r) {
+                // A span that ends short of the step (at the half's end).
+                let d1 = (d + n).min(dn);
+                let p1 = read_at(scan, nodes, &h, &un, d1);
+                let m = d1 - d;
+                let (l1, step) = span_step(fr, p0, p1, m, shift);
+                if S::LOD {
+                    let lod = sink.span_lod(step.0, step.1, r);
+                    buf.push_lod((d - c0) as u32, lod);
+                }
+                fill(fr, buf, (d - c0) as usize, m as usize, p0, step);
+                p0 = (l1, p1.1);
+                d = d1;
+                if d - c0 >= HALF_CHUNK as i64 {
+                    flush(buf, sink, c0, d - c0);
+                    c0 = d;
+                }
             }
         }
+        // The last pixel, a span of one.
+        if S::LOD {
+            let lod = sink.span_lod(0, 0, r);
+            buf.push_lod((d - c0) as u32, lod);
+        }
+        fill(fr, buf, (d - c0) as usize, 1, p0, (0, 0));
+        flush(buf, sink, c0, d + 1 - c0);
     });
 }
 

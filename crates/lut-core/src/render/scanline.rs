@@ -153,6 +153,17 @@ impl Half {
 }
 
 impl Half {
+    /// Where region `r`'s reads end: the first read of the next region (none after the
+    /// last one).
+    #[inline(always)]
+    pub(super) fn region_end(&self, r: usize) -> i64 {
+        if r + 1 < STEP_REGIONS {
+            self.e[r + 1]
+        } else {
+            i64::MAX
+        }
+    }
+
     /// The right half of `scan`, after evaluating exactly into `sink` the pixels neither
     /// half covers (beyond the table, the pole zone between the halves; the whole row
     /// when there is no half).
@@ -247,7 +258,7 @@ impl Unfold {
     }
 
     #[inline(always)]
-    fn apply(&self, (l, v): (Fx, Fx)) -> (Fx, Fx) {
+    pub(super) fn apply(&self, (l, v): (Fx, Fx)) -> (Fx, Fx) {
         (
             ((l ^ self.neg_l) - self.neg_l) + self.off_l,
             (v ^ self.neg_v) - self.neg_v,
