@@ -562,6 +562,24 @@ impl Band<'_> {
         }
     }
 
+    /// A band of the given rows (kernel tests: values a table would not hold).
+    #[cfg(test)]
+    pub(crate) fn from_rows<'a>(top: &'a [[i32; 2]], bot: &'a [[i32; 2]], wa: i64) -> Band<'a> {
+        Band {
+            top,
+            bot,
+            wa,
+            scale: 1.0,
+        }
+    }
+
+    /// The two rows' nodes `k0..k0 + n` and the blend weight of the lower one (Q.16):
+    /// what [`Band::blend_nodes`] blends, for the SIMD kernel that does the same.
+    #[inline]
+    pub(crate) fn rows(&self, k0: usize, n: usize) -> (&[[i32; 2]], &[[i32; 2]], i64) {
+        (&self.top[k0..k0 + n], &self.bot[k0..k0 + n], self.wa)
+    }
+
     /// Nodes `k0..k0 + out.len()` with the two rows blended (what [`Band::lookup`] blends
     /// per read), for [`Blended`].
     #[inline]

@@ -20,12 +20,14 @@
 //! reads the same buffers, so the measured sampling error is this pass's.
 
 use super::kernel::{expand, sample_level, sample_q8, wrap_q8, Level, Positions, SpanQ8, Texels};
-use super::scanline::{blend_pays, read_at, render_row, span_step, with_nodes, wrap_u, Half, Unfold};
+use super::scanline::{
+    blend_pays, read_at, render_row, span_step, with_nodes, wrap_u, Half, Unfold,
+};
 use super::scanline::{RowScratch, Scratch, BLEND_NODES};
 use super::setup::{Scan, Setup};
-use super::steps::STEP_REGIONS;
 use super::sink::Sink;
 use super::sink::{PixelSink, PosSink, TriSink};
+use super::steps::STEP_REGIONS;
 use crate::geom::fixed::{Fx, FX_ONE};
 use crate::lut::{Blended, LutTable};
 use crate::map::envmap::EnvMap;
@@ -171,6 +173,7 @@ pub(crate) fn row_pass<S: Sink>(
             let stop = h.region_end(r).min(dn);
             let mut c = (h.a0 + 2 * d) * npx;
             let dc = 2 * n * npx;
+            let lim = step_limit(fr, n as usize);
             while d + n <= stop {
                 c += dc;
                 let p1 = un.apply(nodes.lookup_q(c));
@@ -179,7 +182,7 @@ pub(crate) fn row_pass<S: Sink>(
                     let lod = sink.span_lod(step.0, step.1, r);
                     buf.push_lod((d - c0) as u32, lod);
                 }
-                fill(fr, buf, (d - c0) as usize, n as usize, p0, step);
+                fill_within(fr, buf, ((d - c0) as usize, n as usize), p0, step, lim);
                 p0 = (l1, p1.1);
                 d += n;
                 if d - c0 >= HALF_CHUNK as i64 {
@@ -223,10 +226,34 @@ pub(crate) fn row_pass<S: Sink>(
 /// travels too far for them (a map width or more: far zoomed out on a tiny map) is
 /// written here, u wrapped per pixel.
 #[inline(always)]
-fn fill(fr: &Setup, buf: &mut HalfBuf, k: usize, m: usize, (l, vv): (Fx, Fx), (dl, dvv): (Fx, Fx)) {
+fn fill(fr: &Setup, buf: &mut HalfBuf, k: usize, m: usize, (l, vv): (Fx, Fx), step: (Fx, Fx)) {
+    fill_within(fr, buf, (k, m), (l, vv), step, step_limit(fr, m));
+}
+
+/// The largest |dΛ|, |dV| (Q.16 per pixel) a span of `m` pixels may step and still be
+/// recorded for `kernel::expand` (see [`fill`]): its lanes, up to 16 past the span, stay
+/// less than min(W, 2³⁰) − 1 pixels from its start. (The same test as
+/// `max(|dΛ|, |dV|)·(m + 16) + 1 px ≤ min(W, 2³⁰)`, with the division done once per
+/// step length instead of the product per span.)
+#[inline(always)]
+fn step_limit(fr: &Setup, m: usize) -> u64 {
+    ((fr.map_w_fx as u64).min(1 << 30) - FX_ONE as u64) / (m as u64 + 16)
+}
+
+/// [`fill`] with the span's [`step_limit`] given.
+#[inline(always)]
+fn fill_within(
+    fr: &Setup,
+    buf: &mut HalfBuf,
+    (k, m): (usize, usize),
+    (l, vv): (Fx, Fx),
+    (dl, dvv): (Fx, Fx),
+    lim: u64,
+) {
     let wfx = fr.map_w_fx;
     let mut u = wrap_u(l + fr.off_fx, wfx);
-    if !(0..wfx).contains(&u) {
+    // (As unsigned: below 0 or from W on.)
+    if u as u64 >= wfx as u64 {
         u = u.rem_euclid(wfx);
     }
     // In [0, W] (the kernels' common case: inside the map).
@@ -238,8 +265,7 @@ fn fill(fr: &Setup, buf: &mut HalfBuf, k: usize, m: usize, (l, vv): (Fx, Fx), (d
     let dv = -dvv;
     // Lanes run up to 16 past the span. (|v| < 2³², as table entries and H/2 are i32:
     // v >> 8 fits.)
-    let reach = dl.unsigned_abs().max(dv.unsigned_abs()) * (m as u64 + 16);
-    if reach + FX_ONE as u64 <= (wfx as u64).min(1 << 30) {
+    if dl.unsigned_abs().max(dv.unsigned_abs()) <= lim {
         buf.spans[buf.n_spans] = SpanQ8 {
             k: k as u32,
             m: m as u32,

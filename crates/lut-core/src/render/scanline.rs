@@ -5,6 +5,7 @@
 //! steps continuously. The rest (pole zones, beyond the table) is evaluated exactly.
 //! Spans go to a [`Sink`].
 
+use super::kernel::simd_blend;
 use super::rowpass::HalfBuf;
 use super::setup::{Scan, Setup};
 use super::sink::Sink;
@@ -80,7 +81,7 @@ macro_rules! with_nodes {
         let count = k1 + 1 - k0;
         if count <= BLEND_NODES && blend_pays(scan, count, (h.dn + 1) as usize) {
             let nodes = &mut $scratch[..count];
-            band.blend_nodes(k0, nodes);
+            $crate::render::kernel::blend_nodes(&band, k0, nodes);
             let $nodes = &Blended { band, k0, nodes };
             $body
         } else {
@@ -223,16 +224,19 @@ impl Nodes for Blended<'_> {
 }
 
 /// Whether to blend a run's `nodes` once instead of two per read: when there are at
-/// most 1.25 nodes per read, the reads estimated from the run's length and the mean step
-/// of the regions. (Callgrind: about 20 instructions per blended node against 27 saved
-/// per read puts the break-even near 1.35; with the row pass, which reads only the right
-/// half, a limit of 2 blended at about 1.9 nodes per read and cost 0.6 instructions per
-/// pixel at hfov 90, docs/performance.md.) Only the cost depends on it, not the output.
+/// most 1.25 nodes per read (5 with a SIMD blend, `kernel::simd_blend`), the reads
+/// estimated from the run's length and the mean step of the regions. (Callgrind: about
+/// 20 instructions per node blended in scalar code against 27 saved per read puts the
+/// break-even near 1.35; with the row pass, which reads only the right half, a limit of
+/// 2 blended at about 1.9 nodes per read and cost 0.6 instructions per pixel at hfov 90,
+/// docs/performance.md. The AVX2 blend costs about 5 instructions a node.) Only the cost
+/// depends on it, not the output.
 #[inline(never)]
 pub(super) fn blend_pays(scan: &Scan, nodes: usize, pixels: usize) -> bool {
     // Reads per 256 pixels, summed over the regions.
     let per_256: usize = scan.shifts.iter().map(|&s| 256 >> s).sum();
-    4 * nodes * 256 * STEP_REGIONS <= 5 * pixels * per_256
+    let quarters = if simd_blend() { 20 } else { 5 };
+    4 * nodes * 256 * STEP_REGIONS <= quarters * pixels * per_256
 }
 
 /// The one-eighth unfolding of one half of a scanline, hoisted out of its reads: Λ =

@@ -123,6 +123,7 @@
 mod face;
 mod face_step;
 mod jobs;
+mod nodes;
 mod row;
 mod scalar;
 mod select;
@@ -139,6 +140,7 @@ pub use select::{
 pub(crate) use face::{face_blend, face_span, FaceRun};
 pub(crate) use face_step::{face_steps, StepBuf};
 pub use face_step::{FACE_STEP_BOUND, FACE_STEP_ERROR, FACE_STEP_MAX};
+pub(crate) use nodes::{blend_nodes, simd_blend};
 pub(crate) use row::{expand, sample_level, sample_q8, wrap_q8, Level, Positions, SpanQ8};
 
 use crate::geom::fixed::{Fx, FX_BITS};

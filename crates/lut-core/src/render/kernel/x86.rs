@@ -25,6 +25,7 @@ use crate::geom::fixed::FX_BITS;
 use std::arch::x86_64::*;
 
 pub(super) mod face;
+pub(super) mod nodes;
 pub(super) mod row;
 
 /// The span's start split for 32-bit lanes: `base` = the start pixel's index in the

@@ -585,3 +585,39 @@ fn env_chooses_the_active_kernel() {
         _ => assert_eq!(info.active, Kernel::best()),
     }
 }
+
+/// A table value: anywhere in `i32` (the extremes included), or small.
+fn node_value() -> impl Strategy<Value = i32> {
+    prop_oneof![
+        4 => any::<i32>(),
+        2 => -70_000..70_000i32,
+        1 => Just(i32::MIN),
+        1 => Just(i32::MAX),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+
+    /// The node blend: every kernel writes what `Band::blend_nodes` (the scalar twin)
+    /// writes, for runs of 0 to 40 nodes from any offset, weights 0 to 1 (Q.16) and any
+    /// `i32` values, and nothing past the run.
+    #[test]
+    fn node_blend_equals_scalar(
+        rows in prop::collection::vec(((node_value(), node_value()), (node_value(), node_value())), 2..48),
+        wa in prop_oneof![3 => 0..=65536i64, 1 => Just(0i64), 1 => Just(65536i64), 1 => Just(32768i64)],
+        (k0, n) in (0..4usize, 0..=40usize),
+    ) {
+        let top: Vec<[i32; 2]> = rows.iter().map(|r| [r.0 .0, r.0 .1]).collect();
+        let bot: Vec<[i32; 2]> = rows.iter().map(|r| [r.1 .0, r.1 .1]).collect();
+        let band = crate::lut::Band::from_rows(&top, &bot, wa);
+        let n = n.min(top.len().saturating_sub(k0));
+        let mut want = vec![[7i32, 7]; n + 3];
+        band.blend_nodes(k0, &mut want[..n]);
+        for k in Kernel::available() {
+            let mut got = vec![[7i32, 7]; n + 3];
+            nodes::blend_nodes_with(k.selected(), &band, k0, &mut got[..n]);
+            prop_assert_eq!(&got, &want, "{} k0 {} n {} wa {}", k, k0, n, wa);
+        }
+    }
+}
