@@ -611,7 +611,8 @@ proptest! {
         let top: Vec<[i32; 2]> = rows.iter().map(|r| [r.0 .0, r.0 .1]).collect();
         let bot: Vec<[i32; 2]> = rows.iter().map(|r| [r.1 .0, r.1 .1]).collect();
         let band = crate::lut::Band::from_rows(&top, &bot, wa);
-        let n = n.min(top.len().saturating_sub(k0));
+        let k0 = k0.min(top.len());
+        let n = n.min(top.len() - k0);
         let mut want = vec![[7i32, 7]; n + 3];
         band.blend_nodes(k0, &mut want[..n]);
         for k in Kernel::available() {
