@@ -37,8 +37,8 @@
 //! `mod.rs` (this file): the kernels' data types and the entries the renderer calls on an
 //! [`EnvMap`]; `jobs.rs`: the span check, batches and the dispatch; `scalar.rs`: the
 //! portable kernels (the reference); `x86.rs`: SSE4.1 and AVX2, and the AVX-512 pieces
-//! (the only module where `unsafe` is allowed; `x86/face.rs` and `x86/row.rs` are its
-//! children); `select.rs`: choosing the kernel;
+//! (the only module where `unsafe` is allowed; `x86/face.rs`, `x86/row.rs` and
+//! `x86/nodes.rs` are its children); `select.rs`: choosing the kernel;
 //! `tests/`: the property tests (`row_pass.rs`: the row kernels'); `face.rs`:
 //! cube-face runs, whose positions are a projective line evaluated exactly per pixel
 //! (the cube scanline renderer's nearest and trilinear runs); `face_step.rs`: cube-face
@@ -47,7 +47,8 @@
 //! `row.rs` (and `x86/row.rs`): the row pass's kernels (`render/rowpass.rs`), a run's
 //! Q.8 positions expanded from its spans and one gather-and-blend pass over them, with
 //! no per-span check (the LUT rows of full maps, trilinear's pyramid levels by
-//! `sample_level`; the span kernels draw the rest).
+//! `sample_level`; the span kernels draw the rest); `nodes.rs` (and `x86/nodes.rs`): a
+//! scanline's table nodes, the two table rows blended once for the walk's reads.
 //!
 //! # Batches
 //! Spans are short (8–16 pixels at hfov 90), so what a span costs besides its pixels
