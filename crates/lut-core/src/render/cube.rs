@@ -79,6 +79,16 @@ impl CubeRenderer {
     pub fn name(self) -> &'static str {
         Named::name(self)
     }
+
+    /// How far, in face texels, this renderer's sampling positions with `sampler` may lie
+    /// from the exact ones: [`crate::FACE_STEP_BOUND`] where it steps them (the scanline
+    /// renderer's bilinear runs), `None` where it evaluates every position exactly.
+    pub fn position_bound(self, sampler: Sampler) -> Option<f64> {
+        match (self, sampler) {
+            (CubeRenderer::Accelerated, Sampler::Bilinear) => Some(crate::FACE_STEP_BOUND),
+            _ => None,
+        }
+    }
 }
 
 impl std::str::FromStr for CubeRenderer {

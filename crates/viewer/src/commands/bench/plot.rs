@@ -175,19 +175,14 @@ fn series(rows: &[Row]) -> Vec<Series<'_>> {
     out
 }
 
-/// A vertical line's legend: the renderer and sampler, and for the one that has a
-/// position error by construction, its bound (the cube scanline renderer's bilinear runs
-/// step the face's projective line, `lut_core::FACE_STEP_BOUND`; the others sample the
-/// exact positions).
+/// A vertical line's legend: the renderer and sampler, and for a row whose positions are
+/// stepped within a bound rather than exact (`position_bound_texels`: the cube scanline
+/// renderer's bilinear runs, `lut_core::CubeRenderer::position_bound`), that bound.
 fn reference_label(r: &Row) -> String {
     let label = format!("{}, {}", r.renderer, r.sampler);
-    if r.renderer == "cube-scanline" && r.sampler == "bilinear" {
-        format!(
-            "{label} (stepped: max error <= {:.4} face texel, bound)",
-            lut_core::FACE_STEP_BOUND
-        )
-    } else {
-        label
+    match r.position_bound_texels {
+        Some(b) => format!("{label} (stepped: max error <= {b:.4} face texel, bound)"),
+        None => label,
     }
 }
 
@@ -846,6 +841,33 @@ mod tests {
          "ours_ms": null, "ours": "-", "ratio_ours_over_theirs": null, "psnr_db_vs_exact": null},
         {"peer": "again", "key": "cv_float_bil", "ms_median": 0.8, "psnr_db_vs_exact": 71.7}
     ]}"#;
+
+    /// A reference line's legend names a stepped row's bound (from the row, as
+    /// `viewer bench` fills it in from `CubeRenderer::position_bound`), and the bound
+    /// survives the JSON round trip of `--replot`; exact rows carry none.
+    #[test]
+    fn stepped_rows_name_their_bound() {
+        let mut stepped = Row::timed(&run(), "cube-scanline", Sampler::Bilinear, 90.0, 1, &[5.0]);
+        stepped.position_bound_texels =
+            lut_core::CubeRenderer::Accelerated.position_bound(Sampler::Bilinear);
+        let exact = Row::timed(&run(), "cube-scanline", Sampler::Nearest, 90.0, 1, &[5.0]);
+        assert_eq!(
+            lut_core::CubeRenderer::Accelerated.position_bound(Sampler::Nearest),
+            None
+        );
+        assert_eq!(
+            reference_label(&stepped),
+            format!(
+                "cube-scanline, bilinear (stepped: max error <= {:.4} face texel, bound)",
+                lut_core::FACE_STEP_BOUND
+            )
+        );
+        assert_eq!(reference_label(&exact), "cube-scanline, nearest");
+        let json = serde_json::to_string(&[&stepped, &exact]).unwrap();
+        assert_eq!(json.matches("position_bound_texels").count(), 1);
+        let back: Vec<Row> = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, vec![stepped, exact]);
+    }
 
     /// `--replot`: the rows of a `--json` run read back (the same rows), the peers read
     /// once per key, and the chart drawn with them.

@@ -78,6 +78,12 @@ pub struct Row {
     /// The table surface: "cylinder", "plane" or "diamond" (LUT rows), else null.
     #[serde(default)]
     pub surface: Option<Name>,
+    /// Rows whose sampling positions are stepped between exact ones rather than exact or
+    /// measured (the cube scanline renderer's bilinear runs): how far, in face texels, a
+    /// position may lie from the exact one (`lut_core::CubeRenderer::position_bound`).
+    /// Absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position_bound_texels: Option<f64>,
 }
 
 impl Row {
@@ -113,6 +119,7 @@ impl Row {
             table_bytes: None,
             table_build_ms: None,
             surface: None,
+            position_bound_texels: None,
         }
     }
 }
