@@ -85,7 +85,7 @@ impl CubeRenderer {
     /// renderer's bilinear runs), `None` where it evaluates every position exactly.
     pub fn position_bound(self, sampler: Sampler) -> Option<f64> {
         match (self, sampler) {
-            (CubeRenderer::Accelerated, Sampler::Bilinear) => Some(crate::FACE_STEP_BOUND),
+            (CubeRenderer::Accelerated, Sampler::Bilinear) => Some(super::kernel::FACE_STEP_BOUND),
             _ => None,
         }
     }
