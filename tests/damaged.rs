@@ -291,6 +291,35 @@ fn a_damaged_b44a_exr_does_not_panic() {
     }
 }
 
+/// A damaged JPEG (found by the `map_jpeg` fuzz target) on which zune-jpeg 0.5.15's AVX2
+/// IDCT unwraps a slice that is too short: refused with an error naming the file, not a
+/// panic. (Without AVX2 the scalar IDCT runs, which may decode it or refuse it: either
+/// is fine, a panic is not.)
+#[test]
+fn a_jpeg_that_trips_the_decoder_is_refused() {
+    let bytes = std::fs::read(test_support::test_data(
+        "fuzz/map_jpeg-idct-avx2-unwrap.jpg",
+    ))
+    .unwrap();
+    let opts = LoadOptions {
+        projection: Some(Projection::Elliptical),
+        max_pixels: 1 << 24,
+        ..LoadOptions::default()
+    };
+    let r = std::panic::catch_unwind(|| {
+        lut_core::decode_map(&bytes, "trips.jpg", &opts, &mut |_| {})
+            .map(|m| (m.width(), m.height()))
+    });
+    match r.expect("decoding the damaged JPEG panicked") {
+        Err(e) => {
+            let msg = e.to_string();
+            assert!(msg.contains("trips.jpg"), "{msg}");
+            assert!(!msg.contains('\n'), "one line: {msg}");
+        }
+        Ok((w, h)) => assert!(w >= 1 && h >= 1),
+    }
+}
+
 #[test]
 fn a_luminance_only_exr_loads_as_gray() {
     use exr::prelude::{Blocks, Compression};

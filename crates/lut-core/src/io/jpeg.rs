@@ -118,6 +118,40 @@ pub(crate) struct Jpeg<'a> {
     pub color: ColorType,
 }
 
+/// `f`, with a panic inside it returned as `Err` (its message) instead of unwinding
+/// further, and not printed. zune-jpeg 0.5.15's AVX2 IDCT unwraps an output slice that
+/// some damaged files make too short (found by the `map_jpeg` fuzz target;
+/// `tests/damaged.rs`, `a_jpeg_that_trips_the_decoder_is_refused`): a bug in the decoder
+/// must refuse the file, not end the process.
+///
+/// The message is kept off stderr by a panic hook installed once that stays quiet for
+/// panics on a thread inside this function and hands every other panic to the hook
+/// that was there before (so other threads' panics print as they did).
+fn without_panics<T>(f: impl FnOnce() -> T) -> Result<T, String> {
+    use std::cell::Cell;
+    thread_local! {
+        static QUIET: Cell<bool> = const { Cell::new(false) };
+    }
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    HOOK.call_once(|| {
+        let before = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !QUIET.with(Cell::get) {
+                before(info);
+            }
+        }));
+    });
+    let was = QUIET.with(|q| q.replace(true));
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+    QUIET.with(|q| q.set(was));
+    r.map_err(|p| {
+        p.downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| p.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "an internal error".to_string())
+    })
+}
+
 fn reason(e: &DecodeErrors) -> String {
     match e {
         DecodeErrors::ExhaustedData => {
@@ -174,8 +208,14 @@ impl<'a> Jpeg<'a> {
     /// # Errors
     /// [`MapError::Decode`] naming `what`: truncated or corrupt image data.
     pub(crate) fn decode_into(mut self, out: &mut [u8], what: &str) -> Result<(), MapError> {
-        self.decoder
-            .decode_into(out)
+        let decoder = &mut self.decoder;
+        without_panics(move || decoder.decode_into(out))
+            .map_err(|panic| MapError::Decode {
+                path: what.into(),
+                reason: format!(
+                    "the image data is corrupt (the JPEG decoder failed on it: {panic})"
+                ),
+            })?
             .map_err(|e| MapError::Decode {
                 path: what.into(),
                 reason: reason(&e),
