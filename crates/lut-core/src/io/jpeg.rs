@@ -179,7 +179,14 @@ impl<'a> Jpeg<'a> {
             .set_max_width(usize::MAX)
             .set_max_height(usize::MAX);
         let mut decoder = zune_jpeg::JpegDecoder::new_with_options(ZCursor::new(bytes), opts);
-        decoder.decode_headers().map_err(err)?;
+        without_panics(|| decoder.decode_headers())
+            .map_err(|panic| MapError::Decode {
+                path: what.into(),
+                reason: format!(
+                    "the headers are corrupt (the JPEG decoder failed on them: {panic})"
+                ),
+            })?
+            .map_err(err)?;
         let (w, h) = decoder.dimensions().unwrap_or((0, 0));
         let input = decoder.input_colorspace().unwrap_or(ColorSpace::YCbCr);
         let (out, color) = match input {
