@@ -36,9 +36,10 @@
 //! # Layout
 //! `mod.rs` (this file): the kernels' data types and the entries the renderer calls on an
 //! [`EnvMap`]; `jobs.rs`: the span check, batches and the dispatch; `scalar.rs`: the
-//! portable kernels (the reference); `x86.rs`: SSE4.1 and AVX2, and the AVX-512 pieces
-//! (the only module where `unsafe` is allowed; `x86/face.rs`, `x86/row.rs` and
-//! `x86/nodes.rs` are its children); `select.rs`: choosing the kernel;
+//! portable kernels (the reference); `x86.rs`: the SSE4.1, AVX2 and AVX-512 texel blend
+//! the x86 kernels share (the only module where `unsafe` is allowed, with its children:
+//! `x86/span.rs` the span kernels, `x86/row.rs`, `x86/face.rs`, `x86/nodes.rs`);
+//! `select.rs`: choosing the kernel;
 //! `tests/`: the property tests (`row_pass.rs`: the row kernels'); `face.rs`:
 //! cube-face runs, whose positions are a projective line evaluated exactly per pixel
 //! (the cube scanline renderer's nearest and trilinear runs); `face_step.rs`: cube-face

@@ -1,8 +1,11 @@
-//! x86-64 span kernels: SSE4.1 (4 pixels per step) and AVX2 (8 pixels per step); the
-//! AVX-512 pieces (`avx512`: `split`, `lerp`, `merge`, the pair layout and `bilinear16`)
-//! that the AVX-512 row and face kernels (`x86/row.rs`, `x86/face.rs`) share. There are
-//! no AVX-512 span kernels: `Kernel::Avx512` runs the AVX2 ones here (an AVX-512 CPU
-//! runs AVX2), and so do the cropped kernels built on them.
+//! x86-64 SIMD kernels. This module holds what they share: the texel blend of each
+//! instruction set (`split`, `lerp`, `merge`, the nearest `gather`, the clamped lane
+//! indices and the bilinear sample of a vector of positions: `bilinear4` with SSE4.1,
+//! `bilinear8` with AVX2, `bilinear16` and the pair layout with AVX-512), the checked
+//! span start (`Local`) and the prefetch of the row and face kernels. The kernels
+//! themselves are its children: `span.rs` (the span kernels and their batch entry
+//! points), `row.rs` (the row pass's), `face.rs` (cube-face runs), `nodes.rs` (the
+//! table-node blend).
 //!
 //! All compute what `scalar.rs` computes, byte for byte (see the module docs of
 //! [`super`]): positions in span-local `i32` lanes, lane indices stored to the stack and
@@ -11,22 +14,26 @@
 //! lanes, two channels per 32-bit lane (blue and red, then green and the unused top byte,
 //! which is dropped at the end as `lerp_px` drops it).
 //!
-//! The only `unsafe` here: calling a `#[target_feature]` function (the CPU was checked:
-//! [`Selected`] is only made for a supported kernel), the unaligned loads and stores,
-//! whose indices are clamped into the slices they read or bounded by the loop, and the
-//! prefetches of the row and face kernels ([`prefetch_texels`]), which read nothing.
+//! The only `unsafe` here and in the children: calling a `#[target_feature]` function
+//! (the CPU was checked: [`Selected`] is only made for a supported kernel), the unaligned
+//! loads and stores, whose indices are clamped into the slices they read or bounded by
+//! the loop, and the prefetches of the row and face kernels ([`prefetch_texels`]), which
+//! read nothing.
 
 #![allow(unsafe_code)]
 
-use super::jobs::{run_jobs, run_tri_jobs, Span};
+use super::jobs::Span;
 use super::select::{Kernel, Selected};
-use super::{scalar, SpanJob, Texels};
+use super::Texels;
 use crate::geom::fixed::FX_BITS;
 use std::arch::x86_64::*;
 
 pub(super) mod face;
 pub(super) mod nodes;
 pub(super) mod row;
+mod span;
+
+pub(super) use span::{jobs, tri_jobs};
 
 /// The span's start split for 32-bit lanes: `base` = the start pixel's index in the
 /// slice, lanes hold `f + i·d` (Q.16, relative to that pixel).
@@ -73,44 +80,6 @@ impl Local {
     }
 }
 
-/// The batch kernels ([`super::jobs`]) with a SIMD kernel; `None` for the scalar one.
-#[inline(always)]
-pub(super) fn jobs<const BILINEAR: bool>(
-    k: Selected,
-    t: &Texels,
-    row: &mut [u32],
-    jobs: &[SpanJob],
-) -> Option<u64> {
-    match k.0 {
-        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        // (No AVX-512 span kernels: AVX-512 CPUs run AVX2, see `Kernel::Avx512`.)
-        Kernel::Avx2 | Kernel::Avx512 => Some(unsafe { avx2::jobs::<BILINEAR>(t, row, jobs) }),
-        // SAFETY: as above.
-        Kernel::Sse41 => Some(unsafe { sse41::jobs::<BILINEAR>(t, row, jobs) }),
-        Kernel::Scalar => None,
-    }
-}
-
-/// The trilinear batch kernels ([`super::tri_jobs`]) with a SIMD kernel; `None` for the
-/// scalar one.
-#[inline(always)]
-pub(super) fn tri_jobs(
-    k: Selected,
-    levels: &[Texels],
-    row: &mut [u32],
-    jobs: &[SpanJob],
-    lods: &[i32],
-) -> Option<u64> {
-    match k.0 {
-        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        // (No AVX-512 span kernels: AVX-512 CPUs run AVX2, see `Kernel::Avx512`.)
-        Kernel::Avx2 | Kernel::Avx512 => Some(unsafe { avx2::tri_jobs(levels, row, jobs, lods) }),
-        // SAFETY: as above.
-        Kernel::Sse41 => Some(unsafe { sse41::tri_jobs(levels, row, jobs, lods) }),
-        Kernel::Scalar => None,
-    }
-}
-
 /// How many pixels ahead the row kernels prefetch the texels they will read.
 ///
 /// Why: a frame reads the map along curves that cross map rows, and each map row the
@@ -144,63 +113,8 @@ fn padded<const N: usize>(src: &[u32]) -> [u32; N] {
     a
 }
 
-/// The two batch entry points of one instruction set, written once: `tri_jobs` and `jobs`
-/// compiled under that set's `target_feature`, so the span setup, the closures and the
-/// module's own `bilinear`/`nearest` inline into one loop per set.
-macro_rules! batch_entries {
-    ($feature:literal) => {
-        /// A batch of trilinear spans (see [`super::super::tri_jobs`]).
-        #[target_feature(enable = $feature)]
-        pub(super) fn tri_jobs(
-            levels: &[Texels],
-            row: &mut [u32],
-            jobs: &[SpanJob],
-            lods: &[i32],
-        ) -> u64 {
-            run_tri_jobs(
-                levels,
-                row,
-                jobs,
-                lods,
-                |t, out, s| match Local::new(t, s, out.len(), true) {
-                    Some(l) if out.len() >= 2 => bilinear::<false, 1>(t.px, t.stride(), out, l, 0),
-                    _ => scalar::bilinear(t, out, s),
-                },
-                |t, out, s, frac| match Local::new(t, s, out.len(), true) {
-                    Some(l) if out.len() >= 2 => {
-                        bilinear::<true, 2>(t.px, t.stride(), out, l, frac)
-                    }
-                    _ => scalar::blend_bilinear(t, out, s, frac),
-                },
-            )
-        }
-
-        /// A batch of spans of one row (see [`super::super::jobs`]): the span setup and the
-        /// kernel compiled together, the constants loaded once.
-        #[target_feature(enable = $feature)]
-        pub(super) fn jobs<const BILINEAR: bool>(
-            t: &Texels,
-            row: &mut [u32],
-            jobs: &[SpanJob],
-        ) -> u64 {
-            run_jobs::<BILINEAR>(t, row, jobs, |out, s| {
-                match Local::new(t, s, out.len(), BILINEAR) {
-                    Some(l) if out.len() >= 2 && BILINEAR => {
-                        bilinear::<false, 0>(t.px, t.stride(), out, l, 0)
-                    }
-                    Some(l) if out.len() >= 2 => nearest(t.px, t.stride(), out, l),
-                    _ if BILINEAR => scalar::bilinear(t, out, s),
-                    _ => scalar::nearest(t, out, s),
-                }
-            })
-        }
-    };
-}
-
 mod avx2 {
     use super::*;
-
-    batch_entries!("avx2");
 
     /// Per 32-bit lane: the fraction byte (bits 8..16) in both 16-bit halves.
     #[inline]
@@ -256,24 +170,10 @@ mod avx2 {
         _mm256_setr_epi32(g(0), g(1), g(2), g(3), g(4), g(5), g(6), g(7))
     }
 
-    /// `d · [0, 1, …, 7]` per lane without `vpmulld` (10 cycles of latency on the
-    /// span's critical path): each lane adds d, 2d and 4d by the bits of its index.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn times_iota(d: __m256i) -> __m256i {
-        let d2 = _mm256_add_epi32(d, d);
-        let d4 = _mm256_add_epi32(d2, d2);
-        let m1 = _mm256_setr_epi32(0, -1, 0, -1, 0, -1, 0, -1);
-        let m2 = _mm256_setr_epi32(0, 0, -1, -1, 0, 0, -1, -1);
-        let m4 = _mm256_setr_epi32(0, 0, 0, 0, -1, -1, -1, -1);
-        let a = _mm256_add_epi32(_mm256_and_si256(d, m1), _mm256_and_si256(d2, m2));
-        _mm256_add_epi32(a, _mm256_and_si256(d4, m4))
-    }
-
     /// Lane indices (relative to the span's base pixel) of positions `ru`, `rv`, clamped.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn indices(ru: __m256i, rv: __m256i, stride: __m256i, l: &Local) -> [i32; 8] {
+    pub(super) fn indices(ru: __m256i, rv: __m256i, stride: __m256i, l: &Local) -> [i32; 8] {
         let x = _mm256_srai_epi32::<16>(ru);
         let y = _mm256_srai_epi32::<16>(rv);
         let i = _mm256_add_epi32(_mm256_mullo_epi32(y, stride), x);
@@ -336,120 +236,11 @@ mod avx2 {
         let bot = lerp(split(left(ba, bb)), split(right(ba, bb)), wx);
         lerp(top, bot, weights(rv))
     }
-
-    /// Bilinear (or, `BLEND`, blended into `out` by `frac`) along a checked span.
-    ///
-    /// `SITE` only tells call sites apart: each instantiation has one caller, so it is
-    /// compiled into that caller (no call, no span setup passed through memory).
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    pub(super) fn bilinear<const BLEND: bool, const SITE: u8>(
-        px: &[u32],
-        stride: usize,
-        out: &mut [u32],
-        l: Local,
-        frac: u32,
-    ) {
-        let m = out.len();
-        let iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-        let (fu, fv) = (_mm256_set1_epi32(l.fu), _mm256_set1_epi32(l.fv));
-        let (du, dv) = (_mm256_set1_epi32(l.du), _mm256_set1_epi32(l.dv));
-        let fw = _mm256_set1_epi32((frac as i32) * 0x10001);
-        let fwt = (fw, _mm256_sub_epi16(_mm256_set1_epi16(256), fw));
-        let blend = |o: __m256i, c: (__m256i, __m256i)| {
-            if BLEND {
-                merge(lerp(split(o), c, fwt))
-            } else {
-                merge(c)
-            }
-        };
-        // Lanes i < m hold f + i·d exactly (Local::new); the wrapping adds stay exact.
-        let mut ru = _mm256_add_epi32(fu, times_iota(du));
-        let mut rv = _mm256_add_epi32(fv, times_iota(dv));
-        let (su, sv) = (_mm256_slli_epi32::<3>(du), _mm256_slli_epi32::<3>(dv));
-        let mut i = 0;
-        while i + 8 <= m {
-            let c = bilinear8(px, stride, &l, ru, rv);
-            let q = out[i..i + 8].as_mut_ptr().cast::<__m256i>();
-            let o = if BLEND {
-                // SAFETY: `q` points at 8 u32 of `out` (the slice above).
-                unsafe { _mm256_loadu_si256(q) }
-            } else {
-                _mm256_setzero_si256()
-            };
-            // SAFETY: as above.
-            unsafe { _mm256_storeu_si256(q, blend(o, c)) };
-            ru = _mm256_add_epi32(ru, su);
-            rv = _mm256_add_epi32(rv, sv);
-            i += 8;
-        }
-        if i < m {
-            // The tail: lanes past the end repeat the last pixel (inside the map).
-            let idx = _mm256_min_epi32(
-                _mm256_add_epi32(_mm256_set1_epi32(i as i32), iota),
-                _mm256_set1_epi32(m as i32 - 1),
-            );
-            let ru = _mm256_add_epi32(fu, _mm256_mullo_epi32(idx, du));
-            let rv = _mm256_add_epi32(fv, _mm256_mullo_epi32(idx, dv));
-            let c = bilinear8(px, stride, &l, ru, rv);
-            let tail = &mut out[i..];
-            let mut buf = padded::<8>(tail);
-            let q = buf.as_mut_ptr().cast::<__m256i>();
-            // SAFETY: `buf` holds 8 u32.
-            let o = unsafe { _mm256_loadu_si256(q) };
-            // SAFETY: as above.
-            unsafe { _mm256_storeu_si256(q, blend(o, c)) };
-            let n = tail.len();
-            tail.copy_from_slice(&buf[..n]);
-        }
-    }
-
-    /// Nearest along a checked span.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    pub(super) fn nearest(px: &[u32], stride: usize, out: &mut [u32], l: Local) {
-        let m = out.len();
-        let iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-        let (fu, fv) = (_mm256_set1_epi32(l.fu), _mm256_set1_epi32(l.fv));
-        let (du, dv) = (_mm256_set1_epi32(l.du), _mm256_set1_epi32(l.dv));
-        let st = _mm256_set1_epi32(stride as i32);
-        let mut ru = _mm256_add_epi32(fu, times_iota(du));
-        let mut rv = _mm256_add_epi32(fv, times_iota(dv));
-        let (su, sv) = (_mm256_slli_epi32::<3>(du), _mm256_slli_epi32::<3>(dv));
-        let p = px.as_ptr();
-        let fetch = |a: &[i32; 8], j: usize| -> u32 {
-            let k = (l.base as isize + a[j] as isize) as usize;
-            // SAFETY: a[j] is clamped to [−base, last − base] with last < px.len().
-            unsafe { p.add(k).read() }
-        };
-        let mut i = 0;
-        while i + 8 <= m {
-            let a = indices(ru, rv, st, &l);
-            for (j, o) in out[i..i + 8].iter_mut().enumerate() {
-                *o = fetch(&a, j);
-            }
-            ru = _mm256_add_epi32(ru, su);
-            rv = _mm256_add_epi32(rv, sv);
-            i += 8;
-        }
-        if i < m {
-            let idx = _mm256_min_epi32(
-                _mm256_add_epi32(_mm256_set1_epi32(i as i32), iota),
-                _mm256_set1_epi32(m as i32 - 1),
-            );
-            let ru = _mm256_add_epi32(fu, _mm256_mullo_epi32(idx, du));
-            let rv = _mm256_add_epi32(fv, _mm256_mullo_epi32(idx, dv));
-            let a = indices(ru, rv, st, &l);
-            for (j, o) in out[i..].iter_mut().enumerate() {
-                *o = fetch(&a, j);
-            }
-        }
-    }
 }
 
 /// The AVX-512 pieces the row and face kernels share (`x86/row.rs`, `x86/face.rs`): the
-/// AVX2 ones on 16 lanes, the same arithmetic. There are no AVX-512 span kernels (the
-/// batch entry points above): `Kernel::Avx512` runs the AVX2 ones.
+/// AVX2 ones on 16 lanes, the same arithmetic. There are no AVX-512 span kernels
+/// (`x86/span.rs`): `Kernel::Avx512` runs the AVX2 ones.
 ///
 /// Every function is `#[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,
 /// avx512dq")]` (a list: `Kernel::Avx512` checks each).
@@ -618,8 +409,6 @@ mod avx512 {
 mod sse41 {
     use super::*;
 
-    batch_entries!("sse4.1");
-
     #[inline]
     #[target_feature(enable = "sse4.1")]
     fn weights(r: __m128i) -> (__m128i, __m128i) {
@@ -670,7 +459,7 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    fn indices(ru: __m128i, rv: __m128i, stride: __m128i, l: &Local) -> [i32; 4] {
+    pub(super) fn indices(ru: __m128i, rv: __m128i, stride: __m128i, l: &Local) -> [i32; 4] {
         let x = _mm_srai_epi32::<16>(ru);
         let y = _mm_srai_epi32::<16>(rv);
         let i = _mm_add_epi32(_mm_mullo_epi32(y, stride), x);
@@ -718,110 +507,5 @@ mod sse41 {
         let top = lerp(split(left(ta, tb)), split(right(ta, tb)), wx);
         let bot = lerp(split(left(ba, bb)), split(right(ba, bb)), wx);
         lerp(top, bot, weights(rv))
-    }
-
-    ///
-    /// `SITE` only tells call sites apart: each instantiation has one caller, so it is
-    /// compiled into that caller (no call, no span setup passed through memory).
-    #[inline]
-    #[target_feature(enable = "sse4.1")]
-    pub(super) fn bilinear<const BLEND: bool, const SITE: u8>(
-        px: &[u32],
-        stride: usize,
-        out: &mut [u32],
-        l: Local,
-        frac: u32,
-    ) {
-        let m = out.len();
-        let iota = _mm_setr_epi32(0, 1, 2, 3);
-        let (fu, fv) = (_mm_set1_epi32(l.fu), _mm_set1_epi32(l.fv));
-        let (du, dv) = (_mm_set1_epi32(l.du), _mm_set1_epi32(l.dv));
-        let fw = _mm_set1_epi32((frac as i32) * 0x10001);
-        let fwt = (fw, _mm_sub_epi16(_mm_set1_epi16(256), fw));
-        let blend = |o: __m128i, c: (__m128i, __m128i)| {
-            if BLEND {
-                merge(lerp(split(o), c, fwt))
-            } else {
-                merge(c)
-            }
-        };
-        let mut ru = _mm_add_epi32(fu, _mm_mullo_epi32(iota, du));
-        let mut rv = _mm_add_epi32(fv, _mm_mullo_epi32(iota, dv));
-        let (su, sv) = (_mm_slli_epi32::<2>(du), _mm_slli_epi32::<2>(dv));
-        let mut i = 0;
-        while i + 4 <= m {
-            let c = bilinear4(px, stride, &l, ru, rv);
-            let q = out[i..i + 4].as_mut_ptr().cast::<__m128i>();
-            let o = if BLEND {
-                // SAFETY: `q` points at 4 u32 of `out` (the slice above).
-                unsafe { _mm_loadu_si128(q) }
-            } else {
-                _mm_setzero_si128()
-            };
-            // SAFETY: as above.
-            unsafe { _mm_storeu_si128(q, blend(o, c)) };
-            ru = _mm_add_epi32(ru, su);
-            rv = _mm_add_epi32(rv, sv);
-            i += 4;
-        }
-        if i < m {
-            let idx = _mm_min_epi32(
-                _mm_add_epi32(_mm_set1_epi32(i as i32), iota),
-                _mm_set1_epi32(m as i32 - 1),
-            );
-            let ru = _mm_add_epi32(fu, _mm_mullo_epi32(idx, du));
-            let rv = _mm_add_epi32(fv, _mm_mullo_epi32(idx, dv));
-            let c = bilinear4(px, stride, &l, ru, rv);
-            let tail = &mut out[i..];
-            let mut buf = padded::<4>(tail);
-            let q = buf.as_mut_ptr().cast::<__m128i>();
-            // SAFETY: `buf` holds 4 u32.
-            let o = unsafe { _mm_loadu_si128(q) };
-            // SAFETY: as above.
-            unsafe { _mm_storeu_si128(q, blend(o, c)) };
-            let n = tail.len();
-            tail.copy_from_slice(&buf[..n]);
-        }
-    }
-
-    #[inline]
-    #[target_feature(enable = "sse4.1")]
-    pub(super) fn nearest(px: &[u32], stride: usize, out: &mut [u32], l: Local) {
-        let m = out.len();
-        let iota = _mm_setr_epi32(0, 1, 2, 3);
-        let (fu, fv) = (_mm_set1_epi32(l.fu), _mm_set1_epi32(l.fv));
-        let (du, dv) = (_mm_set1_epi32(l.du), _mm_set1_epi32(l.dv));
-        let st = _mm_set1_epi32(stride as i32);
-        let mut ru = _mm_add_epi32(fu, _mm_mullo_epi32(iota, du));
-        let mut rv = _mm_add_epi32(fv, _mm_mullo_epi32(iota, dv));
-        let (su, sv) = (_mm_slli_epi32::<2>(du), _mm_slli_epi32::<2>(dv));
-        let p = px.as_ptr();
-        let fetch = |a: &[i32; 4], j: usize| -> u32 {
-            let k = (l.base as isize + a[j] as isize) as usize;
-            // SAFETY: a[j] is clamped to [−base, last − base] with last < px.len().
-            unsafe { p.add(k).read() }
-        };
-        let mut i = 0;
-        while i + 4 <= m {
-            let a = indices(ru, rv, st, &l);
-            for (j, o) in out[i..i + 4].iter_mut().enumerate() {
-                *o = fetch(&a, j);
-            }
-            ru = _mm_add_epi32(ru, su);
-            rv = _mm_add_epi32(rv, sv);
-            i += 4;
-        }
-        if i < m {
-            let idx = _mm_min_epi32(
-                _mm_add_epi32(_mm_set1_epi32(i as i32), iota),
-                _mm_set1_epi32(m as i32 - 1),
-            );
-            let ru = _mm_add_epi32(fu, _mm_mullo_epi32(idx, du));
-            let rv = _mm_add_epi32(fv, _mm_mullo_epi32(idx, dv));
-            let a = indices(ru, rv, st, &l);
-            for (j, o) in out[i..].iter_mut().enumerate() {
-                *o = fetch(&a, j);
-            }
-        }
     }
 }
