@@ -275,20 +275,27 @@ fn a_damaged_dwab_exr_is_refused_within_bounded_memory() {
 /// decodes to whatever its blocks say (B44 has no checksum) or is refused, never a panic.
 #[test]
 fn a_damaged_b44a_exr_does_not_panic() {
-    let bytes = std::fs::read(test_support::test_data("fuzz/map_exr-b44a-underflow.exr")).unwrap();
-    let opts = LoadOptions {
-        projection: Some(Projection::Elliptical),
-        max_pixels: 1 << 18,
-        ..LoadOptions::default()
-    };
-    let r = std::panic::catch_unwind(|| {
-        lut_core::decode_map(&bytes, "b44a.exr", &opts, &mut |_| {})
-            .map(|m| (m.width(), m.height()))
-    });
-    let r = r.expect("decoding a damaged B44A file panicked");
+    let r = decode_found("map_exr-b44a-underflow.exr", "b44a.exr", 1 << 18);
     if let Ok((w, h)) = r {
         assert!(w >= 1 && h >= 1 && u64::from(w) * u64::from(h) <= 1 << 18);
     }
+}
+
+/// Decode the fuzz finding `file` (`tests/data/fuzz/`) as `name` under a pixel limit, as
+/// the fuzz targets do: its size, or the error's message. Fails the test if it panics.
+fn decode_found(file: &str, name: &str, max_pixels: u64) -> Result<(u32, u32), String> {
+    let bytes = std::fs::read(test_support::test_data(&format!("fuzz/{file}"))).unwrap();
+    let opts = LoadOptions {
+        projection: Some(Projection::Elliptical),
+        max_pixels,
+        ..LoadOptions::default()
+    };
+    std::panic::catch_unwind(|| {
+        lut_core::decode_map(&bytes, name, &opts, &mut |_| {})
+            .map(|m| (m.width(), m.height()))
+            .map_err(|e| e.to_string())
+    })
+    .unwrap_or_else(|_| panic!("decoding {file} panicked"))
 }
 
 /// A damaged JPEG (found by the `map_jpeg` fuzz target) on which zune-jpeg 0.5.15's AVX2
@@ -297,22 +304,8 @@ fn a_damaged_b44a_exr_does_not_panic() {
 /// is fine, a panic is not.)
 #[test]
 fn a_jpeg_that_trips_the_decoder_is_refused() {
-    let bytes = std::fs::read(test_support::test_data(
-        "fuzz/map_jpeg-idct-avx2-unwrap.jpg",
-    ))
-    .unwrap();
-    let opts = LoadOptions {
-        projection: Some(Projection::Elliptical),
-        max_pixels: 1 << 24,
-        ..LoadOptions::default()
-    };
-    let r = std::panic::catch_unwind(|| {
-        lut_core::decode_map(&bytes, "trips.jpg", &opts, &mut |_| {})
-            .map(|m| (m.width(), m.height()))
-    });
-    match r.expect("decoding the damaged JPEG panicked") {
-        Err(e) => {
-            let msg = e.to_string();
+    match decode_found("map_jpeg-idct-avx2-unwrap.jpg", "trips.jpg", 1 << 24) {
+        Err(msg) => {
             assert!(msg.contains("trips.jpg"), "{msg}");
             assert!(!msg.contains('\n'), "one line: {msg}");
         }

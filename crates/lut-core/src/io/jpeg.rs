@@ -10,7 +10,8 @@
 //! and reports success, which is what `image` does. Strict mode does not notice data
 //! missing from the last row of blocks, so the stream must also reach its end-of-image
 //! marker ([`end_of_image`], a walk over the segments and scans; data after the marker
-//! is allowed).
+//! is allowed). A panic inside the decoder (zune-jpeg 0.5.15 has one on some damaged
+//! files, `without_panics`) refuses the file too.
 //!
 //! ## What the compressed data can hold
 //! A Huffman-coded JPEG spends at least one bit on every 8×8 block of its

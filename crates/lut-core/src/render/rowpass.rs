@@ -266,18 +266,7 @@ fn fill_within(
     // Lanes run up to 16 past the span. (|v| < 2³², as table entries and H/2 are i32:
     // v >> 8 fits.)
     if dl.unsigned_abs().max(dv.unsigned_abs()) <= lim {
-        buf.spans[buf.n_spans] = SpanQ8 {
-            k: k as u32,
-            m: m as u32,
-            hu: (u >> 8) as i32,
-            lu: (u & 0xFF) as i32,
-            du: dl as i32,
-            hv: (v >> 8) as i32,
-            lv: (v & 0xFF) as i32,
-            dv: dv as i32,
-            hl: (ul >> 8) as i32,
-            ll: (ul & 0xFF) as i32,
-        };
+        buf.spans[buf.n_spans] = SpanQ8::from_q16((k, m), (u, v, ul), (dl, dv));
         buf.n_spans += 1;
         return;
     }

@@ -145,18 +145,7 @@ pub(super) fn plan(n: usize, r: &FaceRun, len: usize, spans: &mut Vec<SpanQ8>) -
         } else {
             (toward_zero(u1 - u0, d), toward_zero(v1 - v0, d))
         };
-        spans.push(SpanQ8 {
-            k: i0 as u32,
-            m: count as u32,
-            hu: (u0 >> 8) as i32,
-            lu: (u0 & 0xFF) as i32,
-            du: du as i32,
-            hv: (v0 >> 8) as i32,
-            lv: (v0 & 0xFF) as i32,
-            dv: dv as i32,
-            hl: 0,
-            ll: 0,
-        });
+        spans.push(SpanQ8::from_q16((i0, count), (u0, v0, 0), (du, dv)));
         low |= v0.max(v1) - FX_HALF >= last_row;
         i0 += count;
         (u0, v0, m0) = (u1, v1, m1);

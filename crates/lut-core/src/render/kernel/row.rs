@@ -251,6 +251,32 @@ pub(crate) struct SpanQ8 {
     pub(crate) ll: i32,
 }
 
+impl SpanQ8 {
+    /// The span of `m` pixels from buffer position `k` whose Q.16 positions start at
+    /// (`u`, `v`), and `ul` for the mirror image (0 where there is none), and step by
+    /// (`du`, `dv`) a pixel (the mirror image by −`du`): each start split into its whole
+    /// Q.8 value and its low byte, as the lanes take them. The steps must fit an `i32`.
+    #[inline(always)]
+    pub(crate) fn from_q16(
+        (k, m): (usize, usize),
+        (u, v, ul): (i64, i64, i64),
+        (du, dv): (i64, i64),
+    ) -> SpanQ8 {
+        SpanQ8 {
+            k: k as u32,
+            m: m as u32,
+            hu: (u >> 8) as i32,
+            lu: (u & 0xFF) as i32,
+            du: du as i32,
+            hv: (v >> 8) as i32,
+            lv: (v & 0xFF) as i32,
+            dv: dv as i32,
+            hl: (ul >> 8) as i32,
+            ll: (ul & 0xFF) as i32,
+        }
+    }
+}
+
 /// The position buffers of a run: u and v of the right half, u of the left half (its v
 /// is the right half's), indexed alike.
 pub(crate) struct Positions<'a> {
