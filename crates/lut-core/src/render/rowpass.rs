@@ -97,7 +97,7 @@ impl HalfBuf {
             v: &mut self.v,
             ul: &mut self.ul,
         };
-        expand(&self.spans[..self.n_spans], p);
+        expand::<true>(&self.spans[..self.n_spans], p);
         self.n_spans = 0;
     }
 }

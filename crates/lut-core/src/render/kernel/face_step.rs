@@ -29,8 +29,9 @@
 //! run) with `E(d)` ≤ [`FACE_STEP_ERROR`] (0.02 face texels, the LUT's own sampling
 //! error; the project's budget is 0.05), taking for `min m` the smaller of `m` at the
 //! sub-span's start and `FACE_STEP_MAX` pixels on (or at the run's last pixel), which
-//! is no larger (m is linear) and costs no division: `d = ⌊√(0.02·min m³ / c)⌋`, checked
-//! once against the rounding of the square root; `d` = 1 is exact. (Any length, not
+//! is no larger (m is linear) and costs no division: `d` the largest length with
+//! `d² ≤ 0.02·min m³ / c`, found by stepping from the sub-span before's (a compare or
+//! two: m changes little between sub-spans); `d` = 1 is exact. (Any length, not
 //! only powers of two: the sub-spans are 1.4x longer on average at the cost of an
 //! `i32` division for the step, 47.3 instead of 54.2 instructions per pixel.) The fixed
 //! point adds less than `d` Q.16 units per axis (the ends' rounding, ≤ ½ unit, and the
@@ -72,6 +73,17 @@ pub const FACE_STEP_ERROR: f64 = 0.02;
 pub const FACE_STEP_BOUND: f64 =
     FACE_STEP_ERROR + std::f64::consts::SQRT_2 * FACE_STEP_MAX as f64 / FX_ONE as f64;
 
+/// `l²` for the sub-span lengths `l` in 0..=FACE_STEP_MAX.
+const SQUARES: [f64; FACE_STEP_MAX + 1] = {
+    let mut q = [0.0; FACE_STEP_MAX + 1];
+    let mut l = 0;
+    while l <= FACE_STEP_MAX {
+        q[l] = (l * l) as f64;
+        l += 1;
+    }
+    q
+};
+
 /// Room past a run the row kernels may write in the position buffers (whole vectors).
 const SLACK: usize = 32;
 
@@ -81,7 +93,6 @@ pub(crate) struct StepBuf {
     spans: Vec<SpanQ8>,
     u: Vec<i32>,
     v: Vec<i32>,
-    ul: Vec<i32>,
 }
 
 /// The exact face position of pixel `i` of the run (the arithmetic of `face_uv`) and its
@@ -106,10 +117,12 @@ pub(super) fn plan(n: usize, r: &FaceRun, len: usize, spans: &mut Vec<SpanQ8>) -
     if len == 0 {
         return false;
     }
-    // Clamped into the face as `CubeMap::bilinear` clamps (the same Q.16 values: `as`
-    // saturates and maps NaN to 0).
+    // Clamped into the face as `CubeMap::bilinear` clamps, the same Q.16 values (it
+    // clamps the truncated integer; clamping the float first gives the same integer,
+    // NaN → 0 included, and leaves a conversion that cannot saturate).
     let top = (n as i64) << FX_BITS;
-    let q16 = |x: f64| ((x * FX_ONE as f64 + 0.5) as i64).clamp(0, top) + FX_ONE;
+    let (topf, one) = (top as f64, FX_ONE as f64);
+    let q16 = |x: f64| ((x * one + 0.5).max(0.0).min(topf) as i64) + FX_ONE;
     let ka = r.d[0] * r.p[2] - r.p[0] * r.d[2];
     let kb = r.d[1] * r.p[2] - r.p[1] * r.d[2];
     // E(d) = c·d² / min(m)³ ≤ FACE_STEP_ERROR ⟺ d² ≤ lim·min(m)³.
@@ -122,6 +135,7 @@ pub(super) fn plan(n: usize, r: &FaceRun, len: usize, spans: &mut Vec<SpanQ8>) -
     let (u, v, mut m0) = exact(r, 0);
     let (mut u0, mut v0) = (q16(u), q16(v));
     let mut i0 = 0;
+    let mut l = 1;
     while i0 < len {
         let rest = len - 1 - i0;
         // m is linear: its minimum over any sub-span from i0 of up to FACE_STEP_MAX
@@ -129,10 +143,14 @@ pub(super) fn plan(n: usize, r: &FaceRun, len: usize, spans: &mut Vec<SpanQ8>) -
         let mm = m0.min(m_at(i0 + FACE_STEP_MAX.min(rest)));
         // (NaN → 0, as m ≤ 0 off a verified run: one pixel per step, exact.)
         let most = (lim * mm * mm * mm).max(0.0);
-        // The largest l with l² ≤ most (`as` saturates: ∞ → the cap); the square root is
-        // correctly rounded, so one check makes it exact.
-        let mut l = (most.sqrt() as usize).clamp(1, FACE_STEP_MAX);
-        if l > 1 && (l * l) as f64 > most {
+        // The largest l in 1..=FACE_STEP_MAX with l² ≤ most (1 if none), searched from
+        // the last sub-span's: m changes little from one sub-span to the next, so this
+        // takes a compare or two where a square root and its conversion took ~35
+        // instructions. (`most` is never NaN; ∞ gives the cap.)
+        while l < FACE_STEP_MAX && SQUARES[l + 1] <= most {
+            l += 1;
+        }
+        while l > 1 && SQUARES[l] > most {
             l -= 1;
         }
         let d = l.min(rest);
@@ -185,7 +203,7 @@ fn run(k: Selected, t: &Texels, r: &FaceRun, out: &mut [u32], buf: &mut StepBuf)
     let len = out.len();
     let n = face_side(t);
     let low = plan(n, r, len, &mut buf.spans);
-    for b in [&mut buf.u, &mut buf.v, &mut buf.ul] {
+    for b in [&mut buf.u, &mut buf.v] {
         if b.len() < len + SLACK {
             b.resize(len + SLACK, 0);
         }
@@ -193,9 +211,9 @@ fn run(k: Selected, t: &Texels, r: &FaceRun, out: &mut [u32], buf: &mut StepBuf)
     let p = Positions {
         u: &mut buf.u,
         v: &mut buf.v,
-        ul: &mut buf.ul,
+        ul: &mut [],
     };
-    expand_with(k, &buf.spans, p);
+    expand_with::<false>(k, &buf.spans, p);
     let (u, v) = (&buf.u[..len], &buf.v[..len]);
     sample_q8_with::<true, false>(k, t, u, v, out);
     if low {

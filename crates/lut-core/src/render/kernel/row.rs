@@ -278,7 +278,8 @@ impl SpanQ8 {
 }
 
 /// The position buffers of a run: u and v of the right half, u of the left half (its v
-/// is the right half's), indexed alike.
+/// is the right half's), indexed alike. `ul` is written only by a mirrored expand
+/// (`expand::<true>`); without a mirror image it may be empty.
 pub(crate) struct Positions<'a> {
     pub(crate) u: &'a mut [i32],
     pub(crate) v: &'a mut [i32],
@@ -287,42 +288,47 @@ pub(crate) struct Positions<'a> {
 
 /// The scalar kernel of [`expand`]: exactly pixels `k..k + m` of each span.
 #[inline(always)]
-pub(super) fn expand_scalar(spans: &[SpanQ8], p: Positions<'_>) {
+pub(super) fn expand_scalar<const MIRROR: bool>(spans: &[SpanQ8], p: Positions<'_>) {
     for s in spans {
         let r = s.k as usize..(s.k + s.m) as usize;
-        let (mut lu, mut lv, mut ll) = (s.lu, s.lv, s.ll);
-        let out = p.u[r.clone()].iter_mut().zip(&mut p.v[r.clone()]);
-        for ((a, b), c) in out.zip(&mut p.ul[r]) {
+        let (mut lu, mut lv) = (s.lu, s.lv);
+        for (a, b) in p.u[r.clone()].iter_mut().zip(&mut p.v[r.clone()]) {
             *a = s.hu.wrapping_add(lu >> 8);
             *b = s.hv.wrapping_add(lv >> 8);
-            *c = s.hl.wrapping_add(ll >> 8);
             lu = lu.wrapping_add(s.du);
             lv = lv.wrapping_add(s.dv);
-            ll = ll.wrapping_sub(s.du);
+        }
+        if MIRROR {
+            let mut ll = s.ll;
+            for c in &mut p.ul[r] {
+                *c = s.hl.wrapping_add(ll >> 8);
+                ll = ll.wrapping_sub(s.du);
+            }
         }
     }
 }
 
 /// Expand `spans` (in order of `k`, each starting where the one before ended) into the
 /// position buffers, which hold at least 16 entries past the last span (the SIMD kernels
-/// write whole vectors; the next span overwrites what lies past a span). The row pass's
+/// write whole vectors; the next span overwrites what lies past a span): u and v, and
+/// with `MIRROR` the mirror image's u (`ul`; the row pass's left half). The row pass's
 /// per-pixel positions, one kernel call per run.
 ///
 /// # Panics
 /// When a span (rounded up to 16 pixels) does not fit in the buffers.
 #[inline]
-pub(crate) fn expand(spans: &[SpanQ8], p: Positions<'_>) {
-    expand_with(active(), spans, p);
+pub(crate) fn expand<const MIRROR: bool>(spans: &[SpanQ8], p: Positions<'_>) {
+    expand_with::<MIRROR>(active(), spans, p);
 }
 
 /// [`expand`] with kernel `k`.
 #[inline]
-pub(super) fn expand_with(k: Selected, spans: &[SpanQ8], p: Positions<'_>) {
+pub(super) fn expand_with<const MIRROR: bool>(k: Selected, spans: &[SpanQ8], p: Positions<'_>) {
     #[cfg(target_arch = "x86_64")]
-    let p = match x86::row::expand(k, spans, p) {
+    let p = match x86::row::expand::<MIRROR>(k, spans, p) {
         None => return,
         Some(p) => p,
     };
     let _ = k;
-    expand_scalar(spans, p);
+    expand_scalar::<MIRROR>(spans, p);
 }

@@ -143,16 +143,24 @@ proptest! {
             })
             .collect();
         let room = k as usize + 16;
-        let run = |kern: Kernel| {
+        // With the mirror line (`ul`) or without it (an empty `ul`, left alone).
+        let run = |kern: Kernel, mirror: bool| {
             let mut b = [vec![0i32; room], vec![0i32; room], vec![0i32; room]];
             let [u, v, ul] = &mut b;
-            row::expand_with(kern.selected(), &spans, row::Positions { u, v, ul });
+            if mirror {
+                row::expand_with::<true>(kern.selected(), &spans, row::Positions { u, v, ul });
+            } else {
+                row::expand_with::<false>(kern.selected(), &spans, row::Positions { u, v, ul: &mut [] });
+            }
             b.map(|mut x| {
                 x.truncate(k as usize);
                 x
             })
         };
-        let want = run(Kernel::Scalar);
+        let want = run(Kernel::Scalar, true);
+        let plain = run(Kernel::Scalar, false);
+        prop_assert_eq!(&plain[..2], &want[..2]);
+        prop_assert!(plain[2].iter().all(|&x| x == 0));
         for s in &spans {
             for j in 0..s.m as i64 {
                 let q = |h: i32, l: i32, d: i32| (((h as i64) << 8) + l as i64 + j * d as i64) >> 8;
@@ -163,7 +171,8 @@ proptest! {
             }
         }
         for kern in others() {
-            prop_assert_eq!(&run(kern), &want, "{}", kern);
+            prop_assert_eq!(&run(kern, true), &want, "{}", kern);
+            prop_assert_eq!(&run(kern, false), &plain, "{} without the mirror line", kern);
         }
     }
 }

@@ -66,18 +66,18 @@ pub(in super::super) fn sample_q8<
 /// [`expand`](super::super::row::expand) with a SIMD kernel; the buffers back, untouched,
 /// for the scalar one.
 #[inline(always)]
-pub(in super::super) fn expand<'a>(
+pub(in super::super) fn expand<'a, const MIRROR: bool>(
     k: Selected,
     spans: &[SpanQ8],
     p: Positions<'a>,
 ) -> Option<Positions<'a>> {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        Kernel::Avx512 => unsafe { avx512::expand(spans, p) },
+        Kernel::Avx512 => unsafe { avx512::expand::<MIRROR>(spans, p) },
         // SAFETY: as above.
-        Kernel::Avx2 => unsafe { avx2::expand(spans, p) },
+        Kernel::Avx2 => unsafe { avx2::expand::<MIRROR>(spans, p) },
         // SAFETY: as above.
-        Kernel::Sse41 => unsafe { sse41::expand(spans, p) },
+        Kernel::Sse41 => unsafe { sse41::expand::<MIRROR>(spans, p) },
         Kernel::Scalar => return Some(p),
     }
     None
@@ -193,36 +193,49 @@ macro_rules! row_kernels {
             from_ps(shuffle_ps::<0xDD>(to_ps(x), to_ps(y)))
         }
 
-        /// `expand` (see `row::expand_scalar`): the three position lines of each span, a
-        /// vector per step, stored whole (the next span overwrites what lies past a span).
+        /// `expand` (see `row::expand_scalar`): the position lines of each span (u, v,
+        /// and with `MIRROR` the left half's u), a vector per step, stored whole (the
+        /// next span overwrites what lies past a span). One bounds check per span: its
+        /// last vector's end against the shortest buffer.
         #[inline]
         #[target_feature(enable = $feature)]
-        pub(super) fn expand(spans: &[SpanQ8], p: Positions<'_>) {
+        pub(super) fn expand<const MIRROR: bool>(spans: &[SpanQ8], p: Positions<'_>) {
+            let len = p.u.len().min(p.v.len());
+            let len = if MIRROR { len.min(p.ul.len()) } else { len };
+            let (pu, pv, pl) = (p.u.as_mut_ptr(), p.v.as_mut_ptr(), p.ul.as_mut_ptr());
             let iota = iota();
             for s in spans {
                 let (k, m) = (s.k as usize, s.m as usize);
-                let r = k..k + m.next_multiple_of(N);
-                let cu = p.u[r.clone()].chunks_exact_mut(N);
-                let out = cu.zip(p.v[r.clone()].chunks_exact_mut(N));
+                // (u32 + u32 rounded up: no overflow in usize.)
+                let end = k + m.next_multiple_of(N);
+                assert!(
+                    end <= len,
+                    "span {k}..{end} past the position buffers ({len})"
+                );
                 let (du, dv) = (set1(s.du), set1(s.dv));
                 let (iu, iv) = (mullo(iota, du), mullo(iota, dv));
                 let (mut lu, mut lv) = (add(set1(s.lu), iu), add(set1(s.lv), iv));
                 let mut ll = sub(set1(s.ll), iu);
                 let (su, sv) = (slli::<LOG2_N>(du), slli::<LOG2_N>(dv));
                 let (hu, hv, hl) = (set1(s.hu), set1(s.hv), set1(s.hl));
-                for ((cu, cv), cl) in out.zip(p.ul[r].chunks_exact_mut(N)) {
-                    let a = add(hu, srai::<8>(lu));
-                    let b = add(hv, srai::<8>(lv));
-                    let c = add(hl, srai::<8>(ll));
-                    // SAFETY: `cu`, `cv`, `cl` are N writable i32 each; unaligned stores.
+                let mut j = k;
+                while j < end {
+                    // SAFETY: j + N ≤ end ≤ len, the length of `u`, `v` (and of `ul` when
+                    // MIRROR, the only case it is written): N writable i32 at j of each;
+                    // unaligned stores.
                     unsafe {
-                        storeu(cu.as_mut_ptr().cast(), a);
-                        storeu(cv.as_mut_ptr().cast(), b);
-                        storeu(cl.as_mut_ptr().cast(), c);
+                        storeu(pu.add(j).cast(), add(hu, srai::<8>(lu)));
+                        storeu(pv.add(j).cast(), add(hv, srai::<8>(lv)));
+                        if MIRROR {
+                            storeu(pl.add(j).cast(), add(hl, srai::<8>(ll)));
+                        }
                     }
                     lu = add(lu, su);
                     lv = add(lv, sv);
-                    ll = sub(ll, su);
+                    if MIRROR {
+                        ll = sub(ll, su);
+                    }
+                    j += N;
                 }
             }
         }
