@@ -8,7 +8,9 @@ use crate::render::kernel::row::SpanQ8;
 /// Q.8 positions as the row pass hands them to the row kernels (`row.rs`): u within W − 1
 /// pixels of the map (mostly inside, at the seam, or a period off), v anywhere from a
 /// map height above the top to one below the bottom (the pole rows), 1..=64 pixels
-/// written at an offset 0..8 of a sentinel-filled buffer.
+/// written at an offset 0..8 of a sentinel-filled buffer. Half the cases have every
+/// position inside the map, so that whole vectors take the kernels' inside-the-map path
+/// (`x86/row.rs`, `within`), and the others mostly mix lanes inside and outside.
 #[derive(Debug, Clone)]
 struct RowCase {
     u: Vec<i32>,
@@ -17,6 +19,20 @@ struct RowCase {
 }
 
 fn row_case(w: u32, h: u32) -> impl Strategy<Value = RowCase> {
+    let (wq, hq) = ((w as i32) << 8, (h as i32) << 8);
+    let inside = (1usize..=64, 0usize..8).prop_flat_map(move |(n, off)| {
+        (
+            prop::collection::vec(0..wq, n),
+            prop::collection::vec(0..hq, n),
+            Just(off),
+        )
+            .prop_map(|(u, v, off)| RowCase { u, v, off })
+    });
+    prop_oneof![mixed_case(w, h), inside]
+}
+
+/// [`row_case`]'s positions inside and outside the map.
+fn mixed_case(w: u32, h: u32) -> impl Strategy<Value = RowCase> {
     let (wq, hq) = ((w as i32) << 8, (h as i32) << 8);
     (1usize..=64, 0usize..8).prop_flat_map(move |(n, off)| {
         // Within W − 1 pixels of the map (a span travels less than that from [0, W)).

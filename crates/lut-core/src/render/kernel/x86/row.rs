@@ -125,7 +125,8 @@ fn prefetch_every(u: &[i32], k: u32) -> usize {
 macro_rules! row_kernels {
     ($feature:literal) => {
         /// (indices clamped to `last`, fx, fy) of positions (u, v), Q.8 (see
-        /// `row::sample_at`: bilinear biased by −½, x wrapped, y clamped with fy dropped).
+        /// `row::sample_at`: bilinear biased by −½, x wrapped, y clamped with fy dropped;
+        /// when every lane is inside the map, one test (`within`) and none of that).
         #[inline]
         #[target_feature(enable = $feature)]
         fn lanes<const BILINEAR: bool>(t: &Texels, u: V, v: V, last: usize) -> (V, V, V) {
@@ -136,15 +137,28 @@ macro_rules! row_kernels {
             } else {
                 (u, v)
             };
-            let wv = set1(w);
             let x = srai::<8>(u);
+            let ff = set1(0xFF);
+            // The common case first: every lane inside the map (as unsigned, x ≤ W − 1
+            // and y ≤ H − 2, the last row a bilinear read starts on, or H − 1 for
+            // nearest), where the wrap and the clamps below change nothing.
+            let y_in = if BILINEAR { h1 - 1 } else { h1 };
+            if y_in >= 0 && within(x, set1(w - 1), srai::<8>(v), set1(y_in)) {
+                let (fx, fy) = if BILINEAR {
+                    (and(u, ff), and(v, ff))
+                } else {
+                    (zero, zero)
+                };
+                let i = add(mullo(srai::<8>(v), set1(t.stride() as i32)), x);
+                return (minu(i, set1(last as i32)), fx, fy);
+            }
+            let wv = set1(w);
             let x = add_if_below(x, zero, wv);
             let x = add_if_below(x, zero, wv);
             let x = sub_if_above(x, set1(w - 1), wv);
             let x = sub_if_above(x, set1(w - 1), wv);
             let x = min(max(x, zero), set1(w - 1));
             let y = srai::<8>(v);
-            let ff = set1(0xFF);
             let (fx, fy) = if BILINEAR {
                 (and(u, ff), zero_outside(y, set1(h1 - 1), and(v, ff)))
             } else {
@@ -361,6 +375,15 @@ macro_rules! vector_compares {
         fn zero_outside(y: V, hi: V, f: V) -> V {
             andnot(or(gt(zero(), y), gt(y, hi)), f)
         }
+
+        /// Whether every lane has `x` ≤ `xm` and `y` ≤ `ym` as unsigned (0 ≤ x ≤ xm,
+        /// 0 ≤ y ≤ ym for non-negative bounds).
+        #[inline]
+        #[target_feature(enable = $feature)]
+        fn within(x: V, xm: V, y: V, ym: V) -> bool {
+            let ok = and(eq(minu(x, xm), x), eq(minu(y, ym), y));
+            movemask(ok) == ALL_LANES
+        }
     };
 }
 
@@ -378,10 +401,13 @@ mod avx2 {
         _mm256_slli_epi32 as slli, _mm256_sra_epi32 as sra, _mm256_srai_epi32 as srai,
         _mm256_storeu_si256 as storeu, _mm256_sub_epi16 as sub16, _mm256_sub_epi32 as sub,
     };
+    use std::arch::x86_64::{_mm256_cmpeq_epi32 as eq, _mm256_movemask_epi8 as movemask};
 
     /// Pixels per step, and its log2.
     const N: usize = 8;
     const LOG2_N: i32 = 3;
+    /// `movemask` of a vector with every lane set.
+    const ALL_LANES: i32 = -1;
 
     row_kernels!("avx2");
     vector_compares!("avx2");
@@ -446,6 +472,13 @@ mod avx512 {
         _mm512_mask_sub_epi32(x, _mm512_cmpgt_epi32_mask(x, hi), x, w)
     }
 
+    /// Whether every lane has `x` ≤ `xm` and `y` ≤ `ym` as unsigned (two mask compares).
+    #[inline]
+    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
+    fn within(x: V, xm: V, y: V, ym: V) -> bool {
+        _mm512_cmple_epu32_mask(x, xm) & _mm512_cmple_epu32_mask(y, ym) == 0xFFFF
+    }
+
     /// `f` where 0 ≤ `y` ≤ `hi`, else 0.
     #[inline]
     #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
@@ -484,10 +517,13 @@ mod sse41 {
         _mm_srai_epi32 as srai, _mm_storeu_si128 as storeu, _mm_sub_epi16 as sub16,
         _mm_sub_epi32 as sub,
     };
+    use std::arch::x86_64::{_mm_cmpeq_epi32 as eq, _mm_movemask_epi8 as movemask};
 
     /// Pixels per step, and its log2.
     const N: usize = 4;
     const LOG2_N: i32 = 2;
+    /// `movemask` of a vector with every lane set.
+    const ALL_LANES: i32 = 0xFFFF;
 
     row_kernels!("sse4.1");
     vector_compares!("sse4.1");
