@@ -220,8 +220,9 @@ macro_rules! row_kernels {
             let iota = iota();
             for s in spans {
                 let (k, m) = (s.k as usize, s.m as usize);
-                // (u32 + u32 rounded up: no overflow in usize.)
-                let end = k + m.next_multiple_of(N);
+                // m rounded up to whole vectors (N a power of two; u32 + u32 and the
+                // rounding do not overflow a usize).
+                let end = k + ((m + N - 1) & !(N - 1));
                 assert!(
                     end <= len,
                     "span {k}..{end} past the position buffers ({len})"
@@ -233,6 +234,19 @@ macro_rules! row_kernels {
                 let (su, sv) = (slli::<LOG2_N>(du), slli::<LOG2_N>(dv));
                 let (hu, hv, hl) = (set1(s.hu), set1(s.hv), set1(s.hl));
                 let mut j = k;
+                // (A span of at most N pixels, the common case, is one step: the lines'
+                // updates after it are dead and the loop test is known.)
+                if m <= N && m > 0 {
+                    // SAFETY: as in the loop below, with j = k and end = k + N.
+                    unsafe {
+                        storeu(pu.add(j).cast(), add(hu, srai::<8>(lu)));
+                        storeu(pv.add(j).cast(), add(hv, srai::<8>(lv)));
+                        if MIRROR {
+                            storeu(pl.add(j).cast(), add(hl, srai::<8>(ll)));
+                        }
+                    }
+                    continue;
+                }
                 while j < end {
                     // SAFETY: j + N ≤ end ≤ len, the length of `u`, `v` (and of `ul` when
                     // MIRROR, the only case it is written): N writable i32 at j of each;
