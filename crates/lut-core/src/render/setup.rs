@@ -136,7 +136,7 @@ pub(crate) fn prepare(
     let pitch = view.pitch();
     let half_w = width as f64 * 0.5;
     // One scanline's setup (independent of the others: the rows are set up in parallel).
-    let row_scan = |y: u32| -> Scan {
+    let row_scan = |y: u32, hint: &[u8; STEP_REGIONS]| -> Scan {
         let yc = height as f64 * 0.5 - (y as f64 + 0.5);
         let rho = yc.hypot(f);
         let alpha = pitch + yc.atan2(f);
@@ -206,7 +206,8 @@ pub(crate) fn prepare(
             let reg_x = half_w / STEP_REGIONS as f64;
             for (r, shift) in scan.shifts.iter_mut().enumerate() {
                 let (x_lo, x_hi) = (r as f64 * reg_x, (r + 1) as f64 * reg_x);
-                let n = step_for(&bounds, (sn, c), t_min, x_lo, x_hi, scan.t_per_x, nominal);
+                let (dt, hint) = (scan.t_per_x, 1 << hint[r]);
+                let n = step_for(&bounds, (sn, c), t_min, x_lo, x_hi, dt, nominal, hint);
                 *shift = n.trailing_zeros() as u8;
             }
         }
@@ -214,9 +215,14 @@ pub(crate) fn prepare(
     };
     scans.clear();
     scans.resize(height as usize, Scan::default());
+    // Each row's steps searched from the row before's (`step_for`: the same steps).
     let set_up = |y0: usize, rows: &mut [Scan]| {
+        let mut hint = [nominal.trailing_zeros() as u8; STEP_REGIONS];
         for (i, s) in rows.iter_mut().enumerate() {
-            *s = row_scan((y0 + i) as u32);
+            *s = row_scan((y0 + i) as u32, &hint);
+            if s.lut {
+                hint = s.shifts;
+            }
         }
     };
     if opts.threads && scans.len() >= PARALLEL_SETUP_ROWS {

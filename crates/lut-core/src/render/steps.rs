@@ -41,12 +41,57 @@ pub(crate) struct StepBounds {
 /// span. A span of n pixels from |X| in [x_lo, x_hi] covers |X| ∈ [x_lo − n, x_hi + n];
 /// linear interpolation over it errs by at most (n·dt)²/8 · max|f''| there. (Bounds
 /// checked numerically; 10 % margin added.)
+///
+/// `nominal` is a power of two. The search starts at `hint` (the same region's step on
+/// the scanline before, usually the answer: two tests instead of up to seven from the
+/// top) and is the same as from the top: a step that fits makes every shorter one fit
+/// (its interval lies inside the longer one's, so its bound is no larger, up to
+/// rounding, while its error term is a quarter).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn step_for(
     b: &StepBounds,
     sc: (f64, f64),
     t_min: f64,
     x_lo: f64,
     x_hi: f64,
+    dt: f64,
+    nominal: u32,
+    hint: u32,
+) -> u32 {
+    debug_assert!(nominal.is_power_of_two() && hint.is_power_of_two());
+    let top = nominal.max(1);
+    let fits = |n: u32| {
+        let reach = n as f64;
+        let t_lo = ((x_lo - reach) * dt).max(t_min).max(0.0);
+        let t_hi = ((x_hi + reach) * dt).max(t_lo);
+        let bound = span_bound(b, sc, t_lo, t_hi);
+        let len = reach * dt;
+        n == 1 || (bound.is_finite() && len * len / 8.0 * bound <= SPAN_ERROR_BUDGET)
+    };
+    let mut n = hint.clamp(1, top);
+    if fits(n) {
+        while n < top && fits(2 * n) {
+            n *= 2;
+        }
+        return n;
+    }
+    // (1 always fits.)
+    loop {
+        n >>= 1;
+        if fits(n) {
+            return n;
+        }
+    }
+}
+
+/// [`step_for`] searched from the top, as it was before the hint (the reference the
+/// hinted search is tested against).
+#[cfg(test)]
+pub(crate) fn step_from_top(
+    b: &StepBounds,
+    sc: (f64, f64),
+    t_min: f64,
+    (x_lo, x_hi): (f64, f64),
     dt: f64,
     nominal: u32,
 ) -> u32 {
@@ -86,4 +131,39 @@ fn span_bound(b: &StepBounds, (s, c): (f64, f64), t_lo: f64, t_hi: f64) -> f64 {
     };
     let v_tt = b.v1 * phi_tt + b.v2 * s * s;
     1.1 * (b.lam_px * lam_tt + (1.0 + b.coupling) * v_tt)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// The search from any hint finds what the search from the top finds, over
+        /// scanline angles, regions, pole zones, map factors and steps (log-uniform
+        /// over the ranges frames have, and beyond).
+        #[test]
+        fn hinted_step_equals_the_search_from_the_top(
+            a in 0.0f64..std::f64::consts::FRAC_PI_2,
+            (x_lo, w) in (0.0f64..4000.0, 1.0f64..1000.0),
+            t_min in prop_oneof![Just(0.0), 0.0f64..3.0],
+            dt in (-14.0f64..-4.0).prop_map(f64::exp2),
+            (lam, v1, v2, cpl) in (8.0f64..16.0, 7.0f64..16.0, 0.0f64..14.0, 0.0f64..2.0),
+            nominal in prop::sample::select(vec![1u32, 2, 4, 8, 16, 64]),
+            hint_log in 0u32..8,
+        ) {
+            let b = StepBounds {
+                lam_px: lam.exp2(),
+                v1: v1.exp2(),
+                v2: v2.exp2() - 1.0,
+                coupling: cpl,
+            };
+            let sc = (a.sin(), a.cos());
+            let want = step_from_top(&b, sc, t_min, (x_lo, x_lo + w), dt, nominal);
+            let got = step_for(&b, sc, t_min, x_lo, x_lo + w, dt, nominal, 1 << hint_log);
+            prop_assert_eq!(got, want);
+        }
+    }
 }
