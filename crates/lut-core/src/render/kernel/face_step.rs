@@ -129,6 +129,7 @@ pub(super) fn plan(n: usize, r: &FaceRun, len: usize, spans: &mut Vec<SpanQ8>) -
     let c = 0.25 * r.half * r.d[2].abs() * ka.hypot(kb);
     let lim = FACE_STEP_ERROR / c;
     let m_at = |i: usize| r.p[2] + (r.dx + f64::from(i as u32)) * r.d[2];
+    let rising = r.d[2] >= 0.0;
     // The row (bordered, with bilinear's −½) at which the map kernels clamp.
     let last_row = (n as i64) << FX_BITS;
     let mut low = false;
@@ -139,8 +140,15 @@ pub(super) fn plan(n: usize, r: &FaceRun, len: usize, spans: &mut Vec<SpanQ8>) -
     while i0 < len {
         let rest = len - 1 - i0;
         // m is linear: its minimum over any sub-span from i0 of up to FACE_STEP_MAX
-        // pixels (all on the run) is at least the smaller of these two.
-        let mm = m0.min(m_at(i0 + FACE_STEP_MAX.min(rest)));
+        // pixels (all on the run) is at least the smaller of m there and at i0 (`m0`,
+        // computed as `m_at(i0)` is). Rounded, m is still monotone in the pixel, so
+        // that is `m0` where m rises (the other end not needed) and the far end where it
+        // falls (NaN as before: both ends NaN).
+        let mm = if rising {
+            m0
+        } else {
+            m_at(i0 + FACE_STEP_MAX.min(rest))
+        };
         // (NaN → 0, as m ≤ 0 off a verified run: one pixel per step, exact.)
         let most = (lim * mm * mm * mm).max(0.0);
         // The largest l in 1..=FACE_STEP_MAX with l² ≤ most (1 if none), searched from
