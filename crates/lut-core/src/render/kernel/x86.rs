@@ -80,14 +80,24 @@ impl Local {
     }
 }
 
-/// How many pixels ahead the row kernels prefetch the texels they will read.
+/// How many pixels ahead the face kernels prefetch the texels they will read, and the
+/// least the row kernels do (see [`PREFETCH_TEXELS`]).
 ///
 /// Why: a frame reads the map along curves that cross map rows, and each map row the
 /// curve enters starts with cache misses the hardware prefetchers (which follow address
 /// streams) cannot foresee; the row's positions, already in the buffers, say where the
-/// reads will go. About 50 pixels is a few hundred nanoseconds of drawing, longer than a
-/// trip to memory; 32–64 measured alike (`docs/performance.md`, "Prefetching").
+/// reads will go. About 50 pixels is a few hundred nanoseconds of drawing, about a trip
+/// to memory (`docs/performance.md`, "Prefetching").
 pub(super) const PREFETCH_AHEAD: usize = 48;
+
+/// How many map texels ahead along a run the row kernels prefetch (`x86/row.rs`,
+/// `prefetch_ahead`: the pixels that cover this many texels, between
+/// [`PREFETCH_AHEAD`] and this many pixels). On the AMD EPYC VM of
+/// `docs/performance.md` ("Prefetch distance"), 256 pixels ahead drew the 8k frame at
+/// hfov 90 (about a texel per pixel) ~15 % faster than 48, while the 32k map's (5.4
+/// texels per pixel) was best near 48 pixels: about the same ~256 texels (1 KiB) of
+/// map row ahead in both.
+pub(super) const PREFETCH_TEXELS: usize = 256;
 
 /// Prefetch the cache line holding texel `at` and, for bilinear, the one `stride` texels
 /// below it (the row kernels' and the face kernels' look-ahead). `at` need not point

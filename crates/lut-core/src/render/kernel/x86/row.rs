@@ -2,8 +2,10 @@
 //! per step, the seam wrap and the pole clamp as lane compares, the texels read as the map kernels read
 //! them (two 64-bit loads per bilinear pixel) and blended with their `split`, `lerp` and
 //! `merge`; the left half's pixels reversed in the register before the store. Each
-//! kernel prefetches the texels of the position [`PREFETCH_AHEAD`] pixels ahead (the
-//! frame is bound by memory latency, not instructions: see there).
+//! kernel prefetches the texels of the position about [`PREFETCH_TEXELS`] map texels
+//! ahead along the run (`prefetch_ahead`: 256 pixels where a pixel steps a texel or
+//! less, at least [`PREFETCH_AHEAD`]; the frame is bound by memory latency, not
+//! instructions: see there).
 //!
 //! The kernels are written once (`row_kernels!`) and expanded in each instruction set's
 //! module, where short names stand for that set's intrinsics (`add` is
@@ -26,7 +28,7 @@
 //! `docs/performance.md`, "AVX-512".
 
 use super::super::row::{sample_lv_scalar, Level, Positions, SpanQ8};
-use super::{prefetch_texels, Kernel, Selected, Texels, PREFETCH_AHEAD};
+use super::{prefetch_texels, Kernel, Selected, Texels, PREFETCH_AHEAD, PREFETCH_TEXELS};
 use std::arch::x86_64::*;
 
 /// The row kernel with a SIMD kernel (see `row::sample_lv_scalar`); `false` (nothing
@@ -102,6 +104,20 @@ fn prefetch<const BILINEAR: bool>(t: &Texels, (u, v): (&[i32], &[i32]), j: usize
             t.px.as_ptr()
                 .wrapping_offset(y.wrapping_mul(stride).wrapping_add(x));
         prefetch_texels::<BILINEAR>(at, t.stride());
+    }
+}
+
+/// How far ahead (pixels) a run of positions `u` (Q.8, on level `k`) prefetches: the
+/// pixels that cover about [`PREFETCH_TEXELS`] texels of the map along the run (from its
+/// ends), at least [`PREFETCH_AHEAD`] and at most `PREFETCH_TEXELS` pixels.
+#[inline(always)]
+fn prefetch_ahead(u: &[i32], k: u32) -> usize {
+    match (u.first(), u.last()) {
+        (Some(&a), Some(&b)) => {
+            let travel = ((b - a).unsigned_abs() >> (8 + k)) as usize;
+            (PREFETCH_TEXELS * u.len() / travel.max(1)).clamp(PREFETCH_AHEAD, PREFETCH_TEXELS)
+        }
+        _ => PREFETCH_TEXELS,
     }
 }
 
@@ -289,13 +305,15 @@ macro_rules! row_kernels {
             let last = last_index::<BILINEAR>(t);
             let stride = t.stride();
             let p = t.px.as_ptr();
-            // Prefetched up to (not including) `ahead`, every `every` positions.
+            // Prefetched up to (not including) `ahead`, every `every` positions, `pfa`
+            // positions past the vector being drawn.
             let k = if LEVEL { lv.k } else { 0 };
             let every = prefetch_every(u, k);
+            let pfa = prefetch_ahead(u, k);
             let mut ahead = 0;
             let mut j = 0;
             while j + N <= n {
-                while ahead < j + N + PREFETCH_AHEAD {
+                while ahead < j + N + pfa {
                     prefetch::<BILINEAR>(t, (u, v), ahead, k);
                     ahead += every;
                 }
