@@ -57,7 +57,8 @@ fn absolute(t: &Texels) -> Local {
 /// The face kernels of one instruction set (`$feature`), in terms of the names its
 /// module defines (see the module docs).
 /// Prefetch the cache lines pixel `i` of the run (of `m` pixels) will read, as the row
-/// kernels do ([`PREFETCH_AHEAD`] pixels ahead, see there why): its face position from
+/// kernels do ([`PREFETCH_AHEAD`] pixels ahead, see there why; the row kernels now look
+/// further ahead, `PREFETCH_TEXELS`, not measured here): its face position from
 /// the run's projective line (as the kernels compute it, without their rounding: a line
 /// off by one texel is prefetched at worst), its texel and for bilinear the one below.
 /// Pixels past the run or behind the face are skipped.
