@@ -35,6 +35,14 @@ cargo fmt --all -- --check
 cargo fmt --manifest-path fuzz/Cargo.toml -- --check
 echo "== cargo clippy"
 cargo clippy --workspace --all-targets --profile ci -- -D warnings
+echo "== cargo clippy for aarch64 (the portable kernels compile warning-free off x86-64; lib and binaries: the benches' and tests' C dependencies need a cross compiler)"
+if rustup target list --installed 2>/dev/null | grep -q aarch64-unknown-linux-gnu \
+    || rustup target add aarch64-unknown-linux-gnu >/dev/null 2>&1; then
+  cargo clippy -p lut-core --lib --target aarch64-unknown-linux-gnu -- -D warnings
+  cargo clippy -p viewer --bins --target aarch64-unknown-linux-gnu -- -D warnings
+else
+  echo "warning: could not install the aarch64 standard library (rustup target add); aarch64 check skipped" >&2
+fi
 echo "== cargo test (profile ci: optimized, overflow checks on)"
 cargo test --workspace --profile ci
 echo "== cargo test again with the scalar span kernel forced (LUTPANO_KERNEL=scalar)"

@@ -70,7 +70,9 @@ pub(crate) fn table() -> &'static [u8] {
 }
 
 /// The form of the row loop this CPU runs (detected once, see [`ShadeRow::detect`]).
+/// (Off x86-64 both flags are false and read only by the tests.)
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 pub(crate) struct ShadeRow {
     avx2: bool,
     avx512: bool,

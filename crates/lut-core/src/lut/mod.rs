@@ -574,8 +574,10 @@ impl Band<'_> {
     }
 
     /// The two rows' nodes `k0..k0 + n` and the blend weight of the lower one (Q.16):
-    /// what [`Band::blend_nodes`] blends, for the SIMD kernel that does the same.
+    /// what [`Band::blend_nodes`] blends, for the SIMD kernel that does the same (x86-64
+    /// only, so unused elsewhere).
     #[inline]
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     pub(crate) fn rows(&self, k0: usize, n: usize) -> (&[[i32; 2]], &[[i32; 2]], i64) {
         (&self.top[k0..k0 + n], &self.bot[k0..k0 + n], self.wa)
     }

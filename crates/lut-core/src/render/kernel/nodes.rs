@@ -29,6 +29,7 @@ pub(super) fn blend_nodes_with(k: Selected, band: &Band, k0: usize, out: &mut [[
             return;
         }
     }
+    let _ = k;
     band.blend_nodes(k0, out);
 }
 
