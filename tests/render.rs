@@ -265,6 +265,31 @@ fn threads_are_byte_identical() {
     }
 }
 
+/// Frames wide enough that each half row fills the row pass's position buffer
+/// (`HALF_CHUNK`, 1024 pixels) more than once: the buffer is drawn and refilled mid-row,
+/// and the positions stay within the bound across those joins (seam, pole and wide
+/// views; fixed and adaptive steps).
+#[test]
+fn wide_frames_within_bound_across_position_buffers() {
+    let views = [
+        (0.0, 10.0, 90.0),
+        (179.0, 0.0, 150.0),
+        (33.0, 80.0, 120.0),
+        (-90.0, -45.0, 60.0),
+    ];
+    for &(y, pi, hf) in &views {
+        let view = View::new(y, pi, hf).unwrap();
+        for step in [IndexStep::Fixed(4), IndexStep::Adaptive] {
+            let o = opts(step, LutChoice::Auto, Surface::Cylinder);
+            let st = measure(8192, 4096, Projection::Equirect, view, o, 4801, 9);
+            check(
+                &format!("4801x9 yaw {y} pitch {pi} hfov {hf} {step:?}"),
+                &st,
+            );
+        }
+    }
+}
+
 /// Every output size from 1x1, odd sizes and 1-pixel strips render without panic and
 /// match the exact renderer's positions.
 #[test]

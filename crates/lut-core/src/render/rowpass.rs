@@ -33,8 +33,11 @@ use crate::lut::{Blended, LutTable};
 use crate::map::envmap::EnvMap;
 use crate::map::sample::lerp_px;
 
-/// Pixels of a half row whose positions are buffered before the row kernels run.
-pub(crate) const HALF_CHUNK: usize = 512;
+/// Pixels of a half row whose positions are buffered before the row kernels run: a whole
+/// half row up to 2048-pixel frames, so a 1080p row is drawn as two runs rather than
+/// four (each run starts with a burst of prefetches its first pixels wait for: 512 drew
+/// the 8k frame at hfov 90 about 3 % slower, docs/performance.md "Prefetch distance").
+pub(crate) const HALF_CHUNK: usize = 1024;
 
 /// A buffer's room: a chunk, then up to one more span (64 pixels) and the last pixel,
 /// and the 15 positions past it a 16-lane `kernel::expand` writes.
