@@ -147,6 +147,39 @@ fn golden_trilinear() {
     }
 }
 
+/// Frames wide enough (4801 pixels) that the row pass draws and refills its position
+/// buffer mid-row (`HALF_CHUNK`, 1024 pixels a half): every sampler against the exact
+/// renderer with the tolerances above (trilinear's as in [`golden_trilinear`]), so a
+/// pixel misplaced or a level-of-detail run split wrongly at a buffer's join shows.
+#[test]
+fn golden_wide_frames_across_position_buffers() {
+    let map = grid_map(2048, 1024, Projection::Equirect).unwrap();
+    let mut r = Renderer::new(&map);
+    for (case, yaw, pitch, hfov) in [("front", 10.0, 5.0, 150.0), ("seam", 179.0, 40.0, 120.0)] {
+        let view = View::new(yaw, pitch, hfov).unwrap();
+        for sampler in [Sampler::Nearest, Sampler::Bilinear, Sampler::Trilinear] {
+            let opts = RenderOptions {
+                sampler,
+                ..RenderOptions::default()
+            };
+            let (lut, ex) = lut_and_exact(&mut r, &map, view, &opts, 4801, 6);
+            let name = format!("equirect_{}_wide_{case}", sampler.name());
+            if sampler == Sampler::Trilinear {
+                let (d, p) = (diff(&lut, &ex), psnr(&lut, &ex));
+                report(&name, "LUT vs exact", format!("{p:.1} dB {d:?}"));
+                assert!(
+                    p >= 40.0 && d.mean <= 1.0,
+                    "{name}: LUT vs exact {p:.1} dB, worst {} mean {:.3}",
+                    d.worst,
+                    d.mean
+                );
+            } else {
+                assert_close_to_exact(&name, sampler, &lut, &ex);
+            }
+        }
+    }
+}
+
 /// A partial panorama (a crop of the grid map placed in its full panorama): the LUT
 /// renderer against the exact renderer, inside, outside and across the crop's edges,
 /// with the tolerances of the projection suite.
