@@ -55,7 +55,7 @@ use grid::{Grid, GridStats};
 use kernel::{level_texels, texels};
 use rowpass::{pixel_row, position_row, tri_row};
 use rows::{for_each_band_init, for_each_row, for_each_row_init, post_bands};
-use scanline::{RowScratch, ROW_SCALE_ONE};
+use scanline::{RowScratch, ScratchLoan, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
 use sink::{Batch, PixelRows, PosRows, RowSinks, TriRows, TriSink};
 use std::f64::consts::TAU;
@@ -568,7 +568,7 @@ impl Renderer {
             let (levels, n) = level_texels(map);
             let levels = &levels[..n];
             let fp = ExactFootprint::new(view, width, height, geometry_of(map));
-            let row = |scratch: &mut RowScratch, y: usize, row: &mut [u32]| {
+            let row = |scratch: &mut ScratchLoan, y: usize, row: &mut [u32]| {
                 let scan = &scans[y];
                 let mut s = TriSink {
                     row,
@@ -585,11 +585,11 @@ impl Renderer {
             return Ok(match hook {
                 Some(post) => {
                     let (b, t) = (HOOK_BAND_ROWS, opts.threads);
-                    for_each_band_init(out, w, b, t, RowScratch::new, row, post);
+                    for_each_band_init(out, w, b, t, RowScratch::loan, row, post);
                     (report, true)
                 }
                 None => {
-                    for_each_row_init(out, w, opts.threads, RowScratch::new, row);
+                    for_each_row_init(out, w, opts.threads, RowScratch::loan, row);
                     (report, false)
                 }
             });
@@ -606,15 +606,15 @@ impl Renderer {
         ) {
             let (scans, table, setup, row_scale) = k;
             let t = texels(map);
-            let row = |scratch: &mut RowScratch, y: usize, row: &mut [u32]| {
+            let row = |scratch: &mut ScratchLoan, y: usize, row: &mut [u32]| {
                 let lut = (&scans[y], table, setup, row_scale);
                 pixel_row::<BILINEAR, CROP>(lut, scratch, (map, &t), row);
             };
             match hook {
                 Some(post) => {
-                    for_each_band_init(out, w, HOOK_BAND_ROWS, threads, RowScratch::new, row, post)
+                    for_each_band_init(out, w, HOOK_BAND_ROWS, threads, RowScratch::loan, row, post)
                 }
-                None => for_each_row_init(out, w, threads, RowScratch::new, row),
+                None => for_each_row_init(out, w, threads, RowScratch::loan, row),
             }
         }
         let k = (&scans[..], table, &setup, row_scale);
@@ -741,7 +741,7 @@ impl Renderer {
             &mut out,
             width as usize,
             opts.threads,
-            RowScratch::new,
+            RowScratch::loan,
             |scratch, y, row| {
                 let lut = (&scans[y], table, &setup, row_scale);
                 position_row(lut, scratch, pass.then_some(wq), row);
