@@ -153,19 +153,19 @@ macro_rules! row_kernels {
             } else {
                 (u, v)
             };
-            let x = srai::<8>(u);
+            let (x, y) = (srai::<8>(u), srai::<8>(v));
             let ff = set1(0xFF);
             // The common case first: every lane inside the map (as unsigned, x ≤ W − 1
             // and y ≤ H − 2, the last row a bilinear read starts on, or H − 1 for
             // nearest), where the wrap and the clamps below change nothing.
             let y_in = if BILINEAR { h1 - 1 } else { h1 };
-            if y_in >= 0 && within(x, set1(w - 1), srai::<8>(v), set1(y_in)) {
+            if y_in >= 0 && within(x, set1(w - 1), y, set1(y_in)) {
                 let (fx, fy) = if BILINEAR {
                     (and(u, ff), and(v, ff))
                 } else {
                     (zero, zero)
                 };
-                let i = add(mullo(srai::<8>(v), set1(t.stride() as i32)), x);
+                let i = add(mullo(y, set1(t.stride() as i32)), x);
                 return (minu(i, set1(last as i32)), fx, fy);
             }
             let wv = set1(w);
@@ -174,7 +174,6 @@ macro_rules! row_kernels {
             let x = sub_if_above(x, set1(w - 1), wv);
             let x = sub_if_above(x, set1(w - 1), wv);
             let x = min(max(x, zero), set1(w - 1));
-            let y = srai::<8>(v);
             let (fx, fy) = if BILINEAR {
                 (and(u, ff), zero_outside(y, set1(h1 - 1), and(v, ff)))
             } else {
@@ -249,20 +248,10 @@ macro_rules! row_kernels {
                 let mut ll = sub(set1(s.ll), iu);
                 let (su, sv) = (slli::<LOG2_N>(du), slli::<LOG2_N>(dv));
                 let (hu, hv, hl) = (set1(s.hu), set1(s.hv), set1(s.hl));
+                // Whole vectors from k to `end`; the lines step after a vector only if
+                // another follows (a span of at most N pixels, the common case, is one
+                // store per line and no update).
                 let mut j = k;
-                // (A span of at most N pixels, the common case, is one step: the lines'
-                // updates after it are dead and the loop test is known.)
-                if m <= N && m > 0 {
-                    // SAFETY: as in the loop below, with j = k and end = k + N.
-                    unsafe {
-                        storeu(pu.add(j).cast(), add(hu, srai::<8>(lu)));
-                        storeu(pv.add(j).cast(), add(hv, srai::<8>(lv)));
-                        if MIRROR {
-                            storeu(pl.add(j).cast(), add(hl, srai::<8>(ll)));
-                        }
-                    }
-                    continue;
-                }
                 while j < end {
                     // SAFETY: j + N ≤ end ≤ len, the length of `u`, `v` (and of `ul` when
                     // MIRROR, the only case it is written): N writable i32 at j of each;
@@ -274,12 +263,15 @@ macro_rules! row_kernels {
                             storeu(pl.add(j).cast(), add(hl, srai::<8>(ll)));
                         }
                     }
+                    j += N;
+                    if j >= end {
+                        break;
+                    }
                     lu = add(lu, su);
                     lv = add(lv, sv);
                     if MIRROR {
                         ll = sub(ll, su);
                     }
-                    j += N;
                 }
             }
         }
