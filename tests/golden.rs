@@ -128,28 +128,32 @@ fn golden_trilinear() {
         let view = View::new(yaw, pitch, hfov).unwrap();
         let (lut, ex) = lut_and_exact(&mut r, &map, view, &opts, w, h);
         let name = format!("equirect_trilinear_{case}");
-        let d = diff(&lut, &ex);
-        let p = psnr(&lut, &ex);
-        report(&name, "LUT vs exact", format!("{p:.1} dB {d:?}"));
-        // The level of detail comes from different footprints (the span's step and the
-        // row spacing against the exact per-pixel footprint; pixels the LUT evaluates
-        // exactly use the exact footprint too), so single pixels where the footprint
-        // changes fast (near the pole: up to 82 levels measured) may differ; the images
-        // agree to 40 dB and 1 level on average (measured 53.7 / 46.2 dB, mean 0.33 /
-        // 0.45 levels).
-        assert!(
-            p >= 40.0 && d.mean <= 1.0,
-            "{name}: LUT vs exact {p:.1} dB, worst {} mean {:.3}",
-            d.worst,
-            d.mean
-        );
+        assert_trilinear_close_to_exact(&name, &lut, &ex);
         compare_to_truth(&name, &lut, w, h);
     }
 }
 
+/// A trilinear LUT image `lut` against the exact renderer's `ex`. The level of detail
+/// comes from different footprints (the span's step and the row spacing against the
+/// exact per-pixel footprint; pixels the LUT evaluates exactly use the exact footprint
+/// too), so single pixels where the footprint changes fast (near the pole: up to 82
+/// levels measured) may differ; the images agree to 40 dB and 1 level on average
+/// (measured 53.7 / 46.2 dB, mean 0.33 / 0.45 levels, in [`golden_trilinear`]).
+fn assert_trilinear_close_to_exact(name: &str, lut: &[u32], ex: &[u32]) {
+    let d = diff(lut, ex);
+    let p = psnr(lut, ex);
+    report(name, "LUT vs exact", format!("{p:.1} dB {d:?}"));
+    assert!(
+        p >= 40.0 && d.mean <= 1.0,
+        "{name}: LUT vs exact {p:.1} dB, worst {} mean {:.3}",
+        d.worst,
+        d.mean
+    );
+}
+
 /// Frames wide enough (4801 pixels) that the row pass draws and refills its position
 /// buffer mid-row (`HALF_CHUNK`, 1024 pixels a half): every sampler against the exact
-/// renderer with the tolerances above (trilinear's as in [`golden_trilinear`]), so a
+/// renderer with the tolerances above, so a
 /// pixel misplaced or a level-of-detail run split wrongly at a buffer's join shows.
 #[test]
 fn golden_wide_frames_across_position_buffers() {
@@ -165,14 +169,7 @@ fn golden_wide_frames_across_position_buffers() {
             let (lut, ex) = lut_and_exact(&mut r, &map, view, &opts, 4801, 6);
             let name = format!("equirect_{}_wide_{case}", sampler.name());
             if sampler == Sampler::Trilinear {
-                let (d, p) = (diff(&lut, &ex), psnr(&lut, &ex));
-                report(&name, "LUT vs exact", format!("{p:.1} dB {d:?}"));
-                assert!(
-                    p >= 40.0 && d.mean <= 1.0,
-                    "{name}: LUT vs exact {p:.1} dB, worst {} mean {:.3}",
-                    d.worst,
-                    d.mean
-                );
+                assert_trilinear_close_to_exact(&name, &lut, &ex);
             } else {
                 assert_close_to_exact(&name, sampler, &lut, &ex);
             }
