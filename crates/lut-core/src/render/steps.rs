@@ -60,14 +60,7 @@ pub(crate) fn step_for(
 ) -> u32 {
     debug_assert!(nominal.is_power_of_two() && hint.is_power_of_two());
     let top = nominal.max(1);
-    let fits = |n: u32| {
-        let reach = n as f64;
-        let t_lo = ((x_lo - reach) * dt).max(t_min).max(0.0);
-        let t_hi = ((x_hi + reach) * dt).max(t_lo);
-        let bound = span_bound(b, sc, t_lo, t_hi);
-        let len = reach * dt;
-        n == 1 || (bound.is_finite() && len * len / 8.0 * bound <= SPAN_ERROR_BUDGET)
-    };
+    let fits = |n: u32| step_fits(b, sc, t_min, (x_lo, x_hi), dt, n);
     let mut n = hint.clamp(1, top);
     if fits(n) {
         while n < top && fits(2 * n) {
@@ -84,6 +77,24 @@ pub(crate) fn step_for(
     }
 }
 
+/// Whether a step of `n` pixels keeps the error bound for spans starting at |X| ∈
+/// [x_lo, x_hi] ([`step_for`]; a step of 1 always does).
+fn step_fits(
+    b: &StepBounds,
+    sc: (f64, f64),
+    t_min: f64,
+    (x_lo, x_hi): (f64, f64),
+    dt: f64,
+    n: u32,
+) -> bool {
+    let reach = n as f64;
+    let t_lo = ((x_lo - reach) * dt).max(t_min).max(0.0);
+    let t_hi = ((x_hi + reach) * dt).max(t_lo);
+    let bound = span_bound(b, sc, t_lo, t_hi);
+    let len = reach * dt;
+    n == 1 || (bound.is_finite() && len * len / 8.0 * bound <= SPAN_ERROR_BUDGET)
+}
+
 /// [`step_for`] searched from the top, as it was before the hint (the reference the
 /// hinted search is tested against).
 #[cfg(test)]
@@ -91,22 +102,15 @@ pub(crate) fn step_from_top(
     b: &StepBounds,
     sc: (f64, f64),
     t_min: f64,
-    (x_lo, x_hi): (f64, f64),
+    xs: (f64, f64),
     dt: f64,
     nominal: u32,
 ) -> u32 {
     let mut n = nominal.max(1);
-    loop {
-        let reach = n as f64;
-        let t_lo = ((x_lo - reach) * dt).max(t_min).max(0.0);
-        let t_hi = ((x_hi + reach) * dt).max(t_lo);
-        let bound = span_bound(b, sc, t_lo, t_hi);
-        let len = reach * dt;
-        if n == 1 || (bound.is_finite() && len * len / 8.0 * bound <= SPAN_ERROR_BUDGET) {
-            return n;
-        }
+    while !step_fits(b, sc, t_min, xs, dt, n) {
         n >>= 1;
     }
+    n
 }
 
 /// Bound on the second derivative (in source pixels per unit t²) of the map position
