@@ -86,8 +86,12 @@ fn timed_frames(
 /// One frame of a plain gather along precomputed indices, in row bands.
 fn gather_frame(src: &[u32], idx: &[u32], out: &mut [u32], w: usize) {
     use rayon::prelude::*;
+    let rows = (16384 / w.max(1)).max(1);
+    // Tasks of one size, as the renderer's and `viewer bench`'s gather.
     out.par_chunks_mut(w)
         .zip(idx.par_chunks(w))
+        .with_min_len(rows)
+        .with_max_len(rows)
         .for_each(|(o, i)| {
             for (o, &i) in o.iter_mut().zip(i) {
                 *o = src[i as usize];

@@ -48,6 +48,7 @@
 use super::exact::render_exact;
 use super::frame::Frame;
 use super::kernel::{face_blend, face_span, face_steps, FaceRun, StepBuf, Texels};
+use super::rows::rows_per_task;
 use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
     check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
@@ -330,8 +331,8 @@ fn render_with<S: Fetch>(
     threads: bool,
 ) {
     let w = frame.w as usize;
-    // Bands of whole rows, at least ~16k pixels each so small frames stay on one thread.
-    let rows_per_band = (16384 / w).clamp(1, frame.h as usize);
+    // Bands of whole rows, ~16k pixels each so small frames stay on one thread.
+    let rows_per_band = rows_per_task(w).clamp(1, frame.h as usize);
     // The scratch (segments, stepped runs' buffers) is kept from band to band on a
     // thread: made afresh per band, its buffers were zeroed ~135 times a 1080p frame.
     let scratch = || (Vec::with_capacity(16), StepBuf::default());
@@ -345,8 +346,11 @@ fn render_with<S: Fetch>(
         }
     };
     if threads {
+        // One band per task, so the threads share the work to the last band
+        // (`rows::rows_per_task`).
         out.par_chunks_mut(w * rows_per_band)
             .enumerate()
+            .with_max_len(1)
             .for_each_init(scratch, band);
     } else {
         let mut sc = scratch();

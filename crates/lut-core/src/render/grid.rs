@@ -621,8 +621,11 @@ impl<'a> Grid<'a> {
         };
         let bands = self.h.div_ceil(GRID_CELL);
         let stats = if threads {
+            // One band per task: the threads share the work to the last band
+            // (`rows::rows_per_task`).
             (0..bands)
                 .into_par_iter()
+                .with_max_len(1)
                 .map(run)
                 .reduce(GridStats::empty, GridStats::merge)
         } else {
@@ -704,6 +707,7 @@ impl<'a> Grid<'a> {
         let stats = if threads {
             out.par_chunks_mut(band_len)
                 .enumerate()
+                .with_max_len(1)
                 .map(run)
                 .reduce(GridStats::empty, GridStats::merge)
         } else {

@@ -313,6 +313,9 @@ fn gather(src: &[u32], idx: &[u32], out: &mut [u32], w: usize, background: u32) 
     out.par_chunks_mut(w)
         .zip(idx.par_chunks(w))
         .with_min_len((16384 / w.max(1)).max(1))
+        // Tasks of one size, as the renderer's (`lut_core` `rows_per_task`): rayon's
+        // default pieces left one thread finishing a quarter frame alone.
+        .with_max_len((16384 / w.max(1)).max(1))
         .for_each(|(o, i)| {
             for (p, &k) in o.iter_mut().zip(i) {
                 *p = src.get(k as usize).copied().unwrap_or(background);
