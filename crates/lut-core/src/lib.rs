@@ -128,8 +128,8 @@ pub use render::heat::{
 };
 pub use render::kernel::{
     active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
-    KernelError, KernelInfo, KernelSource, SpanJob, Texels, Window, FACE_STEP_BOUND,
-    FACE_STEP_ERROR, FACE_STEP_MAX, KERNEL_ENV, MAX_JOBS, MAX_LEVELS, TRILINEAR_CHUNK,
+    KernelError, KernelInfo, KernelSource, SpanJob, Texels, Window, KERNEL_ENV, MAX_JOBS,
+    MAX_LEVELS, TRILINEAR_CHUNK,
 };
 pub use render::steps::{ADAPTIVE_MAX_STEP, SPAN_ERROR_BUDGET};
 pub use render::{

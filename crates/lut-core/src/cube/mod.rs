@@ -29,13 +29,12 @@
 //! # Renderers (`render/cube.rs`)
 //! [`crate::Renderer::render`] of a [`crate::Scene::Cube`] with [`CubeRenderer::Basic`] (the paper's section 1: per pixel, ray → face →
 //! face coordinates → sample) or [`CubeRenderer::Accelerated`] (section 2: each scanline is
-//! a 3-D line, cut into face segments found by binary search, stepped inside each segment
+//! a 3-D line, cut into face segments found by binary search, drawn inside each segment
 //! without choosing a face). Both compute every ray with the same expression, and the
 //! accelerated path *proves* each segment's face before using it (falling back to the
-//! per-pixel choice where it cannot), so the faces agree; inside a segment bilinear face
-//! coordinates are stepped linearly between exact ones, within [`crate::FACE_STEP_BOUND`]
-//! (0.0207) face texels of the basic renderer's exact coordinates (nearest ones are
-//! exact: byte-identical images). Trilinear sampling
+//! per-pixel choice where it cannot), so the faces agree; inside a segment the face
+//! coordinates are evaluated exactly at every pixel in SIMD lanes, with the basic
+//! renderer's arithmetic: nearest and bilinear images are byte-identical. Trilinear sampling
 //! reads a face pyramid (`cube/pyramid.rs`). See `docs/cube.md`.
 //!
 //! Loading from files is `io/cube.rs`; layouts and namings are `cube/layout.rs`.

@@ -22,32 +22,24 @@
 //! scanline lying in an edge plane) are peeled off and handled per pixel; a run that still
 //! fails is done per pixel.
 //!
-//! # Runs stepped like spans
+//! # Runs on the span kernels
 //! On a verified run's face the ray's axes `(a, b, m)` are linear in `dx` and the face
-//! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line. Bilinear runs
-//! are stepped like the LUT's spans (`render/kernel/face_step.rs`): the line is evaluated
-//! exactly (with the arithmetic of [`face_uv`]) every 1–32 pixels, the
-//! sub-span length chosen from a proven bound on the interpolation error (the curvature
-//! of the projective line, largest where `m` is smallest), and stepped linearly in Q.16
-//! between; the positions are then gathered and blended by the row kernels
-//! (`render/kernel/row.rs`: AVX2, SSE4.1 or the scalar twin, chosen once per process,
-//! `LUTPANO_KERNEL=scalar` forcing the portable one) on the face's bordered texels. Every
-//! stepped position is within [`crate::FACE_STEP_BOUND`] (0.0207) face texels of the
-//! exact one (0.0200 the largest measured over a sweep of views); the per-pixel
-//! (`Basic`) renderer stays exact, so the two renderers' bilinear images now differ by
-//! that much in position: per pixel by at most (bound + 1/256) × the local texel
-//! gradient + 2 levels (`tests/cube.rs`).
-//!
-//! Nearest runs, and trilinear runs on the two pyramid levels of each
-//! [`TRILINEAR_RUN_CHUNK`], still evaluate the line exactly at every pixel
-//! (`render/kernel/face.rs`: `f64` SIMD lanes, one division per pixel, with the
-//! per-pixel path's arithmetic), so nearest images stay byte-identical to the basic
-//! renderer's. (Stepped, nearest took 36.8 instead of 20.4 instructions per pixel and was
-//! no faster.)
+//! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line, evaluated
+//! exactly at every pixel with the arithmetic of [`face_uv`] in `f64` SIMD lanes
+//! (`render/kernel/face.rs`, `x86/face.rs`). Bilinear runs compute the positions in a pass
+//! of their own and draw them with the LUT's row kernels (`render/kernel/face_rows.rs`);
+//! nearest runs, and trilinear runs on the two pyramid levels of each
+//! [`TRILINEAR_RUN_CHUNK`], compute and draw them in one fused kernel (`face.rs`). Every
+//! kernel (AVX-512, AVX2, SSE4.1 or the scalar twin, chosen once per process,
+//! `LUTPANO_KERNEL=scalar` forcing the portable one) reads the face's bordered texels
+//! with the per-pixel path's rounding, so nearest and bilinear images are byte-identical
+//! to the basic renderer's (`tests/cube.rs`). (Until 2026-12-02 bilinear runs were
+//! stepped linearly between exact points, within 0.0207 face texels; the separate
+//! positions pass is faster and exact: `docs/performance.md`.)
 
 use super::exact::render_exact;
 use super::frame::Frame;
-use super::kernel::{face_blend, face_span, face_steps, FaceRun, StepBuf, Texels};
+use super::kernel::{face_blend, face_rows, face_span, FaceBuf, FaceRun, Texels};
 use super::rows::rows_per_task;
 use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
@@ -61,11 +53,10 @@ use crate::named::{parse_name, unknown_name, Named};
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// Which of the paper's renderers to use. With nearest sampling both give byte-identical
-/// images; with bilinear they differ by the scanline renderer's stepped positions (within
-/// [`crate::FACE_STEP_BOUND`] face texels, see `render/cube.rs`); with trilinear the
-/// scanline renderer takes the level of detail per 16 pixels of a face run, the basic one
-/// per pixel (`cube/pyramid.rs`).
+/// Which of the paper's renderers to use. With nearest and bilinear sampling both give
+/// byte-identical images (see `render/cube.rs`); with trilinear the scanline renderer
+/// takes the level of detail per 16 pixels of a face run, the basic one per pixel
+/// (`cube/pyramid.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum CubeRenderer {
     /// Section 1: per pixel, ray → face by the largest |coordinate| → face coordinates.
@@ -82,13 +73,13 @@ impl CubeRenderer {
     }
 
     /// How far, in face texels, this renderer's sampling positions with `sampler` may lie
-    /// from the exact ones: [`crate::FACE_STEP_BOUND`] where it steps them (the scanline
-    /// renderer's bilinear runs), `None` where it evaluates every position exactly.
+    /// from the exact ones where it steps them between exact points; `None` where it
+    /// evaluates every position exactly, which both renderers now do with every sampler
+    /// (the scanline renderer's bilinear runs were stepped within 0.0207 texels until
+    /// 2026-12-02; `viewer bench --replot` still reads that bound from older JSON rows).
     pub fn position_bound(self, sampler: Sampler) -> Option<f64> {
-        match (self, sampler) {
-            (CubeRenderer::Accelerated, Sampler::Bilinear) => Some(super::kernel::FACE_STEP_BOUND),
-            _ => None,
-        }
+        let _ = (self, sampler);
+        None
     }
 }
 
@@ -204,7 +195,7 @@ trait Fetch: Copy + Send + Sync {
     /// The sample of ray `d` on `face` (the face of `d`), per pixel.
     fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32;
     /// A verified run on `face` (`run`: its projective line), with the span kernels
-    /// (`buf`: the band's scratch for the stepped runs).
+    /// (`buf`: the band's scratch for the bilinear runs' positions).
     fn span(
         self,
         cube: &CubeMap,
@@ -212,7 +203,7 @@ trait Fetch: Copy + Send + Sync {
         face: Face,
         run: &FaceRun,
         out: &mut [u32],
-        buf: &mut StepBuf,
+        buf: &mut FaceBuf,
     );
 }
 
@@ -230,7 +221,7 @@ impl Fetch for NearestFetch {
         cube.nearest(face, u, v)
     }
     #[inline(always)]
-    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], _: &mut StepBuf) {
+    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], _: &mut FaceBuf) {
         face_span::<false>(&face_texels(c, f), r, o)
     }
 }
@@ -242,8 +233,8 @@ impl Fetch for BilinearFetch {
         cube.bilinear(face, u, v)
     }
     #[inline(always)]
-    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut StepBuf) {
-        face_steps(&face_texels(c, f), r, o, b)
+    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut FaceBuf) {
+        face_rows(&face_texels(c, f), r, o, b)
     }
 }
 
@@ -265,7 +256,7 @@ impl Fetch for TrilinearFetch {
         face: Face,
         run: &FaceRun,
         out: &mut [u32],
-        _: &mut StepBuf,
+        _: &mut FaceBuf,
     ) {
         // The image's x and y steps on the face's axes (y: −R₁ per row; the sign does not
         // change the footprint).
@@ -333,10 +324,10 @@ fn render_with<S: Fetch>(
     let w = frame.w as usize;
     // Bands of whole rows, ~16k pixels each so small frames stay on one thread.
     let rows_per_band = rows_per_task(w).clamp(1, frame.h as usize);
-    // The scratch (segments, stepped runs' buffers) is kept from band to band on a
+    // The scratch (segments, bilinear runs' position buffers) is kept from band to band on a
     // thread: made afresh per band, its buffers were zeroed ~135 times a 1080p frame.
-    let scratch = || (Vec::with_capacity(16), StepBuf::default());
-    let band = |(segs, buf): &mut (Vec<Seg>, StepBuf), (bi, chunk): (usize, &mut [u32])| {
+    let scratch = || (Vec::with_capacity(16), FaceBuf::default());
+    let band = |(segs, buf): &mut (Vec<Seg>, FaceBuf), (bi, chunk): (usize, &mut [u32])| {
         for (r, line) in chunk.chunks_exact_mut(w).enumerate() {
             let y = bi * rows_per_band + r;
             match renderer {
@@ -438,7 +429,7 @@ fn accel_row<S: Fetch>(
     s: S,
     y: usize,
     line: &mut [u32],
-    (segs, buf): (&mut Vec<Seg>, &mut StepBuf),
+    (segs, buf): (&mut Vec<Seg>, &mut FaceBuf),
 ) {
     let w = line.len();
     let p = frame.row(frame.dy(y));

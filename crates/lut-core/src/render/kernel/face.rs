@@ -1,13 +1,14 @@
 //! Cube-face runs evaluated exactly: the span kernels' gather and blend fed by a
 //! projective line, one division per pixel. The cube scanline renderer's nearest runs
-//! and trilinear runs (both pyramid levels of each chunk); its bilinear runs are stepped
-//! (`face_step.rs`).
+//! and trilinear runs (both pyramid levels of each chunk); its bilinear runs compute the
+//! same positions in a pass of their own and draw them with the row kernels
+//! (`face_rows.rs`: faster for bilinear, see there).
 //!
 //! Along a scanline the cube renderer's ray is `P + dx · B` (`render/cube.rs`), so on a
 //! face with axes `(a, b, m)` the face coordinates are `u = h + h·a/m`, `v = h − h·b/m`
 //! with `a`, `b`, `m` linear in `dx`: a projective line, not a linear one. Stepping it
-//! linearly between exact points needs a bound on the curvature (`face_step.rs`) and
-//! changes bytes; these kernels instead evaluate the projective line *exactly* at every
+//! linearly between exact points needs a bound on the curvature and
+//! changes bytes (tried for bilinear, `docs/performance.md`); these kernels instead evaluate the projective line *exactly* at every
 //! pixel, in `f64` SIMD lanes (8 per AVX-512 vector, 4 per AVX2 vector, 2 per SSE
 //! vector: three multiply-adds, one division, two multiply-adds per pixel), with the
 //! very operations, in the very order,

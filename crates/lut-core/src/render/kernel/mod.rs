@@ -42,9 +42,9 @@
 //! `select.rs`: choosing the kernel;
 //! `tests/`: the property tests (`row_pass.rs`: the row kernels'); `face.rs`:
 //! cube-face runs, whose positions are a projective line evaluated exactly per pixel
-//! (the cube scanline renderer's nearest and trilinear runs); `face_step.rs`: cube-face
-//! runs stepped like spans (exact every 1–32 pixels by a proven error bound, Q.16 steps
-//! between) and drawn by the row kernels (the scanline renderer's bilinear runs);
+//! (the cube scanline renderer's nearest and trilinear runs); `face_rows.rs`: cube-face
+//! runs whose exact positions are computed in a pass of their own and drawn by the row
+//! kernels (the scanline renderer's bilinear runs);
 //! `row.rs` (and `x86/row.rs`): the row pass's kernels (`render/rowpass.rs`), a run's
 //! Q.8 positions expanded from its spans and one gather-and-blend pass over them, with
 //! no per-span check (the LUT rows of full maps, trilinear's pyramid levels by
@@ -123,7 +123,7 @@
 //! aarch64 and x86 CPUs without SSE4.1 run the scalar kernel.
 
 mod face;
-mod face_step;
+mod face_rows;
 mod jobs;
 mod nodes;
 mod row;
@@ -140,8 +140,7 @@ pub use select::{
 };
 
 pub(crate) use face::{face_blend, face_span, FaceRun};
-pub(crate) use face_step::{face_steps, StepBuf};
-pub use face_step::{FACE_STEP_BOUND, FACE_STEP_ERROR, FACE_STEP_MAX};
+pub(crate) use face_rows::{face_rows, FaceBuf};
 pub(crate) use nodes::{blend_nodes, simd_blend};
 pub(crate) use row::{expand, sample_level, sample_q8, wrap_q8, Level, Positions, SpanQ8};
 

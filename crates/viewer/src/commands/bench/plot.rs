@@ -176,8 +176,9 @@ fn series(rows: &[Row]) -> Vec<Series<'_>> {
 }
 
 /// A vertical line's legend: the renderer and sampler, and for a row whose positions are
-/// stepped within a bound rather than exact (`position_bound_texels`: the cube scanline
-/// renderer's bilinear runs, `lut_core::CubeRenderer::position_bound`), that bound.
+/// stepped within a bound rather than exact (`position_bound_texels`,
+/// `lut_core::CubeRenderer::position_bound`: none today; the cube scanline renderer's
+/// bilinear rows of older JSON files), that bound.
 fn reference_label(r: &Row) -> String {
     let label = format!("{}, {}", r.renderer, r.sampler);
     match r.position_bound_texels {
@@ -187,8 +188,7 @@ fn reference_label(r: &Row) -> String {
 }
 
 /// Renderers drawn as vertical lines (no position error measured: exact, cube, gather;
-/// the cube scanline renderer's bilinear runs are within a bound, [`reference_label`]),
-/// at the first set's hfov.
+/// a row stepped within a bound names it, [`reference_label`]), at the first set's hfov.
 fn references(rows: &[Row]) -> Vec<&Row> {
     let Some(hfov) = rows.first().map(|r| r.hfov) else {
         return Vec::new();
@@ -842,25 +842,26 @@ mod tests {
         {"peer": "again", "key": "cv_float_bil", "ms_median": 0.8, "psnr_db_vs_exact": 71.7}
     ]}"#;
 
-    /// A reference line's legend names a stepped row's bound (from the row, as
-    /// `viewer bench` fills it in from `CubeRenderer::position_bound`), and the bound
-    /// survives the JSON round trip of `--replot`; exact rows carry none.
+    /// A reference line's legend names a stepped row's bound (as rows of older JSON files
+    /// carry it for the cube scanline renderer's bilinear runs), and the bound survives
+    /// the JSON round trip of `--replot`; exact rows carry none, which is every cube row
+    /// `viewer bench` writes now (`CubeRenderer::position_bound`).
     #[test]
     fn stepped_rows_name_their_bound() {
         let mut stepped = Row::timed(&run(), "cube-scanline", Sampler::Bilinear, 90.0, 1, &[5.0]);
-        stepped.position_bound_texels =
-            lut_core::CubeRenderer::Accelerated.position_bound(Sampler::Bilinear);
+        stepped.position_bound_texels = Some(0.0207);
         let exact = Row::timed(&run(), "cube-scanline", Sampler::Nearest, 90.0, 1, &[5.0]);
-        assert_eq!(
-            lut_core::CubeRenderer::Accelerated.position_bound(Sampler::Nearest),
-            None
-        );
+        for s in [Sampler::Nearest, Sampler::Bilinear, Sampler::Trilinear] {
+            for r in [
+                lut_core::CubeRenderer::Accelerated,
+                lut_core::CubeRenderer::Basic,
+            ] {
+                assert_eq!(r.position_bound(s), None, "{r:?} {s:?}");
+            }
+        }
         assert_eq!(
             reference_label(&stepped),
-            format!(
-                "cube-scanline, bilinear (stepped: max error <= {:.4} face texel, bound)",
-                lut_core::FACE_STEP_BOUND
-            )
+            "cube-scanline, bilinear (stepped: max error <= 0.0207 face texel, bound)"
         );
         assert_eq!(reference_label(&exact), "cube-scanline, nearest");
         let json = serde_json::to_string(&[&stepped, &exact]).unwrap();

@@ -39,6 +39,35 @@ pub(in super::super) fn face_span<const BILINEAR: bool, const BLEND: bool>(
     true
 }
 
+/// The bordered Q.8 positions of a face run's first `m` pixels with a SIMD kernel (see
+/// `face_rows.rs`; whole vectors written: `u` and `v` hold `m` rounded up to 16),
+/// and the largest `v`; `None` (nothing written) for the scalar one.
+#[inline(always)]
+pub(in super::super) fn positions(
+    k: Selected,
+    n: usize,
+    r: &FaceRun,
+    u: &mut [i32],
+    v: &mut [i32],
+    m: usize,
+) -> Option<i32> {
+    let whole = m.next_multiple_of(16);
+    assert!(
+        u.len() >= whole && v.len() >= whole,
+        "position buffers too short"
+    );
+    Some(match k.0 {
+        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel; the
+        // buffers hold whole vectors past `m` (asserted above).
+        Kernel::Avx512 => unsafe { avx512::positions(n, r, u, v, m) },
+        // SAFETY: as above.
+        Kernel::Avx2 => unsafe { avx2::positions(n, r, u, v, m) },
+        // SAFETY: as above.
+        Kernel::Sse41 => unsafe { sse41::positions(n, r, u, v, m) },
+        Kernel::Scalar => return None,
+    })
+}
+
 /// A [`Local`] for absolute positions in the face's texels (base 0): lane indices are
 /// clamped into `[0, len − stride − 2]`, so every 2×2 read stays in the slice.
 #[inline(always)]
@@ -155,6 +184,49 @@ macro_rules! face_kernels {
             gather(g)
         }
 
+        /// The bordered Q.8 positions of the run's pixels 0..m (`((q16 + FX_ONE) >> 8)`
+        /// of `uv`'s Q.16), N per step, whole vectors (the caller's buffers hold `m`
+        /// rounded up to 16; lanes past `m` repeat pixel m − 1), and the largest `v`.
+        ///
+        /// # Safety
+        /// `u` and `v` hold at least `m` rounded up to N entries.
+        #[target_feature(enable = $feature)]
+        pub(super) unsafe fn positions(
+            n: usize,
+            r: &FaceRun,
+            u: &mut [i32],
+            v: &mut [i32],
+            m: usize,
+        ) -> i32 {
+            let (half, step) = (set1_pd((N / 2) as f64), set1_pd(N as f64));
+            // Lane offsets past the end clamped to m − 1 (small whole numbers: exact).
+            let last = set1_pd(m.saturating_sub(1) as f64);
+            let one = set1(FX_ONE as i32);
+            let mut top = set1(i32::MIN);
+            let mut fi = iota_pd();
+            let mut i = 0;
+            while i < m {
+                let (lo, hi) = (min_pd(fi, last), min_pd(add_pd(fi, half), last));
+                let (u0, v0) = uv::<true>(r, n as f64, lo);
+                let (u1, v1) = uv::<true>(r, n as f64, hi);
+                let pu = srai::<8>(add(join(u0, u1), one));
+                let pv = srai::<8>(add(join(v0, v1), one));
+                top = max(top, pv);
+                // SAFETY: i < m, so i + N ≤ m rounded up to N ≤ the buffers' lengths (the
+                // caller's contract); unaligned stores.
+                unsafe {
+                    storeu(u.as_mut_ptr().add(i).cast(), pu);
+                    storeu(v.as_mut_ptr().add(i).cast(), pv);
+                }
+                fi = add_pd(fi, step);
+                i += N;
+            }
+            let mut lanes = [0i32; N];
+            // SAFETY: `lanes` is N writable i32; unaligned store.
+            unsafe { storeu(lanes.as_mut_ptr().cast(), top) };
+            lanes.into_iter().max().unwrap_or(i32::MIN)
+        }
+
         /// The run, N pixels per step (`BLEND`: blended into `out` by `frac`); the tail's
         /// lanes past the end repeat the last pixel.
         #[target_feature(enable = $feature)]
@@ -219,8 +291,8 @@ mod avx2 {
         _mm256_max_epi32 as max, _mm256_max_pd as max_pd, _mm256_min_epi32 as min,
         _mm256_min_pd as min_pd, _mm256_mul_pd as mul_pd, _mm256_mullo_epi32 as mullo,
         _mm256_set1_epi16 as set1_16, _mm256_set1_epi32 as set1, _mm256_set1_pd as set1_pd,
-        _mm256_setzero_pd as zero_pd, _mm256_setzero_si256 as zero, _mm256_storeu_si256 as storeu,
-        _mm256_sub_epi16 as sub16, _mm256_sub_pd as sub_pd,
+        _mm256_setzero_pd as zero_pd, _mm256_setzero_si256 as zero, _mm256_srai_epi32 as srai,
+        _mm256_storeu_si256 as storeu, _mm256_sub_epi16 as sub16, _mm256_sub_pd as sub_pd,
     };
 
     /// Pixels per step.
@@ -254,8 +326,8 @@ mod avx512 {
         _mm512_max_epi32 as max, _mm512_max_pd as max_pd, _mm512_min_epi32 as min,
         _mm512_min_pd as min_pd, _mm512_mul_pd as mul_pd, _mm512_mullo_epi32 as mullo,
         _mm512_set1_epi16 as set1_16, _mm512_set1_epi32 as set1, _mm512_set1_pd as set1_pd,
-        _mm512_setzero_pd as zero_pd, _mm512_setzero_si512 as zero, _mm512_storeu_si512 as storeu,
-        _mm512_sub_epi16 as sub16, _mm512_sub_pd as sub_pd,
+        _mm512_setzero_pd as zero_pd, _mm512_setzero_si512 as zero, _mm512_srai_epi32 as srai,
+        _mm512_storeu_si512 as storeu, _mm512_sub_epi16 as sub16, _mm512_sub_pd as sub_pd,
     };
 
     /// Pixels per step.
@@ -289,8 +361,8 @@ mod sse41 {
         _mm_max_epi32 as max, _mm_max_pd as max_pd, _mm_min_epi32 as min, _mm_min_pd as min_pd,
         _mm_mul_pd as mul_pd, _mm_mullo_epi32 as mullo, _mm_set1_epi16 as set1_16,
         _mm_set1_epi32 as set1, _mm_set1_pd as set1_pd, _mm_setzero_pd as zero_pd,
-        _mm_setzero_si128 as zero, _mm_storeu_si128 as storeu, _mm_sub_epi16 as sub16,
-        _mm_sub_pd as sub_pd,
+        _mm_setzero_si128 as zero, _mm_srai_epi32 as srai, _mm_storeu_si128 as storeu,
+        _mm_sub_epi16 as sub16, _mm_sub_pd as sub_pd,
     };
 
     /// Pixels per step.
