@@ -26,9 +26,9 @@
 //! On a verified run's face the ray's axes `(a, b, m)` are linear in `dx` and the face
 //! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line, evaluated
 //! exactly at every pixel with the arithmetic of [`face_uv`] in `f64` SIMD lanes
-//! (`render/kernel/face.rs`, `x86/face.rs`). Bilinear runs compute the positions in a pass
-//! of their own and draw them with the LUT's row kernels (`render/kernel/face_rows.rs`);
-//! nearest runs, and trilinear runs on the two pyramid levels of each
+//! (`render/kernel/face.rs`, `x86/face.rs`). Nearest and bilinear runs compute the
+//! positions in a pass of their own and draw them with the LUT's row kernels
+//! (`render/kernel/face_rows.rs`); trilinear runs, on the two pyramid levels of each
 //! [`TRILINEAR_RUN_CHUNK`], compute and draw them in one fused kernel (`face.rs`). Every
 //! kernel (AVX-512, AVX2, SSE4.1 or the scalar twin, chosen once per process,
 //! `LUTPANO_KERNEL=scalar` forcing the portable one) reads the face's bordered texels
@@ -221,8 +221,8 @@ impl Fetch for NearestFetch {
         cube.nearest(face, u, v)
     }
     #[inline(always)]
-    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], _: &mut FaceBuf) {
-        face_span::<false>(&face_texels(c, f), r, o)
+    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut FaceBuf) {
+        face_rows::<false>(&face_texels(c, f), r, o, b)
     }
 }
 
@@ -234,7 +234,7 @@ impl Fetch for BilinearFetch {
     }
     #[inline(always)]
     fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut FaceBuf) {
-        face_rows(&face_texels(c, f), r, o, b)
+        face_rows::<true>(&face_texels(c, f), r, o, b)
     }
 }
 
@@ -270,7 +270,7 @@ impl Fetch for TrilinearFetch {
             let on_level = |k: usize, out: &mut [u32]| {
                 let (l, _) = cube.level(k);
                 let half = l.face_size() as f64 / 2.0;
-                face_span::<true>(&face_texels(l, face), &FaceRun { half, ..sub }, out)
+                face_span(&face_texels(l, face), &FaceRun { half, ..sub }, out)
             };
             if lod <= 0 {
                 on_level(0, chunk);

@@ -1,19 +1,18 @@
 //! Cube-face runs evaluated exactly: the span kernels' gather and blend fed by a
-//! projective line, one division per pixel. The cube scanline renderer's nearest runs
-//! and trilinear runs (both pyramid levels of each chunk); its bilinear runs compute the
-//! same positions in a pass of their own and draw them with the row kernels
-//! (`face_rows.rs`: faster for bilinear, see there).
+//! projective line, one division per pixel, in one fused kernel. The cube scanline
+//! renderer's trilinear runs (both pyramid levels of each chunk, bilinear on each); its
+//! nearest and bilinear runs compute the same positions in a pass of their own and draw
+//! them with the row kernels (`face_rows.rs`: faster, see there).
 //!
 //! Along a scanline the cube renderer's ray is `P + dx · B` (`render/cube.rs`), so on a
 //! face with axes `(a, b, m)` the face coordinates are `u = h + h·a/m`, `v = h − h·b/m`
 //! with `a`, `b`, `m` linear in `dx`: a projective line, not a linear one. Stepping it
-//! linearly between exact points needs a bound on the curvature and
-//! changes bytes (tried for bilinear, `docs/performance.md`); these kernels instead evaluate the projective line *exactly* at every
-//! pixel, in `f64` SIMD lanes (8 per AVX-512 vector, 4 per AVX2 vector, 2 per SSE
-//! vector: three multiply-adds, one division, two multiply-adds per pixel), with the
-//! very operations, in the very order,
-//! of [`crate::cube::face_uv`] and [`crate::cube::CubeMap::bilinear`] /
-//! [`crate::cube::CubeMap::nearest`] (IEEE `f64` arithmetic is deterministic and
+//! linearly between exact points needs a bound on the curvature and changes bytes
+//! (tried for bilinear, `docs/performance.md`); these kernels instead evaluate the
+//! projective line *exactly* at every pixel, in `f64` SIMD lanes (8 per AVX-512 vector,
+//! 4 per AVX2 vector, 2 per SSE vector: three multiply-adds, one division, two
+//! multiply-adds per pixel), with the very operations, in the very order, of
+//! [`crate::cube::face_uv`] and [`crate::cube::CubeMap::bilinear`] (IEEE `f64` arithmetic is deterministic and
 //! correctly rounded, and rounding is symmetric in sign, so a negated axis is computed
 //! as the negation of the same sum). The rounded positions then go to the same 2×2 gather
 //! and 8-bit blend as the map's span kernels. So the images stay byte-identical to the
@@ -58,14 +57,9 @@ pub(super) fn face_side(t: &Texels) -> usize {
 }
 
 /// The portable kernel, one pixel at a time: the reference the SIMD kernels equal, and
-/// the per-pixel renderer's arithmetic (see the module docs)
-/// (`BLEND`: bilinear blended into `out` by `frac`, `lerp_px(out, sample, frac)`).
-pub(super) fn scalar<const BILINEAR: bool, const BLEND: bool>(
-    t: &Texels,
-    r: &FaceRun,
-    out: &mut [u32],
-    frac: u32,
-) {
+/// the per-pixel renderer's arithmetic (see the module docs): bilinear (`BLEND`: blended
+/// into `out` by `frac`, `lerp_px(out, sample, frac)`).
+pub(super) fn scalar<const BLEND: bool>(t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
     let n = face_side(t);
     let stride = t.stride();
     let nf = n as f64;
@@ -76,27 +70,20 @@ pub(super) fn scalar<const BILINEAR: bool, const BLEND: bool>(
         let m = r.p[2] + dx * r.d[2];
         let q = r.half / m;
         let (u, v) = (r.half + a * q, r.half - b * q);
-        let sample = if BILINEAR {
-            // `CubeMap::bilinear`: Q.16 rounded half up, + ½ − ½ (border, centres).
-            let uu = (u.max(0.0).min(nf) * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
-            let vv = (v.max(0.0).min(nf) * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
-            let x0 = (uu >> FX_BITS) as usize;
-            let y0 = (vv >> FX_BITS) as usize;
-            let fx = ((uu >> (FX_BITS - 8)) & 0xFF) as u32;
-            let fy = ((vv >> (FX_BITS - 8)) & 0xFF) as u32;
-            let k = y0 * stride + x0;
-            let q = &t.px[k..k + stride + 2];
-            lerp_px(
-                lerp_px(q[0], q[1], fx),
-                lerp_px(q[stride], q[stride + 1], fx),
-                fy,
-            )
-        } else {
-            // `CubeMap::nearest`: the texel containing (u, v), clamped into the face.
-            let x = (u.max(0.0) as usize).min(n - 1);
-            let y = (v.max(0.0) as usize).min(n - 1);
-            t.px[(y + 1) * stride + x + 1]
-        };
+        // `CubeMap::bilinear`: Q.16 rounded half up, + ½ − ½ (border, centres).
+        let uu = (u.max(0.0).min(nf) * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
+        let vv = (v.max(0.0).min(nf) * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
+        let x0 = (uu >> FX_BITS) as usize;
+        let y0 = (vv >> FX_BITS) as usize;
+        let fx = ((uu >> (FX_BITS - 8)) & 0xFF) as u32;
+        let fy = ((vv >> (FX_BITS - 8)) & 0xFF) as u32;
+        let k = y0 * stride + x0;
+        let q = &t.px[k..k + stride + 2];
+        let sample = lerp_px(
+            lerp_px(q[0], q[1], fx),
+            lerp_px(q[stride], q[stride + 1], fx),
+            fy,
+        );
         *o = if BLEND {
             lerp_px(*o, sample, frac)
         } else {
@@ -107,46 +94,40 @@ pub(super) fn scalar<const BILINEAR: bool, const BLEND: bool>(
 
 /// [`Kernel::face_span`] / [`Kernel::face_blend`] with kernel `k`.
 #[inline]
-fn run<const BILINEAR: bool, const BLEND: bool>(
-    k: Selected,
-    t: &Texels,
-    r: &FaceRun,
-    out: &mut [u32],
-    frac: u32,
-) {
+fn run<const BLEND: bool>(k: Selected, t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
     debug_assert!(t.width == t.height && t.width >= 2, "bordered face texels");
     #[cfg(target_arch = "x86_64")]
-    if x86::face::face_span::<BILINEAR, BLEND>(k, t, r, out, frac) {
+    if x86::face::face_span::<BLEND>(k, t, r, out, frac) {
         return;
     }
     let _ = k;
-    scalar::<BILINEAR, BLEND>(t, r, out, frac)
+    scalar::<BLEND>(t, r, out, frac)
 }
 
 /// [`Kernel::face_span`] with the [`active_kernel`](super::active_kernel).
 #[inline]
-pub(crate) fn face_span<const BILINEAR: bool>(t: &Texels, r: &FaceRun, out: &mut [u32]) {
-    run::<BILINEAR, false>(active(), t, r, out, 0)
+pub(crate) fn face_span(t: &Texels, r: &FaceRun, out: &mut [u32]) {
+    run::<false>(active(), t, r, out, 0)
 }
 
 /// [`Kernel::face_blend`] with the [`active_kernel`](super::active_kernel).
 #[inline]
 pub(crate) fn face_blend(t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
-    run::<true, true>(active(), t, r, out, frac)
+    run::<true>(active(), t, r, out, frac)
 }
 
 #[cfg(test)]
 impl Kernel {
-    /// Bilinear (`BILINEAR`) or nearest samples of one cube face along a [`FaceRun`]:
+    /// Bilinear samples of one cube face along a [`FaceRun`]:
     /// `t` is the face's bordered texels (`(n + 2)²`, as [`Texels`] of side `n + 1`).
     /// Writes every pixel of `out` (positions are clamped into the face).
     ///
     /// # Panics
     /// When the CPU does not run this kernel, or `t` is not a face's bordered texels
     /// (a square of side 2 or more).
-    pub(crate) fn face_span<const BILINEAR: bool>(self, t: &Texels, r: &FaceRun, out: &mut [u32]) {
+    pub(crate) fn face_span(self, t: &Texels, r: &FaceRun, out: &mut [u32]) {
         assert!(t.width == t.height && t.width >= 2, "bordered face texels");
-        run::<BILINEAR, false>(self.selected(), t, r, out, 0)
+        run::<false>(self.selected(), t, r, out, 0)
     }
 
     /// `out[i]` = `lerp_px(out[i], bilinear sample i, frac)` along a [`FaceRun`] (the
@@ -156,7 +137,7 @@ impl Kernel {
     /// As [`Kernel::face_span`].
     pub(crate) fn face_blend(self, t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
         assert!(t.width == t.height && t.width >= 2, "bordered face texels");
-        run::<true, true>(self.selected(), t, r, out, frac)
+        run::<true>(self.selected(), t, r, out, frac)
     }
 }
 
@@ -201,8 +182,9 @@ pub(super) mod tests {
         Texels::new(c.bordered_face(f), s, s, false).unwrap()
     }
 
-    /// The per-pixel samplers of [`CubeMap`] at [`crate::cube::face_uv`] of the ray.
-    fn per_pixel(c: &CubeMap, f: Face, r: &FaceRun, len: usize, bilinear: bool) -> Vec<u32> {
+    /// The per-pixel bilinear sampler of [`CubeMap`] at [`crate::cube::face_uv`] of the
+    /// ray.
+    fn per_pixel(c: &CubeMap, f: Face, r: &FaceRun, len: usize) -> Vec<u32> {
         (0..len)
             .map(|i| {
                 let dx = r.dx + i as f64;
@@ -213,11 +195,7 @@ pub(super) mod tests {
                 );
                 let q = r.half / m;
                 let (u, v) = (r.half + a * q, r.half - b * q);
-                if bilinear {
-                    c.bilinear(f, u, v)
-                } else {
-                    c.nearest(f, u, v)
-                }
+                c.bilinear(f, u, v)
             })
             .collect()
     }
@@ -228,33 +206,25 @@ pub(super) mod tests {
     fn check(ci: usize, f: Face, r: &FaceRun, len: usize, off: usize, frac: u32) {
         let c = &cubes()[ci];
         let t = face_texels(c, f);
-        for bilinear in [false, true] {
-            let want = per_pixel(c, f, r, len, bilinear);
-            for k in Kernel::available() {
-                let mut buf = vec![0xDEAD_BEEFu32; off + len + 3];
-                let out = &mut buf[off..off + len];
-                if bilinear {
-                    k.face_span::<true>(&t, r, out);
-                } else {
-                    k.face_span::<false>(&t, r, out);
-                }
-                assert!(
-                    buf[..off]
-                        .iter()
-                        .chain(&buf[off + len..])
-                        .all(|&x| x == 0xDEAD_BEEF),
-                    "{} wrote outside its run",
-                    k.name()
-                );
-                assert_eq!(
-                    &buf[off..off + len],
-                    &want[..],
-                    "{} bilinear={bilinear} {f:?} {r:?} len {len}",
-                    k.name()
-                );
-            }
+        let want = per_pixel(c, f, r, len);
+        for k in Kernel::available() {
+            let mut buf = vec![0xDEAD_BEEFu32; off + len + 3];
+            k.face_span(&t, r, &mut buf[off..off + len]);
+            assert!(
+                buf[..off]
+                    .iter()
+                    .chain(&buf[off + len..])
+                    .all(|&x| x == 0xDEAD_BEEF),
+                "{} wrote outside its run",
+                k.name()
+            );
+            assert_eq!(
+                &buf[off..off + len],
+                &want[..],
+                "{} {f:?} {r:?} len {len}",
+                k.name()
+            );
         }
-        let want = per_pixel(c, f, r, len, true);
         let under: Vec<u32> = (0..len as u32)
             .map(|i| i.wrapping_mul(0x9E37_79B9))
             .collect();

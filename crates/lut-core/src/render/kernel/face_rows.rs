@@ -1,30 +1,31 @@
-//! Cube-face bilinear runs on the row kernels: the face's projective line evaluated
-//! exactly at every pixel in a positions pass (`f64` SIMD lanes, [`positions_scalar`] the
-//! twin), then the row kernels' gather and blend over the positions (`kernel/row.rs`,
-//! AVX-512 / AVX2 / SSE4.1 / the scalar twin), as the LUT's rows are drawn. The cube
-//! scanline renderer's bilinear runs (`render/cube.rs`); its nearest and trilinear runs
-//! use the fused exact kernel (`face.rs`).
+//! Cube-face runs on the row kernels: the face's projective line evaluated exactly at
+//! every pixel in a positions pass (`f64` SIMD lanes, [`positions_scalar`] the twin),
+//! then the row kernels' gather (and for bilinear, blend) over the positions
+//! (`kernel/row.rs`, AVX-512 / AVX2 / SSE4.1 / the scalar twin), as the LUT's rows are
+//! drawn. The cube scanline renderer's nearest and bilinear runs (`render/cube.rs`); its
+//! trilinear runs use the fused exact kernel (`face.rs`).
 //!
 //! # Why a separate positions pass
 //! The fused kernel (`face.rs`: position, gather and blend per vector) is the slowest way
-//! to draw a bilinear run here: its division sits between the position and the gather
-//! in every iteration (1080p bilinear cube frame from the 8k map, one thread, 9.5 ms).
-//! Stepping the line linearly between exact points every ~9 pixels (this module until
-//! 2026-12-02) took 5.8 ms but ~21 instructions per pixel of planning and expanding, and
-//! moved positions by up to 0.02 texels. A pass of positions alone is a stream of
-//! independent divisions (8 `f64` lanes per AVX-512 division, ~0.14 ns a lane on this
-//! machine), then the row kernels read the positions as they read the LUT's: 4.6 ms,
-//! and every position exact.
+//! to draw a run here: its division sits between the position and the gather in every
+//! iteration (1080p cube frame from the 8k map's 2048² faces, one thread: bilinear 9.5
+//! ms, nearest 7.3 ms). Stepping the line linearly between exact points every ~9 pixels
+//! (bilinear, this module until 2026-12-02) took 5.8 ms but ~21 instructions per pixel of
+//! planning and expanding, and moved positions by up to 0.02 texels. A pass of positions
+//! alone is a stream of independent divisions (8 `f64` lanes per AVX-512 division, ~0.14
+//! ns a lane on this machine), then the row kernels read the positions as they read the
+//! LUT's: bilinear 4.6 ms, nearest 4.0 ms, every position exact.
 //!
 //! # Positions
 //! On a run ([`FaceRun`]) the face coordinates are `u = h + h·a/m`, `v = h − h·b/m` with
 //! `a`, `b`, `m` linear in the pixel. Pixel `i`'s are computed with the operations of
 //! [`crate::cube::face_uv`] in their order (IEEE `f64` is deterministic: the SIMD lanes
-//! equal the scalar twin), rounded to Q.16 and clamped to the face as
-//! `CubeMap::bilinear` does, moved into the bordered face (+1 texel) and floored to
-//! Q.8, the row kernels' positions. The row kernels' bilinear then reads exactly the
-//! texels and 8-bit weights `CubeMap::bilinear` reads: the scanline renderer's bilinear
-//! images are byte-identical to the per-pixel renderer's.
+//! equal the scalar twin) and rounded as the per-pixel samplers round them: bilinear to
+//! Q.16, clamped to the face as `CubeMap::bilinear` does; nearest to the texel
+//! `CubeMap::nearest` reads. Both are moved into the bordered face (+1 texel) and given
+//! in Q.8, the row kernels' positions. The row kernels then read exactly the texels (and
+//! 8-bit weights) the per-pixel samplers read: the scanline renderer's nearest and
+//! bilinear images are byte-identical to the per-pixel renderer's.
 //!
 //! # Texels
 //! The positions are bordered-face coordinates (the face's `(n + 2)²` texels as a
@@ -70,16 +71,29 @@ fn exact(r: &FaceRun, i: usize) -> (f64, f64, f64) {
 /// The bordered Q.8 positions of the run's pixels 0..m, exact (see the module docs), one
 /// pixel at a time: the SIMD kernels' scalar twin. Returns the largest `v` (`i32::MIN`
 /// for no pixel).
-fn positions_scalar(n: usize, r: &FaceRun, u: &mut [i32], v: &mut [i32], m: usize) -> i32 {
-    let (topf, one) = (((n as i64) << FX_BITS) as f64, FX_ONE as f64);
-    // `CubeMap::bilinear`'s Q.16 (rounded half up, clamped into the face; NaN → 0: the
-    // float clamped first gives the same integer), then + 1 texel (the border).
-    let q16 = |x: f64| ((x * one + 0.5).max(0.0).min(topf) as i64) + FX_ONE;
+fn positions_scalar<const BILINEAR: bool>(
+    n: usize,
+    r: &FaceRun,
+    u: &mut [i32],
+    v: &mut [i32],
+    m: usize,
+) -> i32 {
+    let (nf, topf, one) = (n as f64, ((n as i64) << FX_BITS) as f64, FX_ONE as f64);
+    let q8 = |x: f64| {
+        if BILINEAR {
+            // `CubeMap::bilinear`'s Q.16 (rounded half up, clamped into the face; NaN → 0:
+            // the float clamped first gives the same integer), + 1 texel (the border).
+            ((((x * one + 0.5).max(0.0).min(topf) as i64) + FX_ONE) >> 8) as i32
+        } else {
+            // `CubeMap::nearest`'s texel (NaN → 0), + 1 (the border), in Q.8.
+            (((x.max(0.0).min(nf) as i32).min(n as i32 - 1)) + 1) << 8
+        }
+    };
     let mut top = i32::MIN;
     for (i, (pu, pv)) in u[..m].iter_mut().zip(&mut v[..m]).enumerate() {
         let (x, y, _) = exact(r, i);
-        *pu = (q16(x) >> 8) as i32;
-        *pv = (q16(y) >> 8) as i32;
+        *pu = q8(x);
+        *pv = q8(y);
         top = top.max(*pv);
     }
     top
@@ -87,7 +101,7 @@ fn positions_scalar(n: usize, r: &FaceRun, u: &mut [i32], v: &mut [i32], m: usiz
 
 /// [`positions_scalar`] with kernel `k` (the buffers hold `m` rounded up to 16).
 #[inline]
-fn positions_with(
+fn positions_with<const BILINEAR: bool>(
     k: Selected,
     n: usize,
     r: &FaceRun,
@@ -96,11 +110,11 @@ fn positions_with(
     m: usize,
 ) -> i32 {
     #[cfg(target_arch = "x86_64")]
-    if let Some(top) = super::x86::face::positions(k, n, r, u, v, m) {
+    if let Some(top) = super::x86::face::positions::<BILINEAR>(k, n, r, u, v, m) {
         return top;
     }
     let _ = k;
-    positions_scalar(n, r, u, v, m)
+    positions_scalar::<BILINEAR>(n, r, u, v, m)
 }
 
 /// The bilinear sample at bordered Q.8 position (`u`, `v`) reading the rows `y` and
@@ -121,9 +135,15 @@ fn bottom(t: &Texels, u: i32, v: i32) -> u32 {
     )
 }
 
-/// A face run with kernel `k`.
+/// A face run with kernel `k`, bilinear (`BILINEAR`) or nearest.
 #[inline]
-fn run(k: Selected, t: &Texels, r: &FaceRun, out: &mut [u32], buf: &mut FaceBuf) {
+fn run<const BILINEAR: bool>(
+    k: Selected,
+    t: &Texels,
+    r: &FaceRun,
+    out: &mut [u32],
+    buf: &mut FaceBuf,
+) {
     debug_assert!(t.width == t.height && t.width >= 2, "bordered face texels");
     let len = out.len();
     let n = face_side(t);
@@ -132,10 +152,10 @@ fn run(k: Selected, t: &Texels, r: &FaceRun, out: &mut [u32], buf: &mut FaceBuf)
             b.resize(len + SLACK, 0);
         }
     }
-    let top = positions_with(k, n, r, &mut buf.u, &mut buf.v, len);
+    let top = positions_with::<BILINEAR>(k, n, r, &mut buf.u, &mut buf.v, len);
     let (u, v) = (&buf.u[..len], &buf.v[..len]);
-    sample_q8_with::<true, false>(k, t, u, v, out);
-    if len > 0 && (top - 128) >> 8 >= n as i32 {
+    sample_q8_with::<BILINEAR, false>(k, t, u, v, out);
+    if BILINEAR && len > 0 && (top - 128) >> 8 >= n as i32 {
         let last = n as i32;
         for ((o, &u), &v) in out.iter_mut().zip(u).zip(v) {
             if (v - 128) >> 8 >= last {
@@ -145,12 +165,18 @@ fn run(k: Selected, t: &Texels, r: &FaceRun, out: &mut [u32], buf: &mut FaceBuf)
     }
 }
 
-/// Bilinear samples of one cube face along a run (see the module docs), with the
-/// [`active_kernel`](super::active_kernel). `t` is the face's bordered texels. Every pixel
-/// of `out` is written; positions are clamped into the face, so any run is safe.
+/// Bilinear (`BILINEAR`) or nearest samples of one cube face along a run (see the
+/// module docs), with the [`active_kernel`](super::active_kernel). `t` is the face's
+/// bordered texels. Every pixel of `out` is written; positions are clamped into the face,
+/// so any run is safe.
 #[inline]
-pub(crate) fn face_rows(t: &Texels, r: &FaceRun, out: &mut [u32], buf: &mut FaceBuf) {
-    run(active(), t, r, out, buf)
+pub(crate) fn face_rows<const BILINEAR: bool>(
+    t: &Texels,
+    r: &FaceRun,
+    out: &mut [u32],
+    buf: &mut FaceBuf,
+) {
+    run::<BILINEAR>(active(), t, r, out, buf)
 }
 
 #[cfg(test)]
@@ -159,9 +185,15 @@ impl Kernel {
     ///
     /// # Panics
     /// When the CPU does not run this kernel, or `t` is not a face's bordered texels.
-    pub(crate) fn face_rows(self, t: &Texels, r: &FaceRun, out: &mut [u32], buf: &mut FaceBuf) {
+    pub(crate) fn face_rows<const BILINEAR: bool>(
+        self,
+        t: &Texels,
+        r: &FaceRun,
+        out: &mut [u32],
+        buf: &mut FaceBuf,
+    ) {
         assert!(t.width == t.height && t.width >= 2, "bordered face texels");
-        run(self.selected(), t, r, out, buf)
+        run::<BILINEAR>(self.selected(), t, r, out, buf)
     }
 }
 
@@ -195,21 +227,32 @@ mod tests {
             let (_, r) = view_run((yaw, pitch, hfov), (w, h), (x, y), n);
             let n = n as usize;
             let whole = len.next_multiple_of(16);
-            let (mut su, mut sv) = (vec![0; len], vec![0; len]);
-            let top = positions_scalar(n, &r, &mut su, &mut sv, len);
-            prop_assert_eq!(top, sv.iter().copied().max().unwrap_or(i32::MIN));
-            for k in Kernel::available() {
-                let (mut u, mut v) = (vec![7; whole + 5], vec![7; whole + 5]);
-                let t = positions_with(k.selected(), n, &r, &mut u, &mut v, len);
-                prop_assert_eq!(&u[..len], &su[..], "{} u", k.name());
-                prop_assert_eq!(&v[..len], &sv[..], "{} v", k.name());
-                prop_assert_eq!(t, top, "{} top", k.name());
-                prop_assert!(u[whole..].iter().chain(&v[whole..]).all(|&x| x == 7));
+            for bilinear in [false, true] {
+                let (mut su, mut sv) = (vec![0; len], vec![0; len]);
+                let top = if bilinear {
+                    positions_scalar::<true>(n, &r, &mut su, &mut sv, len)
+                } else {
+                    positions_scalar::<false>(n, &r, &mut su, &mut sv, len)
+                };
+                prop_assert_eq!(top, sv.iter().copied().max().unwrap_or(i32::MIN));
+                for k in Kernel::available() {
+                    let (mut u, mut v) = (vec![7; whole + 5], vec![7; whole + 5]);
+                    let (ks, (pu, pv)) = (k.selected(), (&mut u, &mut v));
+                    let t = if bilinear {
+                        positions_with::<true>(ks, n, &r, pu, pv, len)
+                    } else {
+                        positions_with::<false>(ks, n, &r, pu, pv, len)
+                    };
+                    prop_assert_eq!(&u[..len], &su[..], "{} u {}", k.name(), bilinear);
+                    prop_assert_eq!(&v[..len], &sv[..], "{} v {}", k.name(), bilinear);
+                    prop_assert_eq!(t, top, "{} top", k.name());
+                    prop_assert!(u[whole..].iter().chain(&v[whole..]).all(|&x| x == 7));
+                }
             }
         }
 
-        /// Every kernel draws the per-pixel renderer's bytes (`CubeMap::bilinear` at the
-        /// exact position) and nothing outside the run: view runs of any length 1..=64
+        /// Every kernel draws the per-pixel renderer's bytes (`CubeMap::bilinear` and
+        /// `CubeMap::nearest` at the exact position) and nothing outside the run: view runs of any length 1..=64
         /// (past the face's edge too: clamped), odd offsets.
         #[test]
         fn face_rows_equal_per_pixel(
@@ -230,27 +273,43 @@ mod tests {
         }
     }
 
-    /// Every kernel against the per-pixel samples, with sentinels around `out`.
+    /// Every kernel against the per-pixel samples (`CubeMap::bilinear` and
+    /// `CubeMap::nearest`), with sentinels around `out`.
     fn check(ci: usize, f: Face, r: &FaceRun, len: usize, off: usize) {
+        check_with(ci, f, r, len, off, true);
+        check_with(ci, f, r, len, off, false);
+    }
+
+    fn check_with(ci: usize, f: Face, r: &FaceRun, len: usize, off: usize, bilinear: bool) {
         let c = &cubes()[ci];
         let t = face_texels(c, f);
         let mut buf = FaceBuf::default();
         let want: Vec<u32> = (0..len)
             .map(|i| {
                 let (u, v, _) = exact(r, i);
-                c.bilinear(f, u, v)
+                if bilinear {
+                    c.bilinear(f, u, v)
+                } else {
+                    c.nearest(f, u, v)
+                }
             })
             .collect();
         for k in Kernel::available() {
             let mut o = vec![0xDEAD_BEEFu32; off + len + 3];
-            k.face_rows(&t, r, &mut o[off..off + len], &mut buf);
+            let run = &mut o[off..off + len];
+            if bilinear {
+                k.face_rows::<true>(&t, r, run, &mut buf);
+            } else {
+                k.face_rows::<false>(&t, r, run, &mut buf);
+            }
             let outside = o[..off].iter().chain(&o[off + len..]);
             assert!(
                 outside.into_iter().all(|&x| x == 0xDEAD_BEEF),
                 "{}",
                 k.name()
             );
-            assert_eq!(&o[off..off + len], &want[..], "{} {f:?} {r:?}", k.name());
+            let got = &o[off..off + len];
+            assert_eq!(got, &want[..], "{} {bilinear} {f:?} {r:?}", k.name());
         }
     }
 

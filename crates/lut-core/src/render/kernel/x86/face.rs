@@ -1,16 +1,18 @@
-//! x86-64 cube-face runs (see `kernel/face.rs`): the face coordinates of 8 (AVX-512), 4
-//! (AVX2) or 2 (SSE) pixels per `f64` vector, computed with the scalar twin's operations in its
-//! order, rounded to Q.16 as it rounds them, then the map kernels' gather and blend
-//! (`bilinear16` / `bilinear8` / `bilinear4` on absolute positions: base 0) or a nearest
-//! fetch. AVX-512 takes 16 pixels per step (two `f64` vectors, one 16-lane gather and
-//! blend); the division, the kernel's bottleneck, then runs 8 lanes wide.
+//! x86-64 cube-face runs (see `kernel/face.rs` and `kernel/face_rows.rs`): the face
+//! coordinates of 8 (AVX-512), 4 (AVX2) or 2 (SSE) pixels per `f64` vector, computed with
+//! the scalar twin's operations in its order and rounded as it rounds them, either
+//! written out as the row kernels' Q.8 positions (`positions`: nearest and bilinear runs)
+//! or gathered and blended at once (`face`: the trilinear runs' levels, with the map
+//! kernels' `bilinear16` / `bilinear8` / `bilinear4` on absolute positions: base 0).
+//! AVX-512 takes 16 pixels per step (two `f64` vectors); the division then runs 8 lanes
+//! wide.
 //!
 //! Written once (`face_kernels!`) as the row kernels are (`x86/row.rs`): each
 //! instruction set's module names its intrinsics with short aliases (`add_pd` is
 //! `_mm256_add_pd` in `avx2`, `_mm_add_pd` in `sse41`; `V` the i32 vector of `N` lanes,
 //! `D` the f64 vector of `N / 2`, `H` the rounded coordinates of one `D`) and holds what
-//! differs in more than the prefix: joining two halves' coordinates (`join`), the nearest gather (`gather`), the lane offsets
-//! (`iota_pd`).
+//! differs in more than the prefix: joining two halves' coordinates (`join`), the lane
+//! offsets (`iota_pd`).
 
 use super::super::face::{face_side, FaceRun};
 use super::{padded, prefetch_texels, Kernel, Local, Selected, Texels, PREFETCH_AHEAD};
@@ -20,7 +22,7 @@ use std::arch::x86_64::*;
 /// The face run with a SIMD kernel (`BLEND`: bilinear blended into `out` by `frac`);
 /// `false` (nothing written) for the scalar one.
 #[inline(always)]
-pub(in super::super) fn face_span<const BILINEAR: bool, const BLEND: bool>(
+pub(in super::super) fn face_span<const BLEND: bool>(
     k: Selected,
     t: &Texels,
     r: &FaceRun,
@@ -29,11 +31,11 @@ pub(in super::super) fn face_span<const BILINEAR: bool, const BLEND: bool>(
 ) -> bool {
     match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        Kernel::Avx512 => unsafe { avx512::face::<BILINEAR, BLEND>(t, r, out, frac) },
+        Kernel::Avx512 => unsafe { avx512::face::<BLEND>(t, r, out, frac) },
         // SAFETY: as above.
-        Kernel::Avx2 => unsafe { avx2::face::<BILINEAR, BLEND>(t, r, out, frac) },
+        Kernel::Avx2 => unsafe { avx2::face::<BLEND>(t, r, out, frac) },
         // SAFETY: as above.
-        Kernel::Sse41 => unsafe { sse41::face::<BILINEAR, BLEND>(t, r, out, frac) },
+        Kernel::Sse41 => unsafe { sse41::face::<BLEND>(t, r, out, frac) },
         Kernel::Scalar => return false,
     }
     true
@@ -43,7 +45,7 @@ pub(in super::super) fn face_span<const BILINEAR: bool, const BLEND: bool>(
 /// `face_rows.rs`; whole vectors written: `u` and `v` hold `m` rounded up to 16),
 /// and the largest `v`; `None` (nothing written) for the scalar one.
 #[inline(always)]
-pub(in super::super) fn positions(
+pub(in super::super) fn positions<const BILINEAR: bool>(
     k: Selected,
     n: usize,
     r: &FaceRun,
@@ -59,11 +61,11 @@ pub(in super::super) fn positions(
     Some(match k.0 {
         // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel; the
         // buffers hold whole vectors past `m` (asserted above).
-        Kernel::Avx512 => unsafe { avx512::positions(n, r, u, v, m) },
+        Kernel::Avx512 => unsafe { avx512::positions::<BILINEAR>(n, r, u, v, m) },
         // SAFETY: as above.
-        Kernel::Avx2 => unsafe { avx2::positions(n, r, u, v, m) },
+        Kernel::Avx2 => unsafe { avx2::positions::<BILINEAR>(n, r, u, v, m) },
         // SAFETY: as above.
-        Kernel::Sse41 => unsafe { sse41::positions(n, r, u, v, m) },
+        Kernel::Sse41 => unsafe { sse41::positions::<BILINEAR>(n, r, u, v, m) },
         Kernel::Scalar => return None,
     })
 }
@@ -92,7 +94,7 @@ fn absolute(t: &Texels) -> Local {
 /// off by one texel is prefetched at worst), its texel and for bilinear the one below.
 /// Pixels past the run or behind the face are skipped.
 #[inline(always)]
-fn prefetch<const BILINEAR: bool>(t: &Texels, r: &FaceRun, i: usize, m: usize) {
+fn prefetch(t: &Texels, r: &FaceRun, i: usize, m: usize) {
     if i >= m {
         return;
     }
@@ -107,7 +109,7 @@ fn prefetch<const BILINEAR: bool>(t: &Texels, r: &FaceRun, i: usize, m: usize) {
     let v = (r.half - (r.p[1] + dx * r.d[1]) * q).clamp(0.0, n);
     let stride = t.stride();
     let at = t.px.as_ptr().wrapping_add(v as usize * stride + u as usize);
-    prefetch_texels::<BILINEAR>(at, stride);
+    prefetch_texels::<true>(at, stride);
 }
 
 macro_rules! face_kernels {
@@ -139,12 +141,12 @@ macro_rules! face_kernels {
             (fx(u), fx(v))
         }
 
-        /// N pixels at lane offsets `lo` (lanes 0..N / 2) and `hi` (N / 2..N): bilinear
-        /// (merged 0RGB) or nearest.
+        /// N bilinear pixels (merged 0RGB) at lane offsets `lo` (lanes 0..N / 2) and `hi`
+        /// (N / 2..N).
         #[inline]
         #[target_feature(enable = $feature)]
         #[allow(clippy::too_many_arguments)]
-        fn px<const BILINEAR: bool, const BLEND: bool>(
+        fn px<const BLEND: bool>(
             t: &Texels,
             r: &FaceRun,
             l: &Local,
@@ -154,44 +156,28 @@ macro_rules! face_kernels {
             hi: D,
         ) -> V {
             let n = face_side(t);
-            let stride = t.stride();
-            let (u0, v0) = uv::<BILINEAR>(r, n as f64, lo);
-            let (u1, v1) = uv::<BILINEAR>(r, n as f64, hi);
+            let (u0, v0) = uv::<true>(r, n as f64, lo);
+            let (u1, v1) = uv::<true>(r, n as f64, hi);
             let (u, v) = (join(u0, u1), join(v0, v1));
-            if BILINEAR {
-                // + ½ texel: the border's +1 and the centres' −½ (CubeMap::bilinear).
-                let h = set1(FX_HALF as i32);
-                let c = bilinear(t.px, stride, l, add(u, h), add(v, h));
-                return if BLEND {
-                    merge(lerp(split(prev), c, w))
-                } else {
-                    merge(c)
-                };
+            // + ½ texel: the border's +1 and the centres' −½ (CubeMap::bilinear).
+            let h = set1(FX_HALF as i32);
+            let c = bilinear(t.px, t.stride(), l, add(u, h), add(v, h));
+            if BLEND {
+                merge(lerp(split(prev), c, w))
+            } else {
+                merge(c)
             }
-            let last = set1(n as i32 - 1);
-            let (x, y) = (min(u, last), min(v, last));
-            let k = add(
-                mullo(y, set1(stride as i32)),
-                add(x, set1(stride as i32 + 1)),
-            );
-            let k = min(max(k, zero()), set1(t.px.len() as i32 - 1));
-            let mut a = [0i32; N];
-            // SAFETY: `a` is N writable i32; the store is unaligned.
-            unsafe { storeu(a.as_mut_ptr().cast(), k) };
-            let p = t.px.as_ptr();
-            // SAFETY: each a[j] is clamped to [0, len − 1] just above.
-            let g = |j: usize| unsafe { p.add(a[j] as usize).read() } as i32;
-            gather(g)
         }
 
-        /// The bordered Q.8 positions of the run's pixels 0..m (`((q16 + FX_ONE) >> 8)`
-        /// of `uv`'s Q.16), N per step, whole vectors (the caller's buffers hold `m`
-        /// rounded up to 16; lanes past `m` repeat pixel m − 1), and the largest `v`.
+        /// The bordered Q.8 positions of the run's pixels 0..m, N per step, whole vectors
+        /// (the caller's buffers hold `m` rounded up to 16; lanes past `m` repeat pixel
+        /// m − 1), and the largest `v`: bilinear `(q16 + FX_ONE) >> 8` of `uv`'s Q.16,
+        /// nearest `(min(texel, n − 1) + 1) << 8` of its whole texels.
         ///
         /// # Safety
         /// `u` and `v` hold at least `m` rounded up to N entries.
         #[target_feature(enable = $feature)]
-        pub(super) unsafe fn positions(
+        pub(super) unsafe fn positions<const BILINEAR: bool>(
             n: usize,
             r: &FaceRun,
             u: &mut [i32],
@@ -201,16 +187,23 @@ macro_rules! face_kernels {
             let (half, step) = (set1_pd((N / 2) as f64), set1_pd(N as f64));
             // Lane offsets past the end clamped to m − 1 (small whole numbers: exact).
             let last = set1_pd(m.saturating_sub(1) as f64);
-            let one = set1(FX_ONE as i32);
+            let (one, texel, side) = (set1(FX_ONE as i32), set1(1), set1(n as i32 - 1));
+            let q8 = |x: V| {
+                if BILINEAR {
+                    srai::<8>(add(x, one))
+                } else {
+                    slli::<8>(add(min(x, side), texel))
+                }
+            };
             let mut top = set1(i32::MIN);
             let mut fi = iota_pd();
             let mut i = 0;
             while i < m {
                 let (lo, hi) = (min_pd(fi, last), min_pd(add_pd(fi, half), last));
-                let (u0, v0) = uv::<true>(r, n as f64, lo);
-                let (u1, v1) = uv::<true>(r, n as f64, hi);
-                let pu = srai::<8>(add(join(u0, u1), one));
-                let pv = srai::<8>(add(join(v0, v1), one));
+                let (u0, v0) = uv::<BILINEAR>(r, n as f64, lo);
+                let (u1, v1) = uv::<BILINEAR>(r, n as f64, hi);
+                let pu = q8(join(u0, u1));
+                let pv = q8(join(v0, v1));
                 top = max(top, pv);
                 // SAFETY: i < m, so i + N ≤ m rounded up to N ≤ the buffers' lengths (the
                 // caller's contract); unaligned stores.
@@ -230,12 +223,7 @@ macro_rules! face_kernels {
         /// The run, N pixels per step (`BLEND`: blended into `out` by `frac`); the tail's
         /// lanes past the end repeat the last pixel.
         #[target_feature(enable = $feature)]
-        pub(super) fn face<const BILINEAR: bool, const BLEND: bool>(
-            t: &Texels,
-            r: &FaceRun,
-            out: &mut [u32],
-            frac: u32,
-        ) {
+        pub(super) fn face<const BLEND: bool>(t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
             let m = out.len();
             let l = absolute(t);
             let fw = set1((frac as i32) * 0x10001);
@@ -247,7 +235,7 @@ macro_rules! face_kernels {
             let mut i = 0;
             while i + N <= m {
                 while ahead < (i + N + PREFETCH_AHEAD).min(m) {
-                    prefetch::<BILINEAR>(t, r, ahead, m);
+                    prefetch(t, r, ahead, m);
                     ahead += 8;
                 }
                 let q = out[i..i + N].as_mut_ptr().cast::<V>();
@@ -257,7 +245,7 @@ macro_rules! face_kernels {
                 } else {
                     zero()
                 };
-                let c = px::<BILINEAR, BLEND>(t, r, &l, prev, w, fi, add_pd(fi, half));
+                let c = px::<BLEND>(t, r, &l, prev, w, fi, add_pd(fi, half));
                 // SAFETY: as above; unaligned store.
                 unsafe { storeu(q, c) };
                 fi = add_pd(fi, step);
@@ -272,7 +260,7 @@ macro_rules! face_kernels {
                 let q = buf.as_mut_ptr().cast::<V>();
                 // SAFETY: `buf` holds N u32; unaligned load.
                 let prev = unsafe { loadu(q) };
-                let c = px::<BILINEAR, BLEND>(t, r, &l, prev, w, lo, hi);
+                let c = px::<BLEND>(t, r, &l, prev, w, lo, hi);
                 // SAFETY: as above; unaligned store.
                 unsafe { storeu(q, c) };
                 let n = tail.len();
@@ -283,15 +271,15 @@ macro_rules! face_kernels {
 }
 
 mod avx2 {
-    use super::super::avx2::{bilinear8 as bilinear, gather, lerp, merge, split};
+    use super::super::avx2::{bilinear8 as bilinear, lerp, merge, split};
     use super::*;
     use std::arch::x86_64::{
         __m256d as D, __m256i as V, _mm256_add_epi32 as add, _mm256_add_pd as add_pd,
         _mm256_cvttpd_epi32 as cvtt_pd, _mm256_div_pd as div_pd, _mm256_loadu_si256 as loadu,
         _mm256_max_epi32 as max, _mm256_max_pd as max_pd, _mm256_min_epi32 as min,
-        _mm256_min_pd as min_pd, _mm256_mul_pd as mul_pd, _mm256_mullo_epi32 as mullo,
-        _mm256_set1_epi16 as set1_16, _mm256_set1_epi32 as set1, _mm256_set1_pd as set1_pd,
-        _mm256_setzero_pd as zero_pd, _mm256_setzero_si256 as zero, _mm256_srai_epi32 as srai,
+        _mm256_min_pd as min_pd, _mm256_mul_pd as mul_pd, _mm256_set1_epi16 as set1_16,
+        _mm256_set1_epi32 as set1, _mm256_set1_pd as set1_pd, _mm256_setzero_pd as zero_pd,
+        _mm256_setzero_si256 as zero, _mm256_slli_epi32 as slli, _mm256_srai_epi32 as srai,
         _mm256_storeu_si256 as storeu, _mm256_sub_epi16 as sub16, _mm256_sub_pd as sub_pd,
     };
 
@@ -318,15 +306,15 @@ mod avx2 {
 }
 
 mod avx512 {
-    use super::super::avx512::{bilinear16 as bilinear, gather, lerp, merge, split};
+    use super::super::avx512::{bilinear16 as bilinear, lerp, merge, split};
     use super::*;
     use std::arch::x86_64::{
         __m512d as D, __m512i as V, _mm512_add_epi32 as add, _mm512_add_pd as add_pd,
         _mm512_cvttpd_epi32 as cvtt_pd, _mm512_div_pd as div_pd, _mm512_loadu_si512 as loadu,
         _mm512_max_epi32 as max, _mm512_max_pd as max_pd, _mm512_min_epi32 as min,
-        _mm512_min_pd as min_pd, _mm512_mul_pd as mul_pd, _mm512_mullo_epi32 as mullo,
-        _mm512_set1_epi16 as set1_16, _mm512_set1_epi32 as set1, _mm512_set1_pd as set1_pd,
-        _mm512_setzero_pd as zero_pd, _mm512_setzero_si512 as zero, _mm512_srai_epi32 as srai,
+        _mm512_min_pd as min_pd, _mm512_mul_pd as mul_pd, _mm512_set1_epi16 as set1_16,
+        _mm512_set1_epi32 as set1, _mm512_set1_pd as set1_pd, _mm512_setzero_pd as zero_pd,
+        _mm512_setzero_si512 as zero, _mm512_slli_epi32 as slli, _mm512_srai_epi32 as srai,
         _mm512_storeu_si512 as storeu, _mm512_sub_epi16 as sub16, _mm512_sub_pd as sub_pd,
     };
 
@@ -353,15 +341,15 @@ mod avx512 {
 }
 
 mod sse41 {
-    use super::super::sse41::{bilinear4 as bilinear, gather, lerp, merge, split};
+    use super::super::sse41::{bilinear4 as bilinear, lerp, merge, split};
     use super::*;
     use std::arch::x86_64::{
         __m128d as D, __m128i as V, _mm_add_epi32 as add, _mm_add_pd as add_pd,
         _mm_cvttpd_epi32 as cvtt_pd, _mm_div_pd as div_pd, _mm_loadu_si128 as loadu,
         _mm_max_epi32 as max, _mm_max_pd as max_pd, _mm_min_epi32 as min, _mm_min_pd as min_pd,
-        _mm_mul_pd as mul_pd, _mm_mullo_epi32 as mullo, _mm_set1_epi16 as set1_16,
-        _mm_set1_epi32 as set1, _mm_set1_pd as set1_pd, _mm_setzero_pd as zero_pd,
-        _mm_setzero_si128 as zero, _mm_srai_epi32 as srai, _mm_storeu_si128 as storeu,
+        _mm_mul_pd as mul_pd, _mm_set1_epi16 as set1_16, _mm_set1_epi32 as set1,
+        _mm_set1_pd as set1_pd, _mm_setzero_pd as zero_pd, _mm_setzero_si128 as zero,
+        _mm_slli_epi32 as slli, _mm_srai_epi32 as srai, _mm_storeu_si128 as storeu,
         _mm_sub_epi16 as sub16, _mm_sub_pd as sub_pd,
     };
 
