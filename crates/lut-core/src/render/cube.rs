@@ -26,10 +26,9 @@
 //! On a verified run's face the ray's axes `(a, b, m)` are linear in `dx` and the face
 //! coordinates `u = h + a·(h/m)`, `v = h − b·(h/m)` are a projective line, evaluated
 //! exactly at every pixel with the arithmetic of [`face_uv`] in `f64` SIMD lanes
-//! (`render/kernel/face.rs`, `x86/face.rs`). Nearest and bilinear runs compute the
-//! positions in a pass of their own and draw them with the LUT's row kernels
-//! (`render/kernel/face_rows.rs`); trilinear runs, on the two pyramid levels of each
-//! [`TRILINEAR_RUN_CHUNK`], compute and draw them in one fused kernel (`face.rs`). Every
+//! (`render/kernel/face.rs`, `x86/face.rs`), in a pass of their own, and drawn with the
+//! LUT's row kernels; trilinear runs do so on the two pyramid levels of each
+//! [`TRILINEAR_RUN_CHUNK`] (the second blended in). Every
 //! kernel (AVX-512, AVX2, SSE4.1 or the scalar twin, chosen once per process,
 //! `LUTPANO_KERNEL=scalar` forcing the portable one) reads the face's bordered texels
 //! with the per-pixel path's rounding, so nearest and bilinear images are byte-identical
@@ -39,7 +38,7 @@
 
 use super::exact::render_exact;
 use super::frame::Frame;
-use super::kernel::{face_blend, face_rows, face_span, FaceBuf, FaceRun, Texels};
+use super::kernel::{face_rows, face_rows_blend, FaceBuf, FaceRun, Texels};
 use super::rows::rows_per_task;
 use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
@@ -52,6 +51,8 @@ use crate::map::sample::Sampler;
 use crate::named::{parse_name, unknown_name, Named};
 use glam::DVec3;
 use rayon::prelude::*;
+use std::mem::take;
+use std::ops::Range;
 
 /// Which of the paper's renderers to use. With nearest and bilinear sampling both give
 /// byte-identical images (see `render/cube.rs`); with trilinear the scanline renderer
@@ -240,8 +241,9 @@ impl Fetch for BilinearFetch {
 
 /// Trilinear on the face pyramid (`cube/pyramid.rs`): per pixel, the level of detail of
 /// the pixel's own footprint; on a run, one per [`TRILINEAR_RUN_CHUNK`] pixels (at the
-/// chunk's middle pixel), the chunk drawn by the span kernels on the two levels and
-/// blended.
+/// chunk's middle pixel). The run's chunks that share their finer level are drawn on it
+/// in one go, then those that share their coarser level (and blend it in) are blended
+/// in one go (`face_rows`, `face_rows_blend`: the positions pass and the row kernels).
 impl Fetch for TrilinearFetch {
     #[inline(always)]
     fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32 {
@@ -256,36 +258,63 @@ impl Fetch for TrilinearFetch {
         face: Face,
         run: &FaceRun,
         out: &mut [u32],
-        _: &mut FaceBuf,
+        buf: &mut FaceBuf,
     ) {
+        const C: usize = TRILINEAR_RUN_CHUNK;
+        let n = out.len();
         // The image's x and y steps on the face's axes (y: −R₁ per row; the sign does not
         // change the footprint).
         let (sx, sy) = (face_axes(face, frame.b), face_axes(face, frame.r1));
-        for (c, chunk) in out.chunks_mut(TRILINEAR_RUN_CHUNK).enumerate() {
-            let dx = run.dx + (c * TRILINEAR_RUN_CHUNK) as f64;
-            let mid = dx + (chunk.len() / 2) as f64;
+        let (mut levels, mut fracs) = (take(&mut buf.levels), take(&mut buf.fracs));
+        levels.clear();
+        fracs.clear();
+        for c in 0..n.div_ceil(C) {
+            let mid = run.dx + (c * C + C.min(n - c * C) / 2) as f64;
             let at = |i: usize| run.p[i] + mid * run.d[i];
             let lod = lod_q8(footprint((at(0), at(1), at(2)), sx, sy, frame.half_face));
-            let sub = FaceRun { dx, ..*run };
-            let on_level = |k: usize, out: &mut [u32]| {
+            let (k, frac) = ((lod.max(0) >> 8) as usize, (lod.max(0) & 0xFF) as u32);
+            let (ka, kb) = (cube.level(k).1, cube.level(k + 1).1);
+            levels.push((ka, kb));
+            fracs.push(if ka == kb { 0 } else { frac });
+        }
+        // Consecutive chunks [c0, c1) with `same` level: the run's pixels there on it.
+        let by = |same: &dyn Fn(usize) -> Option<usize>, draw: &mut dyn FnMut(_, _, _)| {
+            let mut c0 = 0;
+            while c0 < levels.len() {
+                let Some(k) = same(c0) else {
+                    c0 += 1;
+                    continue;
+                };
+                let mut c1 = c0 + 1;
+                while c1 < levels.len() && same(c1) == Some(k) {
+                    c1 += 1;
+                }
                 let (l, _) = cube.level(k);
                 let half = l.face_size() as f64 / 2.0;
-                face_span(&face_texels(l, face), &FaceRun { half, ..sub }, out)
-            };
-            if lod <= 0 {
-                on_level(0, chunk);
-                continue;
+                let sub = FaceRun {
+                    half,
+                    dx: run.dx + (c0 * C) as f64,
+                    ..*run
+                };
+                draw(l, sub, c0..c1);
+                c0 = c1;
             }
-            let (k, frac) = ((lod >> 8) as usize, (lod & 0xFF) as u32);
-            let (ka, kb) = (cube.level(k).1, cube.level(k + 1).1);
-            on_level(ka, chunk);
-            if frac == 0 || ka == kb {
-                continue;
-            }
-            let (l, _) = cube.level(kb);
-            let half = l.face_size() as f64 / 2.0;
-            face_blend(&face_texels(l, face), &FaceRun { half, ..sub }, chunk, frac);
-        }
+        };
+        by(
+            &|c| Some(levels[c].0),
+            &mut |l: &CubeMap, sub: FaceRun, cs: Range<usize>| {
+                let px = &mut out[cs.start * C..(cs.end * C).min(n)];
+                face_rows::<true>(&face_texels(l, face), &sub, px, buf);
+            },
+        );
+        let blended = |c: usize| (fracs[c] != 0).then_some(levels[c].1);
+        by(&blended, &mut |l: &CubeMap,
+                           sub: FaceRun,
+                           cs: Range<usize>| {
+            let px = &mut out[cs.start * C..(cs.end * C).min(n)];
+            face_rows_blend(&face_texels(l, face), &sub, px, (C, &fracs[cs]), buf);
+        });
+        (buf.levels, buf.fracs) = (levels, fracs);
     }
 }
 

@@ -1,39 +1,50 @@
-//! Cube-face runs evaluated exactly: the span kernels' gather and blend fed by a
-//! projective line, one division per pixel, in one fused kernel. The cube scanline
-//! renderer's trilinear runs (both pyramid levels of each chunk, bilinear on each); its
-//! nearest and bilinear runs compute the same positions in a pass of their own and draw
-//! them with the row kernels (`face_rows.rs`: faster, see there).
+//! Cube-face runs on the row kernels: the face's projective line evaluated exactly at
+//! every pixel in a positions pass (`f64` SIMD lanes, [`positions_scalar`] the twin),
+//! then the row kernels' gather (and for bilinear, blend) over the positions
+//! (`kernel/row.rs`, AVX-512 / AVX2 / SSE4.1 / the scalar twin), as the LUT's rows are
+//! drawn. The cube scanline renderer's runs (`render/cube.rs`): nearest, bilinear, and
+//! trilinear's two levels ([`face_rows_blend`] blends the second in by a weight per
+//! chunk of pixels).
 //!
-//! Along a scanline the cube renderer's ray is `P + dx · B` (`render/cube.rs`), so on a
-//! face with axes `(a, b, m)` the face coordinates are `u = h + h·a/m`, `v = h − h·b/m`
-//! with `a`, `b`, `m` linear in `dx`: a projective line, not a linear one. Stepping it
-//! linearly between exact points needs a bound on the curvature and changes bytes
-//! (tried for bilinear, `docs/performance.md`); these kernels instead evaluate the
-//! projective line *exactly* at every pixel, in `f64` SIMD lanes (8 per AVX-512 vector,
-//! 4 per AVX2 vector, 2 per SSE vector: three multiply-adds, one division, two
-//! multiply-adds per pixel), with the very operations, in the very order, of
-//! [`crate::cube::face_uv`] and [`crate::cube::CubeMap::bilinear`] (IEEE `f64` arithmetic is deterministic and
-//! correctly rounded, and rounding is symmetric in sign, so a negated axis is computed
-//! as the negation of the same sum). The rounded positions then go to the same 2×2 gather
-//! and 8-bit blend as the map's span kernels. So the images stay byte-identical to the
-//! per-pixel renderer: the sampling-position error of the cube renderer stays zero.
+//! # Why a separate positions pass
+//! A fused kernel (position, gather and blend per vector; this module's until
+//! 2026-12-02) is the slowest way to draw a run here: its division sits between the
+//! position and the gather in every iteration (1080p cube frame from the 8k map's 2048²
+//! faces, one thread: bilinear 9.5 ms, nearest 7.3 ms, trilinear 14.1 ms). Stepping the
+//! line linearly between exact points every ~9 pixels (bilinear, `face_step.rs` until
+//! 2026-12-02) took 5.8 ms but ~21 instructions per pixel of planning and expanding, and
+//! moved positions by up to 0.02 texels. A pass of positions alone is a stream of
+//! independent divisions (8 `f64` lanes per AVX-512 division, ~0.14 ns a lane on this
+//! machine), then the row kernels read the positions as they read the LUT's: bilinear
+//! 4.6 ms, nearest 4.0 ms, trilinear 6.7 ms, every position exact.
 //!
-//! A run reads one face's bordered texels ([`Texels`] of side `n + 1`, the stored
-//! `(n + 2)²` texels: the face and its one-texel border from the neighbours), so a
-//! bilinear read across a face edge reads the neighbour exactly as the per-pixel path
-//! does. Positions are clamped to the face as the per-pixel samplers clamp them
-//! (NaN → 0), so any input is safe; only the renderer's proven runs (every pixel strictly
-//! on the face) call it.
+//! # Positions
+//! On a run ([`FaceRun`]) the face coordinates are `u = h + h·a/m`, `v = h − h·b/m` with
+//! `a`, `b`, `m` linear in the pixel. Pixel `i`'s are computed with the operations of
+//! [`crate::cube::face_uv`] in their order (IEEE `f64` is deterministic: the SIMD lanes
+//! equal the scalar twin) and rounded as the per-pixel samplers round them: bilinear to
+//! Q.16, clamped to the face as `CubeMap::bilinear` does; nearest to the texel
+//! `CubeMap::nearest` reads. Both are moved into the bordered face (+1 texel) and given
+//! in Q.8, the row kernels' positions. The row kernels then read exactly the texels (and
+//! 8-bit weights) the per-pixel samplers read: the scanline renderer's nearest and
+//! bilinear images are byte-identical to the per-pixel renderer's.
+//!
+//! # Texels
+//! The positions are bordered-face coordinates (the face's `(n + 2)²` texels as a
+//! [`Texels`] of side `n + 1`: face texel `j` is column `j + 1`), so the row kernels read
+//! the border (the neighbouring faces) at the face's edges as `CubeMap::bilinear` does.
+//! One difference remains: the row kernels clamp a bilinear read at the last row
+//! (`row::sample_at`, the map's pole), which is the face's last texel row, not the
+//! border below it; runs reaching the lower half of that row (the positions pass
+//! returns the largest `v`) are redrawn there by [`bottom`] (reading the border row).
 
+use super::row::{sample_lv_with, sample_q8_with, Level};
 #[cfg(test)]
 use super::select::Kernel;
 use super::select::{active, Selected};
 use super::Texels;
-use crate::geom::fixed::{FX_BITS, FX_HALF, FX_ONE};
+use crate::geom::fixed::{FX_BITS, FX_ONE};
 use crate::map::sample::lerp_px;
-
-#[cfg(target_arch = "x86_64")]
-use super::x86;
 
 /// A run of pixels on one cube face: pixel `i` has the ray coordinates on the face's
 /// axes `(a, b, m) = p + (dx + i) · d` (componentwise), and face coordinates
@@ -56,95 +67,250 @@ pub(super) fn face_side(t: &Texels) -> usize {
     t.width as usize - 1
 }
 
-/// The portable kernel, one pixel at a time: the reference the SIMD kernels equal, and
-/// the per-pixel renderer's arithmetic (see the module docs): bilinear (`BLEND`: blended
-/// into `out` by `frac`, `lerp_px(out, sample, frac)`).
-pub(super) fn scalar<const BLEND: bool>(t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
-    let n = face_side(t);
-    let stride = t.stride();
-    let nf = n as f64;
-    for (i, o) in out.iter_mut().enumerate() {
-        let dx = r.dx + i as f64;
-        let a = r.p[0] + dx * r.d[0];
-        let b = r.p[1] + dx * r.d[1];
-        let m = r.p[2] + dx * r.d[2];
-        let q = r.half / m;
-        let (u, v) = (r.half + a * q, r.half - b * q);
-        // `CubeMap::bilinear`: Q.16 rounded half up, + ½ − ½ (border, centres).
-        let uu = (u.max(0.0).min(nf) * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
-        let vv = (v.max(0.0).min(nf) * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
-        let x0 = (uu >> FX_BITS) as usize;
-        let y0 = (vv >> FX_BITS) as usize;
-        let fx = ((uu >> (FX_BITS - 8)) & 0xFF) as u32;
-        let fy = ((vv >> (FX_BITS - 8)) & 0xFF) as u32;
-        let k = y0 * stride + x0;
-        let q = &t.px[k..k + stride + 2];
-        let sample = lerp_px(
-            lerp_px(q[0], q[1], fx),
-            lerp_px(q[stride], q[stride + 1], fx),
-            fy,
-        );
-        *o = if BLEND {
-            lerp_px(*o, sample, frac)
-        } else {
-            sample
-        };
-    }
+/// Room past a run the kernels may write in the position buffers (whole vectors).
+const SLACK: usize = 16;
+
+/// A band's scratch for face runs: the position buffers, and for trilinear's blended
+/// level the weights and the pixels under redrawn ones.
+#[derive(Debug, Default)]
+pub(crate) struct FaceBuf {
+    u: Vec<i32>,
+    v: Vec<i32>,
+    w: Vec<u32>,
+    under: Vec<u32>,
+    /// The caller's per-chunk scratch (trilinear: each chunk's two levels, and the
+    /// weights of the second), kept here so a band allocates it once.
+    pub(crate) levels: Vec<(usize, usize)>,
+    pub(crate) fracs: Vec<u32>,
 }
 
-/// [`Kernel::face_span`] / [`Kernel::face_blend`] with kernel `k`.
+/// The exact face position of pixel `i` of the run (the arithmetic of `face_uv`) and its
+/// `m`.
+#[inline(always)]
+fn exact(r: &FaceRun, i: usize) -> (f64, f64, f64) {
+    // (Runs are shorter than 2³² pixels: u32 converts to f64 in one instruction.)
+    let dx = r.dx + f64::from(i as u32);
+    let a = r.p[0] + dx * r.d[0];
+    let b = r.p[1] + dx * r.d[1];
+    let m = r.p[2] + dx * r.d[2];
+    let q = r.half / m;
+    (r.half + a * q, r.half - b * q, m)
+}
+
+/// The bordered Q.8 positions of the run's pixels 0..m, exact (see the module docs), one
+/// pixel at a time: the SIMD kernels' scalar twin. Returns the largest `v` (`i32::MIN`
+/// for no pixel).
+fn positions_scalar<const BILINEAR: bool>(
+    n: usize,
+    r: &FaceRun,
+    u: &mut [i32],
+    v: &mut [i32],
+    m: usize,
+) -> i32 {
+    let (nf, topf, one) = (n as f64, ((n as i64) << FX_BITS) as f64, FX_ONE as f64);
+    let q8 = |x: f64| {
+        if BILINEAR {
+            // `CubeMap::bilinear`'s Q.16 (rounded half up, clamped into the face; NaN → 0:
+            // the float clamped first gives the same integer), + 1 texel (the border).
+            ((((x * one + 0.5).max(0.0).min(topf) as i64) + FX_ONE) >> 8) as i32
+        } else {
+            // `CubeMap::nearest`'s texel (NaN → 0), + 1 (the border), in Q.8.
+            (((x.max(0.0).min(nf) as i32).min(n as i32 - 1)) + 1) << 8
+        }
+    };
+    let mut top = i32::MIN;
+    for (i, (pu, pv)) in u[..m].iter_mut().zip(&mut v[..m]).enumerate() {
+        let (x, y, _) = exact(r, i);
+        *pu = q8(x);
+        *pv = q8(y);
+        top = top.max(*pv);
+    }
+    top
+}
+
+/// [`positions_scalar`] with kernel `k` (the buffers hold `m` rounded up to 16).
 #[inline]
-fn run<const BLEND: bool>(k: Selected, t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
-    debug_assert!(t.width == t.height && t.width >= 2, "bordered face texels");
+fn positions_with<const BILINEAR: bool>(
+    k: Selected,
+    n: usize,
+    r: &FaceRun,
+    u: &mut [i32],
+    v: &mut [i32],
+    m: usize,
+) -> i32 {
     #[cfg(target_arch = "x86_64")]
-    if x86::face::face_span::<BLEND>(k, t, r, out, frac) {
-        return;
+    if let Some(top) = super::x86::face::positions::<BILINEAR>(k, n, r, u, v, m) {
+        return top;
     }
     let _ = k;
-    scalar::<BLEND>(t, r, out, frac)
+    positions_scalar::<BILINEAR>(n, r, u, v, m)
 }
 
-/// [`Kernel::face_span`] with the [`active_kernel`](super::active_kernel).
+/// The bilinear sample at bordered Q.8 position (`u`, `v`) reading the rows `y` and
+/// `y + 1` for any `y` ≤ n (the row kernels stop at row n − 1: see the module docs).
 #[inline]
-pub(crate) fn face_span(t: &Texels, r: &FaceRun, out: &mut [u32]) {
-    run::<false>(active(), t, r, out, 0)
+fn bottom(t: &Texels, u: i32, v: i32) -> u32 {
+    let n = face_side(t) as i32;
+    let (u, v) = (u - 128, v - 128);
+    let (x, y) = ((u >> 8).clamp(0, n) as usize, (v >> 8).clamp(0, n) as usize);
+    let (fx, fy) = ((u & 0xFF) as u32, (v & 0xFF) as u32);
+    let stride = t.stride();
+    let i = y * stride + x;
+    let q = &t.px[i..i + stride + 2];
+    lerp_px(
+        lerp_px(q[0], q[1], fx),
+        lerp_px(q[stride], q[stride + 1], fx),
+        fy,
+    )
 }
 
-/// [`Kernel::face_blend`] with the [`active_kernel`](super::active_kernel).
+/// A face run with kernel `k`, bilinear (`BILINEAR`) or nearest.
 #[inline]
-pub(crate) fn face_blend(t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
-    run::<true>(active(), t, r, out, frac)
+fn run<const BILINEAR: bool>(
+    k: Selected,
+    t: &Texels,
+    r: &FaceRun,
+    out: &mut [u32],
+    buf: &mut FaceBuf,
+) {
+    debug_assert!(t.width == t.height && t.width >= 2, "bordered face texels");
+    let (len, n) = (out.len(), face_side(t));
+    let low = positions::<BILINEAR>(k, t, r, len, buf);
+    let (u, v) = (&buf.u[..len], &buf.v[..len]);
+    sample_q8_with::<BILINEAR, false>(k, t, u, v, out);
+    if BILINEAR && low {
+        let last = n as i32;
+        for ((o, &u), &v) in out.iter_mut().zip(u).zip(v) {
+            if (v - 128) >> 8 >= last {
+                *o = bottom(t, u, v);
+            }
+        }
+    }
+}
+
+/// The run's `len` positions into `buf` (grown as needed) with kernel `k`; whether a
+/// bilinear read reaches the lower half of the face's last texel row (see [`bottom`]).
+#[inline]
+fn positions<const BILINEAR: bool>(
+    k: Selected,
+    t: &Texels,
+    r: &FaceRun,
+    len: usize,
+    buf: &mut FaceBuf,
+) -> bool {
+    let n = face_side(t);
+    for b in [&mut buf.u, &mut buf.v] {
+        if b.len() < len + SLACK {
+            b.resize(len + SLACK, 0);
+        }
+    }
+    let top = positions_with::<BILINEAR>(k, n, r, &mut buf.u, &mut buf.v, len);
+    len > 0 && (top - 128) >> 8 >= n as i32
+}
+
+/// Bilinear samples along a run blended into `out` with kernel `k`: pixel `j` gets
+/// `lerp_px(out[j], sample, fracs[j / chunk])` (trilinear's second level, one weight per
+/// chunk of pixels).
+#[inline]
+fn run_blend(
+    k: Selected,
+    t: &Texels,
+    r: &FaceRun,
+    out: &mut [u32],
+    (chunk, fracs): (usize, &[u32]),
+    buf: &mut FaceBuf,
+) {
+    debug_assert!(t.width == t.height && t.width >= 2, "bordered face texels");
+    let (len, n) = (out.len(), face_side(t));
+    assert!(
+        chunk > 0 && fracs.len() * chunk >= len,
+        "a weight per chunk"
+    );
+    let low = positions::<true>(k, t, r, len, buf);
+    buf.w.clear();
+    buf.w.extend((0..len).map(|j| fracs[j / chunk]));
+    if low {
+        buf.under.clear();
+        buf.under.extend_from_slice(out);
+    }
+    let (u, v, w) = (&buf.u[..len], &buf.v[..len], &buf.w[..]);
+    let lv = Level { k: 0, wq: 0, w };
+    sample_lv_with::<true, false, false, true>(k, t, u, v, out, &lv);
+    if low {
+        let last = n as i32;
+        for (j, o) in out.iter_mut().enumerate() {
+            if (v[j] - 128) >> 8 >= last {
+                *o = lerp_px(buf.under[j], bottom(t, u[j], v[j]), w[j]);
+            }
+        }
+    }
+}
+
+/// Bilinear (`BILINEAR`) or nearest samples of one cube face along a run (see the
+/// module docs), with the [`active_kernel`](super::active_kernel). `t` is the face's
+/// bordered texels. Every pixel of `out` is written; positions are clamped into the face,
+/// so any run is safe.
+#[inline]
+pub(crate) fn face_rows<const BILINEAR: bool>(
+    t: &Texels,
+    r: &FaceRun,
+    out: &mut [u32],
+    buf: &mut FaceBuf,
+) {
+    run::<BILINEAR>(active(), t, r, out, buf)
+}
+
+/// Trilinear's second level: bilinear samples of one cube face along a run blended into
+/// `out` (pixel `j` by `fracs[j / chunk]`, 0..=255), with the
+/// [`active_kernel`](super::active_kernel); otherwise as [`face_rows`].
+#[inline]
+pub(crate) fn face_rows_blend(
+    t: &Texels,
+    r: &FaceRun,
+    out: &mut [u32],
+    chunks: (usize, &[u32]),
+    buf: &mut FaceBuf,
+) {
+    run_blend(active(), t, r, out, chunks, buf)
 }
 
 #[cfg(test)]
 impl Kernel {
-    /// Bilinear samples of one cube face along a [`FaceRun`]:
-    /// `t` is the face's bordered texels (`(n + 2)²`, as [`Texels`] of side `n + 1`).
-    /// Writes every pixel of `out` (positions are clamped into the face).
-    ///
-    /// # Panics
-    /// When the CPU does not run this kernel, or `t` is not a face's bordered texels
-    /// (a square of side 2 or more).
-    pub(crate) fn face_span(self, t: &Texels, r: &FaceRun, out: &mut [u32]) {
+    /// [`face_rows_blend`] with this kernel.
+    pub(crate) fn face_rows_blend(
+        self,
+        t: &Texels,
+        r: &FaceRun,
+        out: &mut [u32],
+        chunks: (usize, &[u32]),
+        buf: &mut FaceBuf,
+    ) {
         assert!(t.width == t.height && t.width >= 2, "bordered face texels");
-        run::<false>(self.selected(), t, r, out, 0)
+        run_blend(self.selected(), t, r, out, chunks, buf)
     }
 
-    /// `out[i]` = `lerp_px(out[i], bilinear sample i, frac)` along a [`FaceRun`] (the
-    /// second level of a trilinear chunk; see [`Kernel::face_span`]).
+    /// [`face_rows`] with this kernel.
     ///
     /// # Panics
-    /// As [`Kernel::face_span`].
-    pub(crate) fn face_blend(self, t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
+    /// When the CPU does not run this kernel, or `t` is not a face's bordered texels.
+    pub(crate) fn face_rows<const BILINEAR: bool>(
+        self,
+        t: &Texels,
+        r: &FaceRun,
+        out: &mut [u32],
+        buf: &mut FaceBuf,
+    ) {
         assert!(t.width == t.height && t.width >= 2, "bordered face texels");
-        run::<true>(self.selected(), t, r, out, frac)
+        run::<BILINEAR>(self.selected(), t, r, out, buf)
     }
 }
 
 #[cfg(test)]
-pub(super) mod tests {
+mod tests {
     use super::*;
     use crate::cube::{face_axes, face_of, CubeMap, Face};
+    use crate::geom::camera::View;
+    use crate::render::cube::scanline_runs;
     use glam::DVec3;
     use proptest::prelude::*;
 
@@ -182,79 +348,6 @@ pub(super) mod tests {
         Texels::new(c.bordered_face(f), s, s, false).unwrap()
     }
 
-    /// The per-pixel bilinear sampler of [`CubeMap`] at [`crate::cube::face_uv`] of the
-    /// ray.
-    fn per_pixel(c: &CubeMap, f: Face, r: &FaceRun, len: usize) -> Vec<u32> {
-        (0..len)
-            .map(|i| {
-                let dx = r.dx + i as f64;
-                let (a, b, m) = (
-                    r.p[0] + dx * r.d[0],
-                    r.p[1] + dx * r.d[1],
-                    r.p[2] + dx * r.d[2],
-                );
-                let q = r.half / m;
-                let (u, v) = (r.half + a * q, r.half - b * q);
-                c.bilinear(f, u, v)
-            })
-            .collect()
-    }
-
-    /// Every kernel against the scalar twin, and the twin against `CubeMap`'s samplers,
-    /// with sentinels around the output; the blend with weight `frac` (into random
-    /// pixels) against `lerp_px` of the per-pixel bilinear sample.
-    fn check(ci: usize, f: Face, r: &FaceRun, len: usize, off: usize, frac: u32) {
-        let c = &cubes()[ci];
-        let t = face_texels(c, f);
-        let want = per_pixel(c, f, r, len);
-        for k in Kernel::available() {
-            let mut buf = vec![0xDEAD_BEEFu32; off + len + 3];
-            k.face_span(&t, r, &mut buf[off..off + len]);
-            assert!(
-                buf[..off]
-                    .iter()
-                    .chain(&buf[off + len..])
-                    .all(|&x| x == 0xDEAD_BEEF),
-                "{} wrote outside its run",
-                k.name()
-            );
-            assert_eq!(
-                &buf[off..off + len],
-                &want[..],
-                "{} {f:?} {r:?} len {len}",
-                k.name()
-            );
-        }
-        let under: Vec<u32> = (0..len as u32)
-            .map(|i| i.wrapping_mul(0x9E37_79B9))
-            .collect();
-        for k in Kernel::available() {
-            let mut buf = vec![0xDEAD_BEEFu32; off + len + 3];
-            buf[off..off + len].copy_from_slice(&under);
-            k.face_blend(&t, r, &mut buf[off..off + len], frac);
-            assert!(
-                buf[..off]
-                    .iter()
-                    .chain(&buf[off + len..])
-                    .all(|&x| x == 0xDEAD_BEEF),
-                "{} blend wrote outside its run",
-                k.name()
-            );
-            for (i, (&got, (&u, &b))) in buf[off..off + len]
-                .iter()
-                .zip(under.iter().zip(&want))
-                .enumerate()
-            {
-                assert_eq!(
-                    got,
-                    lerp_px(u, b, frac),
-                    "{} blend {frac} pixel {i} {r:?}",
-                    k.name()
-                );
-            }
-        }
-    }
-
     /// A face run of a view's scanline as the renderer builds it: `P`, `B` of
     /// `render/cube.rs` on the axes of the face of the run's first pixel.
     pub(in crate::render::kernel) fn view_run(
@@ -287,13 +380,94 @@ pub(super) mod tests {
     }
 
     proptest! {
-        #![proptest_config(ProptestConfig::with_cases(500))]
+        #![proptest_config(ProptestConfig::with_cases(300))]
 
-        /// Runs of real views: any row (the poles' up and down faces included at pitch
-        /// ±90), lengths 1..=64 running past the face edge (clamped, the border read),
-        /// odd output offsets.
+        /// Every kernel's positions equal the scalar twin's (and its largest `v`), and
+        /// nothing is written past the whole vectors: view runs (past the face's edge
+        /// too: clamped; behind the eye: NaN or negative `m`), lengths 0..=200.
         #[test]
-        fn view_runs_equal_scalar_and_per_pixel(
+        fn positions_equal_scalar(
+            yaw in -180.0f64..180.0,
+            pitch in prop_oneof![-90.0f64..=90.0, Just(90.0), Just(-90.0), Just(45.0)],
+            hfov in 5.0f64..170.0,
+            (w, x) in (1u32..400).prop_flat_map(|w| (Just(w), 0..w)),
+            yf in 0.0f64..1.0,
+            n in prop_oneof![Just(1u32), 2u32..64, 64u32..=8192],
+            len in 0usize..=200,
+        ) {
+            let h = 300;
+            let y = ((yf * h as f64) as u32).min(h - 1);
+            let (_, r) = view_run((yaw, pitch, hfov), (w, h), (x, y), n);
+            let n = n as usize;
+            let whole = len.next_multiple_of(16);
+            for bilinear in [false, true] {
+                let (mut su, mut sv) = (vec![0; len], vec![0; len]);
+                let top = if bilinear {
+                    positions_scalar::<true>(n, &r, &mut su, &mut sv, len)
+                } else {
+                    positions_scalar::<false>(n, &r, &mut su, &mut sv, len)
+                };
+                prop_assert_eq!(top, sv.iter().copied().max().unwrap_or(i32::MIN));
+                for k in Kernel::available() {
+                    let (mut u, mut v) = (vec![7; whole + 5], vec![7; whole + 5]);
+                    let (ks, (pu, pv)) = (k.selected(), (&mut u, &mut v));
+                    let t = if bilinear {
+                        positions_with::<true>(ks, n, &r, pu, pv, len)
+                    } else {
+                        positions_with::<false>(ks, n, &r, pu, pv, len)
+                    };
+                    prop_assert_eq!(&u[..len], &su[..], "{} u {}", k.name(), bilinear);
+                    prop_assert_eq!(&v[..len], &sv[..], "{} v {}", k.name(), bilinear);
+                    prop_assert_eq!(t, top, "{} top", k.name());
+                    prop_assert!(u[whole..].iter().chain(&v[whole..]).all(|&x| x == 7));
+                }
+            }
+        }
+
+        /// Arbitrary lines: rays behind the face (m ≤ 0: infinite positions; 0/0: NaN),
+        /// far off the face, tiny and huge steps; all clamped as the per-pixel samplers.
+        #[test]
+        fn any_line_equals_per_pixel(
+            ci in 0usize..5,
+            p in prop::array::uniform3(prop_oneof![4 => -3.0f64..3.0, 1 => Just(0.0), 1 => Just(-0.0)]),
+            d in prop::array::uniform3(prop_oneof![-1.0f64..1.0, -1e-6f64..1e-6, Just(0.0)]),
+            dx in -100i32..100,
+            len in 1usize..=64,
+            off in 0usize..9,
+            fi in 0usize..6,
+        ) {
+            let n = cubes()[ci].face_size();
+            let r = FaceRun { p, d, dx: dx as f64 * 0.5, half: n as f64 / 2.0 };
+            check(ci, Face::from_index(fi), &r, len, off);
+        }
+
+        /// Trilinear's second level: every kernel blends the per-pixel bilinear sample
+        /// into what was there by its chunk's weight (`lerp_px`), view runs and lines
+        /// off the face, chunks of 1..=20 pixels, weights 0..=255.
+        #[test]
+        fn blend_equals_per_pixel(
+            ci in 0usize..5,
+            yaw in -180.0f64..180.0,
+            pitch in prop_oneof![-90.0f64..=90.0, Just(90.0), Just(-90.0)],
+            hfov in 5.0f64..170.0,
+            (w, x) in (1u32..400).prop_flat_map(|w| (Just(w), 0..w)),
+            yf in 0.0f64..1.0,
+            len in 1usize..=80,
+            chunk in 1usize..=20,
+            seed in any::<u32>(),
+        ) {
+            let h = 300;
+            let y = ((yf * h as f64) as u32).min(h - 1);
+            let n = cubes()[ci].face_size();
+            let (f, r) = view_run((yaw, pitch, hfov), (w, h), (x, y), n);
+            check_blend(ci, f, &r, len, chunk, seed);
+        }
+
+        /// Every kernel draws the per-pixel renderer's bytes (`CubeMap::bilinear` and
+        /// `CubeMap::nearest` at the exact position) and nothing outside the run: view runs of any length 1..=64
+        /// (past the face's edge too: clamped), odd offsets.
+        #[test]
+        fn face_rows_equal_per_pixel(
             ci in 0usize..5,
             yaw in -180.0f64..180.0,
             pitch in prop_oneof![-90.0f64..=90.0, Just(90.0), Just(-90.0), Just(45.0)],
@@ -302,46 +476,129 @@ pub(super) mod tests {
             yf in 0.0f64..1.0,
             len in 1usize..=64,
             off in 0usize..9,
-            frac in 0u32..256,
         ) {
             let h = 300;
             let y = ((yf * h as f64) as u32).min(h - 1);
             let n = cubes()[ci].face_size();
             let (f, r) = view_run((yaw, pitch, hfov), (w, h), (x, y), n);
-            check(ci, f, &r, len, off, frac);
+            check(ci, f, &r, len, off);
         }
+    }
 
-        /// Arbitrary lines: rays behind the face (m ≤ 0: infinite positions; 0/0: NaN),
-        /// far off the face, tiny and huge steps; all clamped as the per-pixel samplers.
-        #[test]
-        fn any_line_equals_scalar(
-            ci in 0usize..5,
-            p in prop::array::uniform3(prop_oneof![4 => -3.0f64..3.0, 1 => Just(0.0), 1 => Just(-0.0)]),
-            d in prop::array::uniform3(prop_oneof![-1.0f64..1.0, -1e-6f64..1e-6, Just(0.0)]),
-            dx in -100i32..100,
-            len in 1usize..=64,
-            off in 0usize..9,
-            fi in 0usize..6,
-            frac in 0u32..256,
-        ) {
-            let n = cubes()[ci].face_size();
-            let r = FaceRun { p, d, dx: dx as f64 * 0.5, half: n as f64 / 2.0 };
-            check(ci, Face::from_index(fi), &r, len, off, frac);
+    /// Every kernel against the per-pixel samples (`CubeMap::bilinear` and
+    /// `CubeMap::nearest`), with sentinels around `out`.
+    fn check(ci: usize, f: Face, r: &FaceRun, len: usize, off: usize) {
+        check_with(ci, f, r, len, off, true);
+        check_with(ci, f, r, len, off, false);
+    }
+
+    fn check_with(ci: usize, f: Face, r: &FaceRun, len: usize, off: usize, bilinear: bool) {
+        let c = &cubes()[ci];
+        let t = face_texels(c, f);
+        let mut buf = FaceBuf::default();
+        let want: Vec<u32> = (0..len)
+            .map(|i| {
+                let (u, v, _) = exact(r, i);
+                if bilinear {
+                    c.bilinear(f, u, v)
+                } else {
+                    c.nearest(f, u, v)
+                }
+            })
+            .collect();
+        for k in Kernel::available() {
+            let mut o = vec![0xDEAD_BEEFu32; off + len + 3];
+            let run = &mut o[off..off + len];
+            if bilinear {
+                k.face_rows::<true>(&t, r, run, &mut buf);
+            } else {
+                k.face_rows::<false>(&t, r, run, &mut buf);
+            }
+            let outside = o[..off].iter().chain(&o[off + len..]);
+            assert!(
+                outside.into_iter().all(|&x| x == 0xDEAD_BEEF),
+                "{}",
+                k.name()
+            );
+            let got = &o[off..off + len];
+            assert_eq!(got, &want[..], "{} {bilinear} {f:?} {r:?}", k.name());
+        }
+    }
+
+    /// Every kernel's [`face_rows_blend`] against `lerp_px` of what was there and the
+    /// per-pixel bilinear sample, with sentinels around `out`.
+    fn check_blend(ci: usize, f: Face, r: &FaceRun, len: usize, chunk: usize, seed: u32) {
+        let c = &cubes()[ci];
+        let t = face_texels(c, f);
+        let mut buf = FaceBuf::default();
+        let fracs: Vec<u32> = (0..len.div_ceil(chunk) as u32)
+            .map(|i| (seed.wrapping_add(i).wrapping_mul(0x9E37_79B9) >> 24) % 256)
+            .collect();
+        let under: Vec<u32> = (0..len as u32)
+            .map(|i| (i ^ seed).wrapping_mul(0x85EB_CA6B))
+            .collect();
+        let want: Vec<u32> = (0..len)
+            .map(|i| {
+                let (u, v, _) = exact(r, i);
+                lerp_px(under[i], c.bilinear(f, u, v), fracs[i / chunk])
+            })
+            .collect();
+        for k in Kernel::available() {
+            let mut o = vec![0xDEAD_BEEFu32; len + 4];
+            o[1..=len].copy_from_slice(&under);
+            k.face_rows_blend(&t, r, &mut o[1..=len], (chunk, &fracs), &mut buf);
+            assert!(o[0] == 0xDEAD_BEEF && o[len + 1..].iter().all(|&x| x == 0xDEAD_BEEF));
+            assert_eq!(
+                &o[1..=len],
+                &want[..],
+                "{} {f:?} {r:?} chunk {chunk}",
+                k.name()
+            );
         }
     }
 
     #[test]
-    fn long_runs_equal_scalar() {
-        // Whole rows of wide frames (many full vectors), and the one-pixel run.
-        for (yaw, pitch, hfov, w) in [
-            (0.0, 0.0, 60.0, 1920),
-            (30.0, 89.0, 90.0, 1001),
-            (-45.0, -90.0, 150.0, 777),
-            (10.0, 10.0, 1.0, 5),
+    fn whole_rows_and_face_edges_equal_per_pixel() {
+        // Whole rows of wide frames (long runs), runs ending on a face's bottom edge (the
+        // border row) and corners.
+        for (yaw, pitch, hfov, w, y) in [
+            (0.0, 0.0, 60.0, 1920, 540),
+            (30.0, 89.0, 90.0, 1001, 10),
+            (-45.0, -90.0, 150.0, 777, 700),
+            (45.0, 35.26, 120.0, 640, 100),
+            (0.0, -44.9, 90.0, 800, 200),
+            (10.0, 10.0, 1.0, 5, 540),
         ] {
-            let (f, r) = view_run((yaw, pitch, hfov), (w, 1080), (0, 540), 61);
-            check(4, f, &r, w as usize, 1, 77);
-            check(4, f, &r, 1, 0, 255);
+            let v = View::new(yaw, pitch, hfov).unwrap();
+            for (a, e, face, ok) in scanline_runs(v, w, 1080, 61, y) {
+                let (f, r) = view_run((yaw, pitch, hfov), (w, 1080), (a, y), 61);
+                if ok {
+                    assert_eq!(f, face);
+                }
+                check(4, f, &r, (e - a) as usize, 1);
+            }
         }
+    }
+
+    #[test]
+    fn bottom_row_reads_the_border() {
+        // A run along the face's last texel row's lower half: bilinear equals
+        // `CubeMap::bilinear` there (rows n and n + 1, the border), as on the per-pixel
+        // path, to the 8-bit weights.
+        let c = &cubes()[4];
+        let n = c.face_size();
+        let half = n as f64 / 2.0;
+        // a = x (u from 3.5 to 56.5 over 54 pixels), b = −(n − 0.25 − half)/half·m: v = n − 0.25.
+        let m = 10.0;
+        let vb = -(n as f64 - 0.25 - half) / half * m;
+        let r = FaceRun {
+            p: [-m * (1.0 - 3.5 / half), vb, m],
+            d: [m / half, 0.0, 0.0],
+            dx: 0.0,
+            half,
+        };
+        check(4, Face::Front, &r, 54, 0);
+        check_blend(4, Face::Front, &r, 54, 16, 7);
+        check_blend(4, Face::Front, &r, 54, 5, 0xFFFF_FFFF);
     }
 }

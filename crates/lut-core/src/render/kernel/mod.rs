@@ -41,10 +41,9 @@
 //! `x86/span.rs` the span kernels, `x86/row.rs`, `x86/face.rs`, `x86/nodes.rs`);
 //! `select.rs`: choosing the kernel;
 //! `tests/`: the property tests (`row_pass.rs`: the row kernels'); `face.rs`:
-//! cube-face runs, whose positions are a projective line evaluated exactly per pixel
-//! (the cube scanline renderer's nearest and trilinear runs); `face_rows.rs`: cube-face
-//! runs whose exact positions are computed in a pass of their own and drawn by the row
-//! kernels (the scanline renderer's bilinear runs);
+//! cube-face runs, whose positions (a projective line evaluated exactly per pixel) are
+//! computed in a pass of their own and drawn by the row kernels (the cube scanline
+//! renderer's nearest, bilinear and trilinear runs);
 //! `row.rs` (and `x86/row.rs`): the row pass's kernels (`render/rowpass.rs`), a run's
 //! Q.8 positions expanded from its spans and one gather-and-blend pass over them, with
 //! no per-span check (the LUT rows of full maps, trilinear's pyramid levels by
@@ -123,7 +122,6 @@
 //! aarch64 and x86 CPUs without SSE4.1 run the scalar kernel.
 
 mod face;
-mod face_rows;
 mod jobs;
 mod nodes;
 mod row;
@@ -139,8 +137,7 @@ pub use select::{
     KernelError, KernelInfo, KernelSource, KERNEL_ENV,
 };
 
-pub(crate) use face::{face_blend, face_span, FaceRun};
-pub(crate) use face_rows::{face_rows, FaceBuf};
+pub(crate) use face::{face_rows, face_rows_blend, FaceBuf, FaceRun};
 pub(crate) use nodes::{blend_nodes, simd_blend};
 pub(crate) use row::{expand, sample_level, sample_q8, wrap_q8, Level, Positions, SpanQ8};
 

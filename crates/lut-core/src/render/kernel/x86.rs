@@ -1,11 +1,10 @@
 //! x86-64 SIMD kernels. This module holds what they share: the texel blend of each
 //! instruction set (`split`, `lerp`, `merge`, the nearest `gather`, the clamped lane
 //! indices and the bilinear sample of a vector of positions: `bilinear4` with SSE4.1,
-//! `bilinear8` with AVX2, `bilinear16` and the pair layout with AVX-512), the checked
-//! span start (`Local`) and the prefetch of the row and face kernels. The kernels
-//! themselves are its children: `span.rs` (the span kernels and their batch entry
-//! points), `row.rs` (the row pass's), `face.rs` (cube-face runs), `nodes.rs` (the
-//! table-node blend).
+//! `bilinear8` with AVX2; the pair layout with AVX-512), the checked span start
+//! (`Local`) and the prefetch of the row kernels. The kernels themselves are its
+//! children: `span.rs` (the span kernels and their batch entry points), `row.rs` (the
+//! row pass's), `face.rs` (cube-face positions), `nodes.rs` (the table-node blend).
 //!
 //! All compute what `scalar.rs` computes, byte for byte (see the module docs of
 //! [`super`]): positions in span-local `i32` lanes, lane indices stored to the stack and
@@ -17,8 +16,8 @@
 //! The only `unsafe` here and in the children: calling a `#[target_feature]` function
 //! (the CPU was checked: [`Selected`] is only made for a supported kernel), the unaligned
 //! loads and stores, whose indices are clamped into the slices they read or bounded by
-//! the loop, and the prefetches of the row and face kernels ([`prefetch_texels`]), which
-//! read nothing.
+//! the loop, and the prefetches of the row kernels ([`prefetch_texels`]), which read
+//! nothing.
 
 #![allow(unsafe_code)]
 
@@ -80,8 +79,8 @@ impl Local {
     }
 }
 
-/// How many pixels ahead the face kernels prefetch the texels they will read, and the
-/// least the row kernels do (see [`PREFETCH_TEXELS`]).
+/// The least number of pixels ahead the row kernels prefetch the texels they will read
+/// (see [`PREFETCH_TEXELS`]).
 ///
 /// Why: a frame reads the map along curves that cross map rows, and each map row the
 /// curve enters starts with cache misses the hardware prefetchers (which follow address
@@ -100,7 +99,7 @@ pub(super) const PREFETCH_AHEAD: usize = 48;
 pub(super) const PREFETCH_TEXELS: usize = 256;
 
 /// Prefetch the cache line holding texel `at` and, for bilinear, the one `stride` texels
-/// below it (the row kernels' and the face kernels' look-ahead). `at` need not point
+/// below it (the row kernels' look-ahead). `at` need not point
 /// into the map: a line off the map is a wasted prefetch, nothing more.
 #[inline(always)]
 fn prefetch_texels<const BILINEAR: bool>(at: *const u32, stride: usize) {
@@ -173,7 +172,7 @@ mod avx2 {
     }
 
     /// A vector whose lanes 0..8 are `g(0..8)`: the nearest texels, read one by one
-    /// (the row and face kernels' nearest; hardware gathers measured slower).
+    /// (the row kernels' nearest; hardware gathers measured slower).
     #[inline]
     #[target_feature(enable = "avx2")]
     pub(super) fn gather(g: impl Fn(usize) -> i32) -> __m256i {
@@ -248,28 +247,14 @@ mod avx2 {
     }
 }
 
-/// The AVX-512 pieces the row and face kernels share (`x86/row.rs`, `x86/face.rs`): the
-/// AVX2 ones on 16 lanes, the same arithmetic. There are no AVX-512 span kernels
+/// The AVX-512 pieces of the row kernels (`x86/row.rs`): the AVX2 ones on 16 lanes, the
+/// same arithmetic. There are no AVX-512 span kernels
 /// (`x86/span.rs`): `Kernel::Avx512` runs the AVX2 ones.
 ///
 /// Every function is `#[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,
 /// avx512dq")]` (a list: `Kernel::Avx512` checks each).
 mod avx512 {
     use super::*;
-
-    /// Per 32-bit lane: the fraction byte (bits 8..16) in both 16-bit halves.
-    #[inline]
-    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
-    fn weights(r: __m512i) -> (__m512i, __m512i) {
-        let m = _mm512_set4_epi32(
-            0x800D_800D_u32 as i32,
-            0x8009_8009_u32 as i32,
-            0x8005_8005_u32 as i32,
-            0x8001_8001_u32 as i32,
-        );
-        let w = _mm512_shuffle_epi8(r, m);
-        (w, _mm512_sub_epi16(_mm512_set1_epi16(256), w))
-    }
 
     /// 0RGB pixels → (blue and red, green and top byte), one channel per 16-bit lane.
     #[inline]
@@ -358,61 +343,6 @@ mod avx512 {
                 pair(2),
             ),
         )
-    }
-
-    /// The left texels of the pixels whose pairs [`pairs`] laid out in `x`, `y`.
-    #[inline]
-    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
-    pub(super) fn left(x: __m512i, y: __m512i) -> __m512i {
-        _mm512_castps_si512(_mm512_shuffle_ps::<0x88>(
-            _mm512_castsi512_ps(x),
-            _mm512_castsi512_ps(y),
-        ))
-    }
-
-    /// The right texels (see [`left`]).
-    #[inline]
-    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
-    pub(super) fn right(x: __m512i, y: __m512i) -> __m512i {
-        _mm512_castps_si512(_mm512_shuffle_ps::<0xDD>(
-            _mm512_castsi512_ps(x),
-            _mm512_castsi512_ps(y),
-        ))
-    }
-
-    /// Bilinear samples at 16 lane positions (split channels; see `avx2::bilinear8`).
-    #[inline]
-    #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
-    pub(super) fn bilinear16(
-        px: &[u32],
-        stride: usize,
-        l: &Local,
-        ru: __m512i,
-        rv: __m512i,
-    ) -> (__m512i, __m512i) {
-        let x = _mm512_srai_epi32::<16>(ru);
-        let y = _mm512_srai_epi32::<16>(rv);
-        let i = _mm512_add_epi32(_mm512_mullo_epi32(y, _mm512_set1_epi32(stride as i32)), x);
-        let i = _mm512_max_epi32(
-            _mm512_min_epi32(i, _mm512_set1_epi32(l.hi)),
-            _mm512_set1_epi32(l.lo),
-        );
-        let mut a = [0i32; 16];
-        // SAFETY: `a` is 64 writable bytes; the store is unaligned.
-        unsafe { _mm512_storeu_si512(a.as_mut_ptr().cast(), i) };
-        let p = px.as_ptr();
-        let pair = |j: usize, row: usize| -> i64 {
-            let k = (l.base as isize + a[j] as isize) as usize + row;
-            // SAFETY: a[j] is clamped to [−base, last − base], so k ≤ last + row where
-            // last + stride + 1 < px.len() (Local::new): the 8 bytes at k are in `px`.
-            unsafe { p.add(k).cast::<i64>().read_unaligned() }
-        };
-        let (ta, tb) = pairs(|j| pair(j, 0));
-        let (ba, bb) = pairs(|j| pair(j, stride));
-        let wx = weights(ru);
-        let top = lerp(split(left(ta, tb)), split(right(ta, tb)), wx);
-        let bot = lerp(split(left(ba, bb)), split(right(ba, bb)), wx);
-        lerp(top, bot, weights(rv))
     }
 }
 

@@ -1,11 +1,8 @@
-//! x86-64 cube-face runs (see `kernel/face.rs` and `kernel/face_rows.rs`): the face
-//! coordinates of 8 (AVX-512), 4 (AVX2) or 2 (SSE) pixels per `f64` vector, computed with
-//! the scalar twin's operations in its order and rounded as it rounds them, either
-//! written out as the row kernels' Q.8 positions (`positions`: nearest and bilinear runs)
-//! or gathered and blended at once (`face`: the trilinear runs' levels, with the map
-//! kernels' `bilinear16` / `bilinear8` / `bilinear4` on absolute positions: base 0).
-//! AVX-512 takes 16 pixels per step (two `f64` vectors); the division then runs 8 lanes
-//! wide.
+//! x86-64 cube-face positions (see `kernel/face_rows.rs`): the face coordinates of 8
+//! (AVX-512), 4 (AVX2) or 2 (SSE) pixels per `f64` vector, computed with the scalar
+//! twin's operations in its order and rounded as it rounds them, written out as the row
+//! kernels' Q.8 positions (nearest: the texel; bilinear: Q.16 then Q.8). AVX-512 takes 16
+//! pixels per step (two `f64` vectors); the division then runs 8 lanes wide.
 //!
 //! Written once (`face_kernels!`) as the row kernels are (`x86/row.rs`): each
 //! instruction set's module names its intrinsics with short aliases (`add_pd` is
@@ -14,32 +11,10 @@
 //! differs in more than the prefix: joining two halves' coordinates (`join`), the lane
 //! offsets (`iota_pd`).
 
-use super::super::face::{face_side, FaceRun};
-use super::{padded, prefetch_texels, Kernel, Local, Selected, Texels, PREFETCH_AHEAD};
-use crate::geom::fixed::{FX_HALF, FX_ONE};
+use super::super::face::FaceRun;
+use super::{Kernel, Selected};
+use crate::geom::fixed::FX_ONE;
 use std::arch::x86_64::*;
-
-/// The face run with a SIMD kernel (`BLEND`: bilinear blended into `out` by `frac`);
-/// `false` (nothing written) for the scalar one.
-#[inline(always)]
-pub(in super::super) fn face_span<const BLEND: bool>(
-    k: Selected,
-    t: &Texels,
-    r: &FaceRun,
-    out: &mut [u32],
-    frac: u32,
-) -> bool {
-    match k.0 {
-        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
-        Kernel::Avx512 => unsafe { avx512::face::<BLEND>(t, r, out, frac) },
-        // SAFETY: as above.
-        Kernel::Avx2 => unsafe { avx2::face::<BLEND>(t, r, out, frac) },
-        // SAFETY: as above.
-        Kernel::Sse41 => unsafe { sse41::face::<BLEND>(t, r, out, frac) },
-        Kernel::Scalar => return false,
-    }
-    true
-}
 
 /// The bordered Q.8 positions of a face run's first `m` pixels with a SIMD kernel (see
 /// `face_rows.rs`; whole vectors written: `u` and `v` hold `m` rounded up to 16),
@@ -70,48 +45,8 @@ pub(in super::super) fn positions<const BILINEAR: bool>(
     })
 }
 
-/// A [`Local`] for absolute positions in the face's texels (base 0): lane indices are
-/// clamped into `[0, len − stride − 2]`, so every 2×2 read stays in the slice.
-#[inline(always)]
-fn absolute(t: &Texels) -> Local {
-    Local {
-        base: 0,
-        fu: 0,
-        fv: 0,
-        du: 0,
-        dv: 0,
-        hi: (t.px.len() - t.stride() - 2) as i32,
-        lo: 0,
-    }
-}
-
-/// The face kernels of one instruction set (`$feature`), in terms of the names its
+/// The face positions of one instruction set (`$feature`), in terms of the names its
 /// module defines (see the module docs).
-/// Prefetch the cache lines pixel `i` of the run (of `m` pixels) will read, as the row
-/// kernels do ([`PREFETCH_AHEAD`] pixels ahead, see there why; the row kernels now look
-/// further ahead, `PREFETCH_TEXELS`, not measured here): its face position from
-/// the run's projective line (as the kernels compute it, without their rounding: a line
-/// off by one texel is prefetched at worst), its texel and for bilinear the one below.
-/// Pixels past the run or behind the face are skipped.
-#[inline(always)]
-fn prefetch(t: &Texels, r: &FaceRun, i: usize, m: usize) {
-    if i >= m {
-        return;
-    }
-    let dx = r.dx + i as f64;
-    let den = r.p[2] + dx * r.d[2];
-    if den.is_nan() || den <= 0.0 {
-        return;
-    }
-    let q = r.half / den;
-    let n = face_side(t) as f64;
-    let u = (r.half + (r.p[0] + dx * r.d[0]) * q).clamp(0.0, n);
-    let v = (r.half - (r.p[1] + dx * r.d[1]) * q).clamp(0.0, n);
-    let stride = t.stride();
-    let at = t.px.as_ptr().wrapping_add(v as usize * stride + u as usize);
-    prefetch_texels::<true>(at, stride);
-}
-
 macro_rules! face_kernels {
     ($feature:literal) => {
         /// Face coordinates of the N / 2 pixels at lane offsets `i` (f64, from the run's
@@ -139,34 +74,6 @@ macro_rules! face_kernels {
                 }
             };
             (fx(u), fx(v))
-        }
-
-        /// N bilinear pixels (merged 0RGB) at lane offsets `lo` (lanes 0..N / 2) and `hi`
-        /// (N / 2..N).
-        #[inline]
-        #[target_feature(enable = $feature)]
-        #[allow(clippy::too_many_arguments)]
-        fn px<const BLEND: bool>(
-            t: &Texels,
-            r: &FaceRun,
-            l: &Local,
-            prev: V,
-            w: (V, V),
-            lo: D,
-            hi: D,
-        ) -> V {
-            let n = face_side(t);
-            let (u0, v0) = uv::<true>(r, n as f64, lo);
-            let (u1, v1) = uv::<true>(r, n as f64, hi);
-            let (u, v) = (join(u0, u1), join(v0, v1));
-            // + ½ texel: the border's +1 and the centres' −½ (CubeMap::bilinear).
-            let h = set1(FX_HALF as i32);
-            let c = bilinear(t.px, t.stride(), l, add(u, h), add(v, h));
-            if BLEND {
-                merge(lerp(split(prev), c, w))
-            } else {
-                merge(c)
-            }
         }
 
         /// The bordered Q.8 positions of the run's pixels 0..m, N per step, whole vectors
@@ -219,68 +126,18 @@ macro_rules! face_kernels {
             unsafe { storeu(lanes.as_mut_ptr().cast(), top) };
             lanes.into_iter().max().unwrap_or(i32::MIN)
         }
-
-        /// The run, N pixels per step (`BLEND`: blended into `out` by `frac`); the tail's
-        /// lanes past the end repeat the last pixel.
-        #[target_feature(enable = $feature)]
-        pub(super) fn face<const BLEND: bool>(t: &Texels, r: &FaceRun, out: &mut [u32], frac: u32) {
-            let m = out.len();
-            let l = absolute(t);
-            let fw = set1((frac as i32) * 0x10001);
-            let w = (fw, sub16(set1_16(256), fw));
-            let (half, step) = (set1_pd((N / 2) as f64), set1_pd(N as f64));
-            let mut fi = iota_pd();
-            // Prefetched up to (not including) `ahead`, every 8 pixels.
-            let mut ahead = 0;
-            let mut i = 0;
-            while i + N <= m {
-                while ahead < (i + N + PREFETCH_AHEAD).min(m) {
-                    prefetch(t, r, ahead, m);
-                    ahead += 8;
-                }
-                let q = out[i..i + N].as_mut_ptr().cast::<V>();
-                let prev = if BLEND {
-                    // SAFETY: `q` points at N u32 of `out` (the slice above); unaligned load.
-                    unsafe { loadu(q) }
-                } else {
-                    zero()
-                };
-                let c = px::<BLEND>(t, r, &l, prev, w, fi, add_pd(fi, half));
-                // SAFETY: as above; unaligned store.
-                unsafe { storeu(q, c) };
-                fi = add_pd(fi, step);
-                i += N;
-            }
-            if i < m {
-                // Lane offsets past the end clamped to m − 1 (small whole numbers: exact).
-                let last = set1_pd((m - 1) as f64);
-                let (lo, hi) = (min_pd(fi, last), min_pd(add_pd(fi, half), last));
-                let tail = &mut out[i..];
-                let mut buf = padded::<N>(tail);
-                let q = buf.as_mut_ptr().cast::<V>();
-                // SAFETY: `buf` holds N u32; unaligned load.
-                let prev = unsafe { loadu(q) };
-                let c = px::<BLEND>(t, r, &l, prev, w, lo, hi);
-                // SAFETY: as above; unaligned store.
-                unsafe { storeu(q, c) };
-                let n = tail.len();
-                tail.copy_from_slice(&buf[..n]);
-            }
-        }
     };
 }
 
 mod avx2 {
-    use super::super::avx2::{bilinear8 as bilinear, lerp, merge, split};
     use super::*;
     use std::arch::x86_64::{
         __m256d as D, __m256i as V, _mm256_add_epi32 as add, _mm256_add_pd as add_pd,
-        _mm256_cvttpd_epi32 as cvtt_pd, _mm256_div_pd as div_pd, _mm256_loadu_si256 as loadu,
-        _mm256_max_epi32 as max, _mm256_max_pd as max_pd, _mm256_min_epi32 as min,
-        _mm256_min_pd as min_pd, _mm256_mul_pd as mul_pd, _mm256_set1_epi16 as set1_16,
-        _mm256_set1_epi32 as set1, _mm256_set1_pd as set1_pd, _mm256_setzero_pd as zero_pd,
-        _mm256_setzero_si256 as zero, _mm256_slli_epi32 as slli, _mm256_srai_epi32 as srai,
-        _mm256_storeu_si256 as storeu, _mm256_sub_epi16 as sub16, _mm256_sub_pd as sub_pd,
+        _mm256_cvttpd_epi32 as cvtt_pd, _mm256_div_pd as div_pd, _mm256_max_epi32 as max,
+        _mm256_max_pd as max_pd, _mm256_min_epi32 as min, _mm256_min_pd as min_pd,
+        _mm256_mul_pd as mul_pd, _mm256_set1_epi32 as set1, _mm256_set1_pd as set1_pd,
+        _mm256_setzero_pd as zero_pd, _mm256_slli_epi32 as slli, _mm256_srai_epi32 as srai,
+        _mm256_storeu_si256 as storeu, _mm256_sub_pd as sub_pd,
     };
 
     /// Pixels per step.
@@ -306,16 +163,14 @@ mod avx2 {
 }
 
 mod avx512 {
-    use super::super::avx512::{bilinear16 as bilinear, lerp, merge, split};
     use super::*;
     use std::arch::x86_64::{
         __m512d as D, __m512i as V, _mm512_add_epi32 as add, _mm512_add_pd as add_pd,
-        _mm512_cvttpd_epi32 as cvtt_pd, _mm512_div_pd as div_pd, _mm512_loadu_si512 as loadu,
-        _mm512_max_epi32 as max, _mm512_max_pd as max_pd, _mm512_min_epi32 as min,
-        _mm512_min_pd as min_pd, _mm512_mul_pd as mul_pd, _mm512_set1_epi16 as set1_16,
-        _mm512_set1_epi32 as set1, _mm512_set1_pd as set1_pd, _mm512_setzero_pd as zero_pd,
-        _mm512_setzero_si512 as zero, _mm512_slli_epi32 as slli, _mm512_srai_epi32 as srai,
-        _mm512_storeu_si512 as storeu, _mm512_sub_epi16 as sub16, _mm512_sub_pd as sub_pd,
+        _mm512_cvttpd_epi32 as cvtt_pd, _mm512_div_pd as div_pd, _mm512_max_epi32 as max,
+        _mm512_max_pd as max_pd, _mm512_min_epi32 as min, _mm512_min_pd as min_pd,
+        _mm512_mul_pd as mul_pd, _mm512_set1_epi32 as set1, _mm512_set1_pd as set1_pd,
+        _mm512_setzero_pd as zero_pd, _mm512_slli_epi32 as slli, _mm512_srai_epi32 as srai,
+        _mm512_storeu_si512 as storeu, _mm512_sub_pd as sub_pd,
     };
 
     /// Pixels per step.
@@ -341,16 +196,14 @@ mod avx512 {
 }
 
 mod sse41 {
-    use super::super::sse41::{bilinear4 as bilinear, lerp, merge, split};
     use super::*;
     use std::arch::x86_64::{
         __m128d as D, __m128i as V, _mm_add_epi32 as add, _mm_add_pd as add_pd,
-        _mm_cvttpd_epi32 as cvtt_pd, _mm_div_pd as div_pd, _mm_loadu_si128 as loadu,
-        _mm_max_epi32 as max, _mm_max_pd as max_pd, _mm_min_epi32 as min, _mm_min_pd as min_pd,
-        _mm_mul_pd as mul_pd, _mm_set1_epi16 as set1_16, _mm_set1_epi32 as set1,
-        _mm_set1_pd as set1_pd, _mm_setzero_pd as zero_pd, _mm_setzero_si128 as zero,
+        _mm_cvttpd_epi32 as cvtt_pd, _mm_div_pd as div_pd, _mm_max_epi32 as max,
+        _mm_max_pd as max_pd, _mm_min_epi32 as min, _mm_min_pd as min_pd, _mm_mul_pd as mul_pd,
+        _mm_set1_epi32 as set1, _mm_set1_pd as set1_pd, _mm_setzero_pd as zero_pd,
         _mm_slli_epi32 as slli, _mm_srai_epi32 as srai, _mm_storeu_si128 as storeu,
-        _mm_sub_epi16 as sub16, _mm_sub_pd as sub_pd,
+        _mm_sub_pd as sub_pd,
     };
 
     /// Pixels per step.
