@@ -39,7 +39,7 @@
 use super::exact::render_exact;
 use super::frame::Frame;
 use super::kernel::{face_rows, face_rows_blend, FaceBuf, FaceRun, Texels};
-use super::rows::rows_per_task;
+use super::rows::{rows_per_task, Loan};
 use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
     check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
@@ -342,6 +342,15 @@ pub(crate) fn render_cube(
     }
 }
 
+/// A cube band task's scratch: a scanline's face segments and its runs' position buffers.
+type BandScratch = (Vec<Seg>, FaceBuf);
+
+thread_local! {
+    /// The scratch a thread's last cube band task gave back (`Loan`).
+    static BAND_SCRATCH: std::cell::Cell<Option<Box<BandScratch>>> =
+        const { std::cell::Cell::new(None) };
+}
+
 fn render_with<S: Fetch>(
     cube: &CubeMap,
     frame: &Rays,
@@ -353,10 +362,12 @@ fn render_with<S: Fetch>(
     let w = frame.w as usize;
     // Bands of whole rows, ~16k pixels each so small frames stay on one thread.
     let rows_per_band = rows_per_task(w).clamp(1, frame.h as usize);
-    // The scratch (segments, bilinear runs' position buffers) is kept from band to band on a
-    // thread: made afresh per band, its buffers were zeroed ~135 times a 1080p frame.
-    let scratch = || (Vec::with_capacity(16), FaceBuf::default());
-    let band = |(segs, buf): &mut (Vec<Seg>, FaceBuf), (bi, chunk): (usize, &mut [u32])| {
+    // The scratch (segments, runs' position buffers) is kept by each thread from band to
+    // band and frame to frame (`Loan`): made afresh per band, its buffers were allocated
+    // and zeroed ~135 times a 1080p frame.
+    let scratch = || Loan::take(&BAND_SCRATCH, BandScratch::default);
+    let band = |sc: &mut Loan<BandScratch>, (bi, chunk): (usize, &mut [u32])| {
+        let (segs, buf) = &mut **sc;
         for (r, line) in chunk.chunks_exact_mut(w).enumerate() {
             let y = bi * rows_per_band + r;
             match renderer {

@@ -7,6 +7,7 @@
 
 use super::kernel::simd_blend;
 use super::rowpass::HalfBuf;
+use super::rows::Loan;
 use super::setup::{Scan, Setup};
 use super::sink::Sink;
 use super::steps::STEP_REGIONS;
@@ -34,15 +35,11 @@ impl RowScratch {
         }
     }
 
-    /// A row task's scratch: the one its thread kept from its last task (any frame), or
-    /// a new one the first time; back to the thread when the loan drops. Made afresh per
-    /// task, its ~70 KB were zeroed for every rayon job: about 175 times (12 MB) a
+    /// A row task's scratch, kept by its thread between tasks ([`Loan`]): made afresh
+    /// per task, its ~70 KB were zeroed for every rayon job, about 175 times (12 MB) a
     /// 1080p frame on two threads (docs/performance.md, "Prefetch distance").
-    /// (What a scratch holds at the start of a row is never read: every row writes
-    /// what it reads, as with one scratch kept from row to row.)
     pub(crate) fn loan() -> ScratchLoan {
-        let kept = KEPT.take();
-        ScratchLoan(Some(kept.unwrap_or_else(|| Box::new(RowScratch::new()))))
+        Loan::take(&KEPT, RowScratch::new)
     }
 }
 
@@ -52,27 +49,7 @@ thread_local! {
 }
 
 /// A [`RowScratch`] on loan from the thread ([`RowScratch::loan`]).
-pub(crate) struct ScratchLoan(Option<Box<RowScratch>>);
-
-impl std::ops::Deref for ScratchLoan {
-    type Target = RowScratch;
-    fn deref(&self) -> &RowScratch {
-        self.0.as_deref().expect("on loan until dropped")
-    }
-}
-
-impl std::ops::DerefMut for ScratchLoan {
-    fn deref_mut(&mut self) -> &mut RowScratch {
-        self.0.as_deref_mut().expect("on loan until dropped")
-    }
-}
-
-impl Drop for ScratchLoan {
-    fn drop(&mut self) {
-        // (During thread teardown the slot may be gone: the scratch is then freed.)
-        let _ = KEPT.try_with(|k| k.set(self.0.take()));
-    }
-}
+pub(crate) type ScratchLoan = Loan<RowScratch>;
 
 /// Render one scanline into `sink` (`scratch`: room for its blended table nodes).
 ///
