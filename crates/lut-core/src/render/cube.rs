@@ -196,7 +196,7 @@ trait Fetch: Copy + Send + Sync {
     /// The sample of ray `d` on `face` (the face of `d`), per pixel.
     fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32;
     /// A verified run on `face` (`run`: its projective line), with the span kernels
-    /// (`buf`: the band's scratch for the bilinear runs' positions).
+    /// (`buf`: the band's scratch for the runs' positions).
     fn span(
         self,
         cube: &CubeMap,
