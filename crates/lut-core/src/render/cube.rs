@@ -500,9 +500,8 @@ fn accel_row<S: Fetch>(
             continue;
         }
         // A verified run: the ray's coordinates on the face's axes are linear in dx,
-        // the face coordinates a projective line, stepped like a span (bilinear:
-        // render/kernel/face_step.rs) or evaluated exactly per pixel (nearest,
-        // trilinear: render/kernel/face.rs).
+        // the face coordinates a projective line, evaluated exactly per pixel and drawn
+        // by the row kernels (render/kernel/face.rs).
         let (pa, pb, pm) = face_axes(seg.face, p);
         let (ba, bb, bm) = face_axes(seg.face, b);
         let run = FaceRun {
