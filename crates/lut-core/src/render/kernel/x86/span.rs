@@ -51,10 +51,14 @@ pub(in super::super) fn tri_jobs(
     }
 }
 
-/// The two batch entry points of one instruction set, written once: `tri_jobs` and `jobs`
-/// compiled under that set's `target_feature`, so the span setup, the closures and the
-/// module's own `bilinear`/`nearest` inline into one loop per set.
-macro_rules! batch_entries {
+/// The span kernels of one instruction set, written once (as the row and face kernels
+/// are: each set's module names its intrinsics with short aliases, `add` is
+/// `_mm256_add_epi32` in `avx2` and `_mm_add_epi32` in `sse41`, `V` the vector of `N`
+/// lanes, `LOG_N` its log2, and holds what differs in more than the prefix: `iota`,
+/// `times_iota`): `bilinear` and `nearest` along a checked span, and the two batch entry
+/// points `tri_jobs` and `jobs`, compiled under that set's `target_feature`, so the span
+/// setup, the closures and the kernels inline into one loop per set.
+macro_rules! span_kernels {
     ($feature:literal) => {
         /// A batch of trilinear spans (see [`super::super::tri_jobs`]).
         #[target_feature(enable = $feature)]
@@ -101,20 +105,141 @@ macro_rules! batch_entries {
                 }
             })
         }
+
+        /// Bilinear (or, `BLEND`, blended into `out` by `frac`) along a checked span, N
+        /// pixels per step.
+        ///
+        /// `SITE` only tells call sites apart: each instantiation has one caller, so it is
+        /// compiled into that caller (no call, no span setup passed through memory).
+        #[inline]
+        #[target_feature(enable = $feature)]
+        pub(super) fn bilinear<const BLEND: bool, const SITE: u8>(
+            px: &[u32],
+            stride: usize,
+            out: &mut [u32],
+            l: Local,
+            frac: u32,
+        ) {
+            let m = out.len();
+            let iota = iota();
+            let (fu, fv) = (set1(l.fu), set1(l.fv));
+            let (du, dv) = (set1(l.du), set1(l.dv));
+            let fw = set1((frac as i32) * 0x10001);
+            let fwt = (fw, sub16(set1_16(256), fw));
+            let blend = |o: V, c: (V, V)| {
+                if BLEND {
+                    merge(lerp(split(o), c, fwt))
+                } else {
+                    merge(c)
+                }
+            };
+            // Lanes i < m hold f + i·d exactly (Local::new); the wrapping adds stay exact.
+            let mut ru = add(fu, times_iota(du));
+            let mut rv = add(fv, times_iota(dv));
+            let (su, sv) = (slli::<LOG_N>(du), slli::<LOG_N>(dv));
+            let mut i = 0;
+            while i + N <= m {
+                let c = bilinear_n(px, stride, &l, ru, rv);
+                let q = out[i..i + N].as_mut_ptr().cast::<V>();
+                let o = if BLEND {
+                    // SAFETY: `q` points at N u32 of `out` (the slice above).
+                    unsafe { loadu(q) }
+                } else {
+                    zero()
+                };
+                // SAFETY: as above.
+                unsafe { storeu(q, blend(o, c)) };
+                ru = add(ru, su);
+                rv = add(rv, sv);
+                i += N;
+            }
+            if i < m {
+                // The tail: lanes past the end repeat the last pixel (inside the map).
+                let idx = min(add(set1(i as i32), iota), set1(m as i32 - 1));
+                let ru = add(fu, mullo(idx, du));
+                let rv = add(fv, mullo(idx, dv));
+                let c = bilinear_n(px, stride, &l, ru, rv);
+                let tail = &mut out[i..];
+                let mut buf = padded::<N>(tail);
+                let q = buf.as_mut_ptr().cast::<V>();
+                // SAFETY: `buf` holds N u32.
+                let o = unsafe { loadu(q) };
+                // SAFETY: as above.
+                unsafe { storeu(q, blend(o, c)) };
+                let n = tail.len();
+                tail.copy_from_slice(&buf[..n]);
+            }
+        }
+
+        /// Nearest along a checked span, N pixels per step.
+        #[inline]
+        #[target_feature(enable = $feature)]
+        pub(super) fn nearest(px: &[u32], stride: usize, out: &mut [u32], l: Local) {
+            let m = out.len();
+            let iota = iota();
+            let (fu, fv) = (set1(l.fu), set1(l.fv));
+            let (du, dv) = (set1(l.du), set1(l.dv));
+            let st = set1(stride as i32);
+            let mut ru = add(fu, times_iota(du));
+            let mut rv = add(fv, times_iota(dv));
+            let (su, sv) = (slli::<LOG_N>(du), slli::<LOG_N>(dv));
+            let p = px.as_ptr();
+            let fetch = |a: &[i32; N], j: usize| -> u32 {
+                let k = (l.base as isize + a[j] as isize) as usize;
+                // SAFETY: a[j] is clamped to [−base, last − base] with last < px.len().
+                unsafe { p.add(k).read() }
+            };
+            let mut i = 0;
+            while i + N <= m {
+                let a = indices(ru, rv, st, &l);
+                for (j, o) in out[i..i + N].iter_mut().enumerate() {
+                    *o = fetch(&a, j);
+                }
+                ru = add(ru, su);
+                rv = add(rv, sv);
+                i += N;
+            }
+            if i < m {
+                let idx = min(add(set1(i as i32), iota), set1(m as i32 - 1));
+                let ru = add(fu, mullo(idx, du));
+                let rv = add(fv, mullo(idx, dv));
+                let a = indices(ru, rv, st, &l);
+                for (j, o) in out[i..].iter_mut().enumerate() {
+                    *o = fetch(&a, j);
+                }
+            }
+        }
     };
 }
 
 mod avx2 {
-    use super::super::avx2::{bilinear8, indices, lerp, merge, split};
+    use super::super::avx2::{bilinear8 as bilinear_n, indices, lerp, merge, split};
     use super::*;
+    use std::arch::x86_64::{
+        __m256i as V, _mm256_add_epi32 as add, _mm256_loadu_si256 as loadu,
+        _mm256_min_epi32 as min, _mm256_mullo_epi32 as mullo, _mm256_set1_epi16 as set1_16,
+        _mm256_set1_epi32 as set1, _mm256_setzero_si256 as zero, _mm256_slli_epi32 as slli,
+        _mm256_storeu_si256 as storeu, _mm256_sub_epi16 as sub16,
+    };
 
-    batch_entries!("avx2");
+    /// Pixels per step, and its log2.
+    const N: usize = 8;
+    const LOG_N: i32 = 3;
+
+    span_kernels!("avx2");
+
+    /// The lane indices 0..8.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn iota() -> V {
+        _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)
+    }
 
     /// `d · [0, 1, …, 7]` per lane without `vpmulld` (10 cycles of latency on the
     /// span's critical path): each lane adds d, 2d and 4d by the bits of its index.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn times_iota(d: __m256i) -> __m256i {
+    fn times_iota(d: V) -> V {
         let d2 = _mm256_add_epi32(d, d);
         let d4 = _mm256_add_epi32(d2, d2);
         let m1 = _mm256_setr_epi32(0, -1, 0, -1, 0, -1, 0, -1);
@@ -123,227 +248,35 @@ mod avx2 {
         let a = _mm256_add_epi32(_mm256_and_si256(d, m1), _mm256_and_si256(d2, m2));
         _mm256_add_epi32(a, _mm256_and_si256(d4, m4))
     }
-
-    /// Bilinear (or, `BLEND`, blended into `out` by `frac`) along a checked span.
-    ///
-    /// `SITE` only tells call sites apart: each instantiation has one caller, so it is
-    /// compiled into that caller (no call, no span setup passed through memory).
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    pub(super) fn bilinear<const BLEND: bool, const SITE: u8>(
-        px: &[u32],
-        stride: usize,
-        out: &mut [u32],
-        l: Local,
-        frac: u32,
-    ) {
-        let m = out.len();
-        let iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-        let (fu, fv) = (_mm256_set1_epi32(l.fu), _mm256_set1_epi32(l.fv));
-        let (du, dv) = (_mm256_set1_epi32(l.du), _mm256_set1_epi32(l.dv));
-        let fw = _mm256_set1_epi32((frac as i32) * 0x10001);
-        let fwt = (fw, _mm256_sub_epi16(_mm256_set1_epi16(256), fw));
-        let blend = |o: __m256i, c: (__m256i, __m256i)| {
-            if BLEND {
-                merge(lerp(split(o), c, fwt))
-            } else {
-                merge(c)
-            }
-        };
-        // Lanes i < m hold f + i·d exactly (Local::new); the wrapping adds stay exact.
-        let mut ru = _mm256_add_epi32(fu, times_iota(du));
-        let mut rv = _mm256_add_epi32(fv, times_iota(dv));
-        let (su, sv) = (_mm256_slli_epi32::<3>(du), _mm256_slli_epi32::<3>(dv));
-        let mut i = 0;
-        while i + 8 <= m {
-            let c = bilinear8(px, stride, &l, ru, rv);
-            let q = out[i..i + 8].as_mut_ptr().cast::<__m256i>();
-            let o = if BLEND {
-                // SAFETY: `q` points at 8 u32 of `out` (the slice above).
-                unsafe { _mm256_loadu_si256(q) }
-            } else {
-                _mm256_setzero_si256()
-            };
-            // SAFETY: as above.
-            unsafe { _mm256_storeu_si256(q, blend(o, c)) };
-            ru = _mm256_add_epi32(ru, su);
-            rv = _mm256_add_epi32(rv, sv);
-            i += 8;
-        }
-        if i < m {
-            // The tail: lanes past the end repeat the last pixel (inside the map).
-            let idx = _mm256_min_epi32(
-                _mm256_add_epi32(_mm256_set1_epi32(i as i32), iota),
-                _mm256_set1_epi32(m as i32 - 1),
-            );
-            let ru = _mm256_add_epi32(fu, _mm256_mullo_epi32(idx, du));
-            let rv = _mm256_add_epi32(fv, _mm256_mullo_epi32(idx, dv));
-            let c = bilinear8(px, stride, &l, ru, rv);
-            let tail = &mut out[i..];
-            let mut buf = padded::<8>(tail);
-            let q = buf.as_mut_ptr().cast::<__m256i>();
-            // SAFETY: `buf` holds 8 u32.
-            let o = unsafe { _mm256_loadu_si256(q) };
-            // SAFETY: as above.
-            unsafe { _mm256_storeu_si256(q, blend(o, c)) };
-            let n = tail.len();
-            tail.copy_from_slice(&buf[..n]);
-        }
-    }
-
-    /// Nearest along a checked span.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    pub(super) fn nearest(px: &[u32], stride: usize, out: &mut [u32], l: Local) {
-        let m = out.len();
-        let iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-        let (fu, fv) = (_mm256_set1_epi32(l.fu), _mm256_set1_epi32(l.fv));
-        let (du, dv) = (_mm256_set1_epi32(l.du), _mm256_set1_epi32(l.dv));
-        let st = _mm256_set1_epi32(stride as i32);
-        let mut ru = _mm256_add_epi32(fu, times_iota(du));
-        let mut rv = _mm256_add_epi32(fv, times_iota(dv));
-        let (su, sv) = (_mm256_slli_epi32::<3>(du), _mm256_slli_epi32::<3>(dv));
-        let p = px.as_ptr();
-        let fetch = |a: &[i32; 8], j: usize| -> u32 {
-            let k = (l.base as isize + a[j] as isize) as usize;
-            // SAFETY: a[j] is clamped to [−base, last − base] with last < px.len().
-            unsafe { p.add(k).read() }
-        };
-        let mut i = 0;
-        while i + 8 <= m {
-            let a = indices(ru, rv, st, &l);
-            for (j, o) in out[i..i + 8].iter_mut().enumerate() {
-                *o = fetch(&a, j);
-            }
-            ru = _mm256_add_epi32(ru, su);
-            rv = _mm256_add_epi32(rv, sv);
-            i += 8;
-        }
-        if i < m {
-            let idx = _mm256_min_epi32(
-                _mm256_add_epi32(_mm256_set1_epi32(i as i32), iota),
-                _mm256_set1_epi32(m as i32 - 1),
-            );
-            let ru = _mm256_add_epi32(fu, _mm256_mullo_epi32(idx, du));
-            let rv = _mm256_add_epi32(fv, _mm256_mullo_epi32(idx, dv));
-            let a = indices(ru, rv, st, &l);
-            for (j, o) in out[i..].iter_mut().enumerate() {
-                *o = fetch(&a, j);
-            }
-        }
-    }
 }
 
 mod sse41 {
-    use super::super::sse41::{bilinear4, indices, lerp, merge, split};
+    use super::super::sse41::{bilinear4 as bilinear_n, indices, lerp, merge, split};
     use super::*;
+    use std::arch::x86_64::{
+        __m128i as V, _mm_add_epi32 as add, _mm_loadu_si128 as loadu, _mm_min_epi32 as min,
+        _mm_mullo_epi32 as mullo, _mm_set1_epi16 as set1_16, _mm_set1_epi32 as set1,
+        _mm_setzero_si128 as zero, _mm_slli_epi32 as slli, _mm_storeu_si128 as storeu,
+        _mm_sub_epi16 as sub16,
+    };
 
-    batch_entries!("sse4.1");
+    /// Pixels per step, and its log2.
+    const N: usize = 4;
+    const LOG_N: i32 = 2;
 
-    /// Bilinear (or, `BLEND`, blended into `out` by `frac`) along a checked span.
-    ///
-    /// `SITE` only tells call sites apart: each instantiation has one caller, so it is
-    /// compiled into that caller (no call, no span setup passed through memory).
+    span_kernels!("sse4.1");
+
+    /// The lane indices 0..4.
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn bilinear<const BLEND: bool, const SITE: u8>(
-        px: &[u32],
-        stride: usize,
-        out: &mut [u32],
-        l: Local,
-        frac: u32,
-    ) {
-        let m = out.len();
-        let iota = _mm_setr_epi32(0, 1, 2, 3);
-        let (fu, fv) = (_mm_set1_epi32(l.fu), _mm_set1_epi32(l.fv));
-        let (du, dv) = (_mm_set1_epi32(l.du), _mm_set1_epi32(l.dv));
-        let fw = _mm_set1_epi32((frac as i32) * 0x10001);
-        let fwt = (fw, _mm_sub_epi16(_mm_set1_epi16(256), fw));
-        let blend = |o: __m128i, c: (__m128i, __m128i)| {
-            if BLEND {
-                merge(lerp(split(o), c, fwt))
-            } else {
-                merge(c)
-            }
-        };
-        let mut ru = _mm_add_epi32(fu, _mm_mullo_epi32(iota, du));
-        let mut rv = _mm_add_epi32(fv, _mm_mullo_epi32(iota, dv));
-        let (su, sv) = (_mm_slli_epi32::<2>(du), _mm_slli_epi32::<2>(dv));
-        let mut i = 0;
-        while i + 4 <= m {
-            let c = bilinear4(px, stride, &l, ru, rv);
-            let q = out[i..i + 4].as_mut_ptr().cast::<__m128i>();
-            let o = if BLEND {
-                // SAFETY: `q` points at 4 u32 of `out` (the slice above).
-                unsafe { _mm_loadu_si128(q) }
-            } else {
-                _mm_setzero_si128()
-            };
-            // SAFETY: as above.
-            unsafe { _mm_storeu_si128(q, blend(o, c)) };
-            ru = _mm_add_epi32(ru, su);
-            rv = _mm_add_epi32(rv, sv);
-            i += 4;
-        }
-        if i < m {
-            let idx = _mm_min_epi32(
-                _mm_add_epi32(_mm_set1_epi32(i as i32), iota),
-                _mm_set1_epi32(m as i32 - 1),
-            );
-            let ru = _mm_add_epi32(fu, _mm_mullo_epi32(idx, du));
-            let rv = _mm_add_epi32(fv, _mm_mullo_epi32(idx, dv));
-            let c = bilinear4(px, stride, &l, ru, rv);
-            let tail = &mut out[i..];
-            let mut buf = padded::<4>(tail);
-            let q = buf.as_mut_ptr().cast::<__m128i>();
-            // SAFETY: `buf` holds 4 u32.
-            let o = unsafe { _mm_loadu_si128(q) };
-            // SAFETY: as above.
-            unsafe { _mm_storeu_si128(q, blend(o, c)) };
-            let n = tail.len();
-            tail.copy_from_slice(&buf[..n]);
-        }
+    fn iota() -> V {
+        _mm_setr_epi32(0, 1, 2, 3)
     }
 
-    /// Nearest along a checked span.
+    /// `d · [0, 1, 2, 3]` per lane.
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn nearest(px: &[u32], stride: usize, out: &mut [u32], l: Local) {
-        let m = out.len();
-        let iota = _mm_setr_epi32(0, 1, 2, 3);
-        let (fu, fv) = (_mm_set1_epi32(l.fu), _mm_set1_epi32(l.fv));
-        let (du, dv) = (_mm_set1_epi32(l.du), _mm_set1_epi32(l.dv));
-        let st = _mm_set1_epi32(stride as i32);
-        let mut ru = _mm_add_epi32(fu, _mm_mullo_epi32(iota, du));
-        let mut rv = _mm_add_epi32(fv, _mm_mullo_epi32(iota, dv));
-        let (su, sv) = (_mm_slli_epi32::<2>(du), _mm_slli_epi32::<2>(dv));
-        let p = px.as_ptr();
-        let fetch = |a: &[i32; 4], j: usize| -> u32 {
-            let k = (l.base as isize + a[j] as isize) as usize;
-            // SAFETY: a[j] is clamped to [−base, last − base] with last < px.len().
-            unsafe { p.add(k).read() }
-        };
-        let mut i = 0;
-        while i + 4 <= m {
-            let a = indices(ru, rv, st, &l);
-            for (j, o) in out[i..i + 4].iter_mut().enumerate() {
-                *o = fetch(&a, j);
-            }
-            ru = _mm_add_epi32(ru, su);
-            rv = _mm_add_epi32(rv, sv);
-            i += 4;
-        }
-        if i < m {
-            let idx = _mm_min_epi32(
-                _mm_add_epi32(_mm_set1_epi32(i as i32), iota),
-                _mm_set1_epi32(m as i32 - 1),
-            );
-            let ru = _mm_add_epi32(fu, _mm_mullo_epi32(idx, du));
-            let rv = _mm_add_epi32(fv, _mm_mullo_epi32(idx, dv));
-            let a = indices(ru, rv, st, &l);
-            for (j, o) in out[i..].iter_mut().enumerate() {
-                *o = fetch(&a, j);
-            }
-        }
+    fn times_iota(d: V) -> V {
+        _mm_mullo_epi32(iota(), d)
     }
 }
