@@ -277,43 +277,26 @@ impl Fetch for TrilinearFetch {
             levels.push((ka, kb));
             fracs.push(if ka == kb { 0 } else { frac });
         }
-        // Consecutive chunks [c0, c1) with `same` level: the run's pixels there on it.
-        let by = |same: &dyn Fn(usize) -> Option<usize>, draw: &mut dyn FnMut(_, _, _)| {
-            let mut c0 = 0;
-            while c0 < levels.len() {
-                let Some(k) = same(c0) else {
-                    c0 += 1;
-                    continue;
-                };
-                let mut c1 = c0 + 1;
-                while c1 < levels.len() && same(c1) == Some(k) {
-                    c1 += 1;
-                }
-                let (l, _) = cube.level(k);
-                let half = l.face_size() as f64 / 2.0;
-                let sub = FaceRun {
-                    half,
-                    dx: run.dx + (c0 * C) as f64,
-                    ..*run
-                };
-                draw(l, sub, c0..c1);
-                c0 = c1;
-            }
+        // The run on level `k` from chunk `cs.start` and its pixels.
+        let on = |k: usize, cs: &Range<usize>| {
+            let (l, _) = cube.level(k);
+            let half = l.face_size() as f64 / 2.0;
+            let sub = FaceRun {
+                half,
+                dx: run.dx + (cs.start * C) as f64,
+                ..*run
+            };
+            (face_texels(l, face), sub, cs.start * C..(cs.end * C).min(n))
         };
-        by(
-            &|c| Some(levels[c].0),
-            &mut |l: &CubeMap, sub: FaceRun, cs: Range<usize>| {
-                let px = &mut out[cs.start * C..(cs.end * C).min(n)];
-                face_rows::<true>(&face_texels(l, face), &sub, px, buf);
-            },
-        );
+        for (k, cs) in same_runs(levels.len(), |c| Some(levels[c].0)) {
+            let (t, sub, px) = on(k, &cs);
+            face_rows::<true>(&t, &sub, &mut out[px], buf);
+        }
         let blended = |c: usize| (fracs[c] != 0).then_some(levels[c].1);
-        by(&blended, &mut |l: &CubeMap,
-                           sub: FaceRun,
-                           cs: Range<usize>| {
-            let px = &mut out[cs.start * C..(cs.end * C).min(n)];
-            face_rows_blend(&face_texels(l, face), &sub, px, (C, &fracs[cs]), buf);
-        });
+        for (k, cs) in same_runs(levels.len(), blended) {
+            let (t, sub, px) = on(k, &cs);
+            face_rows_blend(&t, &sub, &mut out[px], (C, &fracs[cs]), buf);
+        }
         (buf.levels, buf.fracs) = (levels, fracs);
     }
 }
@@ -340,6 +323,30 @@ pub(crate) fn render_cube(
             render_with(cube, &rays, TrilinearFetch, renderer, out, threads)
         }
     }
+}
+
+/// The runs of consecutive items in `0..n` with the same `key` (items whose key is
+/// `None` skipped): `(key, items)`.
+fn same_runs(
+    n: usize,
+    key: impl Fn(usize) -> Option<usize>,
+) -> impl Iterator<Item = (usize, Range<usize>)> {
+    let mut c0 = 0;
+    std::iter::from_fn(move || {
+        while c0 < n {
+            let Some(k) = key(c0) else {
+                c0 += 1;
+                continue;
+            };
+            let start = c0;
+            c0 += 1;
+            while c0 < n && key(c0) == Some(k) {
+                c0 += 1;
+            }
+            return Some((k, start..c0));
+        }
+        None
+    })
 }
 
 /// A cube band task's scratch: a scanline's face segments and its runs' position buffers.
@@ -581,5 +588,29 @@ impl CubeMap {
         }
         let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
         CubeMap::from_faces(face_size, refs)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::same_runs;
+
+    #[test]
+    fn same_runs_groups_consecutive_keys_and_skips_none() {
+        let keys = [
+            Some(1),
+            Some(1),
+            None,
+            Some(1),
+            Some(2),
+            Some(2),
+            None,
+            None,
+            Some(0),
+        ];
+        let runs: Vec<_> = same_runs(keys.len(), |c| keys[c]).collect();
+        assert_eq!(runs, vec![(1, 0..2), (1, 3..4), (2, 4..6), (0, 8..9)]);
+        assert_eq!(same_runs(0, |_| Some(0)).count(), 0);
+        assert_eq!(same_runs(3, |_| None).count(), 0);
     }
 }

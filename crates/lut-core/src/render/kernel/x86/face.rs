@@ -1,4 +1,4 @@
-//! x86-64 cube-face positions (see `kernel/face_rows.rs`): the face coordinates of 8
+//! x86-64 cube-face positions (see `kernel/face.rs`): the face coordinates of 8
 //! (AVX-512), 4 (AVX2) or 2 (SSE) pixels per `f64` vector, computed with the scalar
 //! twin's operations in its order and rounded as it rounds them, written out as the row
 //! kernels' Q.8 positions (nearest: the texel; bilinear: Q.16 then Q.8). AVX-512 takes 16
@@ -17,7 +17,7 @@ use crate::geom::fixed::FX_ONE;
 use std::arch::x86_64::*;
 
 /// The bordered Q.8 positions of a face run's first `m` pixels with a SIMD kernel (see
-/// `face_rows.rs`; whole vectors written: `u` and `v` hold `m` rounded up to 16),
+/// `kernel/face.rs`; whole vectors written: `u` and `v` hold `m` rounded up to 16),
 /// and the largest `v`; `None` (nothing written) for the scalar one.
 #[inline(always)]
 pub(in super::super) fn positions<const BILINEAR: bool>(
