@@ -272,17 +272,11 @@ pub(crate) fn prepare(
 /// last row), Λ taken the short way round the seam; where the table does not cover both,
 /// the scanline's angular spacing in map pixels.
 fn vertical_footprints(scans: &mut [Scan], table: &LutTable, fr: &Setup, threads: bool) {
-    let n = scans.len();
     let half_w = fr.w_out as f64 * 0.5;
     let reg_x = half_w / STEP_REGIONS as f64;
     let px_per_rad = fr.mw / TAU;
-    let rows: &[Scan] = scans;
-    let footprint = |y: usize| {
-        let other = if y + 1 < n {
-            y + 1
-        } else {
-            y.saturating_sub(1)
-        };
+    // The footprint of scanline `row` against its neighbour `other` (none: a one-row frame).
+    let footprint = |row: &Scan, other: Option<&Scan>| {
         let mut fy = [0f32; STEP_REGIONS];
         for (r, f) in fy.iter_mut().enumerate() {
             let x = ((half_w + (r as f64 + 0.5) * reg_x - 0.5).round() as i64)
@@ -290,36 +284,43 @@ fn vertical_footprints(scans: &mut [Scan], table: &LutTable, fr: &Setup, threads
             let usable = |s: &Scan| {
                 s.lut && x >= s.lut_lo && x <= s.lut_hi && !(x >= s.zone_lo && x <= s.zone_hi)
             };
-            *f = if other != y && usable(&rows[y]) && usable(&rows[other]) {
-                let (l0, v0) = read(&rows[y], table, fr, x);
-                let (l1, v1) = read(&rows[other], table, fr, x);
-                let mut dl = (l1 - l0).unsigned_abs() as i64;
-                if dl > fr.half_map_w_fx {
-                    dl = (fr.map_w_fx - dl).abs();
+            *f = match other {
+                Some(o) if usable(row) && usable(o) => {
+                    let (l0, v0) = read(row, table, fr, x);
+                    let (l1, v1) = read(o, table, fr, x);
+                    let mut dl = (l1 - l0).unsigned_abs() as i64;
+                    if dl > fr.half_map_w_fx {
+                        dl = (fr.map_w_fx - dl).abs();
+                    }
+                    (dl.max((v1 - v0).abs()) as f64 / FX_ONE as f64) as f32
                 }
-                (dl.max((v1 - v0).abs()) as f64 / FX_ONE as f64) as f32
-            } else {
-                (rows[y].row_angle * px_per_rad) as f32
+                _ => (row.row_angle * px_per_rad) as f32,
             };
         }
         fy
     };
-    // Each row's footprint reads the next row's scan, so all are computed first (on two
-    // threads: serial, they were ~10 % of a two-thread trilinear frame, one thread
-    // working while the other waited), then stored.
-    let fys: Vec<[f32; STEP_REGIONS]> = if threads && n >= PARALLEL_SETUP_ROWS {
-        let mid = n / 2;
-        let (mut a, b) = rayon::join(
-            || (0..mid).map(footprint).collect::<Vec<_>>(),
-            || (mid..n).map(footprint).collect::<Vec<_>>(),
-        );
-        a.extend(b);
-        a
-    } else {
-        (0..n).map(footprint).collect()
+    // Rows in order, each against the next (`next`: the one after the last, if any) or,
+    // for the frame's last row, the one before. A row's `fy` is never read here, so it
+    // is written as soon as it is known.
+    let fill = |rows: &mut [Scan], next: Option<&Scan>| {
+        for i in 0..rows.len() {
+            let other = match rows.get(i + 1).or(next) {
+                Some(o) => Some(o),
+                None => i.checked_sub(1).map(|p| &rows[p]),
+            };
+            let fy = footprint(&rows[i], other);
+            rows[i].fy = fy;
+        }
     };
-    for (s, fy) in scans.iter_mut().zip(fys) {
-        s.fy = fy;
+    if threads && scans.len() >= PARALLEL_SETUP_ROWS {
+        // Two halves on two threads, as the rest of the setup (serial, this was ~10 % of
+        // a two-thread trilinear frame, one thread working while the other waited); the
+        // first half's last row reads a copy of the second half's first scan.
+        let (a, b) = scans.split_at_mut(scans.len() / 2);
+        let first_b = b[0];
+        rayon::join(|| fill(a, Some(&first_b)), || fill(b, None));
+    } else {
+        fill(scans, None);
     }
 }
 
