@@ -95,7 +95,7 @@
 //!   (bilinear 67.6 against 62.8 per frame pixel, nearest 62.2 against 49.5): the fixed
 //!   cost of a span (checks, lane setup) stays, and the results must be copied back.
 //! - AVX-512 (`Kernel::Avx512`, 16 lanes) for the row kernels (`x86/row.rs`: runs of
-//!   hundreds of positions, no per-span cost) and the cube-face kernels (`x86/face.rs`:
+//!   hundreds of positions, no per-span cost) and the cube-face positions (`x86/face.rs`:
 //!   the `f64` division 8 lanes wide), not for the span kernels: at 8–16 pixels per span
 //!   the per-span cost, not the blend, dominates them, and a 16-lane vector would be half
 //!   empty on 8-pixel spans; `Kernel::Avx512` runs their AVX2 code. On AMD Zen 5 plain

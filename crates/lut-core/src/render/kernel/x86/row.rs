@@ -12,7 +12,7 @@
 //! `_mm256_add_epi32` in `avx2`, `_mm_add_epi32` in `sse41`; `V` the vector type, `N` its
 //! lanes) and a few functions hold what differs in more than the prefix: the lane
 //! layout of the texel pairs (`pairs`), the nearest gather (`gather`, in `x86.rs` beside
-//! `split`, `lerp` and `merge`, shared with the face kernels), the reversal
+//! `split`, `lerp` and `merge`), the reversal
 //! (`reverse`), `iota`, the compares (`add_if_below`, `sub_if_above`, `zero_outside`:
 //! vector compares and masks in AVX2 and SSE4.1, `vector_compares!`; mask registers and
 //! masked adds in AVX-512), and the kernel for the last pixels of a run (`tail`: the

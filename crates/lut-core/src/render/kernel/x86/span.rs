@@ -3,7 +3,7 @@
 //! bilinear on a level blended into the one before; the batch entry points compiled
 //! under each set's `target_feature`. The texel blend itself (`bilinear8`,
 //! `bilinear4`, `split`, `lerp`, `merge`) is the parent module's, shared with the row
-//! and face kernels. There are no AVX-512 span kernels: at 8–16 pixels per span a
+//! kernels. There are no AVX-512 span kernels: at 8–16 pixels per span a
 //! 16-lane vector would be half empty, so `Kernel::Avx512` runs the AVX2 ones (an
 //! AVX-512 CPU runs AVX2), and so do the cropped kernels built on them.
 
@@ -51,7 +51,7 @@ pub(in super::super) fn tri_jobs(
     }
 }
 
-/// The span kernels of one instruction set, written once (as the row and face kernels
+/// The span kernels of one instruction set, written once (as the row kernels and the face positions
 /// are: each set's module names its intrinsics with short aliases, `add` is
 /// `_mm256_add_epi32` in `avx2` and `_mm_add_epi32` in `sse41`, `V` the vector of `N`
 /// lanes, `LOG_N` its log2, and holds what differs in more than the prefix: `iota`,
