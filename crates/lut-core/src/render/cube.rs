@@ -72,16 +72,6 @@ impl CubeRenderer {
     pub fn name(self) -> &'static str {
         Named::name(self)
     }
-
-    /// How far, in face texels, this renderer's sampling positions with `sampler` may lie
-    /// from the exact ones where it steps them between exact points; `None` where it
-    /// evaluates every position exactly, which both renderers now do with every sampler
-    /// (the scanline renderer's bilinear runs were stepped within 0.0207 texels until
-    /// 2026-12-02; `viewer bench --replot` still reads that bound from older JSON rows).
-    pub fn position_bound(self, sampler: Sampler) -> Option<f64> {
-        let _ = (self, sampler);
-        None
-    }
 }
 
 impl std::str::FromStr for CubeRenderer {

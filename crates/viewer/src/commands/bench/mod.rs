@@ -286,7 +286,6 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
                     let build = measure::time_grid_build(&ctx, &mut renderer, a.passes)?;
                     row.table_build_ms = Some(measure::median(&build));
                 }
-                configs::Config::Cube(s, r) => row.position_bound_texels = r.position_bound(*s),
                 _ => {}
             }
             progress(&row_line(&row));

@@ -176,9 +176,9 @@ fn series(rows: &[Row]) -> Vec<Series<'_>> {
 }
 
 /// A vertical line's legend: the renderer and sampler, and for a row whose positions are
-/// stepped within a bound rather than exact (`position_bound_texels`,
-/// `lut_core::CubeRenderer::position_bound`: none today; the cube scanline renderer's
-/// bilinear rows of older JSON files), that bound.
+/// stepped within a bound rather than exact (`position_bound_texels`: none `viewer
+/// bench` writes today; the cube scanline renderer's bilinear rows of JSON files written
+/// before 2026-12-02), that bound.
 fn reference_label(r: &Row) -> String {
     let label = format!("{}, {}", r.renderer, r.sampler);
     match r.position_bound_texels {
@@ -844,21 +844,13 @@ mod tests {
 
     /// A reference line's legend names a stepped row's bound (as rows of older JSON files
     /// carry it for the cube scanline renderer's bilinear runs), and the bound survives
-    /// the JSON round trip of `--replot`; exact rows carry none, which is every cube row
-    /// `viewer bench` writes now (`CubeRenderer::position_bound`).
+    /// the JSON round trip of `--replot`; exact rows carry none, which is every row
+    /// `viewer bench` writes now.
     #[test]
     fn stepped_rows_name_their_bound() {
         let mut stepped = Row::timed(&run(), "cube-scanline", Sampler::Bilinear, 90.0, 1, &[5.0]);
         stepped.position_bound_texels = Some(0.0207);
         let exact = Row::timed(&run(), "cube-scanline", Sampler::Nearest, 90.0, 1, &[5.0]);
-        for s in [Sampler::Nearest, Sampler::Bilinear, Sampler::Trilinear] {
-            for r in [
-                lut_core::CubeRenderer::Accelerated,
-                lut_core::CubeRenderer::Basic,
-            ] {
-                assert_eq!(r.position_bound(s), None, "{r:?} {s:?}");
-            }
-        }
         assert_eq!(
             reference_label(&stepped),
             "cube-scanline, bilinear (stepped: max error <= 0.0207 face texel, bound)"

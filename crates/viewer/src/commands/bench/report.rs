@@ -79,10 +79,10 @@ pub struct Row {
     #[serde(default)]
     pub surface: Option<Name>,
     /// Rows whose sampling positions are stepped between exact ones rather than exact or
-    /// measured: how far, in face texels, a position may lie from the exact one
-    /// (`lut_core::CubeRenderer::position_bound`). Absent otherwise, which is every row
-    /// today (the cube scanline renderer's bilinear runs were stepped, within 0.0207
-    /// texels, until 2026-12-02; rows of older JSON files may carry it).
+    /// measured: how far, in face texels, a position may lie from the exact one. No row
+    /// `viewer bench` writes today has one (the cube scanline renderer's bilinear runs
+    /// were stepped, within 0.0207 texels, until 2026-12-02); kept so that `--replot`
+    /// reads JSON files written before and labels those rows.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub position_bound_texels: Option<f64>,
 }
