@@ -4,8 +4,8 @@
 //! the LUT renderer and the exact renderer alike, and must not hurt when magnifying.
 
 use lut_core::{
-    render_exact, render_exact_supersampled, EnvMap, Projection, RenderOptions, Renderer, Sampler,
-    View,
+    render_exact, render_exact_supersampled, EnvMap, Projection, RenderOptions, Renderer,
+    RendererKind, Sampler, View,
 };
 use lut_core::{Frame, Scene};
 use test_support::pixels::psnr;
@@ -192,6 +192,100 @@ fn bilinear_level_reads_the_matching_level() {
         let f = render_frame(&mut r, Scene::Map(&map), view, &o, w, h).0;
         assert!(f == lut(&map, view, s, w, h), "{s:?}");
     }
+}
+
+/// `Renderer::set_still_level` (the window's still frames): a bilinear or trilinear
+/// frame is drawn from the deepest pyramid level on which no pixel is magnified by more
+/// than √2, the level 2^k nearest to the frame's smallest footprint, as a plain frame of
+/// that level; views that are not zoomed out are drawn from the map, byte for byte. The
+/// exact renderer draws the same level.
+#[test]
+fn still_level_reads_the_level_no_pixel_is_magnified_on() {
+    let map = fine_map(2048, 1024);
+    let opts = |renderer| RenderOptions {
+        sampler: Sampler::Bilinear,
+        renderer,
+        ..RenderOptions::default()
+    };
+    let still = |view: View, w: u32, h: u32, renderer| {
+        let mut r = Renderer::new(&map);
+        assert!(!r.still_level(), "off by default");
+        r.set_still_level(true);
+        render_frame(&mut r, Scene::Map(&map), view, &opts(renderer), w, h).0
+    };
+    // Magnified (hfov 20 over 160 columns: 0.2 map pixels per screen pixel): the map.
+    let view = View::new(33.0, 12.0, 20.0).unwrap();
+    assert_eq!(
+        still(view, 160, 120, RendererKind::Lut),
+        lut(&map, view, Sampler::Bilinear, 160, 120)
+    );
+    // hfov 90 over 48 columns: 13.6 map pixels per screen pixel at the centre, 7.5 at
+    // the frame's corners (log2 2.91): level 3 (256x128), where the corners read 0.94
+    // level texels per pixel. (The moving frame's rule, the centre, would take level 4.)
+    let (w, h) = (48, 36);
+    let view = View::new(10.0, 0.0, 90.0).unwrap();
+    let level3 = &map.pyramid()[2];
+    assert_eq!((level3.width(), level3.height()), (256, 128));
+    let got = still(view, w, h, RendererKind::Lut);
+    assert!(got == lut(level3, view, Sampler::Bilinear, w, h));
+    assert!(got != lut(&map.pyramid()[3], view, Sampler::Bilinear, w, h));
+    // Closer to the supersampled truth than bilinear on the map, and not further from
+    // it than trilinear by more than 1 dB.
+    let truth = truth(&map, view, w, h);
+    let (pl, pb, pt) = (
+        psnr(&got, &truth),
+        psnr(&lut(&map, view, Sampler::Bilinear, w, h), &truth),
+        psnr(&lut(&map, view, Sampler::Trilinear, w, h), &truth),
+    );
+    assert!(
+        pl >= pb + 3.0 && pl >= pt - 1.0,
+        "level {pl:.1} dB, bilinear {pb:.1}, trilinear {pt:.1}"
+    );
+    // The exact renderer draws the same level: exact bilinear of level 3.
+    let mut ex = vec![0u32; (w * h) as usize];
+    render_exact(
+        level3,
+        view,
+        Sampler::Bilinear,
+        &mut Frame::new(&mut ex, w, h).unwrap(),
+        true,
+    );
+    assert!(still(view, w, h, RendererKind::Exact) == ex);
+    // Looking up at 80°: again one level's frame, none finer than the horizon's (the
+    // footprint only grows towards the pole; the frame's smallest is at its bottom).
+    let up = View::new(10.0, 80.0, 90.0).unwrap();
+    let got = still(up, w, h, RendererKind::Lut);
+    let k = (1..map.pyramid().len())
+        .find(|&i| got == lut(&map.pyramid()[i], up, Sampler::Bilinear, w, h))
+        .expect("the frame of some level");
+    assert!(k >= 2, "pyramid index {k}");
+    // Trilinear: the trilinear frame of the same level (its levels of detail from the
+    // level's own pyramid, which equals the map's below it), within 1.5 dB of trilinear
+    // on the map against the truth (what it gives up: blending in levels finer than 3
+    // where the footprint is smallest), and closer to it than bilinear on the map.
+    let mut r = Renderer::new(&map);
+    r.set_still_level(true);
+    let tri = RenderOptions {
+        sampler: Sampler::Trilinear,
+        ..RenderOptions::default()
+    };
+    let got = render_frame(&mut r, Scene::Map(&map), view, &tri, w, h).0;
+    assert!(got == lut(level3, view, Sampler::Trilinear, w, h));
+    let (l4, m4) = (&level3.pyramid()[0], &map.pyramid()[3]);
+    assert_eq!((l4.width(), l4.height()), (m4.width(), m4.height()));
+    assert!((0..l4.height()).all(|y| (0..l4.width()).all(|x| l4.pixel(x, y) == m4.pixel(x, y))));
+    let p = psnr(&got, &truth);
+    assert!(
+        p >= pt - 1.5 && p >= pb + 3.0,
+        "trilinear on the level {p:.1} dB, on the map {pt:.1}"
+    );
+    // Nearest ignores the switch.
+    let o = RenderOptions {
+        sampler: Sampler::Nearest,
+        ..RenderOptions::default()
+    };
+    let f = render_frame(&mut r, Scene::Map(&map), view, &o, w, h).0;
+    assert!(f == lut(&map, view, Sampler::Nearest, w, h));
 }
 
 /// Maps with odd sides deeper down get every level too (1800×900: 225×113 at level 3,

@@ -19,9 +19,11 @@
 //! quarter of the map's width, converted from the map as `viewer bench` does; cube-basic =
 //! the per-pixel cube renderer), `cache` PATH (keep the generated map's pixels there, and
 //! a cube's faces in PATH.cubeN, and read them on later runs: much faster under valgrind),
-//! `level` 0|1 (0; 1: bilinear reads the pyramid level matching the footprint,
-//! `Renderer::set_bilinear_level`, as the window does while moving; the pyramid is built
-//! before timing).
+//! `level` 0|1|2 (0: bilinear reads the map; 1: bilinear reads the pyramid level matching
+//! the footprint at the centre, `Renderer::set_bilinear_level`, as the window does while
+//! moving; 2: the level no pixel is magnified by more than √2 on,
+//! `Renderer::set_still_level`, the window's still bilinear frames; the pyramid is
+//! built before timing).
 //! `crop` WxH+LEFT+TOP: render a partial map holding only that rectangle of the map's
 //! pixels (the cropped kernels).
 //! `file` PATH: render that panorama instead of the generated map (e.g. `viewer
@@ -173,7 +175,7 @@ fn run() -> Result<(), String> {
     let mut gather = false;
     let mut cube_renderer = None;
     let mut cache = None;
-    let mut level = false;
+    let mut level = 0;
     let mut file = None;
     let mut crop: Option<(u32, u32, u32, u32)> = None;
     for a in std::env::args().skip(1) {
@@ -220,7 +222,7 @@ fn run() -> Result<(), String> {
                 }
             },
             "cache" => cache = Some(std::path::PathBuf::from(v)),
-            "level" => level = num(v)? != 0.0,
+            "level" => level = num(v)? as u32,
             "file" => file = Some(std::path::PathBuf::from(v)),
             _ => return Err(format!("unknown argument '{k}'")),
         }
@@ -272,8 +274,9 @@ fn run() -> Result<(), String> {
     let (w, h) = out_wh;
     let mut out = vec![0u32; w as usize * h as usize];
     let mut r = Renderer::new(&map);
-    r.set_bilinear_level(level);
-    if level {
+    r.set_bilinear_level(level == 1);
+    r.set_still_level(level == 2);
+    if level != 0 {
         let t = Instant::now();
         map.pyramid();
         eprintln!("pyramid built in {:.2} s", t.elapsed().as_secs_f64());

@@ -41,7 +41,7 @@ pub(crate) mod steps;
 use crate::cube::CubeMap;
 use crate::error::ViewError;
 use crate::geom::camera::{check_size, Camera, View};
-use crate::geom::mapping::exact_uv;
+use crate::geom::mapping::{exact_uv, exact_uv_at};
 use crate::geom::projection::Projection;
 use crate::lut::{LutTable, Surface, TableKind, TableSpec};
 use crate::map::envmap::EnvMap;
@@ -315,7 +315,11 @@ pub struct Renderer {
     /// Bilinear reads the pyramid level matching the footprint
     /// ([`Renderer::set_bilinear_level`]).
     bilinear_level: bool,
-    /// The renderer of those frames: its tables are for the level's geometry.
+    /// Still bilinear and trilinear frames read the pyramid level matching the frame's
+    /// smallest footprint ([`Renderer::set_still_level`]).
+    still_level: bool,
+    /// The renderer of frames drawn from a pyramid level: its tables are for the level's
+    /// geometry.
     level: Option<Box<Renderer>>,
 }
 
@@ -363,6 +367,47 @@ impl Renderer {
         self.bilinear_level
     }
 
+    /// Still frames, bilinear and trilinear (bilinear frames not drawn on the level of
+    /// [`Renderer::set_bilinear_level`]), are drawn from the deepest pyramid level on which
+    /// no pixel of the frame is magnified by more than √2 (`on`: what the viewer draws when
+    /// the view stands still), or from the map itself at every zoom (`false`, the default:
+    /// the samplers as the golden images and the accuracy tables define them).
+    ///
+    /// Zoomed out, bilinear on the map reads texels far apart: it aliases (a pixel
+    /// covering four texels shows one of them, and the pick moves as the view moves), and
+    /// the frame's cost grows with the map (each sample a cache miss: a 32768-wide map at
+    /// 1080p and hfov 90 took 4x the 8192-wide map's frame). Trilinear does not alias, but
+    /// its level of detail (with its −½ bias) reaches levels finer than the map's
+    /// 8192-wide level towards the edges of a wide view, where a rectilinear view's pixels
+    /// are smallest, and blends two of them there: 4x the 8192-wide map's frame as well.
+    /// With this on, the frame is drawn as a plain bilinear or trilinear frame of pyramid
+    /// level k, with the level's own tables (and, for trilinear, the level's own pyramid,
+    /// built on its first trilinear frame: a third of the level's bytes), where
+    /// k = ⌊log2(m) + ½⌋ and m is the smallest footprint in the frame (map pixels per
+    /// screen pixel: the larger of the exact distances to the next pixel right and below,
+    /// `frame_min_footprint`, sampled on a grid over the frame that includes its corners
+    /// and edges). Every pixel then reads at least 1/√2 level texels (where the footprint
+    /// is smallest, a level texel is at most √2 pixels wide), and where the footprint is
+    /// larger, bilinear reads fewer texels than on the map and trilinear reads the same
+    /// levels as on the map. The price: trilinear no longer blends in finer levels than k
+    /// where the footprint is smallest (the −½ bias's extra sharpness there), as on a
+    /// smaller map of the same scene. So a 32768-wide map at hfov 90 is drawn as its
+    /// 8192-wide level would be drawn, at that map's cost. Frames whose smallest footprint
+    /// is at most √2 (any view that is not zoomed out: 1080p at hfov 90 or 120 on a map up
+    /// to 8192 wide) are drawn from the map, byte for byte; so are partial maps (no
+    /// pyramid) and nearest frames. Only levels that divide the map's sides exactly are
+    /// used ([`Renderer::set_bilinear_level`]). The exact renderer
+    /// ([`RendererKind::Exact`]) draws the same level, so the two stay comparable. The
+    /// pyramid is built on the first such frame if it was not (`EnvMap::pyramid`).
+    pub fn set_still_level(&mut self, on: bool) {
+        self.still_level = on;
+    }
+
+    /// Whether still frames read a pyramid level ([`Renderer::set_still_level`]).
+    pub fn still_level(&self) -> bool {
+        self.still_level
+    }
+
     fn set_geometry(&mut self, w: u32, h: u32, p: Projection) {
         if self.geometry == Some((w, h, p)) {
             return;
@@ -393,20 +438,31 @@ impl Renderer {
         &self.tables.last().expect("just pushed").2
     }
 
-    /// The pyramid level a bilinear frame of `view` on `width` columns reads instead of
-    /// `map` ([`Renderer::set_bilinear_level`]), or `None` for the map itself.
+    /// The pyramid level a frame of `view` on `width × height` pixels is drawn from instead
+    /// of `map` ([`Renderer::set_bilinear_level`], [`Renderer::set_still_level`]), or
+    /// `None` for the map itself.
     fn level_map<'m>(
         &self,
         map: &'m EnvMap,
         view: View,
         sampler: Sampler,
-        width: u32,
+        (width, height): (u32, u32),
     ) -> Option<&'m EnvMap> {
-        if !(self.bilinear_level && sampler == Sampler::Bilinear) || map.crop().is_some() {
+        if map.crop().is_some() {
             return None;
         }
-        let centre = 2.0 * (view.hfov() * 0.5).tan() / width as f64 * map.width() as f64 / TAU;
-        let k = frame_level(centre, map.width(), map.height());
+        let k = match sampler {
+            Sampler::Bilinear if self.bilinear_level => {
+                let centre =
+                    2.0 * (view.hfov() * 0.5).tan() / width as f64 * map.width() as f64 / TAU;
+                frame_level(centre, map.width(), map.height())
+            }
+            Sampler::Bilinear | Sampler::Trilinear if self.still_level => {
+                let m = frame_min_footprint(view, width, height, geometry_of(map));
+                frame_level(m, map.width(), map.height())
+            }
+            _ => 0,
+        };
         (k > 0).then(|| map.level(k).0)
     }
 
@@ -540,17 +596,18 @@ impl Renderer {
                 return Ok((report, false));
             }
         };
-        if opts.renderer == RendererKind::Exact {
-            render_exact(map, view, opts.sampler, frame, opts.threads);
-            return Ok((RenderReport::exact(pixels), false));
-        }
-        if let Some(level) = self.level_map(map, view, opts.sampler, width) {
+        if let Some(level) = self.level_map(map, view, opts.sampler, (width, height)) {
             // Bilinear on the pyramid level matching the screen: a plain bilinear frame
-            // of the level, with tables for its geometry (`set_bilinear_level`).
+            // of the level, with tables for its geometry (`set_bilinear_level`,
+            // `set_still_level`). The level is drawn as the map itself would be.
             let r = self
                 .level
                 .get_or_insert_with(|| Box::new(Renderer::new(level)));
             return r.render_fused(Scene::Map(level), view, opts, frame, hook);
+        }
+        if opts.renderer == RendererKind::Exact {
+            render_exact(map, view, opts.sampler, frame, opts.threads);
+            return Ok((RenderReport::exact(pixels), false));
         }
         self.set_geometry(map.width(), map.height(), map.projection());
         if uses_grid(view, opts) {
@@ -772,6 +829,45 @@ pub(crate) fn frame_level(centre: f64, w: u32, h: u32) -> usize {
         .map_or(0, |k| k as usize)
 }
 
+/// The smallest footprint in a frame of `view` on `width × height` pixels of a map of
+/// `geometry`, in map pixels per screen pixel ([`Renderer::set_still_level`]): the
+/// minimum of the exact footprint (the larger of the map-pixel distances to the exact
+/// positions one pixel right and one below, `ExactFootprint::footprint`) over a grid of
+/// 17 × 9 points spanning the frame, corners and edges included (in a rectilinear view
+/// the footprint is smallest at the edges, where the view's rays meet the sphere at a
+/// slant). The centre is taken first: the minimum is at most the centre's footprint, so a
+/// frame that is not zoomed out (centre at most √2) stops there and costs one
+/// footprint. Points the map does not cover are skipped; with none covered, 0.
+pub(crate) fn frame_min_footprint(
+    view: View,
+    width: u32,
+    height: u32,
+    geometry: (u32, u32, Projection),
+) -> f64 {
+    let fp = ExactFootprint::new(view, width, height, geometry);
+    let at = |x: f64, y: f64| -> Option<f64> {
+        let uv = exact_uv_at(&fp.cam, fp.proj, fp.mw, fp.mh, x, y)?;
+        let f = fp.footprint(x, y, uv);
+        f.is_finite().then_some(f)
+    };
+    let (w, h) = (width as f64, height as f64);
+    let centre = at(w * 0.5, h * 0.5);
+    if centre.is_some_and(|c| c <= std::f64::consts::SQRT_2) {
+        return centre.unwrap_or(0.0);
+    }
+    const NX: u32 = 17;
+    const NY: u32 = 9;
+    // Pixel centres from the first to the last, in NX × NY steps.
+    let x_at = |i: u32| 0.5 + (w - 1.0) * i as f64 / (NX - 1) as f64;
+    let y_at = |j: u32| 0.5 + (h - 1.0) * j as f64 / (NY - 1) as f64;
+    (0..NY)
+        .flat_map(|j| (0..NX).map(move |i| (i, j)))
+        .filter_map(|(i, j)| at(x_at(i), y_at(j)))
+        .chain(centre)
+        .reduce(f64::min)
+        .unwrap_or(0.0)
+}
+
 fn geometry_of(map: &EnvMap) -> (u32, u32, Projection) {
     (map.width(), map.height(), map.projection())
 }
@@ -796,7 +892,53 @@ fn grid_report(stats: GridStats, width: u32, height: u32) -> RenderReport {
 
 #[cfg(test)]
 mod tests {
-    use super::frame_level;
+    use super::{frame_level, frame_min_footprint};
+    use crate::geom::camera::View;
+    use crate::geom::mapping::exact_uv_at;
+    use crate::geom::projection::Projection;
+    use crate::render::exact::ExactFootprint;
+
+    /// The smallest footprint of a frame, sampled on 17 × 9 points, against the minimum
+    /// over every pixel centre of the frame: never more than 3 % above it (the samples
+    /// include the corners and edges, where a rectilinear view's footprint is smallest)
+    /// and at most 2 % below (the samples are not all pixel centres), on views at the
+    /// horizon, tilted, near a pole, across the seam and wide; and the level chosen from
+    /// it is the one the brute-force minimum gives.
+    #[test]
+    fn frame_min_footprint_is_the_frames_smallest() {
+        let geometry = (2048, 1024, Projection::Equirect);
+        for (yaw, pitch, hfov, w, h) in [
+            (10.0, 0.0, 90.0, 64, 48),
+            (0.0, 45.0, 100.0, 96, 64),
+            (30.0, 80.0, 90.0, 80, 60),
+            (180.0, -30.0, 120.0, 97, 41),
+            (0.0, 0.0, 150.0, 128, 64),
+            (0.0, 0.0, 60.0, 1, 1),
+        ] {
+            let view = View::new(yaw, pitch, hfov).unwrap();
+            let fp = ExactFootprint::new(view, w, h, geometry);
+            let brute = (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x as f64 + 0.5, y as f64 + 0.5)))
+                .filter_map(|(x, y)| {
+                    let uv = exact_uv_at(&fp.cam, fp.proj, fp.mw, fp.mh, x, y)?;
+                    Some(fp.footprint(x, y, uv))
+                })
+                .fold(f64::INFINITY, f64::min);
+            let got = frame_min_footprint(view, w, h, geometry);
+            assert!(
+                got <= brute * 1.03 && got >= brute * 0.98,
+                "{yaw} {pitch} {hfov} {w}x{h}: sampled {got} against {brute}"
+            );
+            assert_eq!(
+                frame_level(got, 2048, 1024),
+                frame_level(brute, 2048, 1024),
+                "{yaw} {pitch} {hfov}: {got} against {brute}"
+            );
+        }
+        // Not zoomed out: the centre's footprint, at most √2, without the grid.
+        let view = View::new(0.0, 0.0, 20.0).unwrap();
+        assert!(frame_min_footprint(view, 160, 120, geometry) <= std::f64::consts::SQRT_2);
+    }
 
     /// The level of a bilinear frame on the level: the nearest power of two to the
     /// centre's footprint, among the levels that divide the map's sides.

@@ -93,12 +93,25 @@ pub struct Sample {
     pub tables_s: f64,
     /// Bytes of both tables.
     pub table_bytes: u64,
-    /// Median frame of the pan, bilinear.
+    /// Median frame of the pan, bilinear as the window draws a still frame: on the
+    /// deepest pyramid level on which no pixel is magnified by more than √2
+    /// (`Renderer::set_still_level`; the map itself unless the view is zoomed
+    /// out; the pyramid built before the pan).
     pub frame_ms_bilinear: f64,
+    /// Median frame of the pan, bilinear on the map itself at every zoom (the library's
+    /// default, what `frame_ms_bilinear` measured before still frames read a level).
+    #[serde(default)]
+    pub frame_ms_bilinear_map: f64,
     /// Median frame of the pan, nearest.
     pub frame_ms_nearest: f64,
-    /// Median frame of the pan, trilinear (the pyramid built before the pan).
+    /// Median frame of the pan, trilinear as the window draws a still frame (its default
+    /// sampler): from the same level as `frame_ms_bilinear` (`Renderer::set_still_level`;
+    /// the pyramid built before the pan, the level's own on the pan's first, untimed frame).
     pub frame_ms_trilinear: f64,
+    /// Median frame of the pan, trilinear on the map itself at every zoom (the library's
+    /// default, what `frame_ms_trilinear` measured before still frames read a level).
+    #[serde(default)]
+    pub frame_ms_trilinear_map: f64,
     /// Median frame of the pan, bilinear on the pyramid level matching the footprint
     /// (`Renderer::set_bilinear_level`, what the window uses while moving).
     #[serde(default)]
@@ -183,12 +196,12 @@ fn print_table(rows: &[Sample], a: &BenchLoadArgs) -> Result<()> {
         a.hfov
     )?;
     crate::outln!(
-        "| map | JPEG | load s (read + decode + convert) | tables s | frame ms bilinear | frame ms nearest | pyramid s | frame ms trilinear | frame ms bilinear on the level | map GiB | pyramid GiB | peak RSS after load GiB | peak RSS GiB |"
+        "| map | JPEG | load s (read + decode + convert) | tables s | frame ms bilinear | frame ms nearest | pyramid s | frame ms trilinear | frame ms bilinear on the level | frame ms bilinear on the map | frame ms trilinear on the map | map GiB | pyramid GiB | peak RSS after load GiB | peak RSS GiB |"
     )?;
-    crate::outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
+    crate::outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
     for s in rows {
         crate::outln!(
-            "| {}x{} | {:.1} MB | {:.2} ({:.2} + {:.2} + {:.2}) | {:.3} | {:.1} | {:.1} | {:.2} | {:.1} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} |",
+            "| {}x{} | {:.1} MB | {:.2} ({:.2} + {:.2} + {:.2}) | {:.3} | {:.1} | {:.1} | {:.2} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} |",
             s.width,
             s.height,
             s.file_bytes as f64 / 1e6,
@@ -202,6 +215,8 @@ fn print_table(rows: &[Sample], a: &BenchLoadArgs) -> Result<()> {
             s.pyramid_s,
             s.frame_ms_trilinear,
             s.frame_ms_bilinear_level,
+            s.frame_ms_bilinear_map,
+            s.frame_ms_trilinear_map,
             gib(s.map_bytes),
             gib(s.pyramid_bytes),
             gib(s.peak_after_load_bytes),
@@ -287,8 +302,11 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
 
     let (w, h) = a.size;
     let mut out = vec![0u32; w as usize * h as usize];
-    let mut pan = |sampler: Sampler, level: bool| -> Result<f64> {
-        renderer.set_bilinear_level(level);
+    // `still`: still frames on a level (`set_still_level`); `moving`: bilinear
+    // on the level of the view's centre (`set_bilinear_level`).
+    let mut pan = |sampler: Sampler, still: bool, moving: bool| -> Result<f64> {
+        renderer.set_still_level(still);
+        renderer.set_bilinear_level(moving);
         let o = RenderOptions {
             sampler,
             ..RenderOptions::default()
@@ -306,13 +324,15 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
         }
         Ok(median(&ms))
     };
-    let frame_ms_bilinear = pan(Sampler::Bilinear, false)?;
-    let frame_ms_nearest = pan(Sampler::Nearest, false)?;
+    let frame_ms_bilinear_map = pan(Sampler::Bilinear, false, false)?;
+    let frame_ms_nearest = pan(Sampler::Nearest, false, false)?;
     let t = Instant::now();
     map.pyramid();
     let pyramid_s = t.elapsed().as_secs_f64();
-    let frame_ms_trilinear = pan(Sampler::Trilinear, false)?;
-    let frame_ms_bilinear_level = pan(Sampler::Bilinear, true)?;
+    let frame_ms_trilinear_map = pan(Sampler::Trilinear, false, false)?;
+    let frame_ms_trilinear = pan(Sampler::Trilinear, true, false)?;
+    let frame_ms_bilinear = pan(Sampler::Bilinear, true, false)?;
+    let frame_ms_bilinear_level = pan(Sampler::Bilinear, false, true)?;
     Ok(Sample {
         width: map.width(),
         height: map.height(),
@@ -325,8 +345,10 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
         tables_s,
         table_bytes,
         frame_ms_bilinear,
+        frame_ms_bilinear_map,
         frame_ms_nearest,
         frame_ms_trilinear,
+        frame_ms_trilinear_map,
         frame_ms_bilinear_level,
         hfov: a.hfov,
         pyramid_s,

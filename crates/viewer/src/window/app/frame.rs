@@ -385,7 +385,10 @@ impl App {
         let opts = s.render_options(level);
         // While the view moves, bilinear frames read the pyramid level that matches the
         // screen (`Renderer::set_bilinear_level`): a huge map then pans at the cost of the
-        // level it shows. The still frame reads the map itself.
+        // level it shows. A still frame (trilinear by default, or bilinear) is drawn from
+        // the deepest level on which no pixel is magnified by more than √2
+        // (`Renderer::set_still_level`): the map itself unless the view is zoomed out, and
+        // then the cost of the level, not of a 32k map.
         let bilinear_level = fast && opts.sampler == Sampler::Bilinear;
         let lit = self.update_lit();
         // Once the lighting has settled, frames pan the lit panorama (unlit frames of it);
@@ -419,6 +422,7 @@ impl App {
         };
         if let SceneRef::Map { renderer, .. } = cur.scene.as_mut() {
             renderer.set_bilinear_level(bilinear_level);
+            renderer.set_still_level(true);
         }
         fit(&mut self.scene, rect.w as usize * rect.h as usize);
         let t0 = Instant::now();
