@@ -222,7 +222,7 @@ def targets_table(ours, peers, runs, load, load120, frame4k):
             if not a.get(f) or not b.get(f):
                 continue
             q = b[f] / a[f]
-            v = ("for reference (the library's default bilinear; the window's stills read the "
+            v = ("for reference (the library's default; the window's still frames read the "
                  "level)" if k.endswith("_map") else verdict(q, 1.25))
             rows.append(f"| 32768 map frame <= 1.25x the 8192 frame, {what}, hfov {hfov} | "
                         f"{b[f]:.1f} / {a[f]:.1f} ms = {q:.2f}x | {v} |")
