@@ -133,8 +133,8 @@ pub use render::kernel::{
 };
 pub use render::steps::{ADAPTIVE_MAX_STEP, SPAN_ERROR_BUDGET};
 pub use render::{
-    BandHook, IndexStep, LutChoice, Positions, RenderOptions, RenderPath, RenderReport, Renderer,
-    RendererKind, Scene, HOOK_BAND_ROWS, LUT_SWITCH_HFOV,
+    build_frame_levels, BandHook, IndexStep, LutChoice, Positions, RenderOptions, RenderPath,
+    RenderReport, Renderer, RendererKind, Scene, HOOK_BAND_ROWS, LUT_SWITCH_HFOV,
 };
 
 // Input.

@@ -382,7 +382,8 @@ impl Renderer {
     /// are smallest, and blends two of them there: 4x the 8192-wide map's frame as well.
     /// With this on, the frame is drawn as a plain bilinear or trilinear frame of pyramid
     /// level k, with the level's own tables (and, for trilinear, the level's own pyramid,
-    /// built on its first trilinear frame: a third of the level's bytes), where
+    /// a third of the level's bytes, built on its first trilinear frame unless
+    /// [`build_frame_levels`] built it before: the window does while loading), where
     /// k = ⌊log2(m) + ½⌋ and m is the smallest footprint in the frame (map pixels per
     /// screen pixel: the larger of the exact distances to the next pixel right and below,
     /// `frame_min_footprint`, sampled on a grid over the frame that includes its corners
@@ -822,11 +823,36 @@ pub(crate) fn frame_level(centre: f64, w: u32, h: u32) -> usize {
     }
     let want = (centre.log2() + 0.5).floor().min(31.0) as u32;
     (1..=want)
-        .take_while(|&k| {
-            w.is_multiple_of(1 << k) && h.is_multiple_of(1 << k) && (w.min(h) >> k) >= 2
-        })
+        .take_while(|&k| exact_level(k, w, h))
         .last()
         .map_or(0, |k| k as usize)
+}
+
+/// Whether level `k` (1 ≤ k ≤ 31) of a `w × h` map is exactly the map at 1/2^k scale and
+/// at least 2 pixels on its shorter side: the levels frames are drawn from
+/// ([`frame_level`]).
+fn exact_level(k: u32, w: u32, h: u32) -> bool {
+    w.is_multiple_of(1 << k) && h.is_multiple_of(1 << k) && (w.min(h) >> k) >= 2
+}
+
+/// Build now what frames drawn from pyramid levels need, so that no frame waits for it
+/// ([`Renderer::set_still_level`], [`Renderer::set_bilinear_level`]): `map`'s pyramid and
+/// the own pyramid of every level a frame can be drawn from (trilinear still frames of a
+/// level read the level's pyramid; its levels equal the map's below it, so this holds
+/// about a ninth of the map's bytes again: 0.22 GiB for a 32768×16384 map). The window
+/// calls it on its loading thread. Partial maps (drawn from the map itself) build
+/// nothing.
+pub fn build_frame_levels(map: &EnvMap) {
+    if map.crop().is_some() {
+        return;
+    }
+    for (i, level) in map.pyramid().iter().enumerate() {
+        let k = i as u32 + 1;
+        if k > 31 || !exact_level(k, map.width(), map.height()) {
+            break;
+        }
+        level.pyramid();
+    }
 }
 
 /// The smallest footprint in a frame of `view` on `width × height` pixels of a map of
@@ -938,6 +964,22 @@ mod tests {
         // Not zoomed out: the centre's footprint, at most √2, without the grid.
         let view = View::new(0.0, 0.0, 20.0).unwrap();
         assert!(frame_min_footprint(view, 160, 120, geometry) <= std::f64::consts::SQRT_2);
+    }
+
+    /// `build_frame_levels` builds the map's pyramid and the own pyramid of exactly the
+    /// levels frames can be drawn from: 48×24 divides down to level 3 (6×3), not 4.
+    #[test]
+    fn build_frame_levels_builds_the_levels_frames_use() {
+        let px: Vec<u32> = (0..48 * 24u32)
+            .map(|i| i.wrapping_mul(2654435761))
+            .collect();
+        let map = crate::EnvMap::from_pixels(48, 24, &px, Projection::Equirect).unwrap();
+        super::build_frame_levels(&map);
+        let levels = map.pyramid();
+        assert!(levels.len() > 3);
+        let built: Vec<bool> = levels.iter().map(|l| l.pyramid_bytes() > 0).collect();
+        assert!(built[..3].iter().all(|&b| b), "{built:?}");
+        assert!(built[3..].iter().all(|&b| !b), "{built:?}");
     }
 
     /// The level of a bilinear frame on the level: the nearest power of two to the

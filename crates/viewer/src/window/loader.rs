@@ -217,8 +217,9 @@ pub fn load(
     let mut on_progress = |p: lut_core::LoadProgress| progress(p.phase.into(), p.fraction);
     let (map, _) = crate::panorama::load_panorama_partial(path, &opts, coverage, &mut on_progress)
         .map_err(|e| format!("{e:#}"))?;
-    // Build both tables and the pyramid (the window's default sampler is trilinear) now,
-    // so the first frames do not wait for them.
+    // Build both tables and the pyramid (the window's default sampler is trilinear), and
+    // the levels' own pyramids (zoomed-out still frames are drawn from a level,
+    // `Renderer::set_still_level`), now, so the first frames do not wait for them.
     progress(LoadStep::Tables, Some(0.0));
     let mut scene = Scene::map(map);
     if let Scene::Map { map, renderer } = &mut scene {
@@ -227,7 +228,7 @@ pub fn load(
         progress(LoadStep::Tables, Some(0.3));
         renderer.table(surface, lut_core::TableKind::High);
         progress(LoadStep::Tables, Some(0.5));
-        map.pyramid();
+        lut_core::build_frame_levels(map);
     }
     progress(LoadStep::Tables, Some(1.0));
     Ok(Box::new(Loaded {
@@ -279,7 +280,11 @@ mod tests {
         assert!(!loaded.hdr && loaded.projection.is_none());
         assert_eq!(steps.last(), Some(&(LoadStep::Tables, Some(1.0))));
         assert!(steps.iter().any(|s| s.0 == LoadStep::Decoding));
-        assert!(loaded.map().unwrap().pyramid_bytes() > 0, "pyramid built");
+        let map = loaded.map().unwrap();
+        assert!(map.pyramid_bytes() > 0, "pyramid built");
+        // 64×32: levels 1 to 3 (down to 8×4) have pyramids of their own (level 4, 4×2,
+        // has none: pyramids end at a side of 2).
+        assert!(map.pyramid()[..3].iter().all(|l| l.pyramid_bytes() > 0));
         // A bad file: one line naming it.
         std::fs::write(tmp.path().join("bad.png"), b"not a png").unwrap();
         let e = load(
