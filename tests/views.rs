@@ -773,6 +773,22 @@ fn heat_map_max_is_the_measured_max() {
     assert_eq!(em.errors[0], None);
     assert_eq!(em.colors()[0], lut_core::HEAT_BACKGROUND);
     assert_eq!(em.errors[16 * 64 + 32], Some(0.0));
+    // A frame the renderer draws from a pyramid level (a zoomed-out still frame,
+    // `set_still_level`: hfov 90 over 48 columns of the 2048-wide map, level 3): the
+    // level's positions against the exact level, as a renderer of the level measures them.
+    let view = View::new(10.0, 0.0, 90.0).unwrap();
+    let opts = RenderOptions::default();
+    let level = &map.pyramid()[2];
+    assert_eq!(level.width(), 256);
+    let measure = |r: &mut Renderer, m: &lut_core::EnvMap| {
+        lut_core::ErrorMap::measure(r, Scene::Map(m), view, &opts, 48, 36).unwrap()
+    };
+    let mut r = Renderer::new(&map);
+    let on_map = measure(&mut r, &map);
+    r.set_still_level(true);
+    let em = measure(&mut r, &map);
+    assert_eq!(em, measure(&mut Renderer::new(level), level));
+    assert_ne!(em, on_map);
 }
 
 #[test]

@@ -65,8 +65,10 @@ pub struct ErrorMap {
 impl ErrorMap {
     /// The errors of the renderer `opts` selects for `view` of `scene` on a
     /// `width × height` output. Map scenes: the renderer's sampling positions
-    /// ([`Renderer::positions`], the same kernels as its frames) against the exact map.
-    /// Cube maps: every pixel's face coordinates are computed exactly by both cube
+    /// ([`Renderer::positions`], the same kernels as its frames) against the exact map;
+    /// for a frame the renderer draws from a pyramid level ([`Renderer::set_still_level`],
+    /// [`Renderer::set_bilinear_level`]) the level's positions against the exact level,
+    /// in the level's pixels (the texels that frame reads). Cube maps: every pixel's face coordinates are computed exactly by both cube
     /// renderers, so every error is 0.
     ///
     /// # Errors
@@ -100,6 +102,12 @@ impl ErrorMap {
                 });
             }
         };
+        if let Some(level) = renderer.level_map(map, view, opts.sampler, (width, height)) {
+            let r = renderer
+                .level
+                .get_or_insert_with(|| Box::new(Renderer::new(level)));
+            return ErrorMap::measure(r, Scene::Map(level), view, opts, width, height);
+        }
         let (mw, mh, p) = (map.width(), map.height(), map.projection());
         let (positions, _) = renderer.positions(mw, mh, p, view, opts, width, height)?;
         let (errors, stats) = position_errors(&positions, view, width, height, p, mw, mh);
