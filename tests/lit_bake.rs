@@ -380,9 +380,11 @@ fn frames_of_the_lit_map_match_frames_lit_per_pixel() {
     let mut renderer = Renderer::new(&pano);
     for (label, scene) in [("ring", ring(&bench_table())), ("walls", walls())] {
         let map = IlluminanceMap::build(&scene, &MapOptions::default()).unwrap();
-        pano.pyramid();
+        lut_core::build_frame_levels(&pano);
         let shade = auto(&map);
         let baked = map.bake_map(&pano, &shade).unwrap();
+        // Built with the copy, as the source's were: its pyramid and its levels' own.
+        assert!(baked.pyramid_bytes() > 0 && baked.pyramid()[0].pyramid_bytes() > 0);
         let case = Case {
             label,
             scene: &scene,
@@ -471,12 +473,13 @@ fn cube_and_partial_maps() {
 
 #[test]
 fn memory_budget_and_bad_options() {
-    // The lit copy: the padded map plus a third for its pyramid (none for a partial map).
+    // The lit copy: the padded map plus a third for its pyramid and a ninth for its
+    // levels' own pyramids (still frames drawn from a level).
     let m = grid_map(64, 32, Projection::Equirect).unwrap();
     assert_eq!(m.bytes(), 65 * 33 * 4);
-    assert_eq!(lit_map_bytes(&m), m.bytes() + m.bytes() / 3);
-    // The budget holds an 8192 × 4096 map and its pyramid, not a 16384 × 8192 one.
-    let bytes = |w: usize, h: usize| (w + 1) * (h + 1) * 4 * 4 / 3;
+    assert_eq!(lit_map_bytes(&m), m.bytes() + m.bytes() / 3 + m.bytes() / 9);
+    // The budget holds an 8192 × 4096 map and its pyramids, not a 16384 × 8192 one.
+    let bytes = |w: usize, h: usize| (w + 1) * (h + 1) * 4 * 13 / 9;
     assert!(bytes(8192, 4096) <= BAKE_MAX_BYTES);
     assert!(bytes(16384, 8192) > BAKE_MAX_BYTES);
     let e = LightError::BakeTooLarge {
@@ -485,7 +488,7 @@ fn memory_budget_and_bad_options() {
     };
     assert_eq!(
         e.to_string(),
-        "the lit panorama would take 683 MiB, more than the 192 MiB a bake may use: frames \
+        "the lit panorama would take 740 MiB, more than the 192 MiB a bake may use: frames \
          are lit one by one instead"
     );
     let scene = walls();

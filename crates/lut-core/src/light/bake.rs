@@ -15,7 +15,8 @@
 //!
 //! Only the base level is lit; the lit copy's pyramid (trilinear, and the level a moving
 //! window frame reads) is the ordinary 2×2 average of the lit texels, built when the
-//! source's pyramid has been built (else on first use). That is the box filter of the
+//! source's pyramid has been built (else on first use), with its levels' own pyramids
+//! (`crate::build_frame_levels`: zoomed-out still frames are drawn from a level). That is the box filter of the
 //! lit picture itself: a coarse texel straddling a room edge averages each side's own
 //! light, where lighting the averaged albedo with E at the texel's centre would put one
 //! face's light on both; and averaging costs a fraction of lighting.
@@ -47,12 +48,15 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// several hundred milliseconds.
 pub const BAKE_MAX_BYTES: usize = 192 << 20;
 
-/// The bytes a lit copy of `map` takes, its pyramid included (about a third more; a
-/// partial map's levels keep the texels its crop reaches, also about a third of its
-/// stored pixels, plus a row or column per level at the edges).
+/// The bytes a lit copy of `map` takes, its pyramids included: about a third more for
+/// its pyramid and, for a full panorama, a ninth more for its levels' own pyramids
+/// (`crate::build_frame_levels`: still frames drawn from a level); a partial map's levels
+/// keep the texels its crop reaches, also about a third of its stored pixels, plus a row
+/// or column per level at the edges.
 pub fn lit_map_bytes(map: &EnvMap) -> usize {
     let base = map.bytes();
-    base + base / 3
+    let levels = if map.crop().is_some() { 0 } else { base / 9 };
+    base + base / 3 + levels
 }
 
 /// The bytes a lit copy of `cube` takes, its pyramid included.
@@ -222,7 +226,7 @@ impl IlluminanceMap {
         cancelled(cancel)?;
         let lit = map.with_padded(data);
         if map.pyramid_bytes() > 0 {
-            lit.pyramid();
+            crate::render::build_frame_levels(&lit);
         }
         Ok(lit)
     }
