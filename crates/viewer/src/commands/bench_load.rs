@@ -40,6 +40,13 @@ pub struct BenchLoadArgs {
     /// Horizontal field of view of the pan, degrees.
     #[arg(long, default_value_t = 90.0)]
     pub hfov: f64,
+    /// Measure every map this many times, the maps taking turns (8k, 32k, 8k, 32k, …),
+    /// each time in a fresh process, and report each frame time as the median over the
+    /// passes (the load, table and pyramid times and the memory are the first pass's).
+    /// On a machine whose speed drifts, one pass per map measures the maps at different
+    /// moments; taking turns and the median make their ratios steadier.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=20))]
+    pub passes: u32,
     /// Print one JSON array instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -145,7 +152,7 @@ pub fn run(a: BenchLoadArgs) -> Result<()> {
     std::fs::create_dir_all(&cache)
         .with_context(|| format!("{}: cannot create the cache folder", cache.display()))?;
     let exe = std::env::current_exe().context("cannot find the viewer executable")?;
-    let mut rows = Vec::new();
+    let mut paths = Vec::new();
     for &w in &a.widths {
         let path = cache.join(format!("grid_{w}x{}_q{}.jpg", w / 2, a.quality));
         if !path.exists() {
@@ -154,32 +161,63 @@ pub fn run(a: BenchLoadArgs) -> Result<()> {
             generate_jpeg(&path, w, w / 2, a.quality)?;
             crate::errln!("  done in {:.1} s", t.elapsed().as_secs_f64());
         }
-        crate::errln!("measuring {}x{} in a child process ...", w, w / 2);
-        let out = std::process::Command::new(&exe)
-            .arg("bench-load")
-            .arg("--child")
-            .arg(&path)
-            .args(["--size", &format!("{}x{}", a.size.0, a.size.1)])
-            .args(["--frames", &a.frames.to_string()])
-            .args(["--hfov", &a.hfov.to_string()])
-            .args(["--max-pixels", &a.limit.max_pixels.to_string()])
-            .stderr(std::process::Stdio::inherit())
-            .output()
-            .context("cannot run the measuring child process")?;
-        if !out.status.success() {
-            bail!("measuring {} failed", path.display());
-        }
-        let line = String::from_utf8_lossy(&out.stdout);
-        let s: Sample = serde_json::from_str(line.trim())
-            .map_err(|e| anyhow!("child output is not a measurement ({e}): {line}"))?;
-        rows.push(s);
+        paths.push((w, path));
     }
+    let mut passes: Vec<Vec<Sample>> = vec![Vec::new(); paths.len()];
+    for pass in 0..a.passes {
+        for ((w, path), samples) in paths.iter().zip(&mut passes) {
+            crate::errln!(
+                "measuring {}x{} in a child process (pass {} of {}) ...",
+                w,
+                w / 2,
+                pass + 1,
+                a.passes
+            );
+            samples.push(measure_child(&exe, path, &a)?);
+        }
+    }
+    let rows: Vec<Sample> = passes.iter().map(|s| combine(s)).collect();
     if a.json {
         crate::outln!("{}", serde_json::to_string_pretty(&rows)?)?;
     } else {
         print_table(&rows, &a)?;
     }
     Ok(())
+}
+
+/// The first pass's sample with each frame time replaced by its median over `passes`.
+fn combine(passes: &[Sample]) -> Sample {
+    let m = |f: fn(&Sample) -> f64| median(&passes.iter().map(f).collect::<Vec<_>>());
+    Sample {
+        frame_ms_bilinear: m(|s| s.frame_ms_bilinear),
+        frame_ms_bilinear_map: m(|s| s.frame_ms_bilinear_map),
+        frame_ms_nearest: m(|s| s.frame_ms_nearest),
+        frame_ms_trilinear: m(|s| s.frame_ms_trilinear),
+        frame_ms_trilinear_map: m(|s| s.frame_ms_trilinear_map),
+        frame_ms_bilinear_level: m(|s| s.frame_ms_bilinear_level),
+        ..passes[0].clone()
+    }
+}
+
+/// Measure `path` in a child process (`viewer bench-load --child`).
+fn measure_child(exe: &Path, path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
+    let out = std::process::Command::new(exe)
+        .arg("bench-load")
+        .arg("--child")
+        .arg(path)
+        .args(["--size", &format!("{}x{}", a.size.0, a.size.1)])
+        .args(["--frames", &a.frames.to_string()])
+        .args(["--hfov", &a.hfov.to_string()])
+        .args(["--max-pixels", &a.limit.max_pixels.to_string()])
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .context("cannot run the measuring child process")?;
+    if !out.status.success() {
+        bail!("measuring {} failed", path.display());
+    }
+    let line = String::from_utf8_lossy(&out.stdout);
+    serde_json::from_str(line.trim())
+        .map_err(|e| anyhow!("child output is not a measurement ({e}): {line}"))
 }
 
 fn gib(b: u64) -> f64 {
@@ -190,12 +228,18 @@ fn print_table(rows: &[Sample], a: &BenchLoadArgs) -> Result<()> {
     // The children inherit LUTPANO_KERNEL, so they run the kernel named here.
     crate::outln!("{}", lut_core::kernel_info())?;
     crate::outln!(
-        "{} threads; pan {}x{}, {} frames, LUT renderer (pitch 10°, hfov {}°)",
+        "{} threads; pan {}x{}, {} frames, LUT renderer (pitch 10°, hfov {}°); {} pass{}",
         rayon::current_num_threads(),
         a.size.0,
         a.size.1,
         a.frames,
-        a.hfov
+        a.hfov,
+        a.passes,
+        if a.passes == 1 {
+            ""
+        } else {
+            "es (frame times: medians)"
+        }
     )?;
     crate::outln!(
         "| map | JPEG | load s (read + decode + convert) | tables s | frame ms bilinear | frame ms nearest | pyramid s | frame ms trilinear | frame ms bilinear on the level | frame ms bilinear on the map | frame ms trilinear on the map | map GiB | pyramid GiB | peak RSS after load GiB | peak RSS GiB |"
@@ -378,5 +422,44 @@ mod tests {
         assert!(parse_width("7").is_err());
         assert!(parse_width("128k").is_err()); // above the map limits
         assert!(parse_width("x").is_err());
+    }
+
+    /// Passes combine into the first pass's sample with the median of each frame time.
+    #[test]
+    fn passes_combine_into_median_frame_times() {
+        let sample = |k: f64| Sample {
+            width: 8192,
+            height: 4096,
+            file_bytes: 1,
+            map_bytes: 2,
+            load_s: k,
+            read_s: 0.0,
+            decode_s: 0.0,
+            convert_s: 0.0,
+            tables_s: 0.0,
+            table_bytes: 3,
+            frame_ms_bilinear: k,
+            frame_ms_bilinear_map: 2.0 * k,
+            frame_ms_nearest: 3.0 * k,
+            frame_ms_trilinear: 4.0 * k,
+            frame_ms_trilinear_map: 5.0 * k,
+            frame_ms_bilinear_level: 6.0 * k,
+            hfov: 90.0,
+            pyramid_s: 0.0,
+            pyramid_bytes: 4,
+            peak_after_load_bytes: 5,
+            peak_bytes: 6,
+        };
+        let c = combine(&[sample(5.0), sample(1.0), sample(2.0)]);
+        assert_eq!(c.load_s, 5.0, "the first pass's");
+        let frames = [
+            c.frame_ms_bilinear,
+            c.frame_ms_bilinear_map,
+            c.frame_ms_nearest,
+            c.frame_ms_trilinear,
+            c.frame_ms_trilinear_map,
+            c.frame_ms_bilinear_level,
+        ];
+        assert_eq!(frames, [2.0, 4.0, 6.0, 8.0, 10.0, 12.0]);
     }
 }
