@@ -598,9 +598,9 @@ impl Renderer {
             }
         };
         if let Some(level) = self.level_map(map, view, opts.sampler, (width, height)) {
-            // Bilinear on the pyramid level matching the screen: a plain bilinear frame
-            // of the level, with tables for its geometry (`set_bilinear_level`,
-            // `set_still_level`). The level is drawn as the map itself would be.
+            // A frame drawn from a pyramid level (`set_bilinear_level`, `set_still_level`):
+            // a plain frame of the level, with tables for its geometry, as the level
+            // would be drawn were it the map (the exact renderer's too).
             let r = self
                 .level
                 .get_or_insert_with(|| Box::new(Renderer::new(level)));
