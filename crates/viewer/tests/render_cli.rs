@@ -45,6 +45,48 @@ fn renders_the_bundled_sample_with_defaults() {
     assert!(rgb.pixels().any(|p| p != first));
 }
 
+/// `--still-level`: zoomed out (64 columns at hfov 90 of the 1024-wide sample), the frame
+/// comes from a pyramid level, so it differs from the frame of the map; and its
+/// neighbouring pixels differ less (the level averages what the map's texels alias).
+/// Zoomed in (hfov 60 over 320 columns), the two are the same image.
+#[test]
+fn still_level_draws_zoomed_out_frames_from_a_level() {
+    let d = tmpdir("still-level");
+    let render = |name: &str, size: &str, hfov: &str, still: bool| {
+        let out = d.join(name);
+        let mut args = vec!["render", "-o", s(&out), "--size", size, "--hfov", hfov];
+        if still {
+            args.push("--still-level");
+        }
+        let o = viewer(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        image::open(&out).unwrap().to_rgb8()
+    };
+    // Sum of the differences between horizontal neighbours: aliasing raises it.
+    let roughness = |img: &image::RgbImage| -> u64 {
+        (0..img.height())
+            .flat_map(|y| (1..img.width()).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let (p, q) = (img.get_pixel(x - 1, y), img.get_pixel(x, y));
+                (0..3).map(|c| u64::from(p[c].abs_diff(q[c]))).sum::<u64>()
+            })
+            .sum()
+    };
+    let map = render("map.png", "64x36", "90", false);
+    let level = render("level.png", "64x36", "90", true);
+    assert!(map != level);
+    assert!(
+        roughness(&level) < roughness(&map),
+        "{} against {}",
+        roughness(&level),
+        roughness(&map)
+    );
+    assert!(
+        render("in-map.png", "320x180", "60", false)
+            == render("in-level.png", "320x180", "60", true)
+    );
+}
+
 #[test]
 fn lut_and_exact_agree_on_the_sample() {
     let d = tmpdir("agree");

@@ -78,6 +78,12 @@ pub struct RenderArgs {
     /// view is larger than the coverage, then clamp pitch and yaw.
     #[arg(long)]
     pub view_limit: bool,
+    /// Draw a zoomed-out bilinear or trilinear frame from the pyramid level on which no
+    /// pixel is magnified by more than √2, as the window draws its still frames (less
+    /// aliasing, and a huge map costs what its level costs). Without it, frames read the
+    /// map itself at every zoom. Views that are not zoomed out are the same either way.
+    #[arg(long)]
+    pub still_level: bool,
     /// Render on one thread.
     #[arg(long)]
     pub single_thread: bool,
@@ -243,6 +249,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
         ));
     }
     let mut scene = a.load(scene_pano)?;
+    if let Scene::Map { renderer, .. } = &mut scene {
+        renderer.set_still_level(a.still_level);
+    }
     if let (true, Some(map)) = (a.view_limit, scene.env_map()) {
         view = lut_core::limit_view(view, w, h, &map.coverage());
     }
