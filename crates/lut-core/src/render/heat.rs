@@ -102,10 +102,8 @@ impl ErrorMap {
                 });
             }
         };
-        if let Some(level) = renderer.level_map(map, view, opts.sampler, (width, height)) {
-            let r = renderer
-                .level
-                .get_or_insert_with(|| Box::new(Renderer::new(level)));
+        if let Some((level, r)) = renderer.level_renderer(map, view, opts.sampler, (width, height))
+        {
             return ErrorMap::measure(r, Scene::Map(level), view, opts, width, height);
         }
         let (mw, mh, p) = (map.width(), map.height(), map.projection());

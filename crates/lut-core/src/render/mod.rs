@@ -181,6 +181,23 @@ impl Renderer {
     }
 
     /// The pyramid level a frame of `view` on `width × height` pixels is drawn from instead
+    /// of `map` ([`Renderer::level_map`]) and the renderer that draws it (tables for the
+    /// level's geometry, kept across frames), or `None` for the map itself.
+    pub(crate) fn level_renderer<'m>(
+        &mut self,
+        map: &'m EnvMap,
+        view: View,
+        sampler: Sampler,
+        size: (u32, u32),
+    ) -> Option<(&'m EnvMap, &mut Renderer)> {
+        let level = self.level_map(map, view, sampler, size)?;
+        let r = self
+            .level
+            .get_or_insert_with(|| Box::new(Renderer::new(level)));
+        Some((level, r))
+    }
+
+    /// The pyramid level a frame of `view` on `width × height` pixels is drawn from instead
     /// of `map` ([`Renderer::set_bilinear_level`], [`Renderer::set_still_level`]), or
     /// `None` for the map itself.
     fn level_map<'m>(
@@ -337,13 +354,10 @@ impl Renderer {
                 return Ok((report, false));
             }
         };
-        if let Some(level) = self.level_map(map, view, opts.sampler, (width, height)) {
+        if let Some((level, r)) = self.level_renderer(map, view, opts.sampler, (width, height)) {
             // A frame drawn from a pyramid level (`set_bilinear_level`, `set_still_level`):
             // a plain frame of the level, with tables for its geometry, as the level
             // would be drawn were it the map (the exact renderer's too).
-            let r = self
-                .level
-                .get_or_insert_with(|| Box::new(Renderer::new(level)));
             return r.render_fused(Scene::Map(level), view, opts, frame, hook);
         }
         if opts.renderer == RendererKind::Exact {
