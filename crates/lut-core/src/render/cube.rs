@@ -181,6 +181,32 @@ fn face_texels(cube: &CubeMap, face: Face) -> Texels<'_> {
         .expect("a cube face holds (n + 2)^2 texels, fewer than 2^31")
 }
 
+/// `t` toward the next scanline (`Texels::toward_next_scanline`): how far (face texels
+/// of `run`'s face, Q.8, positive: down) the next row's ray meets the face below this
+/// run's at its middle pixel (`len` pixels; the next row's rays are this row's minus
+/// R₁).
+#[inline]
+fn toward_next<'a>(
+    t: Texels<'a>,
+    frame: &Rays,
+    face: Face,
+    run: &FaceRun,
+    len: usize,
+) -> Texels<'a> {
+    let (_, db, dm) = face_axes(face, frame.r1);
+    let dx = run.dx + (len / 2) as f64;
+    let v_at = |b: f64, m: f64| -b * (run.half / m);
+    let (b, m) = (run.p[1] + dx * run.d[1], run.p[2] + dx * run.d[2]);
+    let dv = v_at(b - db, m - dm) - v_at(b, m);
+    // (Not finite or huge where the next row leaves the face: then no prefetch.)
+    let dv = if dv.is_finite() {
+        (dv * 256.0).round().clamp(-1e7, 1e7) as i32
+    } else {
+        0
+    };
+    t.toward_next_scanline(dv)
+}
+
 /// Texel fetch, monomorphized per sampler so the inner loops do not branch on it.
 trait Fetch: Copy + Send + Sync {
     /// The sample of ray `d` on `face` (the face of `d`), per pixel.
@@ -212,8 +238,9 @@ impl Fetch for NearestFetch {
         cube.nearest(face, u, v)
     }
     #[inline(always)]
-    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut FaceBuf) {
-        face_rows::<false>(&face_texels(c, f), r, o, b)
+    fn span(self, c: &CubeMap, fr: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut FaceBuf) {
+        let t = toward_next(face_texels(c, f), fr, f, r, o.len());
+        face_rows::<false>(&t, r, o, b)
     }
 }
 
@@ -224,8 +251,9 @@ impl Fetch for BilinearFetch {
         cube.bilinear(face, u, v)
     }
     #[inline(always)]
-    fn span(self, c: &CubeMap, _: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut FaceBuf) {
-        face_rows::<true>(&face_texels(c, f), r, o, b)
+    fn span(self, c: &CubeMap, fr: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut FaceBuf) {
+        let t = toward_next(face_texels(c, f), fr, f, r, o.len());
+        face_rows::<true>(&t, r, o, b)
     }
 }
 
@@ -276,7 +304,9 @@ impl Fetch for TrilinearFetch {
                 dx: run.dx + (cs.start * C) as f64,
                 ..*run
             };
-            (face_texels(l, face), sub, cs.start * C..(cs.end * C).min(n))
+            let px = cs.start * C..(cs.end * C).min(n);
+            let t = toward_next(face_texels(l, face), frame, face, &sub, px.len());
+            (t, sub, px)
         };
         for (k, cs) in same_runs(levels.len(), |c| Some(levels[c].0)) {
             let (t, sub, px) = on(k, &cs);

@@ -307,6 +307,7 @@ pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
     }
     let wq = (map.width() as i32) << 8;
     let RowScratch { nodes, row: buf } = scratch;
+    let t = &t.toward_next_scanline(scan.next_dv);
     row_pass(scan, table, fr, (nodes, buf), &mut s, |s, r| {
         let n = r.u.len();
         if CROP {
@@ -342,8 +343,9 @@ pub(crate) fn tri_row(
         });
         return;
     }
+    let dv = scan.next_dv;
     row_pass(scan, table, fr, (nodes, buf), s, |s, r| {
-        tri_run(levels, wq, r, s.row);
+        tri_run(levels, wq, dv, r, s.row);
     });
 }
 
@@ -360,7 +362,8 @@ fn resolve(lod: i32, last: usize) -> (usize, u32) {
     }
 }
 
-/// A trilinear run (`levels`: level 0, the map `wq` / 256 wide, and its pyramid): the
+/// A trilinear run (`levels`: level 0, the map `wq` / 256 wide, and its pyramid; `dv`:
+/// the next scanline's offset, `Texels::toward_next_scanline`): the
 /// positions are grouped by their first level ka (consecutive [`Seg`]s); each group is
 /// sampled bilinearly on level ka (level 0: the bilinear row kernel, which is all of a
 /// magnified run), then, unless ka is the last level, level ka + 1 is blended in by each
@@ -369,9 +372,9 @@ fn resolve(lod: i32, last: usize) -> (usize, u32) {
 /// identity). Per pixel that is
 /// `EnvMap::trilinear` at the position (u wrapped into the map) with the span's level of
 /// detail.
-fn tri_run(levels: &[Texels], wq: i32, r: HalfRun<'_>, row: &mut [u32]) {
+fn tri_run(levels: &[Texels], wq: i32, dv: i32, r: HalfRun<'_>, row: &mut [u32]) {
     tri_groups(levels.len() - 1, r, row, |k, w, (u, v), out| {
-        let t = &levels[k];
+        let t = &levels[k].toward_next_scanline(dv);
         let lv = Level {
             k: k as u32,
             wq,
@@ -811,7 +814,7 @@ mod tests {
                 };
                 check_run(
                     (&u, &ul, &v, &segs),
-                    |r, row| tri_run(&levels[..nl], wq as i32, r, row),
+                    |r, row| tri_run(&levels[..nl], wq as i32, 0, r, row),
                     at,
                     &format!("{w}x{h}"),
                 );

@@ -42,6 +42,10 @@ pub(crate) struct Scan {
     /// Vertical pixel footprint per region (level-0 map pixels; trilinear only): the
     /// distance between this scanline's and the next one's table positions.
     pub(crate) fy: [f32; STEP_REGIONS],
+    /// Map rows (Q.8, positive: down) from this scanline's read at the centre column to
+    /// the next scanline's: the row kernels prefetch the rows it will read
+    /// (`Texels::toward_next_scanline`).
+    pub(crate) next_dv: i32,
     pub(crate) lut_lo: i64,
     pub(crate) lut_hi: i64,
     pub(crate) zone_lo: i64,
@@ -147,9 +151,17 @@ pub(crate) fn prepare(
         if back {
             a = PI - a;
         }
+        // The centre column's map row on this scanline and the next (the latitude of
+        // a scanline's centre is its angle folded into [−π/2, π/2]).
+        let v_at = |al: f64| -proj.profile(al.sin().clamp(-1.0, 1.0).asin(), mwf, mhf);
+        let dv = v_at(pitch + (yc - 1.0).atan2(f)) - v_at(alpha);
+        let next_dv = (dv * 256.0)
+            .round()
+            .clamp(-(1 << 24) as f64, (1 << 24) as f64) as i32;
         let mut scan = Scan {
             neg_v,
             back,
+            next_dv,
             sa,
             ca,
             t_per_x: 1.0 / rho,
@@ -352,4 +364,66 @@ fn exact_count(s: &Scan, w: i64) -> u64 {
     let zh = s.zone_hi.min(s.lut_hi);
     let zone = if zl <= zh { zh - zl + 1 } else { 0 };
     (outside + zone) as u64
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::geom::camera::{Camera, View};
+    use crate::geom::mapping::exact_uv_at;
+    use crate::geom::projection::Projection;
+    use crate::map::synth::grid_map;
+    use crate::render::{Frame, RenderOptions, Renderer, Scene};
+
+    /// Each scanline's `next_dv` (what the row kernels prefetch for the next scanline) is
+    /// the map-row offset from its centre column's read to the next scanline's: against
+    /// the exact positions of the centre column (X = 0) on both rows, within 1/256 row
+    /// (its Q.8 rounding), on views at the horizon, tilted, past the north pole at the
+    /// top (the offset turns negative there) and past the south pole at the bottom, on
+    /// an equirectangular and a sine map.
+    #[test]
+    fn next_dv_is_the_next_scanlines_offset_at_the_centre() {
+        let (w, h) = (64u32, 48u32);
+        for proj in [Projection::Equirect, Projection::Sine] {
+            let map = grid_map(512, 256, proj).unwrap();
+            let mut r = Renderer::new(&map);
+            for (yaw, pitch, hfov) in [
+                (0.0, 0.0, 90.0),
+                (40.0, 45.0, 70.0),
+                (10.0, 80.0, 90.0),
+                (200.0, -75.0, 120.0),
+            ] {
+                let view = View::new(yaw, pitch, hfov).unwrap();
+                let mut px = vec![0u32; (w * h) as usize];
+                let mut frame = Frame::new(&mut px, w, h).unwrap();
+                r.render(
+                    Scene::Map(&map),
+                    view,
+                    &RenderOptions::default(),
+                    &mut frame,
+                )
+                .unwrap();
+                let cam = Camera::new(view, w, h);
+                let v_at = |y: f64| {
+                    exact_uv_at(&cam, proj, 512.0, 256.0, w as f64 / 2.0, y)
+                        .unwrap()
+                        .1
+                };
+                let mut negative = false;
+                for y in 0..h as usize {
+                    let want = v_at(y as f64 + 1.5) - v_at(y as f64 + 0.5);
+                    let got = r.scans[y].next_dv as f64 / 256.0;
+                    assert!(
+                        (got - want).abs() <= 1.0 / 256.0 + 1e-9 * want.abs(),
+                        "{proj:?} {yaw} {pitch} {hfov}, row {y}: {got} against {want}"
+                    );
+                    negative |= got < 0.0;
+                }
+                assert_eq!(
+                    negative,
+                    pitch.abs() > 60.0,
+                    "{proj:?} {pitch}: the rows past a pole"
+                );
+            }
+        }
+    }
 }

@@ -180,6 +180,10 @@ pub struct Texels<'a> {
     width: u32,
     height: u32,
     wraps: bool,
+    /// How far the next scanline's reads lie below this one's (map rows, level-0 Q.8 as
+    /// the row kernels' positions, negative: above; 0: not known), for the row kernels'
+    /// prefetch of the rows it will read ([`Texels::toward_next_scanline`]).
+    next_dv: i32,
 }
 
 impl<'a> Texels<'a> {
@@ -193,7 +197,33 @@ impl<'a> Texels<'a> {
             width,
             height,
             wraps,
+            next_dv: 0,
         })
+    }
+
+    /// These texels, read by a scanline whose next scanline reads `dv` map rows (level-0
+    /// Q.8, negative: above) further down at the same pixel.
+    ///
+    /// Why: the x86 row kernels prefetch the texels a run will read a few hundred pixels
+    /// ahead into L1; with `dv` known they also prefetch, into L2, the rows the next
+    /// scanline will read that this one does not. Those lines then come from L2 instead
+    /// of L3 or memory when that scanline's own prefetches ask for them: the 8k frame at
+    /// hfov 90 (about 1.2 map rows a scanline) drew about 25 % faster on one thread
+    /// (docs/performance.md, "The next scanline's rows"). A wrong `dv` costs only
+    /// useless prefetches; no result depends on it.
+    #[inline(always)]
+    pub(crate) fn toward_next_scanline(self, dv: i32) -> Texels<'a> {
+        Texels {
+            next_dv: dv,
+            ..self
+        }
+    }
+
+    /// See [`Texels::toward_next_scanline`] (read by the x86 row kernels only).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    #[inline(always)]
+    pub(crate) fn next_dv(&self) -> i32 {
+        self.next_dv
     }
 
     /// Pixels per row, padding included.

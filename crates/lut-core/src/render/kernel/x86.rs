@@ -98,6 +98,18 @@ pub(super) const PREFETCH_AHEAD: usize = 48;
 /// map row ahead in both.
 pub(super) const PREFETCH_TEXELS: usize = 256;
 
+/// Prefetch into L2 the cache lines holding texel `at` and the one `stride` texels below
+/// it (the rows the next scanline will read, `x86/row.rs`). `at` need not point into the
+/// map: a line off the map is a wasted prefetch, nothing more.
+#[inline(always)]
+fn prefetch_next_rows(at: *const u32, stride: usize) {
+    // SAFETY: as in `prefetch_texels`: a prefetch never faults, whatever the address.
+    unsafe {
+        _mm_prefetch::<_MM_HINT_T1>(at.cast());
+        _mm_prefetch::<_MM_HINT_T1>(at.wrapping_add(stride).cast());
+    }
+}
+
 /// Prefetch the cache line holding texel `at` and, for bilinear, the one `stride` texels
 /// below it (the row kernels' look-ahead). `at` need not point
 /// into the map: a line off the map is a wasted prefetch, nothing more.

@@ -28,7 +28,9 @@
 //! `docs/performance.md`, "AVX-512".
 
 use super::super::row::{sample_lv_scalar, Level, Positions, SpanQ8};
-use super::{prefetch_texels, Kernel, Selected, Texels, PREFETCH_AHEAD, PREFETCH_TEXELS};
+use super::{
+    prefetch_next_rows, prefetch_texels, Kernel, Selected, Texels, PREFETCH_AHEAD, PREFETCH_TEXELS,
+};
 use std::arch::x86_64::*;
 
 /// The row kernel with a SIMD kernel (see `row::sample_lv_scalar`); `false` (nothing
@@ -95,15 +97,43 @@ fn last_index<const BILINEAR: bool>(t: &Texels) -> usize {
 /// its texel, and for bilinear the one below. Positions past the run are skipped;
 /// positions off the map (a seam not yet wrapped) prefetch a wrong line, which is
 /// harmless: a prefetch never faults and changes no result.
+///
+/// Where the next scanline's offset is known (`Texels::next_dv`, level-0 Q.8 as `v`)
+/// and is a row or more on this level, also the two rows from [`next_rows`] on, into
+/// L2. (Below a row a scanline, the next one reads mostly this one's rows, and a frame
+/// reads so few rows of the map that they stay in the cache: the 4096x2048 map's frame
+/// at hfov 90, 0.6 rows a scanline, drew ~10 % slower with these prefetches.)
 #[inline(always)]
 fn prefetch<const BILINEAR: bool>(t: &Texels, (u, v): (&[i32], &[i32]), j: usize, k: u32) {
     if let (Some(&u), Some(&v)) = (u.get(j), v.get(j)) {
         let stride = t.stride() as isize;
         let (x, y) = ((u >> (8 + k)) as isize, (v >> (8 + k)) as isize);
-        let at =
-            t.px.as_ptr()
-                .wrapping_offset(y.wrapping_mul(stride).wrapping_add(x));
-        prefetch_texels::<BILINEAR>(at, t.stride());
+        let row = t.px.as_ptr().wrapping_offset(x);
+        prefetch_texels::<BILINEAR>(row.wrapping_offset(y.wrapping_mul(stride)), t.stride());
+        let dv = t.next_dv();
+        if dv.unsigned_abs() >> k >= 256 {
+            let y = next_rows::<BILINEAR>(v, dv, k) as isize;
+            prefetch_next_rows(row.wrapping_offset(y.wrapping_mul(stride)), t.stride());
+        }
+    }
+}
+
+/// The first of the two map rows (on level `k`) that [`prefetch`] fetches for the next
+/// scanline, whose position at this pixel is `dv` rows (level-0 Q.8) from `v`'s: its
+/// row Y = ⌊(v + dv) / 2^(8+k)⌋ unless that is a row this scanline reads (y, and for
+/// bilinear y + 1), then the first row past them in the direction of `dv`. The next
+/// scanline reads Y (and Y + 1), so this covers what it reads anew when `dv` is right,
+/// and when the true offset is smaller (the rows of a scanline's edges move less than
+/// its centre's, where `dv` is measured) the rows just past this one's.
+#[inline(always)]
+fn next_rows<const BILINEAR: bool>(v: i32, dv: i32, k: u32) -> i32 {
+    let s = 8 + k;
+    let (y, ny) = (v >> s, v.saturating_add(dv) >> s);
+    match (BILINEAR, dv > 0) {
+        (true, true) => ny.max(y + 2),
+        (true, false) => ny.min(y - 2),
+        (false, true) => ny.max(y + 1),
+        (false, false) => ny.min(y - 1) - 1,
     }
 }
 
@@ -575,5 +605,42 @@ mod sse41 {
     #[target_feature(enable = "sse4.1")]
     fn reverse(c: V) -> V {
         _mm_shuffle_epi32::<0x1B>(c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::next_rows;
+
+    /// The two rows [`next_rows`] gives hold every row the next scanline reads that this
+    /// one does not (this one reads y and for bilinear y + 1; the next one ⌊(v + dv)⌋ and
+    /// for bilinear the row below), on every level, down and up the map, for offsets
+    /// below a row to several rows, and for every fraction of `v` in the tested rows.
+    #[test]
+    fn next_rows_hold_the_rows_the_next_scanline_reads_anew() {
+        for k in 0..3u32 {
+            let s = 8 + k;
+            for dv in (-2000..=2000).step_by(7).filter(|&d: &i32| d != 0) {
+                for v in (1000 << s)..(1000 << s) + (3 << s) {
+                    for bilinear in [false, true] {
+                        let (y, ny) = (v >> s, (v + dv) >> s);
+                        let rows = |a: i32| if bilinear { vec![a, a + 1] } else { vec![a] };
+                        let first = if bilinear {
+                            next_rows::<true>(v, dv, k)
+                        } else {
+                            next_rows::<false>(v, dv, k)
+                        };
+                        for r in rows(ny) {
+                            assert!(
+                                rows(y).contains(&r) || r == first || r == first + 1,
+                                "k {k}, v {v}, dv {dv}, bilinear {bilinear}: row {r} of the \
+                                 next scanline not fetched (rows {first}, {})",
+                                first + 1
+                            );
+                        }
+                    }
+                }
+            }
+        }
     }
 }
