@@ -8,8 +8,10 @@
 //!    (`accuracy::position_error`, the angular metric), and every renderer's image is
 //!    compared with the exact image of the same sampler (PSNR over R, G, B, pooled over
 //!    the set's frames).
-//! 2. **speed**: every configuration renders every frame of the set (one warm-up pass,
-//!    then `--passes` timed passes); the median milliseconds per frame is reported.
+//! 2. **speed**: every configuration renders every frame of the set, `--passes` times
+//!    (each a warm-up pass, then a timed pass; the configurations take turns, pass by
+//!    pass, so that a drifting machine's speed weighs on all alike: `time_configs`); the
+//!    median milliseconds per frame is reported.
 //!
 //! Tables are built before timing (their build time is reported separately), so a frame's
 //! time is all the per-view work: per-scanline setup plus the kernels. The grid renderer
@@ -63,7 +65,8 @@ pub struct BenchArgs {
     /// The view sets: quick or full.
     #[arg(long, default_value = "quick", value_parser = named::<ViewsArg>())]
     pub views: ViewsArg,
-    /// Timed passes over each set (after one warm-up pass).
+    /// Timed passes over each set, each after a warm-up pass (the configurations take
+    /// turns, pass by pass).
     #[arg(long, default_value_t = 3)]
     pub passes: u32,
     /// Print one JSON array instead of the table.
@@ -121,6 +124,35 @@ fn parse_kernel_choice(s: &str) -> Result<KernelChoice, String> {
                 lut_core::name_list::<Kernel>()
             )
         })
+}
+
+/// Milliseconds per frame of every configuration of `cfgs` over the set, the passes
+/// taking turns: each [`time_config`] call is one warm-up pass and one timed pass, and
+/// pass p of every configuration runs before pass p + 1 of any (exact renders: pass 1
+/// only, as `time_config` times them once).
+///
+/// Why: timed one after the other, each configuration's passes fell in one window of a
+/// few seconds, and on a VM whose speed drifts by 20–30 % over seconds the ratios
+/// between configurations (the cube scanline frame against the LUT's measured 0.64x and
+/// 1.11x in two runs of the same code) followed the drift more than the code. Taking
+/// turns puts every configuration's samples across the whole measurement.
+fn time_configs(
+    ctx: &Ctx,
+    renderer: &mut Renderer,
+    cfgs: &[configs::Config],
+    gather_idx: &[Vec<u32>],
+    passes: u32,
+) -> Result<Vec<Vec<f64>>> {
+    let mut times = vec![Vec::new(); cfgs.len()];
+    for pass in 0..passes {
+        for (cfg, t) in cfgs.iter().zip(&mut times) {
+            if pass > 0 && matches!(cfg, configs::Config::Exact(_)) {
+                continue;
+            }
+            t.extend(time_config(ctx, renderer, *cfg, gather_idx, 1)?);
+        }
+    }
+    Ok(times)
 }
 
 /// Run `viewer bench`.
@@ -248,8 +280,8 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         };
         let errs = measure_errors(&ctx, &mut renderer, &cfgs, export)?;
         let ti = if set.table == TableKind::Wide { 0 } else { 1 };
-        for (cfg, e) in cfgs.iter().zip(&errs.per_config) {
-            let times = time_config(&ctx, &mut renderer, *cfg, &errs.gather_idx, a.passes)?;
+        let times = time_configs(&ctx, &mut renderer, &cfgs, &errs.gather_idx, a.passes)?;
+        for ((cfg, e), times) in cfgs.iter().zip(&errs.per_config).zip(times) {
             let (index_step, lut) = cfg.lut_fields(set.table);
             let mut row = Row {
                 index_step,
