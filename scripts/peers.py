@@ -3,7 +3,7 @@
 
     python3 scripts/peers.py [--size 1920x1080] [--threads 2] [--out /tmp/peers]
                              [--viewer target/release/viewer] [--no-install] [--no-ffmpeg]
-                             [--no-py360] [--no-nona]
+                             [--no-py360] [--no-nona] [--rounds N]
 
 1. Installs the peers with the ordinary tools if missing: `pip install
    opencv-python-headless numpy py360convert`, `apt-get install -y ffmpeg hugin-tools`.
@@ -19,7 +19,11 @@
    * py360convert `e2p` (numpy; builds its sampling grid on every call), one call per view;
    * Hugin's `nona` from a PTO project per view, timed minus a 1x1-output run (loading).
    All with the same thread count (`cv2.setNumThreads`, ffmpeg `-filter_threads`).
-4. Prints a table: median ms per frame, our time as a ratio to theirs, and their PSNR
+4. With `--rounds N`, N - 1 more rounds of ours (`viewer bench --only-default`: the
+   LUT's default nearest and bilinear alone) then OpenCV's four remaps, in turns: our
+   time is the median of the rounds' medians, OpenCV's the median of all its rounds'
+   timings, so a machine whose speed drifts weighs on both alike.
+5. Prints a table: median ms per frame, our time as a ratio to theirs, and their PSNR
    against our exact render (same sampler). Writes OUT/peers.json.
 
 The source map is padded by one wrapped column on each side so OpenCV's
@@ -115,6 +119,10 @@ def main():
     ap.add_argument("--no-py360", action="store_true", help="skip py360convert")
     ap.add_argument("--no-nona", action="store_true", help="skip Hugin's nona")
     ap.add_argument("--bench-args", default="", help="extra arguments for viewer bench")
+    ap.add_argument("--rounds", type=int, default=1,
+                    help="rounds of the OpenCV remap timings, each after a `viewer bench "
+                         "--only-default` of ours (the first after the full bench): ours and "
+                         "theirs timed in turns, medians over the rounds")
     a = ap.parse_args()
     install(a.no_install)
     import cv2
@@ -270,8 +278,50 @@ def main():
                 imgs["nona"].append((np.ascontiguousarray(o[:, :, :3]), ex_bil))
             print(f"peers: nona view {i + 1}/{len(meta['views'])}", file=sys.stderr)
 
-    def our(sampler, step):
-        for r in ours:
+    # Later rounds: ours (`viewer bench --only-default`: the LUT's default configurations
+    # alone) and then OpenCV's remaps again, in turns, so that a VM whose speed drifts by
+    # 20-30 % over seconds weighs on both alike (one round timed ours and theirs a minute
+    # apart: the 8k fixed-point ratio measured 0.40x and 0.56x in two runs of one code).
+    round_args, skip = [], False
+    for x in a.bench_args.split():
+        if skip:
+            skip = False
+        elif x in ("--plot", "--export-maps"):
+            skip = True
+        else:
+            round_args.append(x)
+    later = []
+    for rnd in range(2, a.rounds + 1):
+        cmd = [a.viewer, "bench", "--size", a.size, "--threads", str(a.threads), "--json",
+               "--only-default"] + round_args
+        later.append(json.loads(subprocess.run(cmd, check=True, stdout=subprocess.PIPE,
+                                               stderr=subprocess.DEVNULL).stdout))
+        for v in meta["views"]:
+            rd = lambda name, dt: np.fromfile(os.path.join(a.out, v[name]), dtype=dt)  # noqa: E731
+            mx = rd("mapx", np.float32).reshape(h, w) + 1.0
+            my = rd("mapy", np.float32).reshape(h, w)
+            m1, m2 = cv2.convertMaps(mx, my, cv2.CV_16SC2)
+            n1, _ = cv2.convertMaps(mx, my, cv2.CV_16SC2, nninterpolation=True)
+            bil, nn, rep = cv2.INTER_LINEAR, cv2.INTER_NEAREST, cv2.BORDER_REPLICATE
+            for key, fn in [
+                ("cv_float_bil", lambda: cv2.remap(srcp, mx, my, bil, borderMode=rep)),
+                ("cv_fixed_bil", lambda: cv2.remap(srcp, m1, m2, bil, borderMode=rep)),
+                ("cv_float_nn", lambda: cv2.remap(srcp, mx, my, nn, borderMode=rep)),
+                ("cv_fixed_nn", lambda: cv2.remap(srcp, n1, None, nn, borderMode=rep)),
+            ]:
+                for rep_i in range(a.reps + 1):  # +1 warm-up
+                    t = time.perf_counter()
+                    fn()
+                    if rep_i > 0:
+                        res[key].append(time.perf_counter() - t)
+        print(f"peers: round {rnd}/{a.rounds} (ours, then OpenCV remap)", file=sys.stderr)
+
+    def our(sampler, step, rows=None):
+        if rows is None:
+            vals = [our(sampler, step, r) for r in [ours] + later]
+            vals = [x for x in vals if x is not None]
+            return statistics.median(vals) if vals else None
+        for r in rows:
             if (r["renderer"] == "lut" and r["sampler"] == sampler and r["lut"] == "wide"
                     and r.get("surface", "cylinder") == "cylinder"
                     and r["index_step"] == step and r["hfov"] == 90.0):
@@ -316,7 +366,9 @@ def main():
     rows[-1]["peer"] = "OpenCV fixed nearest vs our plain gather"
 
     summary = {"threads": n, "width": w, "height": h, "map_width": mw, "map_height": mh,
-               "views": len(meta["views"]), "reps": a.reps,
+               "views": len(meta["views"]), "reps": a.reps, "rounds": a.rounds,
+               "ours_lut_bilinear_adaptive_rounds_ms":
+                   [our("bilinear", "adaptive", r) for r in [ours] + later],
                "ours_lut_bilinear_adaptive_ms": lut_bil, "ours_lut_nearest_adaptive_ms": lut_nn,
                "ours_lut_nearest_step4_ms": lut_nn,
                "numpy_map_max_diff_px": np_map_err,

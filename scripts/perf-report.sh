@@ -20,7 +20,9 @@
 #             configurations, the minification set, the chart docs/img/speed_error.png)
 #             and every peer (OpenCV remap, numpy+remap, ffmpeg v360, py360convert, nona)
 #             on the same views; then the chart redrawn with the peers (`viewer bench
-#             --replot main/ours.json --peers main/peers.json`)   -> main/{ours,peers}.json
+#             --replot main/ours.json --peers main/peers.json`); OpenCV's remaps in three
+#             rounds taking turns with ours (`peers.py --rounds 3`: a drifting VM weighs
+#             on both alike)                                     -> main/{ours,peers}.json
 #   extra     the OpenCV remap peers again with 1 thread, and with the 4096x2048 map on
 #             1 and $THREADS threads (viewer bench without cube/minify rows)
 #                                                    -> t1/, map4k/, map4k-t1/ peers.json
@@ -39,10 +41,10 @@ THREADS=${THREADS:-2}
 SIZE=${SIZE:-1920x1080}
 SKIP=${SKIP:-}
 # The sizes (QUICK: a smoke test of this script, not a measurement).
-map8k=8192x4096 map4k=4096x2048 passes=3 reps=3 frames=36 cfr=30 size4k=3840x2160 main_peers= lpasses=3
+map8k=8192x4096 map4k=4096x2048 passes=3 reps=3 frames=36 cfr=30 size4k=3840x2160 main_peers= lpasses=3 rounds=3
 widths=8k,16k,32k widths120=8k,32k plot=$PWD/docs/img/speed_error.png
 if [ -n "${QUICK:-}" ]; then
-  SIZE=320x180 map8k=1024x512 map4k=512x256 passes=1 reps=1 frames=4 cfr=2 lpasses=1
+  SIZE=320x180 map8k=1024x512 map4k=512x256 passes=1 reps=1 frames=4 cfr=2 lpasses=1 rounds=1
   size4k=640x360 widths=1k,2k widths120=1k plot=$OUT/speed_error.png
   SKIP="$SKIP callgrind" main_peers="--no-ffmpeg --no-nona"
 fi
@@ -63,7 +65,8 @@ if ! skip bench; then
   say "viewer bench + all peers (map 8192x4096, $THREADS threads)"
   mkdir -p "$OUT/main"
   # shellcheck disable=SC2086 # main_peers is a list of flags
-  python3 scripts/peers.py --size "$SIZE" --threads "$THREADS" --out "$OUT/main" --reps "$reps" $main_peers \
+  python3 scripts/peers.py --size "$SIZE" --threads "$THREADS" --out "$OUT/main" --reps "$reps" \
+    --rounds "$rounds" $main_peers \
     --bench-args "--passes $passes --map-size $map8k --plot $plot" >"$OUT/main/peers.txt"
   # The chart again, now with the peers of this run (measures nothing).
   "$viewer" bench --replot "$OUT/main/ours.json" --peers "$OUT/main/peers.json" --plot "$plot"
@@ -75,7 +78,7 @@ if ! skip extra; then
     read -r name map threads <<<"$run"
     say "OpenCV remap peers: map $map, $threads thread(s)"
     python3 scripts/peers.py --size "$SIZE" --threads "$threads" --out "$OUT/$name" \
-      --reps "$reps" --no-ffmpeg --no-py360 --no-nona \
+      --reps "$reps" --rounds "$rounds" --no-ffmpeg --no-py360 --no-nona \
       --bench-args "$quick --map-size $map" >"$OUT/$name.txt"
   done
 fi

@@ -36,7 +36,7 @@ use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use configs::{configs, view_sets, ViewsArg};
 use lut_core::CubeMap;
-use lut_core::TableKind;
+use lut_core::{IndexStep, TableKind};
 use lut_core::{Kernel, Projection, Renderer, Sampler, Surface};
 use measure::{gather_source, in_pool, measure_errors, time_config, Ctx};
 use report::{row_line, Row, RunInfo, Tables};
@@ -92,6 +92,12 @@ pub struct BenchArgs {
     /// Skip the cube renderers (they convert the map to a cube first, which takes a while).
     #[arg(long)]
     pub no_cube: bool,
+    /// Measure only the configurations the peers are compared with (LUT, wide table,
+    /// adaptive index step, nearest and bilinear) on the hfov-90 set: no cube, no
+    /// minification set. `scripts/peers.py --rounds` runs this between its rounds of
+    /// OpenCV timings, so that ours and theirs are timed in turns.
+    #[arg(long, conflicts_with_all = ["export_maps", "plot"])]
+    pub only_default: bool,
     /// Skip the minification set (zoomed out: bilinear and trilinear against the exact
     /// render supersampled 8x8, which takes a while).
     #[arg(long)]
@@ -226,7 +232,10 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         projection: map.projection().name().into(),
         kernel: kernel.active.name().into(),
     };
-    let sets = view_sets(a.views)?;
+    let mut sets = view_sets(a.views)?;
+    if a.only_default {
+        sets.retain(|s| s.table == TableKind::Wide && s.hfov == 90.0);
+    }
     let mut renderer = Renderer::new(&map);
 
     // Tables: built once, timed, before any frame (the cylinder's, then the other
@@ -248,7 +257,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         .map(|&sf| (sf.name(), build(sf)))
         .collect();
 
-    let cube_map = if a.no_cube {
+    let cube_map = if a.no_cube || a.only_default {
         None
     } else {
         let size = (map.width() / 4).clamp(16, 4096);
@@ -269,7 +278,10 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
             (Some(d), TableKind::Wide) => Some(d.as_path()),
             _ => None,
         };
-        let cfgs = configs(cube_map.is_some());
+        let mut cfgs = configs(cube_map.is_some());
+        if a.only_default {
+            cfgs.retain(|c| matches!(c, configs::Config::Lut(_, IndexStep::Adaptive)));
+        }
         let ctx = Ctx {
             map: &map,
             cube: cube_map.as_ref(),
@@ -326,7 +338,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
     }
 
     let mut minify_note = None;
-    if !a.no_minify {
+    if !a.no_minify && !a.only_default {
         let (mut mrows, note) = measure::minify_set(&run, a.size, a.passes, &map, &mut renderer)?;
         rows.append(&mut mrows);
         minify_note = Some(note);
