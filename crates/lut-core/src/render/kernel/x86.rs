@@ -16,8 +16,8 @@
 //! The only `unsafe` here and in the children: calling a `#[target_feature]` function
 //! (the CPU was checked: [`Selected`] is only made for a supported kernel), the unaligned
 //! loads and stores, whose indices are clamped into the slices they read or bounded by
-//! the loop, and the prefetches of the row kernels ([`prefetch_texels`]), which read
-//! nothing.
+//! the loop, and the prefetches of the row kernels ([`prefetch_texels`] and, for the
+//! rows the next scanline reads, [`prefetch_next_rows`]), which read nothing.
 
 #![allow(unsafe_code)]
 

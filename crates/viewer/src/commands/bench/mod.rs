@@ -252,8 +252,10 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         tables
     };
     let tables = build(Surface::Cylinder);
+    // (`--only-default` reports neither the other surfaces nor the gather.)
     let others: Vec<(&str, Tables)> = configs::OTHER_SURFACES
         .iter()
+        .filter(|_| !a.only_default)
         .map(|&sf| (sf.name(), build(sf)))
         .collect();
 
@@ -270,7 +272,11 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         ));
         Some(c)
     };
-    let src: Vec<u32> = gather_source(&map);
+    let src: Vec<u32> = if a.only_default {
+        Vec::new()
+    } else {
+        gather_source(&map)
+    };
 
     let mut rows = Vec::new();
     for set in &sets {

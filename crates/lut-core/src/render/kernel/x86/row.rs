@@ -5,7 +5,10 @@
 //! kernel prefetches the texels of the position about [`PREFETCH_TEXELS`] map texels
 //! ahead along the run (`prefetch_ahead`: 256 pixels where a pixel steps a texel or
 //! less, at least [`PREFETCH_AHEAD`]; the frame is bound by memory latency, not
-//! instructions: see there).
+//! instructions: see there), and with it, into L2, the rows the next scanline will read
+//! that this one does not (`next_rows`, from the offset `Texels::toward_next_scanline`
+//! carries; only where a run reads half a texel² of map a pixel or more:
+//! `next_scanline`).
 //!
 //! The kernels are written once (`row_kernels!`) and expanded in each instruction set's
 //! module, where short names stand for that set's intrinsics (`add` is
