@@ -17,13 +17,24 @@ ldconfig -p | grep -q libxkbcommon-x11 || need_pkgs+=(libxkbcommon-x11-0)
 ldconfig -p | grep -q libXcursor || need_pkgs+=(libxcursor1)
 ldconfig -p | grep -q libXi.so || need_pkgs+=(libxi6)
 /usr/bin/python3 -c 'import Xlib' 2>/dev/null || need_pkgs+=(python3-xlib)
+# The HTML report's test opens it in headless Chromium (crates/viewer/tests/report_cli.rs).
+command -v chromium >/dev/null || command -v chromium-browser >/dev/null || need_pkgs+=(chromium)
+# mozjpeg-sys (viewer tile's row-band JPEG reader) assembles libjpeg-turbo's SIMD with nasm.
+command -v nasm >/dev/null || need_pkgs+=(nasm)
+# ... and, for the aarch64 clippy pass over the viewer's binaries, builds its C with the
+# aarch64 cross compiler (the C of a -sys crate is compiled even by `cargo clippy`).
+command -v aarch64-linux-gnu-gcc >/dev/null || need_pkgs+=(gcc-aarch64-linux-gnu)
 if [ ${#need_pkgs[@]} -gt 0 ]; then
   if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
     echo "== installing ${need_pkgs[*]}"
     apt-get update -qq
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq xvfb xdotool x11-utils x11-apps imagemagick \
       python3-xlib libx11-6 libx11-xcb1 libxcursor1 libxi6 libxkbcommon-x11-0 libxkbcommon0 libxcb1 \
-      libxcb-xkb1 >/dev/null
+      libxcb-xkb1 nasm gcc-aarch64-linux-gnu >/dev/null
+    if [[ " ${need_pkgs[*]} " == *" chromium "* ]]; then
+      DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null \
+        || echo "warning: chromium could not be installed: the HTML report's browser test will skip LOUDLY" >&2
+    fi
   else
     echo "missing packages for the window test: ${need_pkgs[*]} (install them, or run as root)" >&2
     exit 1
