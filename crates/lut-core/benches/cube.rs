@@ -11,7 +11,7 @@
 use criterion::{criterion_group, BenchmarkId, Criterion, Throughput};
 use lut_core::LoadOptions;
 use lut_core::{CubeMap, CubeRenderer};
-use lut_core::{Frame, RenderOptions, Renderer, Scene};
+use lut_core::{Frame, Panorama, RenderOptions};
 use lut_core::{Projection, Sampler, View};
 use std::hint::black_box;
 use std::path::Path;
@@ -33,7 +33,7 @@ fn cube_map() -> CubeMap {
 }
 
 fn pan(c: &mut Criterion) {
-    let cube = cube_map();
+    let mut cube = Panorama::cube(cube_map());
     for (pitch, label) in [(0.0, "pitch0"), (30.0, "pitch30")] {
         for sampler in [Sampler::Bilinear, Sampler::Nearest] {
             let mut g = c.benchmark_group(format!("cube_pan_{label}_{}", sampler.name()));
@@ -50,7 +50,7 @@ fn pan(c: &mut Criterion) {
                             frame = frame.wrapping_add(1);
                             let yaw = (frame as f64 * 7.3) % 360.0;
                             let view = View::new(yaw, pitch, 90.0).unwrap();
-                            render_cube(&cube, view, sampler, r, &mut out, w, h);
+                            render_cube(&mut cube, view, sampler, r, &mut out, w, h);
                             black_box(&out);
                         })
                     });
@@ -65,7 +65,7 @@ fn pan(c: &mut Criterion) {
 /// *minimum* time per frame over the sequence reported for each. On a shared, loaded
 /// machine the minimum is the stable statistic; criterion's means are kept as the default.
 fn interleaved_min() {
-    let cube = cube_map();
+    let mut cube = Panorama::cube(cube_map());
     println!("frame time, min over 72 interleaved frames (yaw += 5 deg), one thread:");
     for pitch in [0.0, 30.0] {
         for sampler in [Sampler::Bilinear, Sampler::Nearest] {
@@ -79,7 +79,7 @@ fn interleaved_min() {
                         .enumerate()
                     {
                         let t = std::time::Instant::now();
-                        render_cube(&cube, view, sampler, r, &mut out, w, h);
+                        render_cube(&mut cube, view, sampler, r, &mut out, w, h);
                         black_box(&out);
                         best[k] = best[k].min(t.elapsed().as_secs_f64() * 1e3);
                     }
@@ -109,7 +109,7 @@ fn main() {
 
 /// One frame of `cube` on one thread through the render entry.
 fn render_cube(
-    cube: &CubeMap,
+    cube: &mut Panorama,
     view: View,
     sampler: Sampler,
     renderer: CubeRenderer,
@@ -123,12 +123,6 @@ fn render_cube(
         threads: false,
         ..RenderOptions::default()
     };
-    Renderer::default()
-        .render(
-            Scene::Cube(cube),
-            view,
-            &opts,
-            &mut Frame::new(out, w, h).unwrap(),
-        )
+    cube.render(view, &opts, &mut Frame::new(out, w, h).unwrap())
         .unwrap();
 }

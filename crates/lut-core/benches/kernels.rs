@@ -74,8 +74,9 @@ fn kernels(c: &mut Criterion) {
         g.throughput(Throughput::Elements(W as u64 * H as u64));
         for n in [8u32, 16, 64] {
             let rows = frame_spans(n, 8192, 4096);
-            for k in Kernel::available() {
-                g.bench_function(BenchmarkId::new(k.name(), n), |b| {
+            for kernel in Kernel::available() {
+                let k = kernel.select().expect("an available kernel");
+                g.bench_function(BenchmarkId::new(kernel.name(), n), |b| {
                     b.iter(|| {
                         for jobs in &rows {
                             match sampler {

@@ -29,7 +29,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::DVec3;
-use lut_core::{grid_map, Frame, Projection, RenderOptions, Renderer, Scene};
+use lut_core::{grid_map, Frame, Projection, RenderOptions, Renderer};
 use lut_core::{
     shade_frame, IesFile, IlluminanceMap, Interpolation, LightScene, LightTable, Luminaire,
     MapOptions, Room, ShadeOptions, TableOptions,
@@ -135,7 +135,7 @@ fn pan(c: &mut Criterion) {
                     let view = pan_view(&mut k);
                     let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
                     renderer
-                        .render(Scene::Map(&map), view, &opts, &mut frame)
+                        .render(&map, view, &opts, &mut frame)
                         .expect("render");
                     black_box(&pixels);
                 })
@@ -152,7 +152,7 @@ fn pan(c: &mut Criterion) {
                         let view = pan_view(&mut k);
                         let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
                         renderer
-                            .render(Scene::Map(&lit), view, &opts, &mut frame)
+                            .render(&lit, view, &opts, &mut frame)
                             .expect("render");
                         black_box(&pixels);
                     })
@@ -172,7 +172,7 @@ fn pan(c: &mut Criterion) {
                         let hook = |y0: usize, rows: &mut [u32]| shader.shade_band(y0, rows);
                         let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
                         renderer
-                            .render_with(Scene::Map(&map), view, &opts, &mut frame, &hook)
+                            .render_with(&map, view, &opts, &mut frame, &hook)
                             .expect("render");
                         black_box(&pixels);
                     })
@@ -185,7 +185,7 @@ fn pan(c: &mut Criterion) {
                         let view = pan_view(&mut k);
                         let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
                         renderer
-                            .render(Scene::Map(&map), view, &opts, &mut frame)
+                            .render(&map, view, &opts, &mut frame)
                             .expect("render");
                         let cam = Camera::new(view, W, H);
                         lmap.shade_frame(&cam, &mut pixels, W, H, &shade)
@@ -202,7 +202,7 @@ fn pan(c: &mut Criterion) {
                     let view = pan_view(&mut k);
                     let mut frame = Frame::new(&mut pixels, W, H).expect("frame");
                     renderer
-                        .render(Scene::Map(&map), view, &opts, &mut frame)
+                        .render(&map, view, &opts, &mut frame)
                         .expect("render");
                     let cam = Camera::new(view, W, H);
                     shade_frame(&s, &cam, &mut pixels, W, H, &shade).expect("shade");

@@ -11,7 +11,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use lut_core::grid_map;
-use lut_core::{Frame, Scene};
+use lut_core::Frame;
 use lut_core::{
     IndexStep, LutChoice, Projection, RenderOptions, Renderer, RendererKind, Sampler, View,
 };
@@ -70,7 +70,7 @@ fn setup_one_scanline(c: &mut Criterion) {
     let mut out = vec![0u32; 1920];
     let o = opts(Sampler::Bilinear, false);
     r.render(
-        Scene::Map(&map),
+        &map,
         View::new(0.0, 0.0, 90.0).unwrap(),
         &o,
         &mut Frame::new(&mut out, 1920, 1).unwrap(),
@@ -85,13 +85,8 @@ fn setup_one_scanline(c: &mut Criterion) {
     g.bench_function("setup_plus_row_1920_8k", |b| {
         b.iter(|| {
             let v = pan_view(&mut frame);
-            r.render(
-                Scene::Map(&map),
-                v,
-                &o,
-                &mut Frame::new(&mut out, 1920, 1).unwrap(),
-            )
-            .expect("render");
+            r.render(&map, v, &o, &mut Frame::new(&mut out, 1920, 1).unwrap())
+                .expect("render");
             black_box(&out);
         })
     });
@@ -127,13 +122,8 @@ fn frames(c: &mut Criterion) {
                         p.install(|| {
                             b.iter(|| {
                                 let v = pan_view(&mut frame);
-                                r.render(
-                                    Scene::Map(&map),
-                                    v,
-                                    &o,
-                                    &mut Frame::new(&mut out, ow, oh).unwrap(),
-                                )
-                                .expect("render");
+                                r.render(&map, v, &o, &mut Frame::new(&mut out, ow, oh).unwrap())
+                                    .expect("render");
                                 black_box(&out);
                             })
                         })

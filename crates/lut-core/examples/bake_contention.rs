@@ -11,7 +11,7 @@
 //! ```
 
 use glam::DVec3;
-use lut_core::{grid_map, Frame, Projection, RenderOptions, Renderer, Scene, View};
+use lut_core::{grid_map, Frame, Projection, RenderOptions, Renderer, View};
 use lut_core::{IesFile, IlluminanceMap, LightScene, LightTable, Luminaire, MapOptions};
 use lut_core::{Room, ShadeOptions, TableOptions};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -83,8 +83,7 @@ fn main() {
                 let view = View::new(30.0 + 7.3 * i as f64, 10.0, 90.0).expect("view");
                 let mut f = Frame::new(&mut px, 1920, 1080).expect("frame");
                 let t0 = Instant::now();
-                r.render(Scene::Map(&pano), view, &opts, &mut f)
-                    .expect("render");
+                r.render(&pano, view, &opts, &mut f).expect("render");
                 t0.elapsed().as_secs_f64() * 1e3
             })
             .collect()

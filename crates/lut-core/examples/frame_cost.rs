@@ -31,7 +31,7 @@
 
 use lut_core::grid_map;
 use lut_core::{CubeMap, CubeRenderer, Face};
-use lut_core::{Frame, IndexStep, Projection, RenderOptions, Renderer, Sampler, Scene, View};
+use lut_core::{Frame, IndexStep, Panorama, Projection, RenderOptions, Renderer, Sampler, View};
 use std::time::Instant;
 
 fn main() {
@@ -250,6 +250,8 @@ fn run() -> Result<(), String> {
                 .map_err(|e| e.to_string())?
         }
     };
+    // Shared with the panorama drawn (a map's), not copied.
+    let map = std::sync::Arc::new(map);
     let map_wh = (map.width(), map.height());
     eprintln!("map ready in {:.2} s", t_load.elapsed().as_secs_f64());
     let pool = rayon::ThreadPoolBuilder::new()
@@ -267,15 +269,16 @@ fn run() -> Result<(), String> {
         Some(_) => Some(load_cube(&map, (map_wh.0 / 4).max(1), cache.as_deref())?),
         None => None,
     };
-    let scene = match &cube {
-        Some(c) => Scene::Cube(c),
-        None => Scene::Map(&map),
+    let mut pano = match cube {
+        Some(c) => Panorama::cube(c),
+        None => Panorama::map(map.clone()),
     };
     let (w, h) = out_wh;
     let mut out = vec![0u32; w as usize * h as usize];
+    pano.set_bilinear_level(level == 1);
+    pano.set_still_level(level == 2);
+    // The gather's positions (the map's geometry).
     let mut r = Renderer::new(&map);
-    r.set_bilinear_level(level == 1);
-    r.set_still_level(level == 2);
     if level != 0 {
         let t = Instant::now();
         map.pyramid();
@@ -317,7 +320,7 @@ fn run() -> Result<(), String> {
         // The first frame builds the tables and sizes the scratch: not counted.
         let rep = pool.install(|| {
             let mut f = Frame::new(&mut out, w, h).map_err(|e| e.to_string())?;
-            r.render(scene, view(0)?, &opts, &mut f)
+            pano.render(view(0)?, &opts, &mut f)
                 .map_err(|e| e.to_string())
         })?;
         eprintln!(
@@ -327,7 +330,7 @@ fn run() -> Result<(), String> {
         (times, cpu) = pool.install(|| {
             timed_frames(frames, &mut |i| {
                 let mut f = Frame::new(&mut out, w, h).map_err(|e| e.to_string())?;
-                r.render(scene, view(i + 1)?, &opts, &mut f)
+                pano.render(view(i + 1)?, &opts, &mut f)
                     .map(|_| ())
                     .map_err(|e| e.to_string())
             })

@@ -14,7 +14,7 @@
 //! `viewer bench` (pitches 0 to 80) once each and prints wall-clock milliseconds too.
 
 use lut_core::{
-    EnvMap, Frame, Projection, RenderOptions, Renderer, RendererKind, Scene, View, ViewProjection,
+    EnvMap, Frame, Projection, RenderOptions, Renderer, RendererKind, View, ViewProjection,
 };
 use std::time::Instant;
 
@@ -76,8 +76,7 @@ fn main() {
                 .expect("build")
         } else {
             let mut f = Frame::new(&mut out, w, h).expect("frame");
-            r.render(Scene::Map(&map), view, &opts, &mut f)
-                .expect("render")
+            r.render(&map, view, &opts, &mut f).expect("render")
         };
         exact += rep.exact_pixels;
         cells = (cells.0.min(rep.min_step), cells.1.max(rep.max_step));

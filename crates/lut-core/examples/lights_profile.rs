@@ -13,7 +13,7 @@
 //! `time N` prints the minimum wall-clock times of 15 runs of each (one thread).
 
 use glam::DVec3;
-use lut_core::{grid_map, Frame, Projection, RenderOptions, Renderer, Scene};
+use lut_core::{grid_map, Frame, Projection, RenderOptions, Renderer};
 use lut_core::{
     shade_frame, Camera, IesFile, IlluminanceMap, LightScene, LightTable, Luminaire, MapOptions,
     Room, ShadeOptions, TableOptions, View,
@@ -87,8 +87,7 @@ fn main() {
                 let map = grid_map(4096, 2048, Projection::Equirect).expect("map");
                 let mut r = Renderer::new(&map);
                 let mut frame = Frame::new(&mut pixels, w, h).expect("frame");
-                r.render(Scene::Map(&map), view, &opts, &mut frame)
-                    .expect("render");
+                r.render(&map, view, &opts, &mut frame).expect("render");
             }
             "map" => {
                 let m = IlluminanceMap::build(&scene, &MapOptions::default()).expect("map");
@@ -105,7 +104,7 @@ fn main() {
                 let hook = |y0: usize, rows: &mut [u32]| shader.shade_band(y0, rows);
                 for _ in 0..std::env::var("REPS").map_or(1, |s| s.parse().unwrap()) {
                     let mut frame = Frame::new(&mut pixels, w, h).expect("frame");
-                    r.render_with(Scene::Map(&map), view, &opts, &mut frame, &hook)
+                    r.render_with(&map, view, &opts, &mut frame, &hook)
                         .expect("render");
                 }
             }
@@ -123,8 +122,7 @@ fn main() {
                 for _ in 0..15 {
                     let t = std::time::Instant::now();
                     let mut frame = Frame::new(&mut pixels, w, h).expect("frame");
-                    r.render(Scene::Map(&map), view, &opts, &mut frame)
-                        .expect("render");
+                    r.render(&map, view, &opts, &mut frame).expect("render");
                     best[0] = best[0].min(ms(t));
                     let t = std::time::Instant::now();
                     m.shade_frame(&cam, &mut pixels, w, h, &ShadeOptions::default())
@@ -132,7 +130,7 @@ fn main() {
                     best[1] = best[1].min(ms(t));
                     let t = std::time::Instant::now();
                     let mut frame = Frame::new(&mut pixels, w, h).expect("frame");
-                    r.render_with(Scene::Map(&map), view, &opts, &mut frame, &hook)
+                    r.render_with(&map, view, &opts, &mut frame, &hook)
                         .expect("render");
                     best[2] = best[2].min(ms(t));
                     let t = std::time::Instant::now();

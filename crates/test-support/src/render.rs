@@ -1,16 +1,16 @@
 //! Frames rendered into new buffers, for tests that compare whole images.
 
 use lut_core::{
-    render_exact, EnvMap, Frame, RenderOptions, RenderReport, Renderer, Sampler, Scene, View,
+    render_exact, EnvMap, Frame, Panorama, RenderOptions, RenderReport, Renderer, Sampler, View,
 };
 
-/// `view` of `scene` rendered by `r` with `opts` into a new `w × h` buffer.
+/// `view` of `map` rendered by `r` with `opts` into a new `w × h` buffer.
 ///
 /// # Panics
 /// On a bad size or a render error (tests pass valid requests).
 pub fn render_frame(
     r: &mut Renderer,
-    scene: Scene<'_>,
+    map: &EnvMap,
     view: View,
     opts: &RenderOptions,
     w: u32,
@@ -19,11 +19,30 @@ pub fn render_frame(
     let mut out = vec![0u32; w as usize * h as usize];
     let report = r
         .render(
-            scene,
+            map,
             view,
             opts,
             &mut Frame::new(&mut out, w, h).expect("frame"),
         )
+        .expect("render");
+    (out, report)
+}
+
+/// `view` of `pano` (a map or a cube map) rendered with `opts` into a new `w × h`
+/// buffer.
+///
+/// # Panics
+/// On a bad size or a render error (tests pass valid requests).
+pub fn pano_frame(
+    pano: &mut Panorama,
+    view: View,
+    opts: &RenderOptions,
+    w: u32,
+    h: u32,
+) -> (Vec<u32>, RenderReport) {
+    let mut out = vec![0u32; w as usize * h as usize];
+    let report = pano
+        .render(view, opts, &mut Frame::new(&mut out, w, h).expect("frame"))
         .expect("render");
     (out, report)
 }

@@ -120,6 +120,31 @@ pub fn load_cube(inputs: &[PathBuf], cube: CubeArgs) -> Result<CubeMap> {
     Ok(lut_core::load_cube(inputs, cube.layout, cube.naming)?)
 }
 
+/// True when `path` is a tiled pyramid: a folder holding `config.json`, or a `.json`
+/// file (Pannellum's multires configuration; anything else in it is refused when opened).
+pub fn is_tiled(path: &Path) -> bool {
+    if path.is_dir() {
+        path.join("config.json").exists()
+    } else {
+        path.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+    }
+}
+
+/// Open the tiled pyramid at `path` with a cache of `cache_mib` MiB and a decoding
+/// thread per core (at most 8).
+pub fn open_tiled(path: &Path, cache_mib: u64) -> Result<lut_core::TiledPanorama> {
+    let threads = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(2)
+        .clamp(1, 8);
+    Ok(lut_core::TiledPanorama::open(
+        path,
+        (cache_mib as usize).saturating_mul(1 << 20),
+        threads,
+    )?)
+}
+
 /// True when `inputs` look like a cube map rather than one panorama image: a folder, six
 /// or more files, or one image whose aspect ratio is a cube layout (4:3, 6:1, 3:2). For
 /// the window's drop handler.

@@ -27,7 +27,7 @@
 //! face edge, and reads across into the neighbour, so edges and corners show no seam.
 //!
 //! # Renderers (`render/cube.rs`)
-//! [`crate::Renderer::render`] of a [`crate::Scene::Cube`] with [`CubeRenderer::Basic`] (the paper's section 1: per pixel, ray → face →
+//! [`crate::Panorama::render`] of a [`crate::Panorama::cube`] with [`CubeRenderer::Basic`] (the paper's section 1: per pixel, ray → face →
 //! face coordinates → sample) or [`CubeRenderer::Accelerated`] (section 2: each scanline is
 //! a 3-D line, cut into face segments found by binary search, drawn inside each segment
 //! without choosing a face). Both compute every ray with the same expression, and the
@@ -497,6 +497,9 @@ impl CubeMap {
     }
 
     /// Texel (x, y) of a face, `x, y < face_size`.
+    ///
+    /// # Panics
+    /// When (x, y) lies outside the face and its one-texel border.
     #[inline]
     pub fn pixel(&self, face: Face, x: u32, y: u32) -> u32 {
         let stride = self.size as usize + 2;

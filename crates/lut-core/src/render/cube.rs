@@ -38,12 +38,15 @@
 
 use super::exact::render_exact;
 use super::frame::Frame;
-use super::kernel::{face_rows, face_rows_blend, FaceBuf, FaceRun, Texels};
+use super::kernel::{active, FaceBuf, FaceRun, Texels};
 use super::rows::{rows_per_task, Loan};
+use super::setup::check_step;
+use super::{RenderOptions, RenderPath, RenderReport};
 use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
     check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
 };
+use crate::error::ViewError;
 use crate::geom::camera::View;
 use crate::map::envmap::EnvMap;
 use crate::map::pyramid::lod_q8;
@@ -240,7 +243,7 @@ impl Fetch for NearestFetch {
     #[inline(always)]
     fn span(self, c: &CubeMap, fr: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut FaceBuf) {
         let t = toward_next(face_texels(c, f), fr, f, r, o.len());
-        face_rows::<false>(&t, r, o, b)
+        active().face_rows::<false>(&t, r, o, b)
     }
 }
 
@@ -253,7 +256,7 @@ impl Fetch for BilinearFetch {
     #[inline(always)]
     fn span(self, c: &CubeMap, fr: &Rays, f: Face, r: &FaceRun, o: &mut [u32], b: &mut FaceBuf) {
         let t = toward_next(face_texels(c, f), fr, f, r, o.len());
-        face_rows::<true>(&t, r, o, b)
+        active().face_rows::<true>(&t, r, o, b)
     }
 }
 
@@ -310,19 +313,51 @@ impl Fetch for TrilinearFetch {
         };
         for (k, cs) in same_runs(levels.len(), |c| Some(levels[c].0)) {
             let (t, sub, px) = on(k, &cs);
-            face_rows::<true>(&t, &sub, &mut out[px], buf);
+            active().face_rows::<true>(&t, &sub, &mut out[px], buf);
         }
         let blended = |c: usize| (fracs[c] != 0).then_some(levels[c].1);
         for (k, cs) in same_runs(levels.len(), blended) {
             let (t, sub, px) = on(k, &cs);
-            face_rows_blend(&t, &sub, &mut out[px], (C, &fracs[cs]), buf);
+            active().face_rows_blend(&t, &sub, &mut out[px], (C, &fracs[cs]), buf);
         }
         (buf.levels, buf.fracs) = (levels, fracs);
     }
 }
 
+/// A frame of `view` of `cube` with `opts` (the entry is [`crate::Panorama::render`] of a
+/// cube): rectilinear views with `opts.cube`, the other output projections per pixel
+/// (`projected.rs`).
+///
+/// # Errors
+/// [`ViewError::BadIndexStep`] for an index step not in {1, 2, 4, 8, 16}, as for a map
+/// (the step is unused here, but a request is refused alike whatever it draws).
+pub(crate) fn cube_frame(
+    cube: &CubeMap,
+    view: View,
+    opts: &RenderOptions,
+    frame: &mut Frame<'_>,
+) -> Result<RenderReport, ViewError> {
+    check_step(opts.index_step)?;
+    let pixels = frame.width() as u64 * frame.height() as u64;
+    let path = if view.projection().is_rectilinear() {
+        render_cube(cube, view, opts.sampler, opts.cube, frame, opts.threads);
+        RenderPath::Cube(opts.cube)
+    } else {
+        super::projected::render_cube(cube, view, opts.sampler, frame, opts.threads);
+        RenderPath::CubeProjected
+    };
+    Ok(RenderReport {
+        path,
+        exact_pixels: 0,
+        pixels,
+        table_bytes: cube.bytes(),
+        max_step: 1,
+        min_step: 1,
+    })
+}
+
 /// Render `view` of `cube` into `frame` with the chosen renderer (the entry is
-/// [`crate::Renderer::render`] of a [`crate::Scene::Cube`]). `threads` splits rows into
+/// [`cube_frame`]). `threads` splits rows into
 /// bands across the rayon pool; the output is identical either way (the renderers differ
 /// as [`CubeRenderer`] says; trilinear builds the face pyramid on first use).
 pub(crate) fn render_cube(

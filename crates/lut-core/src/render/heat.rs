@@ -4,10 +4,11 @@
 //! [`HEAT_MAX`] pixels. A diagnostic: it costs about one exact render (the exact position
 //! of every pixel) plus the renderer's positions.
 
-use super::{RenderOptions, Renderer, Scene};
+use super::{RenderOptions, Renderer};
 use crate::error::ViewError;
 use crate::geom::accuracy::{position_errors, ErrorStats};
 use crate::geom::camera::{check_size, Camera, View};
+use crate::map::envmap::EnvMap;
 
 /// The error shown at the bottom of the scale (and below it), source pixels.
 pub const HEAT_MIN: f64 = 0.001;
@@ -63,48 +64,28 @@ pub struct ErrorMap {
 }
 
 impl ErrorMap {
-    /// The errors of the renderer `opts` selects for `view` of `scene` on a
-    /// `width × height` output. Map scenes: the renderer's sampling positions
+    /// The errors of the renderer `opts` selects for `view` of `map` on a
+    /// `width × height` output: the renderer's sampling positions
     /// ([`Renderer::positions`], the same kernels as its frames) against the exact map;
     /// for a frame the renderer draws from a pyramid level ([`Renderer::set_still_level`],
     /// [`Renderer::set_bilinear_level`]) the level's positions against the exact level,
-    /// in the level's pixels (the texels that frame reads). Cube maps: every pixel's face coordinates are computed exactly by both cube
-    /// renderers, so every error is 0.
+    /// in the level's pixels (the texels that frame reads). A panorama of any kind:
+    /// [`crate::Panorama::error_map`].
     ///
     /// # Errors
-    /// As [`Renderer::render`].
+    /// As [`Renderer::render`], and a bad output size.
     pub fn measure(
         renderer: &mut Renderer,
-        scene: Scene<'_>,
+        map: &EnvMap,
         view: View,
         opts: &RenderOptions,
         width: u32,
         height: u32,
     ) -> Result<ErrorMap, ViewError> {
         check_size(width, height)?;
-        let map = match scene {
-            Scene::Map(map) => map,
-            Scene::Cube(_) => {
-                let cam = Camera::new(view, width, height);
-                let errors: Vec<Option<f64>> = (0..height)
-                    .flat_map(|y| (0..width).map(move |x| (x, y)))
-                    .map(|(x, y)| cam.pixel_lat_long(x, y).map(|_| 0.0))
-                    .collect();
-                let stats = ErrorStats {
-                    count: errors.len() as u64,
-                    ..ErrorStats::default()
-                };
-                return Ok(ErrorMap {
-                    width,
-                    height,
-                    errors,
-                    stats,
-                });
-            }
-        };
         if let Some((level, r)) = renderer.level_renderer(map, view, opts.sampler, (width, height))
         {
-            return ErrorMap::measure(r, Scene::Map(level), view, opts, width, height);
+            return ErrorMap::measure(r, level, view, opts, width, height);
         }
         let (mw, mh, p) = (map.width(), map.height(), map.projection());
         let (positions, _) = renderer.positions(mw, mh, p, view, opts, width, height)?;
@@ -115,6 +96,26 @@ impl ErrorMap {
             errors,
             stats,
         })
+    }
+
+    /// The error map of a renderer that computes every pixel's position exactly (the
+    /// cube renderers): 0 wherever the view has a direction, none elsewhere.
+    pub(crate) fn exact(view: View, width: u32, height: u32) -> ErrorMap {
+        let cam = Camera::new(view, width, height);
+        let errors: Vec<Option<f64>> = (0..height)
+            .flat_map(|y| (0..width).map(move |x| (x, y)))
+            .map(|(x, y)| cam.pixel_lat_long(x, y).map(|_| 0.0))
+            .collect();
+        let stats = ErrorStats {
+            count: errors.len() as u64,
+            ..ErrorStats::default()
+        };
+        ErrorMap {
+            width,
+            height,
+            errors,
+            stats,
+        }
     }
 
     /// The heat map image, 0RGB row-major: [`heat_color`] of each error,

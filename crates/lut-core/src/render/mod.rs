@@ -1,5 +1,6 @@
-//! Rendering: the frame type, the [`Scene`] (a map or a cube map) and the one render
-//! entry, [`Renderer::render`].
+//! Rendering: the frame type and the map renderer, [`Renderer::render`]; the cube
+//! renderers (`cube.rs`, `projected.rs`). What kind of panorama is drawn by which is
+//! decided in one place above this stage, `crate::Panorama::render`.
 //!
 //! The LUT renderer (US 5,748,194) is split by what runs how often:
 //! * per frame, `setup.rs`: each scanline's table rows, column scale, index steps (from
@@ -10,7 +11,7 @@
 //!   reads, longitude unwrapped across each span (a span over the ±180° seam steps
 //!   continuously and wraps per pixel instead of smearing across the whole map);
 //!   `rowpass.rs`, for full maps (any sampler): the walk's positions for a run
-//!   of the row at once, then one gather pass (`kernel/row.rs`); `rows.rs` runs the rows
+//!   of the row at once, then one gather pass (`kernel/row/`); `rows.rs` runs the rows
 //!   on one thread or in bands on rayon;
 //! * per pixel, `kernel/`: the row and span kernels, with the rules they keep;
 //! * `sink.rs`: where a scanline's spans go otherwise (pixels per sampler, or positions).
@@ -41,6 +42,7 @@ pub(crate) mod scanline;
 pub(crate) mod setup;
 pub(crate) mod sink;
 pub(crate) mod steps;
+pub(crate) mod walk;
 
 use crate::error::ViewError;
 use crate::geom::camera::{check_size, Camera, View};
@@ -50,16 +52,16 @@ use crate::lut::{LutTable, Surface, TableKind, TableSpec};
 use crate::map::envmap::EnvMap;
 use crate::map::pyramid::lod_q8;
 use crate::map::sample::Sampler;
-use cube::render_cube;
 use exact::{render_exact, ExactFootprint};
 use frame::Frame;
 use grid::{Grid, GridStats};
 use kernel::{level_texels, texels};
-use rowpass::{pixel_row, position_row, tri_row};
+use rowpass::{pixel_row, position_row, tri_row, LutRow};
 use rows::{for_each_band_init, for_each_row, for_each_row_init, post_bands};
 use scanline::{RowScratch, ScratchLoan, ROW_SCALE_ONE};
 use setup::{check_step, prepare, Scan, Setup};
 use sink::{Batch, PixelRows, PosRows, RowSinks, TriRows, TriSink};
+use std::sync::Arc;
 
 pub use levels::build_frame_levels;
 use levels::{centre_footprint, frame_level, frame_min_footprint};
@@ -68,7 +70,8 @@ pub use options::*;
 /// The renderer: owns the tables for one map geometry and per-frame scratch.
 #[derive(Debug, Default)]
 pub struct Renderer {
-    tables: Vec<(Surface, TableKind, LutTable)>,
+    /// The tables built so far (shared with the renderers made by [`Renderer::share`]).
+    tables: Vec<(Surface, TableKind, Arc<LutTable>)>,
     geometry: Option<(u32, u32, Projection)>,
     scans: Vec<Scan>,
     /// Row scale per map row (Q.30: multiplied by Λ up to W/2, so Q.16 would lose up to
@@ -86,7 +89,11 @@ pub struct Renderer {
 }
 
 /// The table of `surface` and `kind` among `tables` (built by [`Renderer::table`]).
-fn find(tables: &[(Surface, TableKind, LutTable)], surface: Surface, kind: TableKind) -> &LutTable {
+fn find(
+    tables: &[(Surface, TableKind, Arc<LutTable>)],
+    surface: Surface,
+    kind: TableKind,
+) -> &LutTable {
     &tables
         .iter()
         .find(|(s, k, _)| *s == surface && *k == kind)
@@ -164,20 +171,40 @@ impl Renderer {
         }
     }
 
-    /// Build (if needed) and return the table of the given kind.
-    pub fn table(&mut self, surface: Surface, kind: TableKind) -> &LutTable {
-        let (w, h, p) = self.geometry.expect("geometry set in new()");
-        if let Some(i) = self
+    /// A renderer for the same geometry sharing this one's tables (built so far: each
+    /// renderer builds the ones it lacks on its own), with its own per-frame scratch: for
+    /// another thread, or a copy of the map with other pixels (a lit copy).
+    pub(crate) fn share(&self) -> Renderer {
+        Renderer {
+            tables: self.tables.clone(),
+            geometry: self.geometry,
+            scans: Vec::new(),
+            row_scale: self.row_scale.clone(),
+            bilinear_level: self.bilinear_level,
+            still_level: self.still_level,
+            level: self.level.as_ref().map(|r| Box::new(r.share())),
+        }
+    }
+
+    /// Build (if needed) and return the table of the given kind for the renderer's map
+    /// geometry; `None` before it has one (a `Renderer::default()` that has drawn no
+    /// frame: [`Renderer::new`] sets it, and so does each frame).
+    pub fn table(&mut self, surface: Surface, kind: TableKind) -> Option<&LutTable> {
+        let (w, h, p) = self.geometry?;
+        let i = match self
             .tables
             .iter()
             .position(|(s, k, _)| *s == surface && *k == kind)
         {
-            return &self.tables[i].2;
-        }
-        let spec = TableSpec::default_for(surface, kind, w);
-        self.tables
-            .push((surface, kind, LutTable::build(spec, p, w, h)));
-        &self.tables.last().expect("just pushed").2
+            Some(i) => i,
+            None => {
+                let spec = TableSpec::default_for(surface, kind, w);
+                let table = LutTable::build(spec, p, w, h);
+                self.tables.push((surface, kind, Arc::new(table)));
+                self.tables.len() - 1
+            }
+        };
+        Some(&self.tables[i].2)
     }
 
     /// The pyramid level a frame of `view` on `width × height` pixels is drawn from instead
@@ -235,7 +262,7 @@ impl Renderer {
     ) -> (Setup, RenderReport) {
         let kind = Self::table_kind(view, opts);
         let geometry = self.geometry.expect("geometry set before a frame");
-        self.table(opts.surface, kind);
+        let _ = self.table(opts.surface, kind);
         let table = find(&self.tables, opts.surface, kind);
         prepare(
             table,
@@ -264,20 +291,21 @@ impl Renderer {
         }
     }
 
-    /// Render `view` of `scene` into `frame`: the one render entry for maps (LUT or exact,
-    /// as `opts.renderer` says) and cube maps (with `opts.cube`).
+    /// Render `view` of `map` into `frame`: LUT, grid or exact, as `opts.renderer` says
+    /// (a panorama of any kind: [`crate::Panorama::render`]). The renderer takes the
+    /// map's geometry (tables for another geometry are dropped).
     ///
     /// # Errors
     /// [`ViewError::BadIndexStep`] for an index step not in {1, 2, 4, 8, 16} (the frame's
     /// size was checked when it was made).
     pub fn render(
         &mut self,
-        scene: Scene<'_>,
+        map: &EnvMap,
         view: View,
         opts: &RenderOptions,
         frame: &mut Frame<'_>,
     ) -> Result<RenderReport, ViewError> {
-        self.render_inner(scene, view, opts, frame, None)
+        self.render_inner(map, view, opts, frame, None)
     }
 
     /// [`Renderer::render`], then `hook` on every band of rows of the frame (see
@@ -290,27 +318,26 @@ impl Renderer {
     /// As [`Renderer::render`].
     pub fn render_with(
         &mut self,
-        scene: Scene<'_>,
+        map: &EnvMap,
         view: View,
         opts: &RenderOptions,
         frame: &mut Frame<'_>,
         hook: BandHook<'_>,
     ) -> Result<RenderReport, ViewError> {
-        self.render_inner(scene, view, opts, frame, Some(hook))
+        self.render_inner(map, view, opts, frame, Some(hook))
     }
 
     fn render_inner(
         &mut self,
-        scene: Scene<'_>,
+        map: &EnvMap,
         view: View,
         opts: &RenderOptions,
         frame: &mut Frame<'_>,
         hook: Option<BandHook<'_>>,
     ) -> Result<RenderReport, ViewError> {
-        let report = self.render_fused(scene, view, opts, frame, hook)?;
+        let report = self.render_fused(map, view, opts, frame, hook)?;
         if let (Some(hook), false) = (hook, report.1) {
-            let w = frame.width() as usize;
-            post_bands(frame.pixels_mut(), w, HOOK_BAND_ROWS, opts.threads, hook);
+            run_hook(frame, opts, hook);
         }
         Ok(report.0)
     }
@@ -318,7 +345,7 @@ impl Renderer {
     /// The frame, and whether `hook` ran on it already (fused into the row bands).
     fn render_fused(
         &mut self,
-        scene: Scene<'_>,
+        map: &EnvMap,
         view: View,
         opts: &RenderOptions,
         frame: &mut Frame<'_>,
@@ -327,38 +354,11 @@ impl Renderer {
         check_step(opts.index_step)?;
         let (width, height) = (frame.width(), frame.height());
         let pixels = width as u64 * height as u64;
-        let map = match scene {
-            Scene::Map(map) => map,
-            Scene::Cube(cube) if !view.projection().is_rectilinear() => {
-                projected::render_cube(cube, view, opts.sampler, frame, opts.threads);
-                let report = RenderReport {
-                    path: RenderPath::CubeProjected,
-                    exact_pixels: 0,
-                    pixels,
-                    table_bytes: cube.bytes(),
-                    max_step: 1,
-                    min_step: 1,
-                };
-                return Ok((report, false));
-            }
-            Scene::Cube(cube) => {
-                render_cube(cube, view, opts.sampler, opts.cube, frame, opts.threads);
-                let report = RenderReport {
-                    path: RenderPath::Cube(opts.cube),
-                    exact_pixels: 0,
-                    pixels,
-                    table_bytes: cube.bytes(),
-                    max_step: 1,
-                    min_step: 1,
-                };
-                return Ok((report, false));
-            }
-        };
         if let Some((level, r)) = self.level_renderer(map, view, opts.sampler, (width, height)) {
             // A frame drawn from a pyramid level (`set_bilinear_level`, `set_still_level`):
             // a plain frame of the level, with tables for its geometry, as the level
             // would be drawn were it the map (the exact renderer's too).
-            return r.render_fused(Scene::Map(level), view, opts, frame, hook);
+            return r.render_fused(level, view, opts, frame, hook);
         }
         if opts.renderer == RendererKind::Exact {
             render_exact(map, view, opts.sampler, frame, opts.threads);
@@ -392,7 +392,13 @@ impl Renderer {
                     batch: Batch::new(),
                 };
                 s.set_lod(lod_q8(scan.fy[0] as f64));
-                tri_row((scan, table, &setup, row_scale), scratch, &mut s);
+                let lut = LutRow {
+                    scan,
+                    table,
+                    fr: &setup,
+                    row_scale,
+                };
+                tri_row(lut, scratch, &mut s);
             };
             return Ok(match hook {
                 Some(post) => {
@@ -419,7 +425,12 @@ impl Renderer {
             let (scans, table, setup, row_scale) = k;
             let t = texels(map);
             let row = |scratch: &mut ScratchLoan, y: usize, row: &mut [u32]| {
-                let lut = (&scans[y], table, setup, row_scale);
+                let lut = LutRow {
+                    scan: &scans[y],
+                    table,
+                    fr: setup,
+                    row_scale,
+                };
                 pixel_row::<BILINEAR, CROP>(lut, scratch, (map, &t), row);
             };
             match hook {
@@ -555,12 +566,24 @@ impl Renderer {
             opts.threads,
             RowScratch::loan,
             |scratch, y, row| {
-                let lut = (&scans[y], table, &setup, row_scale);
+                let lut = LutRow {
+                    scan: &scans[y],
+                    table,
+                    fr: &setup,
+                    row_scale,
+                };
                 position_row(lut, scratch, pass.then_some(wq), row);
             },
         );
         Ok((out, report))
     }
+}
+
+/// `hook` on every band of rows of the finished `frame` (see [`BandHook`]), in bands of
+/// [`HOOK_BAND_ROWS`] rows (on the rayon pool when `opts.threads`).
+pub(crate) fn run_hook(frame: &mut Frame<'_>, opts: &RenderOptions, hook: BandHook<'_>) {
+    let w = frame.width() as usize;
+    post_bands(frame.pixels_mut(), w, HOOK_BAND_ROWS, opts.threads, hook);
 }
 
 /// The map geometry the renderers use: (width, height, projection) of the full panorama.

@@ -1,10 +1,8 @@
-//! What a frame is asked for and what it reports: the [`Scene`], the
+//! What a frame is asked for and what it reports: the
 //! [`RenderOptions`] and their named values, the [`RenderReport`], and the band hook's
 //! types.
 
-use crate::cube::CubeMap;
 use crate::lut::Surface;
-use crate::map::envmap::EnvMap;
 use crate::map::sample::Sampler;
 use crate::named::Named;
 use crate::render::cube::CubeRenderer;
@@ -13,27 +11,6 @@ use crate::render::Renderer;
 
 /// hfov (degrees) above which the wide-FOV table is used (the patent's 60°).
 pub const LUT_SWITCH_HFOV: f64 = 60.0;
-
-/// What to render: a map (any projection, full or partial) or a cube map.
-#[derive(Debug, Clone, Copy)]
-pub enum Scene<'a> {
-    /// An environment map, drawn by the LUT or the exact renderer.
-    Map(&'a EnvMap),
-    /// A cube map, drawn by one of the cube renderers.
-    Cube(&'a CubeMap),
-}
-
-impl<'a> From<&'a EnvMap> for Scene<'a> {
-    fn from(m: &'a EnvMap) -> Self {
-        Scene::Map(m)
-    }
-}
-
-impl<'a> From<&'a CubeMap> for Scene<'a> {
-    fn from(c: &'a CubeMap) -> Self {
-        Scene::Cube(c)
-    }
-}
 
 /// Which renderer draws the frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -84,7 +61,7 @@ pub struct RenderOptions {
     pub surface: Surface,
     /// Render row bands on the rayon pool (output identical either way).
     pub threads: bool,
-    /// The cube renderer, for a [`Scene::Cube`] (both give the same pixels).
+    /// The cube renderer, for a cube map (both give the same pixels).
     pub cube: CubeRenderer,
 }
 
@@ -190,6 +167,14 @@ pub enum RenderPath {
     Cube(CubeRenderer),
     /// A cube map in another output projection, per pixel.
     CubeProjected,
+    /// A tiled pyramid, drawn at `level` (1 = coarsest); `coarser`: some tiles were not
+    /// decoded yet and were drawn from a coarser level.
+    Tiles {
+        /// The level the frame wanted.
+        level: u32,
+        /// Part of the frame was drawn coarser than wanted.
+        coarser: bool,
+    },
 }
 
 impl RenderPath {
@@ -203,6 +188,8 @@ impl RenderPath {
             RenderPath::Cube(CubeRenderer::Basic) => "cube-basic",
             RenderPath::Cube(CubeRenderer::Accelerated) => "cube-accelerated",
             RenderPath::CubeProjected => "cube-per-pixel",
+            RenderPath::Tiles { coarser: false, .. } => "tiles",
+            RenderPath::Tiles { coarser: true, .. } => "tiles-coarser",
         }
     }
 }

@@ -19,106 +19,18 @@
 //! The pixels sample exactly the positions [`row_pass`] writes; `Renderer::positions`
 //! reads the same buffers, so the measured sampling error is this pass's.
 
-use super::kernel::{expand, sample_level, sample_q8, wrap_q8, Level, Positions, SpanQ8, Texels};
-use super::scanline::{
-    blend_pays, read_at, render_row, span_step, with_nodes, wrap_u, Half, Unfold,
-};
+use super::kernel::{active, wrap_q8, Level, SpanQ8, Texels};
+use super::scanline::{blend_pays, render_row, with_nodes};
 use super::scanline::{RowScratch, Scratch, BLEND_NODES};
-use super::setup::{Scan, Setup};
+use super::setup::{Scan, Setup, Unfold};
 use super::sink::Sink;
 use super::sink::{PixelSink, PosSink, TriSink};
 use super::steps::STEP_REGIONS;
+use super::walk::{read_at, span_step, wrap_u, Half, HalfBuf, HalfRun, HALF_CHUNK};
 use crate::geom::fixed::{Fx, FX_ONE};
-use crate::lut::{Blended, LutTable};
+use crate::lut::LutTable;
 use crate::map::envmap::EnvMap;
 use crate::map::sample::lerp_px;
-
-/// Pixels of a half row whose positions are buffered before the row kernels run: a whole
-/// half row up to 2048-pixel frames, so a 1080p row is drawn as two runs rather than
-/// four (each run starts with a burst of prefetches its first pixels wait for: 512 drew
-/// the 8k frame at hfov 90 about 3 % slower, docs/performance.md "Prefetch distance").
-pub(crate) const HALF_CHUNK: usize = 1024;
-
-/// A buffer's room: a chunk, then up to one more span (64 pixels) and the last pixel,
-/// and the 15 positions past it a 16-lane `kernel::expand` writes.
-const ROOM: usize = HALF_CHUNK + 80;
-
-/// Room for a chunk of a half row's positions (Q.8) and its spans, kept from row to row.
-pub(crate) struct HalfBuf {
-    u: [i32; ROOM],
-    v: [i32; ROOM],
-    /// The left half's u (its v is the right half's).
-    ul: [i32; ROOM],
-    /// The spans not yet expanded into `u`, `v` (at most one per pixel of a chunk).
-    spans: [SpanQ8; HALF_CHUNK + 2],
-    n_spans: usize,
-    /// The runs of equal level of detail (trilinear), in order: at most one per span.
-    segs: [Seg; HALF_CHUNK + 2],
-    n_segs: usize,
-    /// Room for per-position weights (trilinear: the second level's).
-    w: [u32; ROOM],
-}
-
-/// Positions from `start` (of a [`HalfRun`]) to the next `Seg`'s start (or the run's end)
-/// have the level of detail `lod` (Q.8, ≥ 0; 0: level 0 alone, plain bilinear).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub(crate) struct Seg {
-    pub(crate) start: u32,
-    pub(crate) lod: i32,
-}
-
-impl HalfBuf {
-    pub(crate) fn new() -> HalfBuf {
-        HalfBuf {
-            u: [0; ROOM],
-            v: [0; ROOM],
-            ul: [0; ROOM],
-            spans: [SpanQ8::default(); HALF_CHUNK + 2],
-            n_spans: 0,
-            segs: [Seg::default(); HALF_CHUNK + 2],
-            n_segs: 0,
-            w: [0; ROOM],
-        }
-    }
-
-    /// The span from position `start` on has level of detail `lod` (a new [`Seg`]
-    /// unless it equals the last one's; below 0 is 0).
-    #[inline(always)]
-    fn push_lod(&mut self, start: u32, lod: i32) {
-        let lod = lod.max(0);
-        if self.n_segs == 0 || self.segs[self.n_segs - 1].lod != lod {
-            self.segs[self.n_segs] = Seg { start, lod };
-            self.n_segs += 1;
-        }
-    }
-
-    /// Expand the recorded spans into the positions (`kernel::expand`).
-    #[inline]
-    fn expand(&mut self) {
-        let p = Positions {
-            u: &mut self.u,
-            v: &mut self.v,
-            ul: &mut self.ul,
-        };
-        expand::<true>(&self.spans[..self.n_spans], p);
-        self.n_spans = 0;
-    }
-}
-
-/// A run of positions of a scanline: pixel `right + j` samples (`u[j]`, `v[j]`) (Q.8 map
-/// coordinates), and pixel `left_end − 1 − j`, its mirror image, (`ul[j]`, `v[j]`);
-/// for a sink that asks ([`Sink::LOD`]) the levels of detail of its positions (`segs`),
-/// and room for a weight per position (`w`).
-#[derive(Debug)]
-pub(crate) struct HalfRun<'a> {
-    pub(crate) right: usize,
-    pub(crate) left_end: usize,
-    pub(crate) u: &'a [i32],
-    pub(crate) v: &'a [i32],
-    pub(crate) ul: &'a [i32],
-    pub(crate) segs: &'a [Seg],
-    pub(crate) w: &'a mut [u32],
-}
 
 /// Whether the row pass draws the LUT rows of `fr`'s map (full 360° maps whose rows do
 /// not scale: equirectangular and sine; the others go span by span).
@@ -286,19 +198,36 @@ fn fill_within(
     }
 }
 
-/// A scanline of the LUT renderer: its scan, the table, the frame's setup, the row scale.
-pub(crate) type LutRow<'a> = (&'a Scan, &'a LutTable, &'a Setup, &'a [i64]);
+/// A scanline of the LUT renderer: what its walk reads.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LutRow<'a> {
+    /// The scanline's setup: its table rows, scale, index steps and zones.
+    pub(crate) scan: &'a Scan,
+    /// The table.
+    pub(crate) table: &'a LutTable,
+    /// The frame's setup.
+    pub(crate) fr: &'a Setup,
+    /// The map's row scale s(v) per map row (Q.30, `scanline::ROW_SCALE_ONE`) for
+    /// projections whose rows scale; empty for the others.
+    pub(crate) row_scale: &'a [i64],
+}
 
 /// Draw one LUT scanline of `map` (`t`: its texels) into `row`: the row pass where it
 /// applies ([`applies`]; partial maps through [`crop_run`]), else span by span through
 /// the sink.
 #[inline]
 pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
-    (scan, table, fr, row_scale): LutRow<'_>,
+    lut: LutRow<'_>,
     scratch: &mut RowScratch,
     (map, t): (&EnvMap, &Texels<'_>),
     row: &mut [u32],
 ) {
+    let LutRow {
+        scan,
+        table,
+        fr,
+        row_scale,
+    } = lut;
     let mut s = PixelSink::<BILINEAR, CROP>::new(row, map);
     if !applies(fr) {
         render_row(scan, table, fr, row_scale, &mut scratch.nodes, &mut s);
@@ -314,8 +243,8 @@ pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
             crop_run(s, t, wq, r);
             return;
         }
-        sample_q8::<BILINEAR, true>(t, r.ul, r.v, &mut s.row[r.left_end - n..r.left_end]);
-        sample_q8::<BILINEAR, false>(t, r.u, r.v, &mut s.row[r.right..r.right + n]);
+        active().sample_q8::<BILINEAR, true>(t, r.ul, r.v, &mut s.row[r.left_end - n..r.left_end]);
+        active().sample_q8::<BILINEAR, false>(t, r.u, r.v, &mut s.row[r.right..r.right + n]);
     });
 }
 
@@ -323,11 +252,13 @@ pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
 /// scanline): the row pass where it applies ([`applies`]; [`tri_run`], partial maps
 /// [`crop_tri_run`]), else span by span through the sink.
 #[inline]
-pub(crate) fn tri_row(
-    (scan, table, fr, row_scale): LutRow<'_>,
-    scratch: &mut RowScratch,
-    s: &mut TriSink<'_>,
-) {
+pub(crate) fn tri_row(lut: LutRow<'_>, scratch: &mut RowScratch, s: &mut TriSink<'_>) {
+    let LutRow {
+        scan,
+        table,
+        fr,
+        row_scale,
+    } = lut;
     if !applies(fr) {
         render_row(scan, table, fr, row_scale, &mut scratch.nodes, s);
         s.flush();
@@ -381,12 +312,12 @@ fn tri_run(levels: &[Texels], wq: i32, dv: i32, r: HalfRun<'_>, row: &mut [u32])
             w: w.unwrap_or(&[]),
         };
         match (k, w.is_some(), out) {
-            (0, false, Out::Left(o)) => sample_q8::<true, true>(t, u, v, o),
-            (0, false, Out::Right(o)) => sample_q8::<true, false>(t, u, v, o),
-            (_, false, Out::Left(o)) => sample_level::<true, false>(t, u, v, o, &lv),
-            (_, false, Out::Right(o)) => sample_level::<false, false>(t, u, v, o, &lv),
-            (_, true, Out::Left(o)) => sample_level::<true, true>(t, u, v, o, &lv),
-            (_, true, Out::Right(o)) => sample_level::<false, true>(t, u, v, o, &lv),
+            (0, false, Out::Left(o)) => active().sample_q8::<true, true>(t, u, v, o),
+            (0, false, Out::Right(o)) => active().sample_q8::<true, false>(t, u, v, o),
+            (_, false, Out::Left(o)) => active().sample_level::<true, false>(t, u, v, o, &lv),
+            (_, false, Out::Right(o)) => active().sample_level::<false, false>(t, u, v, o, &lv),
+            (_, true, Out::Left(o)) => active().sample_level::<true, true>(t, u, v, o, &lv),
+            (_, true, Out::Right(o)) => active().sample_level::<false, true>(t, u, v, o, &lv),
         }
     });
 }
@@ -565,9 +496,9 @@ fn crop_level_pass<const MIRROR: bool, const BLEND: bool>(
             if BLEND {
                 // (Level 0 of the stored texels: u wrapped by the stored width, a no-op.)
                 let l = Level { k: 0, wq: lv.cw, w };
-                sample_level::<MIRROR, true>(lv.t, su, sv, o, &l);
+                active().sample_level::<MIRROR, true>(lv.t, su, sv, o, &l);
             } else {
-                sample_q8::<true, MIRROR>(lv.t, su, sv, o);
+                active().sample_q8::<true, MIRROR>(lv.t, su, sv, o);
             }
         } else if outside {
             for j in 0..m {
@@ -652,7 +583,7 @@ fn crop_run<const BILINEAR: bool, const CROP: bool>(
         }
         let lend = r.left_end - j0;
         if left_in {
-            sample_q8::<BILINEAR, true>(t, &sl[..m], &sv[..m], &mut s.row[lend - m..lend]);
+            active().sample_q8::<BILINEAR, true>(t, &sl[..m], &sv[..m], &mut s.row[lend - m..lend]);
         } else if left_out {
             s.row[lend - m..lend].fill(bg);
         } else {
@@ -662,7 +593,7 @@ fn crop_run<const BILINEAR: bool, const CROP: bool>(
         }
         let rs = r.right + j0;
         if right_in {
-            sample_q8::<BILINEAR, false>(t, &su[..m], &sv[..m], &mut s.row[rs..rs + m]);
+            active().sample_q8::<BILINEAR, false>(t, &su[..m], &sv[..m], &mut s.row[rs..rs + m]);
         } else if right_out {
             s.row[rs..rs + m].fill(bg);
         } else {
@@ -677,11 +608,17 @@ fn crop_run<const BILINEAR: bool, const CROP: bool>(
 /// when the row pass draws these pixels), else the span walk's.
 #[inline]
 pub(crate) fn position_row(
-    (scan, table, fr, row_scale): LutRow<'_>,
+    lut: LutRow<'_>,
     scratch: &mut RowScratch,
     wq: Option<i32>,
     row: &mut [Option<(f64, f64)>],
 ) {
+    let LutRow {
+        scan,
+        table,
+        fr,
+        row_scale,
+    } = lut;
     let mut s = PosSink { row };
     let Some(wq) = wq else {
         render_row(scan, table, fr, row_scale, &mut scratch.nodes, &mut s);
@@ -706,6 +643,7 @@ mod tests {
     use super::*;
     use crate::geom::projection::Projection;
     use crate::render::kernel::level_texels;
+    use crate::render::walk::Seg;
 
     /// A xorshift generator: each call a number below its argument.
     fn xorshift(mut seed: u64) -> impl FnMut(u64) -> u64 {

@@ -5,14 +5,14 @@
 //! steps continuously. The rest (pole zones, beyond the table) is evaluated exactly.
 //! Spans go to a [`Sink`].
 
-use super::kernel::simd_blend;
-use super::rowpass::HalfBuf;
+use super::kernel::active;
 use super::rows::Loan;
-use super::setup::{Scan, Setup};
+use super::setup::{Scan, Setup, Unfold};
 use super::sink::Sink;
 use super::steps::STEP_REGIONS;
+use super::walk::{read_at, span_step, wrap_u, Half, HalfBuf, Nodes};
 use crate::geom::fixed::{Fx, FX_BITS};
-use crate::lut::{Band, Blended, LutTable};
+use crate::lut::LutTable;
 
 /// Room for a run's blended table nodes (a run that reads more blends per read).
 pub(crate) const BLEND_NODES: usize = 512;
@@ -97,8 +97,8 @@ macro_rules! with_nodes {
         let count = k1 + 1 - k0;
         if count <= BLEND_NODES && blend_pays(scan, count, (h.dn + 1) as usize) {
             let nodes = &mut $scratch[..count];
-            $crate::render::kernel::blend_nodes(&band, k0, nodes);
-            let $nodes = &Blended { band, k0, nodes };
+            $crate::render::kernel::active().blend_nodes(&band, k0, nodes);
+            let $nodes = &$crate::lut::Blended { band, k0, nodes };
             $body
         } else {
             let $nodes = &band;
@@ -108,79 +108,7 @@ macro_rules! with_nodes {
 }
 pub(super) use with_nodes;
 
-/// The right half of a scanline's table-covered pixels, `xa..=xe` (`xa` the first pixel
-/// right of the centre or of the exact zone), and where its table reads fall: at pixel
-/// offsets d from `xa`, from 0 on by the step of the region d lies in, and at `dn`.
-/// The reads of region r are `e[r] + k·2^shift[r]` below `e[r + 1]`, so both halves can
-/// walk them in either direction.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Half {
-    pub(super) xa: i64,
-    pub(super) xe: i64,
-    /// 2X at `xa` (≥ 0).
-    pub(super) a0: i64,
-    /// `xe − xa`.
-    pub(super) dn: i64,
-    /// The first read in each region (regions before `xa`'s: 0).
-    pub(super) e: [i64; STEP_REGIONS],
-    /// The region of `xa`.
-    pub(super) r0: usize,
-}
-
 impl Half {
-    /// The right half of `scan` (`None`: the table covers none of it).
-    #[inline]
-    fn of(scan: &Scan, fr: &Setup) -> Option<Half> {
-        if !scan.lut || scan.lut_lo > scan.lut_hi {
-            return None;
-        }
-        let w = fr.w_out as i64;
-        let mut xa = w / 2;
-        let (zl, zh) = (scan.zone_lo.max(scan.lut_lo), scan.zone_hi.min(scan.lut_hi));
-        if zl <= zh {
-            xa = xa.max(zh + 1);
-        }
-        let xe = scan.lut_hi.min(w - 1);
-        if xe < xa {
-            return None;
-        }
-        let a0 = 2 * xa + 1 - w;
-        let thr = &fr.region_2x;
-        let mut r0 = 0;
-        while r0 + 1 < STEP_REGIONS && a0 >= thr[r0 + 1] {
-            r0 += 1;
-        }
-        let mut e = [0i64; STEP_REGIONS];
-        for r in r0..STEP_REGIONS - 1 {
-            let n = 1i64 << scan.shifts[r];
-            // The first offset in region r + 1, then the first read there.
-            let t = (thr[r + 1] - a0 + 1).div_euclid(2);
-            let gap = (t - e[r]).max(0);
-            e[r + 1] = e[r] + (gap + n - 1) / n * n;
-        }
-        Some(Half {
-            xa,
-            xe,
-            a0,
-            dn: xe - xa,
-            e,
-            r0,
-        })
-    }
-}
-
-impl Half {
-    /// Where region `r`'s reads end: the first read of the next region (none after the
-    /// last one).
-    #[inline(always)]
-    pub(super) fn region_end(&self, r: usize) -> i64 {
-        if r + 1 < STEP_REGIONS {
-            self.e[r + 1]
-        } else {
-            i64::MAX
-        }
-    }
-
     /// The right half of `scan`, after evaluating exactly into `sink` the pixels neither
     /// half covers (beyond the table, the pole zone between the halves; the whole row
     /// when there is no half).
@@ -211,36 +139,8 @@ fn exact_run<S: Sink>(scan: &Scan, fr: &Setup, x0: i64, x1: i64, sink: &mut S) {
     }
 }
 
-/// Unfolded table read at pixel x: (Λ, V) in Q.16 for the yaw-0 frame.
-#[inline]
-pub(crate) fn read(scan: &Scan, table: &LutTable, fr: &Setup, x: i64) -> (Fx, Fx) {
-    let a = 2 * x + 1 - fr.w_out as i64;
-    let band = table.band(scan.band, scan.wa);
-    let u = Unfold::new(scan, fr, a < 0);
-    u.apply(band.lookup_q(a.abs() * scan.node_per_2x))
-}
-
-/// The table reads of a scanline: straight from its band, or from its nodes blended once.
-pub(super) trait Nodes {
-    fn lookup_q(&self, c: i64) -> (Fx, Fx);
-}
-
-impl Nodes for Band<'_> {
-    #[inline(always)]
-    fn lookup_q(&self, c: i64) -> (Fx, Fx) {
-        Band::lookup_q(self, c)
-    }
-}
-
-impl Nodes for Blended<'_> {
-    #[inline(always)]
-    fn lookup_q(&self, c: i64) -> (Fx, Fx) {
-        Blended::lookup_q(self, c)
-    }
-}
-
 /// Whether to blend a run's `nodes` once instead of two per read: when there are at
-/// most 1.25 nodes per read (5 with a SIMD blend, `kernel::simd_blend`), the reads
+/// most 1.25 nodes per read (5 with a SIMD blend, `SelectedKernel::simd_blend`), the reads
 /// estimated from the run's length and the mean step of the regions. (Callgrind: about
 /// 20 instructions per node blended in scalar code against 27 saved per read puts the
 /// break-even near 1.35; with the row pass, which reads only the right half, a limit of
@@ -251,71 +151,8 @@ impl Nodes for Blended<'_> {
 pub(super) fn blend_pays(scan: &Scan, nodes: usize, pixels: usize) -> bool {
     // Reads per 256 pixels, summed over the regions.
     let per_256: usize = scan.shifts.iter().map(|&s| 256 >> s).sum();
-    let quarters = if simd_blend() { 20 } else { 5 };
+    let quarters = if active().simd_blend() { 20 } else { 5 };
     4 * nodes * 256 * STEP_REGIONS <= quarters * pixels * per_256
-}
-
-/// The one-eighth unfolding of one half of a scanline, hoisted out of its reads: Λ =
-/// ±Λ₈ + offset (behind the viewer W/2 − Λ₈, negated left of the centre), V = ±V₈ (negated
-/// below the horizon), as sign masks.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Unfold {
-    neg_l: i64,
-    off_l: i64,
-    neg_v: i64,
-}
-
-impl Unfold {
-    #[inline(always)]
-    pub(super) fn new(scan: &Scan, fr: &Setup, left: bool) -> Unfold {
-        let mask = |b: bool| -(b as i64);
-        let off = if scan.back { fr.half_map_w_fx } else { 0 };
-        Unfold {
-            neg_l: mask(scan.back != left),
-            off_l: if left { -off } else { off },
-            neg_v: mask(scan.neg_v),
-        }
-    }
-
-    #[inline(always)]
-    pub(super) fn apply(&self, (l, v): (Fx, Fx)) -> (Fx, Fx) {
-        (
-            ((l ^ self.neg_l) - self.neg_l) + self.off_l,
-            (v ^ self.neg_v) - self.neg_v,
-        )
-    }
-}
-
-/// The unfolded read at offset d of the half `h`.
-#[inline(always)]
-pub(super) fn read_at<N: Nodes>(scan: &Scan, nodes: &N, h: &Half, u: &Unfold, d: i64) -> (Fx, Fx) {
-    u.apply(nodes.lookup_q((h.a0 + 2 * d) * scan.node_per_2x))
-}
-
-/// The span from (l0, v0) to the next read (l1, v1) over `m` pixels (`shift`: log2 of
-/// the region's step, used when m is the whole step): Λ unwrapped across the ±180° seam
-/// (a jump of one map width), and the per-pixel steps.
-#[inline(always)]
-pub(super) fn span_step(
-    fr: &Setup,
-    (l0, v0): (Fx, Fx),
-    (l1, v1): (Fx, Fx),
-    m: i64,
-    shift: u32,
-) -> (Fx, (Fx, Fx)) {
-    let d = l1 - l0;
-    let mut l1 = l1;
-    if d > fr.half_map_w_fx {
-        l1 -= fr.map_w_fx;
-    } else if d < -fr.half_map_w_fx {
-        l1 += fr.map_w_fx;
-    }
-    let step = if m == 1i64 << shift {
-        ((l1 - l0) >> shift, (v1 - v0) >> shift)
-    } else {
-        ((l1 - l0) / m, (v1 - v0) / m)
-    };
-    (l1, step)
 }
 
 /// The right half's spans, outward from its first pixel: [`RightSpans::next`] gives
@@ -446,17 +283,6 @@ pub(crate) fn emit<S: Sink>(
         }
     } else {
         sink.span(x, m, u, v, dl, dv, wfx);
-    }
-}
-
-#[inline(always)]
-pub(crate) fn wrap_u(u: Fx, w: Fx) -> Fx {
-    if u >= w {
-        u - w
-    } else if u < 0 {
-        u + w
-    } else {
-        u
     }
 }
 

@@ -5,7 +5,6 @@
 //! (near a pole, or beyond the table's field of view), and for trilinear sampling its
 //! vertical footprint. Yaw is one column offset added to u.
 
-use super::scanline::read;
 use super::steps::{step_for, StepBounds, ADAPTIVE_MAX_STEP, STEP_REGIONS};
 use super::{IndexStep, RenderOptions, RenderPath, RenderReport};
 use crate::error::ViewError;
@@ -366,13 +365,53 @@ fn exact_count(s: &Scan, w: i64) -> u64 {
     (outside + zone) as u64
 }
 
+/// Unfolded table read at pixel x: (Λ, V) in Q.16 for the yaw-0 frame.
+#[inline]
+pub(crate) fn read(scan: &Scan, table: &LutTable, fr: &Setup, x: i64) -> (Fx, Fx) {
+    let a = 2 * x + 1 - fr.w_out as i64;
+    let band = table.band(scan.band, scan.wa);
+    let u = Unfold::new(scan, fr, a < 0);
+    u.apply(band.lookup_q(a.abs() * scan.node_per_2x))
+}
+
+/// The one-eighth unfolding of one half of a scanline, hoisted out of its reads: Λ =
+/// ±Λ₈ + offset (behind the viewer W/2 − Λ₈, negated left of the centre), V = ±V₈ (negated
+/// below the horizon), as sign masks.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Unfold {
+    neg_l: i64,
+    off_l: i64,
+    neg_v: i64,
+}
+
+impl Unfold {
+    #[inline(always)]
+    pub(crate) fn new(scan: &Scan, fr: &Setup, left: bool) -> Unfold {
+        let mask = |b: bool| -(b as i64);
+        let off = if scan.back { fr.half_map_w_fx } else { 0 };
+        Unfold {
+            neg_l: mask(scan.back != left),
+            off_l: if left { -off } else { off },
+            neg_v: mask(scan.neg_v),
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn apply(&self, (l, v): (Fx, Fx)) -> (Fx, Fx) {
+        (
+            ((l ^ self.neg_l) - self.neg_l) + self.off_l,
+            (v ^ self.neg_v) - self.neg_v,
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use crate::geom::camera::{Camera, View};
     use crate::geom::mapping::exact_uv_at;
     use crate::geom::projection::Projection;
     use crate::map::synth::grid_map;
-    use crate::render::{Frame, RenderOptions, Renderer, Scene};
+    use crate::render::{Frame, RenderOptions, Renderer};
 
     /// Each scanline's `next_dv` (what the row kernels prefetch for the next scanline) is
     /// the map-row offset from its centre column's read to the next scanline's: against
@@ -395,13 +434,8 @@ mod tests {
                 let view = View::new(yaw, pitch, hfov).unwrap();
                 let mut px = vec![0u32; (w * h) as usize];
                 let mut frame = Frame::new(&mut px, w, h).unwrap();
-                r.render(
-                    Scene::Map(&map),
-                    view,
-                    &RenderOptions::default(),
-                    &mut frame,
-                )
-                .unwrap();
+                r.render(&map, view, &RenderOptions::default(), &mut frame)
+                    .unwrap();
                 let cam = Camera::new(view, w, h);
                 let v_at = |y: f64| {
                     exact_uv_at(&cam, proj, 512.0, 256.0, w as f64 / 2.0, y)

@@ -6,10 +6,10 @@
 use super::exact::{sample_at, sample_at_lod, ExactFootprint};
 use super::kernel::{
     nearest_span_direct, sample_span_cropped, sample_spans, texels, trilinear_spans, SpanJob,
-    Texels, MAX_JOBS,
+    Steps, Texels, MAX_JOBS,
 };
-use super::scanline::wrap_u;
 use super::steps::STEP_REGIONS;
+use super::walk::wrap_u;
 use crate::geom::fixed::{from_fx, Fx, FX_ONE};
 use crate::map::envmap::EnvMap;
 use crate::map::pyramid::lod_q8;
@@ -177,10 +177,12 @@ impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CR
     #[inline(always)]
     fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
         if CROP {
-            sample_span_cropped::<BILINEAR>(self.map, &mut self.row[x..x + m], u, v, du, dv);
+            let steps = Steps { u, v, du, dv };
+            sample_span_cropped::<BILINEAR>(self.map, &mut self.row[x..x + m], steps);
         } else if !BILINEAR && m < NEAREST_DIRECT {
             let out = &mut self.row[x..x + m];
-            nearest_span_direct(self.map, self.texels.as_ref(), out, (u, v), (du, dv));
+            let steps = Steps { u, v, du, dv };
+            nearest_span_direct(self.map, self.texels.as_ref(), out, steps);
         } else if self.batch.push(x, m, u, v, du, dv) {
             self.batch.flush::<BILINEAR>(self.map, self.row);
         }

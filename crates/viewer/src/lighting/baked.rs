@@ -1,5 +1,5 @@
 //! The lit panorama in the window: once the lighting has settled, the panorama is lit once
-//! ([`lut_core::IlluminanceMap::bake_map`] / `bake_cube`) on the baking thread
+//! ([`lut_core::IlluminanceMap::bake_panorama`]) on the baking thread
 //! (`baker.rs`) and from then on panned like an unlit one, at an unlit frame's cost.
 //!
 //! While the lighting changes (a light or the room dragged, a slider moving, the coarse
@@ -15,11 +15,8 @@
 //! Panoramas whose lit copy would exceed [`lut_core::BAKE_MAX_BYTES`] keep the per-frame
 //! lighting.
 
-use super::baker::{Baker, Done, Job, Panorama, Wake};
-use crate::scene::{Scene, SceneRef};
-use lut_core::{
-    lit_cube_bytes, lit_map_bytes, CubeMap, EnvMap, IlluminanceMap, ShadeOptions, BAKE_MAX_BYTES,
-};
+use super::baker::{Baker, Done, Job, Wake};
+use lut_core::{lit_panorama_bytes, IlluminanceMap, Panorama, ShadeOptions, BAKE_MAX_BYTES};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
@@ -32,12 +29,6 @@ pub struct BakeKey {
     pub scene_generation: u64,
     /// How E turns into colour.
     pub shade: ShadeOptions,
-}
-
-/// A lit copy of the panorama.
-pub(super) enum LitCopy {
-    Map(EnvMap),
-    Cube(CubeMap),
 }
 
 /// Where the lit panorama stands (the lights panel shows it).
@@ -105,7 +96,8 @@ pub struct LitPanorama {
     seen: Option<BakeKey>,
     /// The key the copy (or the bake in flight, or the decision not to bake) is for.
     key: Option<BakeKey>,
-    copy: Option<LitCopy>,
+    /// The lit copy: a panorama of the same kind and geometry, sharing the tables.
+    copy: Option<Panorama>,
     state: BakeState,
     /// The lighting was settled on the last update (a bake is due on the next frame when
     /// it is [`BakeState::Changing`]).
@@ -144,13 +136,13 @@ impl LitPanorama {
     /// the same since the frame before and is settled; takes the bake that answers the
     /// request for the current lighting when it has arrived; drops the copy, and cancels
     /// the bake in flight, as soon as the lighting differs from theirs. True when frames
-    /// should pan the lit copy ([`LitPanorama::scene_ref`]).
+    /// should pan the lit copy ([`LitPanorama::copy_mut`]).
     pub fn update(
         &mut self,
         key: Option<BakeKey>,
         settled: bool,
         map: Option<&Arc<IlluminanceMap>>,
-        scene: &Scene,
+        scene: &Panorama,
     ) -> bool {
         // First the bakes that have arrived (a stale one is freed before this frame
         // requests another).
@@ -179,11 +171,8 @@ impl LitPanorama {
     }
 
     /// Request the bake for `key` (the memory checked first).
-    fn request(&mut self, key: BakeKey, map: &Arc<IlluminanceMap>, scene: &Scene) {
-        let (bytes, panorama) = match scene {
-            Scene::Map { map, .. } => (lit_map_bytes(map), Panorama::Map(map.clone())),
-            Scene::Cube(cube) => (lit_cube_bytes(cube), Panorama::Cube(cube.clone())),
-        };
+    fn request(&mut self, key: BakeKey, map: &Arc<IlluminanceMap>, scene: &Panorama) {
+        let bytes = lit_panorama_bytes(scene);
         if bytes > BAKE_MAX_BYTES {
             self.state = BakeState::TooLarge { bytes };
             return;
@@ -202,7 +191,7 @@ impl LitPanorama {
         let job = Job {
             id: self.requests,
             map: map.clone(),
-            panorama,
+            panorama: scene.share(),
             shade: key.shade,
             cancel: cancel.clone(),
         };
@@ -262,16 +251,10 @@ impl LitPanorama {
         &self.state
     }
 
-    /// The lit copy of `scene` to render, with `scene`'s renderer (the copy has the same
-    /// geometry), or `None` when there is none.
-    pub fn scene_ref<'a>(&'a self, scene: &'a mut Scene) -> Option<SceneRef<'a>> {
-        match (&self.copy, scene) {
-            (Some(LitCopy::Map(map)), Scene::Map { renderer, .. }) => {
-                Some(SceneRef::Map { map, renderer })
-            }
-            (Some(LitCopy::Cube(cube)), Scene::Cube(_)) => Some(SceneRef::Cube(cube)),
-            _ => None,
-        }
+    /// The lit copy to render (a panorama of the same kind and geometry as the one it
+    /// was lit from, sharing its tables), or `None` when there is none.
+    pub fn copy_mut(&mut self) -> Option<&mut Panorama> {
+        self.copy.as_mut()
     }
 }
 
@@ -287,7 +270,7 @@ mod tests {
     use super::*;
     use crate::lighting::{LightsState, LitCache};
     use crate::scene::render_scene;
-    use lut_core::{grid_map, Camera, Projection, RenderOptions, Sampler, View};
+    use lut_core::{grid_map, Camera, EnvMap, Projection, RenderOptions, Sampler, View};
     use std::path::Path;
     use std::sync::mpsc::{channel, Receiver};
     use std::time::Duration;
@@ -324,7 +307,7 @@ mod tests {
         let mut st = LightsState::default();
         st.load_and_add(&lamp()).unwrap();
         let mut cache = LitCache::default();
-        let mut scene = Scene::map(grid_map(256, 128, Projection::Equirect).unwrap());
+        let mut scene = Panorama::map(grid_map(256, 128, Projection::Equirect).unwrap());
         let (mut lit, wakes) = threaded();
         // Coarse map, then the full one: frames lit one by one.
         let m = cache.update(&mut st, true).unwrap();
@@ -342,7 +325,7 @@ mod tests {
         assert!(lit.update(key(&cache, &st), true, m.as_ref(), &scene));
         assert!(matches!(lit.state(), BakeState::Baked { bytes, .. } if *bytes > 0));
         assert!(lit.state().describe().starts_with("lit panorama: "));
-        assert!(lit.scene_ref(&mut scene).is_some());
+        assert!(lit.copy_mut().is_some());
         // Its frames are the lit room: against the per-frame lighting, within the
         // filtering-order tolerance of tests/lit_bake.rs (here: a few levels on average).
         let view = View::new(20.0, -30.0, 90.0).unwrap();
@@ -352,7 +335,7 @@ mod tests {
             ..RenderOptions::default()
         };
         let mut want = vec![0u32; (w * h) as usize];
-        render_scene(scene.as_mut(), view, &opts, &mut want, w, h).unwrap();
+        render_scene(&mut scene, view, &opts, &mut want, w, h).unwrap();
         m.as_ref()
             .unwrap()
             .shade_frame(
@@ -364,7 +347,7 @@ mod tests {
             )
             .unwrap();
         let mut got = vec![0u32; (w * h) as usize];
-        let r = lit.scene_ref(&mut scene).unwrap();
+        let r = lit.copy_mut().unwrap();
         render_scene(r, view, &opts, &mut got, w, h).unwrap();
         let close = want
             .iter()
@@ -378,7 +361,7 @@ mod tests {
         st.auto_exposure = false;
         let m = cache.update(&mut st, true).unwrap();
         assert!(!lit.update(key(&cache, &st), true, m.as_ref(), &scene));
-        assert!(lit.scene_ref(&mut scene).is_none());
+        assert!(lit.copy_mut().is_none());
         assert!(!lit.update(key(&cache, &st), true, m.as_ref(), &scene));
         woken(&wakes);
         assert!(lit.update(key(&cache, &st), true, m.as_ref(), &scene));
@@ -403,10 +386,8 @@ mod tests {
         st.load_and_add(&lamp()).unwrap();
         st.auto_exposure = false;
         let mut cache = LitCache::default();
-        let scene = Scene::map(grid_map(128, 64, Projection::Equirect).unwrap());
-        let Scene::Map { map: pano, .. } = &scene else {
-            unreachable!()
-        };
+        let scene = Panorama::map(grid_map(128, 64, Projection::Equirect).unwrap());
+        let pano = scene.as_map().unwrap();
         let (mut lit, _wakes) = threaded();
         let (baker, jobs, done) = Baker::fake();
         lit.baker = Some(baker);
@@ -447,7 +428,7 @@ mod tests {
         );
         // Bake 1 arrives late: dropped, frames stay lit one by one.
         let send = |id: u64, copy: EnvMap| {
-            let result = Ok(LitCopy::Map(copy));
+            let result = Ok(Panorama::map(copy));
             done.send(Done {
                 id,
                 result,
@@ -463,7 +444,8 @@ mod tests {
         send(job2.id, copy2);
         assert!(lit.update(b, true, m.as_ref(), &scene));
         assert!(matches!(lit.state(), BakeState::Baked { .. }));
-        assert!(matches!(&lit.copy, Some(LitCopy::Map(c)) if texels(c) == px2));
+        let taken = lit.copy.as_ref().and_then(Panorama::as_map);
+        assert!(taken.is_some_and(|c| texels(c) == px2));
         // A bake for the current lighting that arrives after the lighting changed again
         // (not yet settled) is dropped too.
         st.exposure_lux *= 2.0;

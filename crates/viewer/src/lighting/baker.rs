@@ -14,8 +14,7 @@
 //! A finished bake is sent back with its request's number and the event loop is woken
 //! (no polling); a bake cancelled before it finished is dropped here.
 
-use super::baked::LitCopy;
-use lut_core::{CubeMap, EnvMap, IlluminanceMap, LightError, ShadeOptions};
+use lut_core::{IlluminanceMap, LightError, Panorama, ShadeOptions};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::sync::Arc;
@@ -24,18 +23,13 @@ use std::time::Instant;
 /// Wakes the event loop when a bake is done.
 pub type Wake = Arc<dyn Fn() + Send + Sync>;
 
-/// The panorama to light (shared with the window, not copied).
-#[derive(Clone)]
-pub(super) enum Panorama {
-    Map(Arc<EnvMap>),
-    Cube(Arc<CubeMap>),
-}
-
 /// One bake to run.
 pub(super) struct Job {
     /// The request's number (a later request has a larger one).
     pub id: u64,
     pub map: Arc<IlluminanceMap>,
+    /// The panorama to light: a handle on the window's (`Panorama::share`: the same
+    /// pixels and tables, not copied).
     pub panorama: Panorama,
     pub shade: ShadeOptions,
     /// Set when the lighting changed: the bake stops and nothing is sent back.
@@ -46,8 +40,9 @@ pub(super) struct Job {
 pub(super) struct Done {
     /// The request's number.
     pub id: u64,
-    /// The lit copy, or why it could not be made (one line).
-    pub result: Result<LitCopy, String>,
+    /// The lit copy (a panorama of the same kind, sharing the tables), or why it could
+    /// not be made (one line).
+    pub result: Result<Panorama, String>,
     /// How long the bake took.
     pub ms: f64,
 }
@@ -153,16 +148,9 @@ fn run(jobs: &Receiver<Job>, done: &Sender<Done>, wake: &Wake, pool: &rayon::Thr
 }
 
 /// Light `job`'s panorama (on the calling pool).
-fn bake(job: &Job) -> Result<LitCopy, LightError> {
-    let (map, shade, cancel) = (&job.map, &job.shade, &*job.cancel);
-    match &job.panorama {
-        Panorama::Map(pano) => map
-            .bake_map_cancellable(pano, shade, cancel)
-            .map(LitCopy::Map),
-        Panorama::Cube(cube) => map
-            .bake_cube_cancellable(cube, shade, cancel)
-            .map(LitCopy::Cube),
-    }
+fn bake(job: &Job) -> Result<Panorama, LightError> {
+    job.map
+        .bake_panorama(&job.panorama, &job.shade, &job.cancel)
 }
 
 #[cfg(all(test, target_os = "linux"))]

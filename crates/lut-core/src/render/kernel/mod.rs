@@ -34,27 +34,39 @@
 //! precomputed indices (the same memory accesses) was 3–4× faster than the kernel.
 //!
 //! # Layout
-//! `mod.rs` (this file): the kernels' data types and the entries the renderer calls on an
-//! [`EnvMap`]; `jobs.rs`: the span check, batches and the dispatch; `scalar.rs`: the
-//! portable kernels (the reference); `x86.rs`: the SSE4.1, AVX2 and AVX-512 texel blend
-//! the x86 kernels share (the only module where `unsafe` is allowed, with its children:
-//! `x86/span.rs` the span kernels, `x86/row.rs`, `x86/face.rs`, `x86/nodes.rs`);
-//! `select.rs`: choosing the kernel;
-//! `tests/`: the property tests (`row_pass.rs`: the row kernels'); `face.rs`:
-//! cube-face runs, whose positions (a projective line evaluated exactly per pixel) are
-//! computed in a pass of their own and drawn by the row kernels (the cube scanline
-//! renderer's nearest, bilinear and trilinear runs);
-//! `row.rs` (and `x86/row.rs`): the row pass's kernels (`render/rowpass.rs`), a run's
-//! Q.8 positions expanded from its spans and one gather-and-blend pass over them, with
-//! no per-span check (the LUT rows of full maps, trilinear's pyramid levels by
-//! `sample_level`; the span kernels draw the rest); `nodes.rs` (and `x86/nodes.rs`): a
-//! scanline's table nodes, the two table rows blended once for the walk's reads.
+//! One folder per operation, as fast_image_resize lays out its SIMD: each operation's
+//! `mod.rs` holds its types and its dispatch (methods of [`SelectedKernel`], the one way
+//! to call it), `scalar.rs` the portable twin (the reference), `x86.rs` the SSE4.1, AVX2
+//! and AVX-512 forms.
+//! - `span/`: the span kernels (a run stepping linearly, checked inside the map once;
+//!   batches of a row's spans; partial maps) and the renderer's entries on an
+//!   [`EnvMap`] (`sample_span`, `sample_spans`, `trilinear_spans`, …, which fall back
+//!   to the per-pixel samplers).
+//! - `row/`: the row pass's kernels (`render/rowpass.rs`): a run's Q.8 positions
+//!   expanded from its spans and one gather-and-blend pass over them, with no per-span
+//!   check (the LUT rows of full maps, trilinear's pyramid levels).
+//! - `face/`: cube-face runs, whose positions (a projective line evaluated exactly per
+//!   pixel) are computed in a pass of their own and drawn by the row kernels (the cube
+//!   scanline renderer's nearest, bilinear and trilinear runs).
+//! - `nodes/`: a scanline's table nodes, the two table rows blended once for the walk's
+//!   reads (the scalar twin is `lut::Band::blend_nodes`).
+//! - `shade/`: the lighting's shading rows (light factor × sRGB byte through the
+//!   shading table, `light/shade_table.rs`).
+//! - `x86_lanes.rs`: the lane helpers the x86 forms share (texel blends, prefetches),
+//!   below every operation; `select.rs`: choosing the kernel (CPU detection,
+//!   `LUTPANO_KERNEL`), used by every operation and using none; `tests/`: the
+//!   property tests (`row_pass.rs`: the row kernels').
+//!
+//! The imports run one way: `face` uses `row`; every `x86.rs` uses `x86_lanes`; all use
+//! `select` and this file's [`Texels`]; nothing below uses what is above it (the layout
+//! test in `lib.rs` checks it file by file).
 //!
 //! # Batches
 //! Spans are short (8–16 pixels at hfov 90), so what a span costs besides its pixels
 //! (the range check, the lane setup, a call) matters as much as the blend. The renderer
 //! queues a row's spans and hands up to [`MAX_JOBS`] of them to one call
-//! ([`Kernel::bilinear_spans`], [`Kernel::nearest_spans`], [`Kernel::trilinear_spans`]):
+//! ([`SelectedKernel::bilinear_spans`], [`SelectedKernel::nearest_spans`],
+//! [`SelectedKernel::trilinear_spans`]):
 //! the kernel is chosen once per batch, and the span checks and the SIMD loop are
 //! compiled into one `#[target_feature]` function (each SIMD loop has a single caller, so
 //! it is inlined there; a non-inlined kernel taking its span setup through memory cost a
@@ -94,8 +106,8 @@
 //!   gathering and blending all its pixels in one loop, took more instructions per pixel
 //!   (bilinear 67.6 against 62.8 per frame pixel, nearest 62.2 against 49.5): the fixed
 //!   cost of a span (checks, lane setup) stays, and the results must be copied back.
-//! - AVX-512 (`Kernel::Avx512`, 16 lanes) for the row kernels (`x86/row.rs`: runs of
-//!   hundreds of positions, no per-span cost) and the cube-face positions (`x86/face.rs`:
+//! - AVX-512 (`Kernel::Avx512`, 16 lanes) for the row kernels (`row/x86.rs`: runs of
+//!   hundreds of positions, no per-span cost) and the cube-face positions (`face/x86.rs`:
 //!   the `f64` division 8 lanes wide), not for the span kernels: at 8–16 pixels per span
 //!   the per-span cost, not the blend, dominates them, and a 16-lane vector would be half
 //!   empty on 8-pixel spans; `Kernel::Avx512` runs their AVX2 code. On AMD Zen 5 plain
@@ -108,7 +120,9 @@
 //! ([`Kernel::best`], from `is_x86_feature_detected!`). [`set_kernel`] changes it (the
 //! benchmarks compare kernels in one run); [`kernel_info`] tells what runs and which CPU
 //! features were detected. The choice costs one relaxed atomic load per batch, never a
-//! test per pixel.
+//! test per pixel. Every operation is a method of [`SelectedKernel`] (a kernel this CPU
+//! runs: [`Kernel::select`] checks, `active()` is the active one), so the renderer, the
+//! tests and the benchmarks call the same function.
 //!
 //! Why not a crate: `multiversion` (0.9, MIT/Apache-2.0, maintained) compiles one generic
 //! function for several targets, but these kernels are different code per instruction set
@@ -122,53 +136,29 @@
 //! aarch64 and x86 CPUs without SSE4.1 run the scalar kernel.
 
 mod face;
-mod jobs;
 mod nodes;
 mod row;
-mod scalar;
 mod select;
+mod shade;
+mod span;
 #[cfg(test)]
 mod tests;
 #[cfg(target_arch = "x86_64")]
-mod x86;
+mod x86_lanes;
 
 pub use select::{
     active_kernel, cpu_features, kernel_from_env, kernel_info, parse_kernel, set_kernel, Kernel,
-    KernelError, KernelInfo, KernelSource, KERNEL_ENV,
+    KernelError, KernelInfo, KernelSource, SelectedKernel, KERNEL_ENV,
 };
+pub use span::{SpanJob, Steps, Window, MAX_JOBS, TRILINEAR_CHUNK};
 
-pub(crate) use face::{face_rows, face_rows_blend, FaceBuf, FaceRun};
-pub(crate) use nodes::{blend_nodes, simd_blend};
-pub(crate) use row::{expand, sample_level, sample_q8, wrap_q8, Level, Positions, SpanQ8};
+pub(crate) use face::{FaceBuf, FaceRun};
+pub(crate) use row::{wrap_q8, Level, Positions, SpanQ8};
+pub(crate) use select::active;
+pub(crate) use shade::{Light, ShadeTable};
+pub(crate) use span::{nearest_span_direct, sample_span_cropped, sample_spans, trilinear_spans};
 
-use crate::geom::fixed::{Fx, FX_BITS};
 use crate::map::envmap::EnvMap;
-use crate::map::sample::lerp_px;
-
-/// Longest span the trilinear kernel blends in one piece (the second level restarts its
-/// position every this many pixels, as the per-pixel path always has).
-pub const TRILINEAR_CHUNK: usize = 64;
-
-/// Most spans in one batch ([`Kernel::bilinear_spans`]: one bit per span in its answer).
-pub const MAX_JOBS: usize = 32;
-
-/// One span of an output row, for the batch kernels: `len` pixels from column `x` on
-/// sample (u + i·du, v + i·dv), Q.16 map coordinates.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct SpanJob {
-    /// First output column.
-    pub x: u32,
-    /// Pixels.
-    pub len: u32,
-    /// Position of the first pixel.
-    pub u: Fx,
-    /// Position of the first pixel.
-    pub v: Fx,
-    /// Step per pixel.
-    pub du: Fx,
-    /// Step per pixel.
-    pub dv: Fx,
-}
 
 /// A map's pixels as the kernels read them: `(width + 1) × (height + 1)` 0RGB `u32`,
 /// row-major, the last column and row being padding (column `width` repeats column 0
@@ -233,23 +223,6 @@ impl<'a> Texels<'a> {
     }
 }
 
-/// A partial map's place in the full panorama, for [`Kernel::cropped_span`]: the stored
-/// [`Texels`] hold columns `left..left + width` (mod `full_width`) and rows
-/// `top..top + height` of a `full_width × full_height` panorama.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Window {
-    /// Full panorama width in pixels.
-    pub full_width: u32,
-    /// Full panorama height in pixels.
-    pub full_height: u32,
-    /// First stored column, in `0..full_width`.
-    pub left: u32,
-    /// First stored row.
-    pub top: u32,
-    /// The background colour (0RGB) outside the stored pixels.
-    pub background: u32,
-}
-
 /// Most pyramid levels the trilinear kernels take (level 0, the map, included).
 pub const MAX_LEVELS: usize = 32;
 
@@ -275,225 +248,4 @@ pub(crate) fn level_texels(map: &EnvMap) -> ([Texels<'_>; MAX_LEVELS], usize) {
         *d = texels(l);
     }
     (t, n)
-}
-
-/// Sample a run of positions stepping linearly: `out[i]` = the `BILINEAR` (else nearest)
-/// sample of `map` at (u + i·du, v + i·dv). Identical to calling [`EnvMap::bilinear`] /
-/// [`EnvMap::nearest`] per pixel with u wrapped into [0, W) for 360° maps.
-///
-/// When the whole run stays inside the map (after one wrap of its start), the span
-/// kernel runs ([`Kernel`]: no clamps, no wrap tests, SIMD where the CPU has it).
-/// Otherwise the run falls back to the per-pixel functions.
-#[inline]
-pub(crate) fn sample_span<const BILINEAR: bool>(
-    map: &EnvMap,
-    out: &mut [u32],
-    u: Fx,
-    v: Fx,
-    du: Fx,
-    dv: Fx,
-) {
-    if map.projection.scaled_rows() {
-        // Rows wrap within their own length (`EnvMap::bilinear`): per pixel.
-        return sample_span_slow::<BILINEAR>(map, out, u, v, du, dv);
-    }
-    let t = texels(map);
-    let done = if BILINEAR {
-        jobs::bilinear_span(&t, out, u, v, du, dv)
-    } else {
-        jobs::nearest_span(&t, out, u, v, du, dv)
-    };
-    if !done {
-        sample_span_slow::<BILINEAR>(map, out, u, v, du, dv);
-    }
-}
-
-/// Nearest samples of one span straight into `out`, with no batch: the renderer's short
-/// nearest spans. At the 8 pixels of a span at hfov 90 the scalar loop costs less than
-/// queueing the span and setting up SIMD lanes for it (docs/performance.md, "Nearest
-/// without the batch"); the bytes are the scalar kernel's, which every SIMD kernel
-/// equals (`tests/`). `t` is [`texels`] of `map`, or `None` for
-/// maps whose rows wrap within their own length (per pixel, as [`sample_spans`]).
-#[inline(always)]
-pub(crate) fn nearest_span_direct(
-    map: &EnvMap,
-    t: Option<&Texels>,
-    out: &mut [u32],
-    (u, v): (Fx, Fx),
-    (du, dv): (Fx, Fx),
-) {
-    match t.and_then(|t| Some((t, jobs::prepare::<false>(t, out.len(), (u, v), (du, dv))?))) {
-        Some((t, s)) => scalar::nearest(t, out, s),
-        None => sample_span_slow::<false>(map, out, u, v, du, dv),
-    }
-}
-
-/// [`sample_span`] for a batch of spans of one output row (at most [`MAX_JOBS`]): one
-/// kernel call for them all; spans leaving the map are sampled per pixel.
-pub(crate) fn sample_spans<const BILINEAR: bool>(map: &EnvMap, row: &mut [u32], spans: &[SpanJob]) {
-    let t = texels(map);
-    // Maps whose rows wrap within their own length (scaled rows): every span per pixel.
-    let mut refused = if map.projection.scaled_rows() {
-        (1u64 << spans.len()) - 1
-    } else if BILINEAR {
-        jobs::bilinear_spans(&t, row, spans)
-    } else {
-        jobs::nearest_spans(&t, row, spans)
-    };
-    while refused != 0 {
-        let j = &spans[refused.trailing_zeros() as usize];
-        refused &= refused - 1;
-        let (x, n) = (j.x as usize, j.len as usize);
-        sample_span_slow::<BILINEAR>(map, &mut row[x..x + n], j.u, j.v, j.du, j.dv);
-    }
-}
-
-/// [`sample_span`] for a run that leaves the map: per pixel, wrapping and clamping.
-#[inline(never)]
-fn sample_span_slow<const BILINEAR: bool>(
-    map: &EnvMap,
-    out: &mut [u32],
-    mut u: Fx,
-    mut v: Fx,
-    du: Fx,
-    dv: Fx,
-) {
-    let wfx = (map.width as i64) << FX_BITS;
-    let wraps = map.projection.wraps();
-    for o in out.iter_mut() {
-        let uu = if wraps { u.rem_euclid(wfx) } else { u };
-        *o = if BILINEAR {
-            map.bilinear(uu, v)
-        } else {
-            map.nearest(uu, v)
-        };
-        u += du;
-        v += dv;
-    }
-}
-
-/// [`EnvMap::trilinear`] over a run of positions stepping linearly (see [`sample_span`]),
-/// one level of detail for the run: bilinear spans on the two pyramid levels around
-/// `lod`, blended (the second level restarting every [`TRILINEAR_CHUNK`] pixels).
-#[cfg(test)]
-pub(crate) fn trilinear_span(
-    map: &EnvMap,
-    out: &mut [u32],
-    u: Fx,
-    v: Fx,
-    du: Fx,
-    dv: Fx,
-    lod: i32,
-) {
-    if lod <= 0 {
-        return sample_span::<true>(map, out, u, v, du, dv);
-    }
-    if map.crop.is_some() {
-        // Partial maps: per pixel (their levels are read as the padded map's).
-        return put_trilinear(map, out, (u, v), (du, dv), lod);
-    }
-    let (levels, n) = level_texels(map);
-    if jobs::trilinear_span(&levels[..n], lod, out, u, v, du, dv) {
-        return;
-    }
-    trilinear_span_slow(map, out, u, v, du, dv, lod);
-}
-
-/// [`trilinear_span`] pixel by pixel: [`EnvMap::trilinear`] at each position, u wrapped
-/// into the panorama.
-#[cfg(test)]
-fn put_trilinear(map: &EnvMap, out: &mut [u32], (u, v): (Fx, Fx), (du, dv): (Fx, Fx), lod: i32) {
-    let wfx = (map.width() as i64) << FX_BITS;
-    for (i, o) in out.iter_mut().enumerate() {
-        let i = i as i64;
-        *o = map.trilinear((u + i * du).rem_euclid(wfx), v + i * dv, lod);
-    }
-}
-
-/// [`trilinear_span`] where a level's span leaves its map: per level, with the per-pixel
-/// fallbacks.
-#[inline(never)]
-fn trilinear_span_slow(map: &EnvMap, out: &mut [u32], u: Fx, v: Fx, du: Fx, dv: Fx, lod: i32) {
-    let k = (lod >> 8) as usize;
-    let frac = (lod & 0xFF) as u32;
-    let (a_map, ka) = map.level(k);
-    let (b_map, kb) = map.level(k + 1);
-    sample_span::<true>(a_map, out, u >> ka, v >> ka, du >> ka, dv >> ka);
-    if frac == 0 || kb == ka {
-        return;
-    }
-    let mut scratch = [0u32; TRILINEAR_CHUNK];
-    let (mut u, mut v) = (u, v);
-    for chunk in out.chunks_mut(scratch.len()) {
-        let s = &mut scratch[..chunk.len()];
-        sample_span::<true>(b_map, s, u >> kb, v >> kb, du >> kb, dv >> kb);
-        for (o, b) in chunk.iter_mut().zip(s.iter()) {
-            *o = lerp_px(*o, *b, frac);
-        }
-        u += du * chunk.len() as i64;
-        v += dv * chunk.len() as i64;
-    }
-}
-
-/// [`trilinear_span`] for a batch of spans of one output row (`lods[i]` the level of
-/// detail of `spans[i]`): one kernel call for them all. `levels` is [`level_texels`]
-/// (taken once per frame). For the renderer's trilinear rows of full maps (a partial
-/// map's spans go pixel by pixel: `TriSink::span`).
-pub(crate) fn trilinear_spans(
-    map: &EnvMap,
-    levels: &[Texels],
-    row: &mut [u32],
-    spans: &[SpanJob],
-    lods: &[i32],
-) {
-    let mut refused = if map.projection.scaled_rows() {
-        (1u64 << spans.len()) - 1 // per pixel, as `sample_spans`
-    } else {
-        jobs::trilinear_spans(levels, row, spans, lods)
-    };
-    while refused != 0 {
-        let i = refused.trailing_zeros() as usize;
-        refused &= refused - 1;
-        let j = &spans[i];
-        let o = &mut row[j.x as usize..(j.x + j.len) as usize];
-        trilinear_span_slow(map, o, j.u, j.v, j.du, j.dv, lods[i]);
-    }
-}
-
-/// A run of [`EnvMap::nearest_cropped`] (`BILINEAR` false) or
-/// [`EnvMap::bilinear_cropped`] samples at full-panorama positions (u + i·du, v + i·dv),
-/// u wrapped per pixel. Spans inside the stored pixels or wholly in the background take
-/// the span kernels ([`Kernel::cropped_span`]); spans over the crop's edge are sampled
-/// per pixel.
-pub(crate) fn sample_span_cropped<const BILINEAR: bool>(
-    map: &EnvMap,
-    out: &mut [u32],
-    u: Fx,
-    v: Fx,
-    du: Fx,
-    dv: Fx,
-) {
-    let Some(c) = map.crop else {
-        return sample_span::<BILINEAR>(map, out, u, v, du, dv);
-    };
-    let w = Window {
-        full_width: c.full_width(),
-        full_height: c.full_height(),
-        left: c.left(),
-        top: c.top(),
-        background: map.background,
-    };
-    if jobs::cropped_span(BILINEAR, &texels(map), &w, out, u, v, du, dv) {
-        return;
-    }
-    let (mut u, mut v) = (u, v);
-    for o in out.iter_mut() {
-        *o = if BILINEAR {
-            map.bilinear_cropped(u, v)
-        } else {
-            map.nearest_cropped(u, v)
-        };
-        u += du;
-        v += dv;
-    }
 }

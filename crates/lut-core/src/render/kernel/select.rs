@@ -1,8 +1,5 @@
 //! Choosing the kernel: CPU detection, `LUTPANO_KERNEL`, the active kernel.
 
-use super::jobs::{cropped, jobs, span, tri_jobs, trilinear};
-use super::{SpanJob, Texels, Window};
-use crate::geom::fixed::Fx;
 use crate::named::Named;
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::OnceLock;
@@ -95,124 +92,27 @@ impl Kernel {
             .collect()
     }
 
-    pub(super) fn selected(self) -> Selected {
-        match Selected::new(self) {
+    /// This kernel, to call its operations (the methods of [`SelectedKernel`]).
+    ///
+    /// # Errors
+    /// [`KernelError::Unsupported`] when the CPU does not run it.
+    pub fn select(self) -> Result<SelectedKernel, KernelError> {
+        SelectedKernel::new(self).ok_or_else(|| KernelError::unsupported(self))
+    }
+
+    /// [`Kernel::select`] for the tests, which run only the kernels the CPU has.
+    ///
+    /// # Panics
+    /// When the CPU does not run this kernel.
+    #[cfg(test)]
+    pub(crate) fn selected(self) -> SelectedKernel {
+        match SelectedKernel::new(self) {
             Some(s) => s,
             None => panic!(
-                "the {} span kernel needs CPU features this machine lacks",
+                "the {} kernel needs CPU features this machine lacks",
                 self.name()
             ),
         }
-    }
-
-    /// Nearest samples along a span: `out[i]` = the pixel containing
-    /// (u + i·du, v + i·dv) (Q.16 map coordinates; for a wrapping map u may start up to
-    /// one period outside [0, W)). Returns `false`, writing nothing, when some position
-    /// falls outside the map: the caller then samples per pixel (with clamps and wraps).
-    /// The renderer calls this with the [`active_kernel`].
-    ///
-    /// # Panics
-    /// When the CPU does not run this kernel ([`Kernel::is_supported`]).
-    pub fn nearest_span(self, t: &Texels, out: &mut [u32], u: Fx, v: Fx, du: Fx, dv: Fx) -> bool {
-        span::<false>(self.selected(), t, out, (u, v), (du, dv))
-    }
-
-    /// [`Kernel::nearest_span`] for a batch of spans of one output row (at most
-    /// [`MAX_JOBS`](super::MAX_JOBS)): one call for many short spans. Returns a mask of
-    /// the spans left unwritten because they leave the map (bit i: `spans[i]`).
-    ///
-    /// # Panics
-    /// When the CPU does not run this kernel, a span does not fit in `row`, or there are
-    /// more than [`MAX_JOBS`](super::MAX_JOBS) spans.
-    pub fn nearest_spans(self, t: &Texels, row: &mut [u32], spans: &[SpanJob]) -> u64 {
-        jobs::<false>(self.selected(), t, row, spans)
-    }
-
-    /// [`Kernel::bilinear_span`] for a batch of spans of one output row (see
-    /// [`Kernel::nearest_spans`]).
-    ///
-    /// # Panics
-    /// As [`Kernel::nearest_spans`].
-    pub fn bilinear_spans(self, t: &Texels, row: &mut [u32], spans: &[SpanJob]) -> u64 {
-        jobs::<true>(self.selected(), t, row, spans)
-    }
-
-    /// Bilinear samples along a span: the four pixel centres around each position
-    /// − ½, 8-bit weights (see [`Kernel::nearest_span`] for the coordinates and the
-    /// return value).
-    ///
-    /// # Panics
-    /// When the CPU does not run this kernel ([`Kernel::is_supported`]).
-    pub fn bilinear_span(self, t: &Texels, out: &mut [u32], u: Fx, v: Fx, du: Fx, dv: Fx) -> bool {
-        span::<true>(self.selected(), t, out, (u, v), (du, dv))
-    }
-
-    /// Trilinear samples along a span with level of detail `lod` (Q.8, 256 = one
-    /// level, as `lod_q8` in the pyramid module computes it): `levels[0]` is the map,
-    /// `levels[k]` its pyramid level k (half the size of level k − 1). `lod` ≤ 0 is
-    /// bilinear on level 0; otherwise levels k = `lod >> 8` and k + 1 (each clamped to
-    /// the last) are sampled bilinearly at the positions and steps shifted right by their
-    /// index and blended by `lod & 0xFF` (level k alone when that is 0 or both clamp to
-    /// the same level); the second level restarts its position every
-    /// [`TRILINEAR_CHUNK`](super::TRILINEAR_CHUNK) pixels. Returns `false` when a level's
-    /// span leaves its map; `out` may then hold partial results and the caller samples it
-    /// another way.
-    ///
-    /// # Panics
-    /// When the CPU does not run this kernel, or `levels` is empty.
-    #[allow(clippy::too_many_arguments)]
-    pub fn trilinear_span(
-        self,
-        levels: &[Texels],
-        lod: i32,
-        out: &mut [u32],
-        u: Fx,
-        v: Fx,
-        du: Fx,
-        dv: Fx,
-    ) -> bool {
-        trilinear(self.selected(), levels, lod, out, (u, v), (du, dv))
-    }
-
-    /// [`Kernel::trilinear_span`] for a batch of spans of one output row, `lods[i]` the
-    /// level of detail of `spans[i]` (see [`Kernel::nearest_spans`] for the batch and
-    /// the answer).
-    ///
-    /// # Panics
-    /// As [`Kernel::nearest_spans`], and when `lods` and `spans` differ in length or
-    /// `levels` is empty.
-    pub fn trilinear_spans(
-        self,
-        levels: &[Texels],
-        row: &mut [u32],
-        spans: &[SpanJob],
-        lods: &[i32],
-    ) -> u64 {
-        tri_jobs(self.selected(), levels, row, spans, lods)
-    }
-
-    /// Nearest (`bilinear` false) or bilinear samples of a partial map along a span of
-    /// full-panorama positions (see [`Window`]; `t` holds the stored pixels, wrapping
-    /// only when they span 360°). Handled when the whole span lies in the stored
-    /// pixels' interior (where the crop changes nothing: the plain span kernel on the
-    /// stored pixels) or wholly in the background; otherwise (a span over the crop's
-    /// edge) it returns `false`, writing nothing, and the caller samples per pixel.
-    ///
-    /// # Panics
-    /// When the CPU does not run this kernel ([`Kernel::is_supported`]).
-    #[allow(clippy::too_many_arguments)]
-    pub fn cropped_span(
-        self,
-        bilinear: bool,
-        t: &Texels,
-        w: &Window,
-        out: &mut [u32],
-        u: Fx,
-        v: Fx,
-        du: Fx,
-        dv: Fx,
-    ) -> bool {
-        cropped(self.selected(), bilinear, t, w, out, (u, v), (du, dv))
     }
 }
 
@@ -383,22 +283,23 @@ pub fn active_kernel() -> Kernel {
     active().0
 }
 
+/// The active kernel ([`active_kernel`]), as the operations take it.
 #[inline(always)]
-pub(super) fn active() -> Selected {
+pub(crate) fn active() -> SelectedKernel {
     match ACTIVE.load(Ordering::Relaxed) {
         UNSET => init(),
         // Only supported kernels are stored (init and set_kernel check).
-        n => Selected(decode(n)),
+        n => SelectedKernel(decode(n)),
     }
 }
 
 #[cold]
-fn init() -> Selected {
+fn init() -> SelectedKernel {
     let (k, source) = match kernel_from_env() {
         Ok(Some(k)) => (k, KernelSource::Env),
         _ => (Kernel::best(), KernelSource::Auto),
     };
-    let k = Selected::new(k).unwrap_or(Selected(Kernel::Scalar));
+    let k = SelectedKernel::new(k).unwrap_or(SelectedKernel(Kernel::Scalar));
     // A concurrent set_kernel wins.
     if ACTIVE
         .compare_exchange(UNSET, k.0 as u8, Ordering::Relaxed, Ordering::Relaxed)
@@ -406,7 +307,7 @@ fn init() -> Selected {
     {
         SOURCE.store(source as u8, Ordering::Relaxed);
     }
-    Selected(decode(ACTIVE.load(Ordering::Relaxed)))
+    SelectedKernel(decode(ACTIVE.load(Ordering::Relaxed)))
 }
 
 /// Use `kernel` from now on in this process (`None`: the best the CPU runs); returns
@@ -416,7 +317,7 @@ fn init() -> Selected {
 /// [`KernelError::Unsupported`] when the CPU cannot run it (nothing changes).
 pub fn set_kernel(kernel: Option<Kernel>) -> Result<Kernel, KernelError> {
     let k = kernel.unwrap_or_else(Kernel::best);
-    let s = Selected::new(k).ok_or_else(|| KernelError::unsupported(k))?;
+    let s = SelectedKernel::new(k).ok_or_else(|| KernelError::unsupported(k))?;
     ACTIVE.store(s.0 as u8, Ordering::Relaxed);
     let source = if kernel.is_some() {
         KernelSource::Api
@@ -444,12 +345,20 @@ pub fn kernel_info() -> KernelInfo {
     }
 }
 
-/// A kernel this CPU runs: made only by [`Selected::new`], which checks.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Selected(pub(super) Kernel);
+/// A kernel this CPU runs, made only by [`Kernel::select`] (or, for the active kernel,
+/// by the renderer's `active()`), which check: the operations are its methods (each
+/// operation's `mod.rs`: `span/`, `row/`, `face/`, `nodes/`, `shade/`), and their SIMD
+/// forms rely on that check.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SelectedKernel(pub(super) Kernel);
 
-impl Selected {
-    fn new(k: Kernel) -> Option<Selected> {
-        k.is_supported().then_some(Selected(k))
+impl SelectedKernel {
+    fn new(k: Kernel) -> Option<SelectedKernel> {
+        k.is_supported().then_some(SelectedKernel(k))
+    }
+
+    /// The kernel.
+    pub fn kernel(self) -> Kernel {
+        self.0
     }
 }

@@ -1,10 +1,14 @@
 //! Every kernel the CPU runs against the scalar twin (identical bytes, same answer to
 //! "inside?"), and the scalar twin against the per-pixel samplers of [`EnvMap`].
 
+use super::span::{
+    nearest_span_direct, sample_span, sample_span_cropped, sample_spans, trilinear_span,
+};
 use super::*;
 use crate::geom::coverage::Crop;
-use crate::geom::fixed::{to_fx, FX_ONE};
+use crate::geom::fixed::{to_fx, FX_BITS, FX_ONE};
 use crate::geom::projection::Projection;
+use crate::map::sample::lerp_px;
 use crate::map::synth::grid_map;
 use crate::named::Named;
 use proptest::prelude::*;
@@ -74,6 +78,17 @@ struct SpanCase {
     off: usize,
 }
 
+impl SpanCase {
+    fn steps(&self) -> Steps {
+        Steps {
+            u: self.u,
+            v: self.v,
+            du: self.du,
+            dv: self.dv,
+        }
+    }
+}
+
 fn span_case(w: u32, h: u32) -> impl Strategy<Value = SpanCase> {
     (
         coord(w),
@@ -129,9 +144,9 @@ proptest! {
         for c in &cases {
             for bilinear in [false, true] {
                 let f = |k: Kernel| move |o: &mut [u32]| if bilinear {
-                    k.bilinear_span(&t, o, c.u, c.v, c.du, c.dv)
+                    k.selected().bilinear_span(&t, o, c.steps())
                 } else {
-                    k.nearest_span(&t, o, c.u, c.v, c.du, c.dv)
+                    k.selected().nearest_span(&t, o, c.steps())
                 };
                 let want = run(c, f(Kernel::Scalar));
                 if !want.0 {
@@ -177,9 +192,9 @@ proptest! {
         for (i, j) in jobs.iter().enumerate() {
             let o = &mut want[j.x as usize..(j.x + j.len) as usize];
             let ok = if bilinear {
-                Kernel::Scalar.bilinear_span(&t, o, j.u, j.v, j.du, j.dv)
+                Kernel::Scalar.selected().bilinear_span(&t, o, j.steps())
             } else {
-                Kernel::Scalar.nearest_span(&t, o, j.u, j.v, j.du, j.dv)
+                Kernel::Scalar.selected().nearest_span(&t, o, j.steps())
             };
             if !ok {
                 want_refused |= 1 << i;
@@ -188,9 +203,9 @@ proptest! {
         for k in Kernel::available() {
             let mut got = vec![SENTINEL; x as usize + 3];
             let refused = if bilinear {
-                k.bilinear_spans(&t, &mut got, &jobs)
+                k.selected().bilinear_spans(&t, &mut got, &jobs)
             } else {
-                k.nearest_spans(&t, &mut got, &jobs)
+                k.selected().nearest_spans(&t, &mut got, &jobs)
             };
             prop_assert_eq!(refused, want_refused, "{}", k);
             prop_assert_eq!(&got, &want, "{} bilinear {}", k, bilinear);
@@ -218,9 +233,9 @@ proptest! {
             for bilinear in [false, true] {
                 let mut out = vec![0u32; c.len];
                 let ok = if bilinear {
-                    Kernel::Scalar.bilinear_span(&t, &mut out, c.u, c.v, c.du, c.dv)
+                    Kernel::Scalar.selected().bilinear_span(&t, &mut out, c.steps())
                 } else {
-                    Kernel::Scalar.nearest_span(&t, &mut out, c.u, c.v, c.du, c.dv)
+                    Kernel::Scalar.selected().nearest_span(&t, &mut out, c.steps())
                 };
                 if !ok {
                     continue;
@@ -255,7 +270,7 @@ proptest! {
         cases[0].du = (cases[0].du / 4).clamp(-FX_ONE, FX_ONE);
         cases[0].dv = (cases[0].dv / 4).clamp(-FX_ONE / 8, FX_ONE / 8);
         for c in &cases {
-            let f = |kk: Kernel| move |o: &mut [u32]| kk.trilinear_span(levels, lod, o, c.u, c.v, c.du, c.dv);
+            let f = |kk: Kernel| move |o: &mut [u32]| kk.selected().trilinear_span(levels, o, c.steps(), lod);
             let want = run(c, f(Kernel::Scalar));
             for kk in others() {
                 let got = run(c, f(kk));
@@ -276,12 +291,12 @@ proptest! {
             };
             let level = |k: usize| if k == 0 { m } else { &m.pyramid()[k - 1] };
             let mut sep = vec![0u32; c.len];
-            sample_span::<true>(level(ka), &mut sep, c.u >> ka, c.v >> ka, c.du >> ka, c.dv >> ka);
+            sample_span::<true>(level(ka), &mut sep, Steps { u: c.u >> ka, v: c.v >> ka, du: c.du >> ka, dv: c.dv >> ka });
             if frac != 0 && ka != kb {
                 let (mut u, mut v) = (c.u, c.v);
                 for chunk in sep.chunks_mut(TRILINEAR_CHUNK) {
                     let mut s = vec![0u32; chunk.len()];
-                    sample_span::<true>(level(kb), &mut s, u >> kb, v >> kb, c.du >> kb, c.dv >> kb);
+                    sample_span::<true>(level(kb), &mut s, Steps { u: u >> kb, v: v >> kb, du: c.du >> kb, dv: c.dv >> kb });
                     for (o, q) in chunk.iter_mut().zip(&s) {
                         *o = lerp_px(*o, *q, frac);
                     }
@@ -315,13 +330,13 @@ proptest! {
             let mut want_refused = 0u64;
             for (i, (j, &lod)) in jobs.iter().zip(&lods).enumerate() {
                 let o = &mut want[j.x as usize..(j.x + j.len) as usize];
-                if !k.trilinear_span(&levels, lod, o, j.u, j.v, j.du, j.dv) {
+                if !k.selected().trilinear_span(&levels, o, j.steps(), lod) {
                     want_refused |= 1 << i;
                     o.fill(SENTINEL); // refused spans may hold partial results
                 }
             }
             let mut got = vec![SENTINEL; x as usize + 3];
-            let refused = k.trilinear_spans(&levels, &mut got, &jobs, &lods);
+            let refused = k.selected().trilinear_spans(&levels, &mut got, &jobs, &lods);
             prop_assert_eq!(refused, want_refused, "{}", k);
             for (i, j) in jobs.iter().enumerate() {
                 if refused & (1 << i) != 0 {
@@ -358,16 +373,16 @@ proptest! {
             // Spread the 64×32 positions over the panorama.
             let c = SpanCase { u: c.u * fw as i64 / 64 * scale / 2, v: c.v * fh as i64 / 32, du: c.du * scale / 2, ..*c };
             for bilinear in [false, true] {
-                let f = |k: Kernel| move |o: &mut [u32]| k.cropped_span(bilinear, &t, &win, o, c.u, c.v, c.du, c.dv);
+                let f = |k: Kernel| move |o: &mut [u32]| if bilinear { k.selected().cropped_span::<true>(&t, &win, o, c.steps()) } else { k.selected().cropped_span::<false>(&t, &win, o, c.steps()) };
                 let want = run(&c, f(Kernel::Scalar));
                 for k in others() {
                     prop_assert_eq!(&run(&c, f(k)), &want, "{} {:?} {:?}", k, crop, c);
                 }
                 let mut full = vec![0u32; c.len];
                 if bilinear {
-                    sample_span_cropped::<true>(&m, &mut full, c.u, c.v, c.du, c.dv);
+                    sample_span_cropped::<true>(&m, &mut full, c.steps());
                 } else {
-                    sample_span_cropped::<false>(&m, &mut full, c.u, c.v, c.du, c.dv);
+                    sample_span_cropped::<false>(&m, &mut full, c.steps());
                 }
                 for (i, &got) in full.iter().enumerate() {
                     // u wrapped per pixel, as the renderer does (a crop covering the
@@ -431,9 +446,9 @@ fn widest_map_spans() {
                 let f = |k: Kernel| {
                     move |o: &mut [u32]| {
                         if bilinear {
-                            k.bilinear_span(&t, o, c.u, c.v, c.du, c.dv)
+                            k.selected().bilinear_span(&t, o, c.steps())
                         } else {
-                            k.nearest_span(&t, o, c.u, c.v, c.du, c.dv)
+                            k.selected().nearest_span(&t, o, c.steps())
                         }
                     }
                 };
@@ -499,8 +514,8 @@ fn spans_equal_per_pixel_samples() {
             let (u, v, du, dv) = (to_fx(u), to_fx(v), to_fx(du), to_fx(dv));
             let mut nb = vec![0u32; 40];
             let mut nn = vec![0u32; 40];
-            sample_span::<true>(&m, &mut nb, u, v, du, dv);
-            sample_span::<false>(&m, &mut nn, u, v, du, dv);
+            sample_span::<true>(&m, &mut nb, Steps { u, v, du, dv });
+            sample_span::<false>(&m, &mut nn, Steps { u, v, du, dv });
             for i in 0..40 {
                 let uu = u + du * i as i64;
                 let uu = if proj.wraps() { uu.rem_euclid(wfx) } else { uu };
@@ -518,7 +533,7 @@ fn span_equals_per_pixel() {
     for lod in [0, 100, 256, 300, 700, 5000] {
         let (u, v, du, dv) = (to_fx(250.3), to_fx(40.2), to_fx(1.7), to_fx(-0.4));
         let mut out = vec![0u32; 100];
-        trilinear_span(&m, &mut out, u, v, du, dv, lod);
+        trilinear_span(&m, &mut out, Steps { u, v, du, dv }, lod);
         for (i, o) in out.iter().enumerate() {
             let uu = (u + du * i as i64).rem_euclid(256 << FX_BITS);
             let vv = v + dv * i as i64;
@@ -551,7 +566,7 @@ fn direct_nearest_spans_equal_per_pixel_samples() {
             for len in [1usize, 2, 7, 8, 9, 40] {
                 let mut direct = vec![0u32; len];
                 let mut batch = vec![0u32; len];
-                nearest_span_direct(&m, t.as_ref(), &mut direct, (u, v), (du, dv));
+                nearest_span_direct(&m, t.as_ref(), &mut direct, Steps { u, v, du, dv });
                 let job = SpanJob {
                     x: 0,
                     len: len as u32,
@@ -617,8 +632,83 @@ proptest! {
         band.blend_nodes(k0, &mut want[..n]);
         for k in Kernel::available() {
             let mut got = vec![[7i32, 7]; n + 3];
-            nodes::blend_nodes_with(k.selected(), &band, k0, &mut got[..n]);
+            k.selected().blend_nodes(&band, k0, &mut got[..n]);
             prop_assert_eq!(&got, &want, "{} k0 {} n {} wa {}", k, k0, n, wa);
+        }
+    }
+}
+
+/// A shading table of random bytes: the shading kernels only look entries up, so any
+/// table tells whether they read the right entry.
+fn shade_table() -> ShadeTable<'static> {
+    static T: OnceLock<Vec<u8>> = OnceLock::new();
+    let bytes = T.get_or_init(|| {
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        (0..ShadeTable::LEN)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                (x >> 24) as u8
+            })
+            .collect()
+    });
+    ShadeTable::new(bytes).expect("a table's length")
+}
+
+/// Illuminances: any `f32` (negatives, NaN, infinities, subnormals), values over the
+/// table's range, and smooth rows (a constant or a slow ramp: runs of 16 pixels on one
+/// table row, the AVX-512 form's byte-permute path, and on two or more).
+fn lux_row() -> impl Strategy<Value = Vec<f32>> {
+    let value = prop_oneof![
+        4 => (-20.0f32..20.0).prop_map(|e| 300.0 * 2f32.powf(e)),
+        2 => any::<f32>(),
+        1 => Just(0.0f32),
+    ];
+    prop_oneof![
+        2 => prop::collection::vec(value, 0..100),
+        1 => (0.0f32..5000.0, 0usize..100).prop_map(|(e, n)| vec![e; n]),
+        1 => (1.0f32..5000.0, -1e-2f32..1e-2, 0usize..100)
+            .prop_map(|(e, s, n)| (0..n).map(|i| e * (1.0 + s * i as f32)).collect()),
+    ]
+}
+
+/// A light factor's `ambient` or `exposure`: any `f32` but NaN (which no caller passes:
+/// with NaN on both sides of a product the NaN's sign, and so the row, would depend on
+/// the operand order the compiler picks), typical values, and 0.
+fn light_term() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        2 => 0.0f32..2.0,
+        1 => 1e-5f32..0.1,
+        1 => Just(0.0f32),
+        1 => any::<f32>().prop_filter("not NaN", |x| !x.is_nan()),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(600))]
+
+    /// The shading rows: every kernel the CPU runs writes the scalar kernel's bytes
+    /// (pixels with any top byte, which must not leak through; illuminances as
+    /// [`lux_row`], rows of 0 to 99 pixels from an odd offset, so every form's tail runs;
+    /// pixels past the illuminances left as they were).
+    #[test]
+    fn shade_rows_equal_scalar(
+        pixels in prop::collection::vec(any::<u32>(), 0..104),
+        lux in lux_row(),
+        ambient in light_term(),
+        exposure in light_term(),
+        off in 0usize..4,
+    ) {
+        let t = shade_table();
+        let l = Light { ambient, exposure };
+        let off = off.min(pixels.len());
+        let mut want = pixels.clone();
+        Kernel::Scalar.selected().shade_row(t, &mut want[off..], &lux, l);
+        for k in Kernel::available() {
+            let mut got = pixels.clone();
+            k.selected().shade_row(t, &mut got[off..], &lux, l);
+            prop_assert_eq!(&got, &want, "{} {:?}", k, l);
         }
     }
 }

@@ -63,7 +63,7 @@ fn run_row<const B: bool, const M: bool>(k: Kernel, t: &Texels, c: &RowCase) -> 
     let n = c.u.len();
     let mut buf = vec![SENTINEL; n + 16];
     let out = &mut buf[c.off..c.off + n];
-    row::sample_q8_with::<B, M>(k.selected(), t, &c.u, &c.v, out);
+    k.selected().sample_q8::<B, M>(t, &c.u, &c.v, out);
     buf
 }
 
@@ -164,9 +164,9 @@ proptest! {
             let mut b = [vec![0i32; room], vec![0i32; room], vec![0i32; room]];
             let [u, v, ul] = &mut b;
             if mirror {
-                row::expand_with::<true>(kern.selected(), &spans, row::Positions { u, v, ul });
+                kern.selected().expand::<true>(&spans, row::Positions { u, v, ul });
             } else {
-                row::expand_with::<false>(kern.selected(), &spans, row::Positions { u, v, ul: &mut [] });
+                kern.selected().expand::<false>(&spans, row::Positions { u, v, ul: &mut [] });
             }
             b.map(|mut x| {
                 x.truncate(k as usize);
@@ -208,7 +208,8 @@ fn run_level<const M: bool, const BLEND: bool>(
     buf[c.off..c.off + n].copy_from_slice(&base[..n]);
     let lv = row::Level { k: lk, wq, w };
     let out = &mut buf[c.off..c.off + n];
-    row::sample_lv_with::<true, M, true, BLEND>(k.selected(), t, &c.u, &c.v, out, &lv);
+    k.selected()
+        .sample_lv::<true, M, true, BLEND>(t, &c.u, &c.v, out, &lv);
     buf
 }
 
@@ -284,16 +285,16 @@ proptest! {
                 let b = row::Level { k: ka as u32 + 1, wq, w: &wts };
                 let s = Kernel::Scalar.selected();
                 if rev {
-                    row::sample_lv_with::<true, true, true, false>(s, &levels[ka], &c.u, &c.v, &mut out, &a);
+                    s.sample_lv::<true, true, true, false>(&levels[ka], &c.u, &c.v, &mut out, &a);
                 } else {
-                    row::sample_lv_with::<true, false, true, false>(s, &levels[ka], &c.u, &c.v, &mut out, &a);
+                    s.sample_lv::<true, false, true, false>(&levels[ka], &c.u, &c.v, &mut out, &a);
                 }
                 if ka < last {
                     let t = &levels[ka + 1];
                     if rev {
-                        row::sample_lv_with::<true, true, true, true>(s, t, &c.u, &c.v, &mut out, &b);
+                        s.sample_lv::<true, true, true, true>(t, &c.u, &c.v, &mut out, &b);
                     } else {
-                        row::sample_lv_with::<true, false, true, true>(s, t, &c.u, &c.v, &mut out, &b);
+                        s.sample_lv::<true, false, true, true>(t, &c.u, &c.v, &mut out, &b);
                     }
                 }
                 for j in 0..n {

@@ -1,82 +1,40 @@
-//! x86-64 SIMD kernels. This module holds what they share: the texel blend of each
-//! instruction set (`split`, `lerp`, `merge`, the nearest `gather`, the clamped lane
-//! indices and the bilinear sample of a vector of positions: `bilinear4` with SSE4.1,
-//! `bilinear8` with AVX2; the pair layout with AVX-512), the checked span start
-//! (`Local`) and the prefetch of the row kernels. The kernels themselves are its
-//! children: `span.rs` (the span kernels and their batch entry points), `row.rs` (the
-//! row pass's), `face.rs` (cube-face positions), `nodes.rs` (the table-node blend).
+//! The x86-64 lane helpers every operation's `x86.rs` shares (below them all: this
+//! module uses none of them): the texel blend of each instruction set (`split`, `lerp`,
+//! `merge`, the nearest `gather`, the clamped lane indices and the bilinear sample of a
+//! vector of positions: `bilinear4` with SSE4.1, `bilinear8` with AVX2; the pair layout
+//! with AVX-512), a checked span's start in lanes ([`Local`], made by `span/x86.rs`),
+//! and the row kernels' prefetches.
 //!
-//! All compute what `scalar.rs` computes, byte for byte (see the module docs of
+//! All compute what the scalar twins compute, byte for byte (see the module docs of
 //! [`super`]): positions in span-local `i32` lanes, lane indices stored to the stack and
 //! clamped into the pixel slice, two 64-bit loads per bilinear pixel (its top and bottom
 //! pairs), `shufps` to separate left and right texels, and the 8-bit blend in 16-bit
 //! lanes, two channels per 32-bit lane (blue and red, then green and the unused top byte,
 //! which is dropped at the end as `lerp_px` drops it).
 //!
-//! The only `unsafe` here and in the children: calling a `#[target_feature]` function
-//! (the CPU was checked: [`Selected`] is only made for a supported kernel), the unaligned
-//! loads and stores, whose indices are clamped into the slices they read or bounded by
-//! the loop, and the prefetches of the row kernels ([`prefetch_texels`] and, for the
-//! rows the next scanline reads, [`prefetch_next_rows`]), which read nothing.
+//! The only `unsafe` here: the unaligned loads, whose indices are clamped into the slices
+//! they read, and the prefetches ([`prefetch_texels`] and, for the rows the next scanline
+//! reads, [`prefetch_next_rows`]), which read nothing. Each function is
+//! `#[target_feature]` and is called only from kernels compiled under the same features.
 
 #![allow(unsafe_code)]
 
-use super::jobs::Span;
-use super::select::{Kernel, Selected};
-use super::Texels;
-use crate::geom::fixed::FX_BITS;
 use std::arch::x86_64::*;
 
-pub(super) mod face;
-pub(super) mod nodes;
-pub(super) mod row;
-mod span;
-
-pub(super) use span::{jobs, tri_jobs};
-
-/// The span's start split for 32-bit lanes: `base` = the start pixel's index in the
-/// slice, lanes hold `f + i·d` (Q.16, relative to that pixel).
+/// A checked span's start split for 32-bit lanes (made by the span kernels,
+/// `span/x86.rs`): `base` = the start pixel's index in the slice, lanes hold `f + i·d`
+/// (Q.16, relative to that pixel).
 #[derive(Debug, Clone, Copy)]
-struct Local {
-    base: usize,
-    fu: i32,
-    fv: i32,
-    du: i32,
-    dv: i32,
+pub(super) struct Local {
+    pub(super) base: usize,
+    pub(super) fu: i32,
+    pub(super) fv: i32,
+    pub(super) du: i32,
+    pub(super) dv: i32,
     /// Largest lane index (relative to `base`) whose reads stay inside the slice.
-    hi: i32,
+    pub(super) hi: i32,
     /// Smallest (−base).
-    lo: i32,
-}
-
-impl Local {
-    /// `None` when some lane value `f + i·d` (i < len) would not fit an `i32`, or the
-    /// slice holds 2³¹ pixels or more. `s` was checked by `prepare` (steps below 2⁴⁶,
-    /// fewer than 2¹⁶ pixels: the product below cannot overflow).
-    #[inline(always)]
-    fn new(t: &Texels, s: Span, len: usize, bilinear: bool) -> Option<Local> {
-        const LIM: u64 = i32::MAX as u64 - 0xFFFF;
-        let reach = s.du.unsigned_abs().max(s.dv.unsigned_abs()) * (len as u64 - 1);
-        let stride = t.stride();
-        // The last index whose read (one pixel, or the 2×2 block) stays in the slice.
-        let last =
-            t.px.len()
-                .wrapping_sub(if bilinear { stride + 2 } else { 1 });
-        let base = (s.v >> FX_BITS) as usize * stride + (s.u >> FX_BITS) as usize;
-        // (base ≤ last always holds for a checked span.)
-        if reach > LIM || t.px.len() > i32::MAX as usize || base > last {
-            return None;
-        }
-        Some(Local {
-            base,
-            fu: (s.u & 0xFFFF) as i32,
-            fv: (s.v & 0xFFFF) as i32,
-            du: s.du as i32,
-            dv: s.dv as i32,
-            hi: (last - base) as i32,
-            lo: -(base as i32),
-        })
-    }
+    pub(super) lo: i32,
 }
 
 /// The least number of pixels ahead the row kernels prefetch the texels they will read
@@ -89,7 +47,7 @@ impl Local {
 /// to memory (`docs/performance.md`, "Prefetching").
 pub(super) const PREFETCH_AHEAD: usize = 48;
 
-/// How many map texels ahead along a run the row kernels prefetch (`x86/row.rs`,
+/// How many map texels ahead along a run the row kernels prefetch (`row/x86.rs`,
 /// `prefetch_ahead`: the pixels that cover this many texels, between
 /// [`PREFETCH_AHEAD`] and this many pixels). On the AMD EPYC VM of
 /// `docs/performance.md` ("Prefetch distance"), 256 pixels ahead drew the 8k frame at
@@ -99,10 +57,10 @@ pub(super) const PREFETCH_AHEAD: usize = 48;
 pub(super) const PREFETCH_TEXELS: usize = 256;
 
 /// Prefetch into L2 the cache lines holding texel `at` and the one `stride` texels below
-/// it (the rows the next scanline will read, `x86/row.rs`). `at` need not point into the
+/// it (the rows the next scanline will read, `row/x86.rs`). `at` need not point into the
 /// map: a line off the map is a wasted prefetch, nothing more.
 #[inline(always)]
-fn prefetch_next_rows(at: *const u32, stride: usize) {
+pub(super) fn prefetch_next_rows(at: *const u32, stride: usize) {
     // SAFETY: as in `prefetch_texels`: a prefetch never faults, whatever the address.
     unsafe {
         _mm_prefetch::<_MM_HINT_T1>(at.cast());
@@ -114,7 +72,7 @@ fn prefetch_next_rows(at: *const u32, stride: usize) {
 /// below it (the row kernels' look-ahead). `at` need not point
 /// into the map: a line off the map is a wasted prefetch, nothing more.
 #[inline(always)]
-fn prefetch_texels<const BILINEAR: bool>(at: *const u32, stride: usize) {
+pub(super) fn prefetch_texels<const BILINEAR: bool>(at: *const u32, stride: usize) {
     // SAFETY: SSE is part of every x86-64 CPU; a prefetch reads nothing the program sees
     // and never faults, whatever the address.
     unsafe {
@@ -127,14 +85,14 @@ fn prefetch_texels<const BILINEAR: bool>(at: *const u32, stride: usize) {
 
 /// Copies `src[..n]` into a zeroed `[u32; N]` (tails shorter than a vector).
 #[inline(always)]
-fn padded<const N: usize>(src: &[u32]) -> [u32; N] {
+pub(super) fn padded<const N: usize>(src: &[u32]) -> [u32; N] {
     let mut a = [0u32; N];
     let n = src.len().min(N);
     a[..n].copy_from_slice(&src[..n]);
     a
 }
 
-mod avx2 {
+pub(super) mod avx2 {
     use super::*;
 
     /// Per 32-bit lane: the fraction byte (bits 8..16) in both 16-bit halves.
@@ -152,7 +110,7 @@ mod avx2 {
     /// 0RGB pixels → (blue and red, green and top byte), one channel per 16-bit lane.
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn split(p: __m256i) -> (__m256i, __m256i) {
+    pub(in crate::render::kernel) fn split(p: __m256i) -> (__m256i, __m256i) {
         (
             _mm256_and_si256(p, _mm256_set1_epi32(0x00FF_00FF)),
             _mm256_srli_epi16::<8>(p),
@@ -162,7 +120,7 @@ mod avx2 {
     /// Per channel `(a·iw + b·w + 128) >> 8` (at most 255·256 + 128: no 16-bit overflow).
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn lerp(
+    pub(in crate::render::kernel) fn lerp(
         a: (__m256i, __m256i),
         b: (__m256i, __m256i),
         w: (__m256i, __m256i),
@@ -178,7 +136,7 @@ mod avx2 {
     /// Split channels back to 0RGB (the top byte dropped).
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn merge(c: (__m256i, __m256i)) -> __m256i {
+    pub(in crate::render::kernel) fn merge(c: (__m256i, __m256i)) -> __m256i {
         let g = _mm256_and_si256(_mm256_slli_epi32::<8>(c.1), _mm256_set1_epi32(0xFF00));
         _mm256_or_si256(c.0, g)
     }
@@ -187,14 +145,19 @@ mod avx2 {
     /// (the row kernels' nearest; hardware gathers measured slower).
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn gather(g: impl Fn(usize) -> i32) -> __m256i {
+    pub(in crate::render::kernel) fn gather(g: impl Fn(usize) -> i32) -> __m256i {
         _mm256_setr_epi32(g(0), g(1), g(2), g(3), g(4), g(5), g(6), g(7))
     }
 
     /// Lane indices (relative to the span's base pixel) of positions `ru`, `rv`, clamped.
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn indices(ru: __m256i, rv: __m256i, stride: __m256i, l: &Local) -> [i32; 8] {
+    pub(in crate::render::kernel) fn indices(
+        ru: __m256i,
+        rv: __m256i,
+        stride: __m256i,
+        l: &Local,
+    ) -> [i32; 8] {
         let x = _mm256_srai_epi32::<16>(ru);
         let y = _mm256_srai_epi32::<16>(rv);
         let i = _mm256_add_epi32(_mm256_mullo_epi32(y, stride), x);
@@ -211,7 +174,7 @@ mod avx2 {
     /// Bilinear samples at 8 lane positions (split channels).
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn bilinear8(
+    pub(in crate::render::kernel) fn bilinear8(
         px: &[u32],
         stride: usize,
         l: &Local,
@@ -223,7 +186,7 @@ mod avx2 {
         let pair = |j: usize, row: usize| -> i64 {
             let k = (l.base as isize + a[j] as isize) as usize + row;
             // SAFETY: a[j] is clamped to [−base, last − base], so k ≤ last + row where
-            // last + stride + 1 < px.len() (Local::new): the 8 bytes at k are in `px`.
+            // last + stride + 1 < px.len() (`span/x86.rs`, `local`): the 8 bytes at k are in `px`.
             unsafe { p.add(k).cast::<i64>().read_unaligned() }
         };
         let ta = _mm256_set_epi64x(pair(5, 0), pair(4, 0), pair(1, 0), pair(0, 0));
@@ -259,19 +222,19 @@ mod avx2 {
     }
 }
 
-/// The AVX-512 pieces of the row kernels (`x86/row.rs`): the AVX2 ones on 16 lanes, the
+/// The AVX-512 pieces of the row kernels (`row/x86.rs`): the AVX2 ones on 16 lanes, the
 /// same arithmetic. There are no AVX-512 span kernels
-/// (`x86/span.rs`): `Kernel::Avx512` runs the AVX2 ones.
+/// (`span/x86.rs`): `Kernel::Avx512` runs the AVX2 ones.
 ///
 /// Every function is `#[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,
 /// avx512dq")]` (a list: `Kernel::Avx512` checks each).
-mod avx512 {
+pub(super) mod avx512 {
     use super::*;
 
     /// 0RGB pixels → (blue and red, green and top byte), one channel per 16-bit lane.
     #[inline]
     #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
-    pub(super) fn split(p: __m512i) -> (__m512i, __m512i) {
+    pub(in crate::render::kernel) fn split(p: __m512i) -> (__m512i, __m512i) {
         (
             _mm512_and_si512(p, _mm512_set1_epi32(0x00FF_00FF)),
             _mm512_srli_epi16::<8>(p),
@@ -281,7 +244,7 @@ mod avx512 {
     /// Per channel `(a·iw + b·w + 128) >> 8` (at most 255·256 + 128: no 16-bit overflow).
     #[inline]
     #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
-    pub(super) fn lerp(
+    pub(in crate::render::kernel) fn lerp(
         a: (__m512i, __m512i),
         b: (__m512i, __m512i),
         w: (__m512i, __m512i),
@@ -297,7 +260,7 @@ mod avx512 {
     /// Split channels back to 0RGB (the top byte dropped).
     #[inline]
     #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
-    pub(super) fn merge(c: (__m512i, __m512i)) -> __m512i {
+    pub(in crate::render::kernel) fn merge(c: (__m512i, __m512i)) -> __m512i {
         let g = _mm512_and_si512(_mm512_slli_epi32::<8>(c.1), _mm512_set1_epi32(0xFF00));
         _mm512_or_si512(c.0, g)
     }
@@ -306,7 +269,7 @@ mod avx512 {
     /// (`vpgatherdd` measured slower, docs/performance.md "AVX-512").
     #[inline]
     #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
-    pub(super) fn gather(g: impl Fn(usize) -> i32) -> __m512i {
+    pub(in crate::render::kernel) fn gather(g: impl Fn(usize) -> i32) -> __m512i {
         _mm512_setr_epi32(
             g(0),
             g(1),
@@ -332,7 +295,7 @@ mod avx512 {
     /// quarters) gives lanes 0..16 in order.
     #[inline]
     #[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512dq")]
-    pub(super) fn pairs(pair: impl Fn(usize) -> i64) -> (__m512i, __m512i) {
+    pub(in crate::render::kernel) fn pairs(pair: impl Fn(usize) -> i64) -> (__m512i, __m512i) {
         (
             _mm512_set_epi64(
                 pair(13),
@@ -358,7 +321,7 @@ mod avx512 {
     }
 }
 
-mod sse41 {
+pub(super) mod sse41 {
     use super::*;
 
     #[inline]
@@ -373,7 +336,7 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn split(p: __m128i) -> (__m128i, __m128i) {
+    pub(in crate::render::kernel) fn split(p: __m128i) -> (__m128i, __m128i) {
         (
             _mm_and_si128(p, _mm_set1_epi32(0x00FF_00FF)),
             _mm_srli_epi16::<8>(p),
@@ -382,7 +345,7 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn lerp(
+    pub(in crate::render::kernel) fn lerp(
         a: (__m128i, __m128i),
         b: (__m128i, __m128i),
         w: (__m128i, __m128i),
@@ -397,7 +360,7 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn merge(c: (__m128i, __m128i)) -> __m128i {
+    pub(in crate::render::kernel) fn merge(c: (__m128i, __m128i)) -> __m128i {
         let g = _mm_and_si128(_mm_slli_epi32::<8>(c.1), _mm_set1_epi32(0xFF00));
         _mm_or_si128(c.0, g)
     }
@@ -405,13 +368,18 @@ mod sse41 {
     /// A vector whose lanes 0..4 are `g(0..4)`: the nearest texels, read one by one.
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn gather(g: impl Fn(usize) -> i32) -> __m128i {
+    pub(in crate::render::kernel) fn gather(g: impl Fn(usize) -> i32) -> __m128i {
         _mm_setr_epi32(g(0), g(1), g(2), g(3))
     }
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn indices(ru: __m128i, rv: __m128i, stride: __m128i, l: &Local) -> [i32; 4] {
+    pub(in crate::render::kernel) fn indices(
+        ru: __m128i,
+        rv: __m128i,
+        stride: __m128i,
+        l: &Local,
+    ) -> [i32; 4] {
         let x = _mm_srai_epi32::<16>(ru);
         let y = _mm_srai_epi32::<16>(rv);
         let i = _mm_add_epi32(_mm_mullo_epi32(y, stride), x);
@@ -424,7 +392,7 @@ mod sse41 {
 
     #[inline]
     #[target_feature(enable = "sse4.1")]
-    pub(super) fn bilinear4(
+    pub(in crate::render::kernel) fn bilinear4(
         px: &[u32],
         stride: usize,
         l: &Local,
@@ -436,7 +404,7 @@ mod sse41 {
         let pair = |j: usize, row: usize| -> i64 {
             let k = (l.base as isize + a[j] as isize) as usize + row;
             // SAFETY: a[j] is clamped to [−base, last − base], so k ≤ last + row where
-            // last + stride + 1 < px.len() (Local::new): the 8 bytes at k are in `px`.
+            // last + stride + 1 < px.len() (`span/x86.rs`, `local`): the 8 bytes at k are in `px`.
             unsafe { p.add(k).cast::<i64>().read_unaligned() }
         };
         let ta = _mm_set_epi64x(pair(1, 0), pair(0, 0));

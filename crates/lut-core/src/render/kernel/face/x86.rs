@@ -1,27 +1,29 @@
-//! x86-64 cube-face positions (see `kernel/face.rs`): the face coordinates of 8
+//! x86-64 cube-face positions (see `face/mod.rs`): the face coordinates of 8
 //! (AVX-512), 4 (AVX2) or 2 (SSE) pixels per `f64` vector, computed with the scalar
 //! twin's operations in its order and rounded as it rounds them, written out as the row
 //! kernels' Q.8 positions (nearest: the texel; bilinear: Q.16 then Q.8). AVX-512 takes 16
 //! pixels per step (two `f64` vectors); the division then runs 8 lanes wide.
 //!
-//! Written once (`face_kernels!`) as the row kernels are (`x86/row.rs`): each
+//! Written once (`face_kernels!`) as the row kernels are (`row/x86.rs`): each
 //! instruction set's module names its intrinsics with short aliases (`add_pd` is
 //! `_mm256_add_pd` in `avx2`, `_mm_add_pd` in `sse41`; `V` the i32 vector of `N` lanes,
 //! `D` the f64 vector of `N / 2`, `H` the rounded coordinates of one `D`) and holds what
 //! differs in more than the prefix: joining two halves' coordinates (`join`), the lane
 //! offsets (`iota_pd`).
 
-use super::super::face::FaceRun;
-use super::{Kernel, Selected};
+#![allow(unsafe_code)]
+
+use super::FaceRun;
 use crate::geom::fixed::FX_ONE;
+use crate::render::kernel::select::{Kernel, SelectedKernel};
 use std::arch::x86_64::*;
 
 /// The bordered Q.8 positions of a face run's first `m` pixels with a SIMD kernel (see
-/// `kernel/face.rs`; whole vectors written: `u` and `v` hold `m` rounded up to 16),
+/// `face/mod.rs`; whole vectors written: `u` and `v` hold `m` rounded up to 16),
 /// and the largest `v`; `None` (nothing written) for the scalar one.
 #[inline(always)]
-pub(in super::super) fn positions<const BILINEAR: bool>(
-    k: Selected,
+pub(super) fn positions<const BILINEAR: bool>(
+    k: SelectedKernel,
     n: usize,
     r: &FaceRun,
     u: &mut [i32],
@@ -34,7 +36,7 @@ pub(in super::super) fn positions<const BILINEAR: bool>(
         "position buffers too short"
     );
     Some(match k.0 {
-        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel; the
+        // SAFETY: `k` is a `SelectedKernel`, made only when the CPU runs the kernel; the
         // buffers hold whole vectors past `m` (asserted above).
         Kernel::Avx512 => unsafe { avx512::positions::<BILINEAR>(n, r, u, v, m) },
         // SAFETY: as above.

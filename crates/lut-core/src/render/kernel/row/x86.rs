@@ -1,4 +1,4 @@
-//! x86-64 row kernels (see `kernel/row.rs`): 16 (AVX-512), 8 (AVX2) or 4 (SSE4.1) pixels
+//! x86-64 row kernels (see `row/mod.rs`): 16 (AVX-512), 8 (AVX2) or 4 (SSE4.1) pixels
 //! per step, the seam wrap and the pole clamp as lane compares, the texels read as the map kernels read
 //! them (two 64-bit loads per bilinear pixel) and blended with their `split`, `lerp` and
 //! `merge`; the left half's pixels reversed in the register before the store. Each
@@ -14,7 +14,7 @@
 //! module, where short names stand for that set's intrinsics (`add` is
 //! `_mm256_add_epi32` in `avx2`, `_mm_add_epi32` in `sse41`; `V` the vector type, `N` its
 //! lanes) and a few functions hold what differs in more than the prefix: the lane
-//! layout of the texel pairs (`pairs`), the nearest gather (`gather`, in `x86.rs` beside
+//! layout of the texel pairs (`pairs`), the nearest gather (`gather`, in `x86_lanes.rs` beside
 //! `split`, `lerp` and `merge`), the reversal
 //! (`reverse`), `iota`, the compares (`add_if_below`, `sub_if_above`, `zero_outside`:
 //! vector compares and masks in AVX2 and SSE4.1, `vector_compares!`; mask registers and
@@ -30,22 +30,27 @@
 //! scalar loads faster than `vpgatherdd` for nearest) on AMD Zen 5: see
 //! `docs/performance.md`, "AVX-512".
 
-use super::super::row::{sample_lv_scalar, Level, Positions, SpanQ8};
-use super::{
-    prefetch_next_rows, prefetch_texels, Kernel, Selected, Texels, PREFETCH_AHEAD, PREFETCH_TEXELS,
+#![allow(unsafe_code)]
+
+use super::scalar::sample_lv as sample_lv_scalar;
+use super::{Level, Positions, SpanQ8};
+use crate::render::kernel::select::{Kernel, SelectedKernel};
+use crate::render::kernel::x86_lanes::{
+    prefetch_next_rows, prefetch_texels, PREFETCH_AHEAD, PREFETCH_TEXELS,
 };
+use crate::render::kernel::Texels;
 use std::arch::x86_64::*;
 
-/// The row kernel with a SIMD kernel (see `row::sample_lv_scalar`); `false` (nothing
+/// The row kernel with a SIMD kernel (see `scalar::sample_lv`); `false` (nothing
 /// written) for the scalar one.
 #[inline(always)]
-pub(in super::super) fn sample_q8<
+pub(super) fn sample_q8<
     const BILINEAR: bool,
     const MIRROR: bool,
     const LEVEL: bool,
     const BLEND: bool,
 >(
-    k: Selected,
+    k: SelectedKernel,
     t: &Texels,
     u: &[i32],
     v: &[i32],
@@ -53,7 +58,7 @@ pub(in super::super) fn sample_q8<
     lv: &Level,
 ) -> bool {
     match k.0 {
-        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
+        // SAFETY: `k` is a `SelectedKernel`, made only when the CPU runs the kernel.
         Kernel::Avx512 => unsafe {
             avx512::sample_q8::<BILINEAR, MIRROR, LEVEL, BLEND>(t, u, v, out, lv)
         },
@@ -70,16 +75,16 @@ pub(in super::super) fn sample_q8<
     true
 }
 
-/// [`expand`](super::super::row::expand) with a SIMD kernel; the buffers back, untouched,
+/// `SelectedKernel::expand` with a SIMD kernel; the buffers back, untouched,
 /// for the scalar one.
 #[inline(always)]
-pub(in super::super) fn expand<'a, const MIRROR: bool>(
-    k: Selected,
+pub(super) fn expand<'a, const MIRROR: bool>(
+    k: SelectedKernel,
     spans: &[SpanQ8],
     p: Positions<'a>,
 ) -> Option<Positions<'a>> {
     match k.0 {
-        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
+        // SAFETY: `k` is a `SelectedKernel`, made only when the CPU runs the kernel.
         Kernel::Avx512 => unsafe { avx512::expand::<MIRROR>(spans, p) },
         // SAFETY: as above.
         Kernel::Avx2 => unsafe { avx2::expand::<MIRROR>(spans, p) },
@@ -467,9 +472,9 @@ macro_rules! vector_compares {
 }
 
 mod avx2 {
-    use super::super::avx2::{gather, lerp, merge, split};
     use super::sample_lv_scalar as tail;
     use super::*;
+    use crate::render::kernel::x86_lanes::avx2::{gather, lerp, merge, split};
     use std::arch::x86_64::{
         __m256i as V, _mm256_add_epi32 as add, _mm256_and_si256 as and,
         _mm256_andnot_si256 as andnot, _mm256_castps_si256 as from_ps,
@@ -518,9 +523,9 @@ mod avx2 {
 }
 
 mod avx512 {
-    use super::super::avx512::{gather, lerp, merge, pairs, split};
     use super::avx2::sample_q8 as tail;
     use super::*;
+    use crate::render::kernel::x86_lanes::avx512::{gather, lerp, merge, pairs, split};
     use std::arch::x86_64::{
         __m512i as V, _mm512_add_epi32 as add, _mm512_and_si512 as and,
         _mm512_castps_si512 as from_ps, _mm512_castsi512_ps as to_ps, _mm512_loadu_si512 as loadu,
@@ -583,9 +588,9 @@ mod avx512 {
 }
 
 mod sse41 {
-    use super::super::sse41::{gather, lerp, merge, split};
     use super::sample_lv_scalar as tail;
     use super::*;
+    use crate::render::kernel::x86_lanes::sse41::{gather, lerp, merge, split};
     use std::arch::x86_64::{
         __m128i as V, _mm_add_epi32 as add, _mm_and_si128 as and, _mm_andnot_si128 as andnot,
         _mm_castps_si128 as from_ps, _mm_castsi128_ps as to_ps, _mm_cmpgt_epi32 as gt,

@@ -1,4 +1,4 @@
-//! The AVX2 node blend (see `kernel/nodes.rs`; `Kernel::Avx512` runs it too): 4 values
+//! The AVX2 node blend (see `nodes/mod.rs`; `Kernel::Avx512` runs it too): 4 values
 //! (2 nodes of Λ, V) per step in `f64` lanes. Every step is exact there: the values are
 //! `i32`, so bot − top has at most 33 bits, (bot − top)·wa/2^16 at most 50 significant
 //! bits (wa ≤ 2^16; the division only moves the exponent), its floor is the arithmetic
@@ -6,18 +6,20 @@
 //! (The same in `i64` lanes, with `_mm256_mul_epi32`, was rewritten by the compiler into
 //! a general 64-bit multiply: 10 instructions a node against about 5 here.)
 
-use super::{Kernel, Selected};
+#![allow(unsafe_code)]
+
+use crate::render::kernel::select::{Kernel, SelectedKernel};
 use std::arch::x86_64::*;
 
 /// Blend with a SIMD kernel; `false` (nothing written) for the others.
 #[inline(always)]
-pub(in super::super) fn blend(
-    k: Selected,
+pub(super) fn blend(
+    k: SelectedKernel,
     rows: (&[[i32; 2]], &[[i32; 2]], i64),
     out: &mut [[i32; 2]],
 ) -> bool {
     match k.0 {
-        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel (an
+        // SAFETY: `k` is a `SelectedKernel`, made only when the CPU runs the kernel (an
         // AVX-512 CPU runs AVX2).
         Kernel::Avx2 | Kernel::Avx512 => unsafe { avx2(rows, out) },
         Kernel::Sse41 | Kernel::Scalar => return false,

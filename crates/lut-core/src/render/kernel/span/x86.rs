@@ -7,22 +7,54 @@
 //! 16-lane vector would be half empty, so `Kernel::Avx512` runs the AVX2 ones (an
 //! AVX-512 CPU runs AVX2), and so do the cropped kernels built on them.
 
-use super::super::jobs::{run_jobs, run_tri_jobs};
-use super::super::select::{Kernel, Selected};
-use super::super::{scalar, SpanJob, Texels};
-use super::{padded, Local};
+#![allow(unsafe_code)]
+
+use super::{run_jobs, run_tri_jobs, scalar, Span, SpanJob};
+use crate::geom::fixed::FX_BITS;
+use crate::render::kernel::select::{Kernel, SelectedKernel};
+use crate::render::kernel::x86_lanes::{padded, Local};
+use crate::render::kernel::Texels;
 use std::arch::x86_64::*;
+
+/// The span's start split for 32-bit lanes ([`Local`]); `None` when some lane value
+/// `f + i·d` (i < len) would not fit an `i32`, or the slice holds 2³¹ pixels or more. `s`
+/// was checked by `prepare` (steps below 2⁴⁶, fewer than 2¹⁶ pixels: the product below
+/// cannot overflow).
+#[inline(always)]
+fn local(t: &Texels, s: Span, len: usize, bilinear: bool) -> Option<Local> {
+    const LIM: u64 = i32::MAX as u64 - 0xFFFF;
+    let reach = s.du.unsigned_abs().max(s.dv.unsigned_abs()) * (len as u64 - 1);
+    let stride = t.stride();
+    // The last index whose read (one pixel, or the 2×2 block) stays in the slice.
+    let last =
+        t.px.len()
+            .wrapping_sub(if bilinear { stride + 2 } else { 1 });
+    let base = (s.v >> FX_BITS) as usize * stride + (s.u >> FX_BITS) as usize;
+    // (base ≤ last always holds for a checked span.)
+    if reach > LIM || t.px.len() > i32::MAX as usize || base > last {
+        return None;
+    }
+    Some(Local {
+        base,
+        fu: (s.u & 0xFFFF) as i32,
+        fv: (s.v & 0xFFFF) as i32,
+        du: s.du as i32,
+        dv: s.dv as i32,
+        hi: (last - base) as i32,
+        lo: -(base as i32),
+    })
+}
 
 /// The batch kernels ([`super::jobs`]) with a SIMD kernel; `None` for the scalar one.
 #[inline(always)]
-pub(in super::super) fn jobs<const BILINEAR: bool>(
-    k: Selected,
+pub(super) fn jobs<const BILINEAR: bool>(
+    k: SelectedKernel,
     t: &Texels,
     row: &mut [u32],
     jobs: &[SpanJob],
 ) -> Option<u64> {
     match k.0 {
-        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
+        // SAFETY: `k` is a `SelectedKernel`, made only when the CPU runs the kernel.
         // (No AVX-512 span kernels: AVX-512 CPUs run AVX2, see `Kernel::Avx512`.)
         Kernel::Avx2 | Kernel::Avx512 => Some(unsafe { avx2::jobs::<BILINEAR>(t, row, jobs) }),
         // SAFETY: as above.
@@ -34,15 +66,15 @@ pub(in super::super) fn jobs<const BILINEAR: bool>(
 /// The trilinear batch kernels ([`super::tri_jobs`]) with a SIMD kernel; `None` for the
 /// scalar one.
 #[inline(always)]
-pub(in super::super) fn tri_jobs(
-    k: Selected,
+pub(super) fn tri_jobs(
+    k: SelectedKernel,
     levels: &[Texels],
     row: &mut [u32],
     jobs: &[SpanJob],
     lods: &[i32],
 ) -> Option<u64> {
     match k.0 {
-        // SAFETY: `k` is a `Selected`, made only when the CPU runs the kernel.
+        // SAFETY: `k` is a `SelectedKernel`, made only when the CPU runs the kernel.
         // (No AVX-512 span kernels: AVX-512 CPUs run AVX2, see `Kernel::Avx512`.)
         Kernel::Avx2 | Kernel::Avx512 => Some(unsafe { avx2::tri_jobs(levels, row, jobs, lods) }),
         // SAFETY: as above.
@@ -60,7 +92,7 @@ pub(in super::super) fn tri_jobs(
 /// setup, the closures and the kernels inline into one loop per set.
 macro_rules! span_kernels {
     ($feature:literal) => {
-        /// A batch of trilinear spans (see [`super::super::tri_jobs`]).
+        /// A batch of trilinear spans (see [`super::tri_jobs`]).
         #[target_feature(enable = $feature)]
         pub(super) fn tri_jobs(
             levels: &[Texels],
@@ -73,11 +105,11 @@ macro_rules! span_kernels {
                 row,
                 jobs,
                 lods,
-                |t, out, s| match Local::new(t, s, out.len(), true) {
+                |t, out, s| match local(t, s, out.len(), true) {
                     Some(l) if out.len() >= 2 => bilinear::<false, 1>(t.px, t.stride(), out, l, 0),
                     _ => scalar::bilinear(t, out, s),
                 },
-                |t, out, s, frac| match Local::new(t, s, out.len(), true) {
+                |t, out, s, frac| match local(t, s, out.len(), true) {
                     Some(l) if out.len() >= 2 => {
                         bilinear::<true, 2>(t.px, t.stride(), out, l, frac)
                     }
@@ -86,7 +118,7 @@ macro_rules! span_kernels {
             )
         }
 
-        /// A batch of spans of one row (see [`super::super::jobs`]): the span setup and the
+        /// A batch of spans of one row (see [`super::jobs`]): the span setup and the
         /// kernel compiled together, the constants loaded once.
         #[target_feature(enable = $feature)]
         pub(super) fn jobs<const BILINEAR: bool>(
@@ -95,7 +127,7 @@ macro_rules! span_kernels {
             jobs: &[SpanJob],
         ) -> u64 {
             run_jobs::<BILINEAR>(t, row, jobs, |out, s| {
-                match Local::new(t, s, out.len(), BILINEAR) {
+                match local(t, s, out.len(), BILINEAR) {
                     Some(l) if out.len() >= 2 && BILINEAR => {
                         bilinear::<false, 0>(t.px, t.stride(), out, l, 0)
                     }
@@ -133,7 +165,7 @@ macro_rules! span_kernels {
                     merge(c)
                 }
             };
-            // Lanes i < m hold f + i·d exactly (Local::new); the wrapping adds stay exact.
+            // Lanes i < m hold f + i·d exactly (`local`); the wrapping adds stay exact.
             let mut ru = add(fu, times_iota(du));
             let mut rv = add(fv, times_iota(dv));
             let (su, sv) = (slli::<LOG_N>(du), slli::<LOG_N>(dv));
@@ -213,8 +245,10 @@ macro_rules! span_kernels {
 }
 
 mod avx2 {
-    use super::super::avx2::{bilinear8 as bilinear_n, indices, lerp, merge, split};
     use super::*;
+    use crate::render::kernel::x86_lanes::avx2::{
+        bilinear8 as bilinear_n, indices, lerp, merge, split,
+    };
     use std::arch::x86_64::{
         __m256i as V, _mm256_add_epi32 as add, _mm256_loadu_si256 as loadu,
         _mm256_min_epi32 as min, _mm256_mullo_epi32 as mullo, _mm256_set1_epi16 as set1_16,
@@ -251,8 +285,10 @@ mod avx2 {
 }
 
 mod sse41 {
-    use super::super::sse41::{bilinear4 as bilinear_n, indices, lerp, merge, split};
     use super::*;
+    use crate::render::kernel::x86_lanes::sse41::{
+        bilinear4 as bilinear_n, indices, lerp, merge, split,
+    };
     use std::arch::x86_64::{
         __m128i as V, _mm_add_epi32 as add, _mm_loadu_si128 as loadu, _mm_min_epi32 as min,
         _mm_mullo_epi32 as mullo, _mm_set1_epi16 as set1_16, _mm_set1_epi32 as set1,

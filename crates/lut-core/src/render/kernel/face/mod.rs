@@ -1,5 +1,5 @@
 //! Cube-face runs on the row kernels: the face's projective line evaluated exactly at
-//! every pixel in a positions pass (`f64` SIMD lanes, [`positions_scalar`] the twin),
+//! every pixel in a positions pass (`f64` SIMD lanes in `x86.rs`, `scalar.rs` the twin),
 //! then the row kernels' gather (and for bilinear, blend) over the positions
 //! (`kernel/row.rs`, AVX-512 / AVX2 / SSE4.1 / the scalar twin), as the LUT's rows are
 //! drawn. The cube scanline renderer's runs (`render/cube.rs`): nearest, bilinear, and
@@ -38,13 +38,14 @@
 //! border below it; runs reaching the lower half of that row (the positions pass
 //! returns the largest `v`) are redrawn there by [`bottom`] (reading the border row).
 
-use super::row::{sample_lv_with, sample_q8_with, Level};
-#[cfg(test)]
-use super::select::Kernel;
-use super::select::{active, Selected};
+use super::row::Level;
+use super::select::SelectedKernel;
 use super::Texels;
-use crate::geom::fixed::{FX_BITS, FX_ONE};
 use crate::map::sample::lerp_px;
+
+mod scalar;
+#[cfg(target_arch = "x86_64")]
+mod x86;
 
 /// A run of pixels on one cube face: pixel `i` has the ray coordinates on the face's
 /// axes `(a, b, m) = p + (dx + i) · d` (componentwise), and face coordinates
@@ -84,54 +85,11 @@ pub(crate) struct FaceBuf {
     pub(crate) fracs: Vec<u32>,
 }
 
-/// The exact face position of pixel `i` of the run (the arithmetic of `face_uv`) and its
-/// `m`.
-#[inline(always)]
-fn exact(r: &FaceRun, i: usize) -> (f64, f64, f64) {
-    // (Runs are shorter than 2³² pixels: u32 converts to f64 in one instruction.)
-    let dx = r.dx + f64::from(i as u32);
-    let a = r.p[0] + dx * r.d[0];
-    let b = r.p[1] + dx * r.d[1];
-    let m = r.p[2] + dx * r.d[2];
-    let q = r.half / m;
-    (r.half + a * q, r.half - b * q, m)
-}
-
-/// The bordered Q.8 positions of the run's pixels 0..m, exact (see the module docs), one
-/// pixel at a time: the SIMD kernels' scalar twin. Returns the largest `v` (`i32::MIN`
-/// for no pixel).
-fn positions_scalar<const BILINEAR: bool>(
-    n: usize,
-    r: &FaceRun,
-    u: &mut [i32],
-    v: &mut [i32],
-    m: usize,
-) -> i32 {
-    let (nf, topf, one) = (n as f64, ((n as i64) << FX_BITS) as f64, FX_ONE as f64);
-    let q8 = |x: f64| {
-        if BILINEAR {
-            // `CubeMap::bilinear`'s Q.16 (rounded half up, clamped into the face; NaN → 0:
-            // the float clamped first gives the same integer), + 1 texel (the border).
-            ((((x * one + 0.5).max(0.0).min(topf) as i64) + FX_ONE) >> 8) as i32
-        } else {
-            // `CubeMap::nearest`'s texel (NaN → 0), + 1 (the border), in Q.8.
-            (((x.max(0.0).min(nf) as i32).min(n as i32 - 1)) + 1) << 8
-        }
-    };
-    let mut top = i32::MIN;
-    for (i, (pu, pv)) in u[..m].iter_mut().zip(&mut v[..m]).enumerate() {
-        let (x, y, _) = exact(r, i);
-        *pu = q8(x);
-        *pv = q8(y);
-        top = top.max(*pv);
-    }
-    top
-}
-
-/// [`positions_scalar`] with kernel `k` (the buffers hold `m` rounded up to 16).
+/// The bordered Q.8 positions of the run's pixels 0..m with kernel `k` (the buffers
+/// hold `m` rounded up to 16), and the largest `v` (`i32::MIN` for no pixel).
 #[inline]
 fn positions_with<const BILINEAR: bool>(
-    k: Selected,
+    k: SelectedKernel,
     n: usize,
     r: &FaceRun,
     u: &mut [i32],
@@ -139,11 +97,11 @@ fn positions_with<const BILINEAR: bool>(
     m: usize,
 ) -> i32 {
     #[cfg(target_arch = "x86_64")]
-    if let Some(top) = super::x86::face::positions::<BILINEAR>(k, n, r, u, v, m) {
+    if let Some(top) = x86::positions::<BILINEAR>(k, n, r, u, v, m) {
         return top;
     }
     let _ = k;
-    positions_scalar::<BILINEAR>(n, r, u, v, m)
+    scalar::positions::<BILINEAR>(n, r, u, v, m)
 }
 
 /// The bilinear sample at bordered Q.8 position (`u`, `v`) reading the rows `y` and
@@ -167,7 +125,7 @@ fn bottom(t: &Texels, u: i32, v: i32) -> u32 {
 /// A face run with kernel `k`, bilinear (`BILINEAR`) or nearest.
 #[inline]
 fn run<const BILINEAR: bool>(
-    k: Selected,
+    k: SelectedKernel,
     t: &Texels,
     r: &FaceRun,
     out: &mut [u32],
@@ -177,7 +135,7 @@ fn run<const BILINEAR: bool>(
     let (len, n) = (out.len(), face_side(t));
     let low = positions::<BILINEAR>(k, t, r, len, buf);
     let (u, v) = (&buf.u[..len], &buf.v[..len]);
-    sample_q8_with::<BILINEAR, false>(k, t, u, v, out);
+    k.sample_q8::<BILINEAR, false>(t, u, v, out);
     if BILINEAR && low {
         let last = n as i32;
         for ((o, &u), &v) in out.iter_mut().zip(u).zip(v) {
@@ -192,7 +150,7 @@ fn run<const BILINEAR: bool>(
 /// bilinear read reaches the lower half of the face's last texel row (see [`bottom`]).
 #[inline]
 fn positions<const BILINEAR: bool>(
-    k: Selected,
+    k: SelectedKernel,
     t: &Texels,
     r: &FaceRun,
     len: usize,
@@ -213,7 +171,7 @@ fn positions<const BILINEAR: bool>(
 /// chunk of pixels).
 #[inline]
 fn run_blend(
-    k: Selected,
+    k: SelectedKernel,
     t: &Texels,
     r: &FaceRun,
     out: &mut [u32],
@@ -235,7 +193,7 @@ fn run_blend(
     }
     let (u, v, w) = (&buf.u[..len], &buf.v[..len], &buf.w[..]);
     let lv = Level { k: 0, wq: 0, w };
-    sample_lv_with::<true, false, false, true>(k, t, u, v, out, &lv);
+    k.sample_lv::<true, false, false, true>(t, u, v, out, &lv);
     if low {
         let last = n as i32;
         for (j, o) in out.iter_mut().enumerate() {
@@ -246,53 +204,11 @@ fn run_blend(
     }
 }
 
-/// Bilinear (`BILINEAR`) or nearest samples of one cube face along a run (see the
-/// module docs), with the [`active_kernel`](super::active_kernel). `t` is the face's
-/// bordered texels. Every pixel of `out` is written; positions are clamped into the face,
-/// so any run is safe.
-#[inline]
-pub(crate) fn face_rows<const BILINEAR: bool>(
-    t: &Texels,
-    r: &FaceRun,
-    out: &mut [u32],
-    buf: &mut FaceBuf,
-) {
-    run::<BILINEAR>(active(), t, r, out, buf)
-}
-
-/// Trilinear's second level: bilinear samples of one cube face along a run blended into
-/// `out` (pixel `j` by `fracs[j / chunk]`, 0..=255), with the
-/// [`active_kernel`](super::active_kernel); otherwise as [`face_rows`].
-#[inline]
-pub(crate) fn face_rows_blend(
-    t: &Texels,
-    r: &FaceRun,
-    out: &mut [u32],
-    chunks: (usize, &[u32]),
-    buf: &mut FaceBuf,
-) {
-    run_blend(active(), t, r, out, chunks, buf)
-}
-
-#[cfg(test)]
-impl Kernel {
-    /// [`face_rows_blend`] with this kernel.
-    pub(crate) fn face_rows_blend(
-        self,
-        t: &Texels,
-        r: &FaceRun,
-        out: &mut [u32],
-        chunks: (usize, &[u32]),
-        buf: &mut FaceBuf,
-    ) {
-        assert!(t.width == t.height && t.width >= 2, "bordered face texels");
-        run_blend(self.selected(), t, r, out, chunks, buf)
-    }
-
-    /// [`face_rows`] with this kernel.
-    ///
-    /// # Panics
-    /// When the CPU does not run this kernel, or `t` is not a face's bordered texels.
+impl SelectedKernel {
+    /// Bilinear (`BILINEAR`) or nearest samples of one cube face along a run (see the
+    /// module docs). `t` is the face's bordered texels. Every pixel of `out` is written;
+    /// positions are clamped into the face, so any run is safe.
+    #[inline]
     pub(crate) fn face_rows<const BILINEAR: bool>(
         self,
         t: &Texels,
@@ -300,8 +216,25 @@ impl Kernel {
         out: &mut [u32],
         buf: &mut FaceBuf,
     ) {
-        assert!(t.width == t.height && t.width >= 2, "bordered face texels");
-        run::<BILINEAR>(self.selected(), t, r, out, buf)
+        run::<BILINEAR>(self, t, r, out, buf)
+    }
+
+    /// Trilinear's second level: bilinear samples of one cube face along a run blended
+    /// into `out` (pixel `j` by `fracs[j / chunk]`, 0..=255); otherwise as
+    /// [`SelectedKernel::face_rows`].
+    ///
+    /// # Panics
+    /// When `fracs` holds fewer than a weight per chunk, or `chunk` is 0.
+    #[inline]
+    pub(crate) fn face_rows_blend(
+        self,
+        t: &Texels,
+        r: &FaceRun,
+        out: &mut [u32],
+        (chunk, fracs): (usize, &[u32]),
+        buf: &mut FaceBuf,
+    ) {
+        run_blend(self, t, r, out, (chunk, fracs), buf)
     }
 }
 
@@ -311,6 +244,7 @@ mod tests {
     use crate::cube::{face_axes, face_of, CubeMap, Face};
     use crate::geom::camera::View;
     use crate::render::cube::scanline_runs;
+    use crate::render::kernel::Kernel;
     use glam::DVec3;
     use proptest::prelude::*;
 
@@ -403,9 +337,9 @@ mod tests {
             for bilinear in [false, true] {
                 let (mut su, mut sv) = (vec![0; len], vec![0; len]);
                 let top = if bilinear {
-                    positions_scalar::<true>(n, &r, &mut su, &mut sv, len)
+                    scalar::positions::<true>(n, &r, &mut su, &mut sv, len)
                 } else {
-                    positions_scalar::<false>(n, &r, &mut su, &mut sv, len)
+                    scalar::positions::<false>(n, &r, &mut su, &mut sv, len)
                 };
                 prop_assert_eq!(top, sv.iter().copied().max().unwrap_or(i32::MIN));
                 for k in Kernel::available() {
@@ -498,7 +432,7 @@ mod tests {
         let mut buf = FaceBuf::default();
         let want: Vec<u32> = (0..len)
             .map(|i| {
-                let (u, v, _) = exact(r, i);
+                let (u, v, _) = scalar::exact(r, i);
                 if bilinear {
                     c.bilinear(f, u, v)
                 } else {
@@ -510,9 +444,9 @@ mod tests {
             let mut o = vec![0xDEAD_BEEFu32; off + len + 3];
             let run = &mut o[off..off + len];
             if bilinear {
-                k.face_rows::<true>(&t, r, run, &mut buf);
+                k.selected().face_rows::<true>(&t, r, run, &mut buf);
             } else {
-                k.face_rows::<false>(&t, r, run, &mut buf);
+                k.selected().face_rows::<false>(&t, r, run, &mut buf);
             }
             let outside = o[..off].iter().chain(&o[off + len..]);
             assert!(
@@ -539,14 +473,15 @@ mod tests {
             .collect();
         let want: Vec<u32> = (0..len)
             .map(|i| {
-                let (u, v, _) = exact(r, i);
+                let (u, v, _) = scalar::exact(r, i);
                 lerp_px(under[i], c.bilinear(f, u, v), fracs[i / chunk])
             })
             .collect();
         for k in Kernel::available() {
             let mut o = vec![0xDEAD_BEEFu32; len + 4];
             o[1..=len].copy_from_slice(&under);
-            k.face_rows_blend(&t, r, &mut o[1..=len], (chunk, &fracs), &mut buf);
+            k.selected()
+                .face_rows_blend(&t, r, &mut o[1..=len], (chunk, &fracs), &mut buf);
             assert!(o[0] == 0xDEAD_BEEF && o[len + 1..].iter().all(|&x| x == 0xDEAD_BEEF));
             assert_eq!(
                 &o[1..=len],

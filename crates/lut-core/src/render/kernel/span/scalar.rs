@@ -1,13 +1,13 @@
 //! The portable span kernels, one pixel at a time: what every machine runs without
 //! SIMD, and the reference the SIMD kernels must equal byte for byte. Every position of
-//! a span is inside the map (checked once by `jobs::prepare`), so the loops neither
+//! a span is inside the map (checked once by `prepare`), so the loops neither
 //! clamp nor wrap nor divide. For bilinear the position is already biased by −½ (the
 //! top-left of the four pixel centres around it).
 
-use super::jobs::Span;
-use super::Texels;
+use super::Span;
 use crate::geom::fixed::FX_BITS;
 use crate::map::sample::lerp_px;
+use crate::render::kernel::Texels;
 
 /// `out[i]` = the pixel containing (u + i·du, v + i·dv) of a span checked inside.
 #[inline(always)]
