@@ -1,0 +1,178 @@
+//! The background decode pool: requests nearest the view's centre first, a request no
+//! longer wanted cancelled (each call of [`TileLoader::request`] replaces the queue; tiles
+//! already being decoded finish), results handed to the owner of the [`TileStore`] between
+//! frames ([`TileLoader::pump`]), so a frame never waits for a tile.
+
+use super::config::{MultiresConfig, TileId};
+use super::decode::decode_tile;
+use super::store::TileStore;
+use std::collections::HashSet;
+use std::sync::mpsc::{channel, Receiver, Sender};
+use std::sync::{Arc, Condvar, Mutex};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+type Done = (TileId, Result<Vec<u32>, String>);
+
+#[derive(Default)]
+struct Queue {
+    /// Wanted tiles, the next to decode last.
+    wanted: Vec<TileId>,
+    busy: HashSet<TileId>,
+    stop: bool,
+}
+
+struct Shared {
+    q: Mutex<Queue>,
+    cv: Condvar,
+}
+
+/// A pool of threads decoding tiles of one pyramid.
+pub struct TileLoader {
+    shared: Arc<Shared>,
+    rx: Receiver<Done>,
+    threads: Vec<JoinHandle<()>>,
+    /// Requested and not yet handed to the store.
+    outstanding: HashSet<TileId>,
+}
+
+impl std::fmt::Debug for TileLoader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TileLoader")
+            .field("threads", &self.threads.len())
+            .field("outstanding", &self.outstanding.len())
+            .finish()
+    }
+}
+
+impl TileLoader {
+    /// Start `threads` decoding threads (at least one) for `cfg`.
+    pub fn new(cfg: Arc<MultiresConfig>, threads: usize) -> TileLoader {
+        let shared = Arc::new(Shared {
+            q: Mutex::new(Queue::default()),
+            cv: Condvar::new(),
+        });
+        let (tx, rx) = channel();
+        let threads = (0..threads.max(1))
+            .map(|i| {
+                let (s, c, tx) = (shared.clone(), cfg.clone(), tx.clone());
+                std::thread::Builder::new()
+                    .name(format!("tiles-{i}"))
+                    .spawn(move || worker(&s, &c, &tx))
+                    .expect("spawn a tile decoding thread")
+            })
+            .collect();
+        TileLoader {
+            shared,
+            rx,
+            threads,
+            outstanding: HashSet::new(),
+        }
+    }
+
+    /// Want `ids` (the first the most), instead of whatever was wanted before: tiles
+    /// not listed and not yet started are cancelled.
+    pub fn request(&mut self, ids: &[TileId]) {
+        let mut q = self.shared.q.lock().unwrap_or_else(|e| e.into_inner());
+        let busy = q.busy.clone();
+        q.wanted = ids
+            .iter()
+            .rev()
+            .filter(|id| !busy.contains(id))
+            .copied()
+            .collect();
+        let mut seen = HashSet::new();
+        q.wanted.retain(|id| seen.insert(*id));
+        self.outstanding = q.wanted.iter().chain(q.busy.iter()).copied().collect();
+        drop(q);
+        self.shared.cv.notify_all();
+    }
+
+    /// Tiles requested and not yet in the store.
+    pub fn pending(&self) -> usize {
+        self.outstanding.len()
+    }
+
+    /// Hand the decoded tiles to `store` (a tile that failed: its one notice); returns
+    /// how many arrived.
+    pub fn pump(&mut self, store: &mut TileStore) -> usize {
+        let mut n = 0;
+        while let Ok((id, r)) = self.rx.try_recv() {
+            self.arrive(store, id, r);
+            n += 1;
+        }
+        n
+    }
+
+    fn arrive(&mut self, store: &mut TileStore, id: TileId, r: Result<Vec<u32>, String>) {
+        self.outstanding.remove(&id);
+        match r.and_then(|px| store.insert(id, &px)) {
+            Ok(()) => {}
+            Err(e) => store.fail(id, &e),
+        }
+    }
+
+    /// Decode `ids` now and wait until every one is in `store` (or failed).
+    pub fn load_now(&mut self, store: &mut TileStore, ids: &[TileId]) {
+        let want: Vec<TileId> = ids
+            .iter()
+            .copied()
+            .filter(|id| !store.settled(*id))
+            .collect();
+        self.request(&want);
+        let mut left: HashSet<TileId> = want.into_iter().collect();
+        while !left.is_empty() {
+            match self.rx.recv_timeout(Duration::from_secs(60)) {
+                Ok((id, r)) => {
+                    left.remove(&id);
+                    self.arrive(store, id, r);
+                }
+                Err(_) => {
+                    for id in left.drain() {
+                        store.fail(id, "not decoded within 60 s");
+                    }
+                }
+            }
+        }
+    }
+}
+
+impl Drop for TileLoader {
+    fn drop(&mut self) {
+        {
+            let mut q = self.shared.q.lock().unwrap_or_else(|e| e.into_inner());
+            q.stop = true;
+            q.wanted.clear();
+        }
+        self.shared.cv.notify_all();
+        for t in self.threads.drain(..) {
+            let _ = t.join();
+        }
+    }
+}
+
+fn worker(s: &Shared, cfg: &MultiresConfig, tx: &Sender<Done>) {
+    loop {
+        let id = {
+            let mut q = s.q.lock().unwrap_or_else(|e| e.into_inner());
+            loop {
+                if q.stop {
+                    return;
+                }
+                if let Some(id) = q.wanted.pop() {
+                    q.busy.insert(id);
+                    break id;
+                }
+                q = s.cv.wait(q).unwrap_or_else(|e| e.into_inner());
+            }
+        };
+        let r = decode_tile(cfg, id);
+        s.q.lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .busy
+            .remove(&id);
+        if tx.send((id, r)).is_err() {
+            return;
+        }
+    }
+}

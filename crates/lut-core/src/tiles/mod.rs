@@ -1,0 +1,215 @@
+//! Tiled multiresolution pyramids (Pannellum's `multires` format) read from disk: the
+//! configuration ([`MultiresConfig`]), decoded tiles in an LRU cache under a byte budget
+//! ([`TileStore`]), a background decode pool ([`TileLoader`]) and frames drawn from the
+//! tiles with the cube renderer's kernels ([`render_tiles`]). [`TiledPanorama`] holds the
+//! three together. -> docs/huge.md, "Gigapixel panoramas from tiles".
+
+pub(crate) mod config;
+pub(crate) mod decode;
+pub(crate) mod loader;
+pub(crate) mod render;
+pub(crate) mod store;
+pub(crate) mod write;
+
+pub use config::{MultiresConfig, TileId, TilesError};
+pub use decode::decode_bytes;
+pub use loader::TileLoader;
+pub use render::{frame_level, render_tiles, TileFrame};
+pub use store::{CacheStats, TileStore};
+pub use write::{generator_levels, write_pyramid};
+
+use crate::cube::Face;
+use crate::geom::camera::View;
+use crate::map::sample::Sampler;
+use std::path::Path;
+use std::sync::Arc;
+
+/// A pyramid opened for viewing: its configuration, the decoded tiles and the pool.
+#[derive(Debug)]
+pub struct TiledPanorama {
+    store: TileStore,
+    loader: TileLoader,
+}
+
+impl TiledPanorama {
+    /// Open the pyramid at `path` (its folder or its `config.json`) with a cache of
+    /// `budget` bytes and `threads` decoding threads; level 1 (the coarsest, at most
+    /// 8 × 8 tiles a face) is decoded before this returns, so every frame has something
+    /// to draw.
+    ///
+    /// # Errors
+    /// The configuration's [`TilesError`]. Tiles that cannot be decoded are not errors:
+    /// they are drawn from their ancestor, or the background, with a notice.
+    pub fn open(path: &Path, budget: usize, threads: usize) -> Result<TiledPanorama, TilesError> {
+        let cfg = Arc::new(MultiresConfig::open(path)?);
+        let mut store = TileStore::new(cfg.clone(), budget);
+        let mut loader = TileLoader::new(cfg.clone(), threads);
+        let n = cfg.tiles_across(1);
+        let base: Vec<TileId> = Face::ALL
+            .iter()
+            .flat_map(|&face| {
+                (0..n).flat_map(move |y| {
+                    (0..n).map(move |x| TileId {
+                        level: 1,
+                        face,
+                        x,
+                        y,
+                    })
+                })
+            })
+            .collect();
+        loader.load_now(&mut store, &base);
+        Ok(TiledPanorama { store, loader })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &MultiresConfig {
+        self.store.config()
+    }
+
+    /// The decoded tiles.
+    pub fn store(&self) -> &TileStore {
+        &self.store
+    }
+
+    /// The decoded tiles, to change the budget.
+    pub fn store_mut(&mut self) -> &mut TileStore {
+        &mut self.store
+    }
+
+    /// Tiles requested and not yet decoded.
+    pub fn pending(&self) -> usize {
+        self.loader.pending()
+    }
+
+    /// Take the tiles decoded since the last call into the cache; returns how many.
+    pub fn pump(&mut self) -> usize {
+        self.loader.pump(&mut self.store)
+    }
+
+    /// A frame that waits for nothing: drawn from what is decoded (missing tiles from
+    /// their ancestors), then the tiles it lacked are requested, nearest the centre
+    /// first, with the ring around them and the next level's tiles under the centre
+    /// (`prefetch`); earlier requests not repeated are cancelled.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render(
+        &mut self,
+        view: View,
+        sampler: Sampler,
+        level: u32,
+        pixels: &mut [u32],
+        width: u32,
+        height: u32,
+        prefetch: bool,
+    ) -> TileFrame {
+        self.pump();
+        self.store.next_frame();
+        let f = render_tiles(&self.store, view, sampler, level, pixels, width, height);
+        let mut want = f.missed();
+        if prefetch {
+            want.extend(self.prefetch(&f));
+        }
+        want.retain(|id| !self.store.settled(*id));
+        self.loader.request(&want);
+        f
+    }
+
+    /// The ring of tiles around those the frame read, then the next level's under them.
+    fn prefetch(&self, f: &TileFrame) -> Vec<TileId> {
+        let cfg = self.store.config();
+        let mut out = Vec::new();
+        let read: std::collections::HashSet<TileId> = f.touched.iter().map(|t| t.0).collect();
+        for (id, _, _) in &f.touched {
+            let n = cfg.tiles_across(id.level as u32) as i64;
+            for dy in -1i64..=1 {
+                for dx in -1i64..=1 {
+                    let (x, y) = (id.x as i64 + dx, id.y as i64 + dy);
+                    if (0..n).contains(&x) && (0..n).contains(&y) {
+                        let t = TileId {
+                            x: x as u32,
+                            y: y as u32,
+                            ..*id
+                        };
+                        if !read.contains(&t) {
+                            out.push(t);
+                        }
+                    }
+                }
+            }
+        }
+        if f.level < cfg.max_level {
+            // The next level's tiles under the nearest quarter of those read.
+            let n = cfg.tiles_across(f.level + 1);
+            for (id, _, _) in f.touched.iter().take(f.touched.len().div_ceil(4)) {
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let (x, y) = (id.x * 2 + dx, id.y * 2 + dy);
+                    if x < n && y < n {
+                        out.push(TileId {
+                            level: id.level + 1,
+                            x,
+                            y,
+                            ..*id
+                        });
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// A frame drawn only when every tile it reads at `level` is decoded (or cannot be):
+    /// the same bytes whatever the timing (the CLI's `viewer render`).
+    pub fn render_wait(
+        &mut self,
+        view: View,
+        sampler: Sampler,
+        level: u32,
+        pixels: &mut [u32],
+        width: u32,
+        height: u32,
+    ) -> TileFrame {
+        let mut f = TileFrame::default();
+        // A frame's tiles are known after drawing it; loading them can change which
+        // border texels a frame reads, never which tiles, so two rounds settle it (four
+        // allowed when the budget evicts).
+        for _ in 0..4 {
+            self.store.next_frame();
+            f = render_tiles(&self.store, view, sampler, level, pixels, width, height);
+            let missed: Vec<TileId> = f
+                .missed()
+                .into_iter()
+                .filter(|id| !self.store.settled(*id))
+                .collect();
+            if missed.is_empty() {
+                break;
+            }
+            self.loader.load_now(&mut self.store, &missed);
+        }
+        f
+    }
+
+    /// Level 1 (decoded at open) as a cube map: what lighting and small previews use.
+    /// A tile of level 1 that could not be decoded is the background there.
+    pub fn base_cube(&self) -> crate::cube::CubeMap {
+        let n = self.config().level_size(1);
+        let faces: Vec<Vec<u32>> = Face::ALL
+            .iter()
+            .map(|&f| {
+                (0..n)
+                    .flat_map(|y| (0..n).map(move |x| (x as f64 + 0.5, y as f64 + 0.5)))
+                    .map(|(u, v)| self.store.nearest(1, f, u, v, false))
+                    .collect()
+            })
+            .collect();
+        let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
+        crate::cube::CubeMap::from_faces(n.max(1), refs).unwrap_or_else(|_| {
+            let one = [self.config().background];
+            crate::cube::CubeMap::from_faces(1, [&one[..]; 6]).expect("a 1-texel cube")
+        })
+    }
+
+    /// Notices since the last call (one per tile that could not be decoded).
+    pub fn take_notices(&mut self) -> Vec<String> {
+        self.store.take_notices()
+    }
+}

@@ -1,0 +1,472 @@
+//! Decoded tiles in memory: an LRU cache under a byte budget, each tile stored with a
+//! one-texel border so the cube kernels' bilinear reads cross tile and face edges as they
+//! cross face edges on a whole [`crate::CubeMap`].
+//!
+//! # Why a border, not runs split per texel
+//! The renderer splits a face run at tile edges and draws each piece with the cube
+//! kernels on the piece's tile. A bilinear read within half a texel of a tile edge needs
+//! the neighbour's texel: kept in the tile's border, the kernels read it with no branch
+//! (the same reason `CubeMap` keeps a border per face). It costs (T + 2)² − T² texels a
+//! tile (0.8 % at 512) and a refill when a neighbour arrives (four strips).
+//!
+//! # Borders
+//! A border texel is the texel the neighbouring tile has there, or across a face edge
+//! the bilinear sample of the neighbouring face in the texel centre's direction (as
+//! `CubeMap` fills its borders). When that neighbour is not decoded the border is
+//! sampled from the nearest decoded ancestor, and refilled when the neighbour arrives
+//! ([`TileStore::insert`]).
+//!
+//! # Misses
+//! A tile not decoded is drawn from its nearest decoded ancestor (level 1 is loaded at
+//! open and never evicted); a tile that cannot be decoded (missing file, wrong size or
+//! format, corrupt, a decompression bomb) is remembered as failed, drawn from its
+//! ancestor for good, with one notice.
+
+use super::config::{MultiresConfig, TileId};
+use crate::cube::{face_dir, face_of, face_uv, Face};
+use crate::geom::fixed::{FX_BITS, FX_HALF, FX_ONE};
+use crate::map::sample::lerp_px;
+use std::collections::{HashMap, HashSet};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+
+/// The default cache budget: 1 GiB of decoded tiles.
+pub const DEFAULT_CACHE_BYTES: usize = 1 << 30;
+
+/// A decoded tile with its border: `(T + 2)²` 0RGB texels, row-major; tile texel
+/// `(x, y)` is at `(y + 1) · (T + 2) + x + 1` (short tiles use the top-left part).
+#[derive(Debug)]
+pub struct Tile {
+    /// Width (texels, without border).
+    pub w: u32,
+    /// Height.
+    pub h: u32,
+    /// The bordered texels.
+    pub px: Vec<u32>,
+    /// The frame that last read it (LRU).
+    used: AtomicU64,
+    /// Level 1: never evicted.
+    pinned: bool,
+}
+
+/// Counters the panel and the bench read.
+#[derive(Debug, Default, Clone, Copy, PartialEq)]
+pub struct CacheStats {
+    /// Decoded tiles held.
+    pub tiles: usize,
+    /// Their bytes.
+    pub bytes: usize,
+    /// The budget.
+    pub budget: usize,
+    /// Tile reads (pieces of runs) found at the wanted level, since the last reset.
+    pub hits: u64,
+    /// Tile reads drawn from an ancestor instead.
+    pub misses: u64,
+    /// Tiles decoded since open.
+    pub decoded: u64,
+    /// Tiles evicted since open.
+    pub evicted: u64,
+    /// Tiles that could not be decoded.
+    pub failed: usize,
+}
+
+impl CacheStats {
+    /// Hits over reads (1 with no reads).
+    pub fn hit_rate(&self) -> f64 {
+        let n = self.hits + self.misses;
+        if n == 0 {
+            1.0
+        } else {
+            self.hits as f64 / n as f64
+        }
+    }
+}
+
+/// The decoded tiles of one pyramid.
+#[derive(Debug)]
+pub struct TileStore {
+    cfg: Arc<MultiresConfig>,
+    tiles: HashMap<TileId, Tile>,
+    failed: HashSet<TileId>,
+    bytes: usize,
+    budget: usize,
+    frame: u64,
+    hits: AtomicU64,
+    misses: AtomicU64,
+    decoded: u64,
+    evicted: u64,
+    notices: Vec<String>,
+}
+
+impl TileStore {
+    /// An empty store for `cfg` keeping at most `budget` bytes of tiles (level 1 is
+    /// always kept, whatever the budget).
+    pub fn new(cfg: Arc<MultiresConfig>, budget: usize) -> TileStore {
+        TileStore {
+            cfg,
+            tiles: HashMap::new(),
+            failed: HashSet::new(),
+            bytes: 0,
+            budget,
+            frame: 1,
+            hits: AtomicU64::new(0),
+            misses: AtomicU64::new(0),
+            decoded: 0,
+            evicted: 0,
+            notices: Vec::new(),
+        }
+    }
+
+    /// The pyramid.
+    pub fn config(&self) -> &Arc<MultiresConfig> {
+        &self.cfg
+    }
+
+    /// Start a new frame (the LRU clock).
+    pub fn next_frame(&mut self) {
+        self.frame += 1;
+    }
+
+    /// Whether `id` is decoded.
+    pub fn has(&self, id: TileId) -> bool {
+        self.tiles.contains_key(&id)
+    }
+
+    /// Whether `id` need not be (or cannot be) loaded: decoded, failed, or left out by
+    /// the generator.
+    pub fn settled(&self, id: TileId) -> bool {
+        self.tiles.contains_key(&id) || self.failed.contains(&id) || self.cfg.is_missing(id)
+    }
+
+    /// The counters.
+    pub fn stats(&self) -> CacheStats {
+        CacheStats {
+            tiles: self.tiles.len(),
+            bytes: self.bytes,
+            budget: self.budget,
+            hits: self.hits.load(Ordering::Relaxed),
+            misses: self.misses.load(Ordering::Relaxed),
+            decoded: self.decoded,
+            evicted: self.evicted,
+            failed: self.failed.len(),
+        }
+    }
+
+    /// Reset the hit and miss counters.
+    pub fn reset_hits(&self) {
+        self.hits.store(0, Ordering::Relaxed);
+        self.misses.store(0, Ordering::Relaxed);
+    }
+
+    /// Change the budget (evicting at once what no longer fits).
+    pub fn set_budget(&mut self, budget: usize) {
+        self.budget = budget;
+        self.evict(None);
+    }
+
+    /// Notices since the last call (one per tile that could not be decoded).
+    pub fn take_notices(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.notices)
+    }
+
+    pub(crate) fn count(&self, hit: bool) {
+        if hit {
+            self.hits.fetch_add(1, Ordering::Relaxed);
+        } else {
+            self.misses.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    /// The decoded tile `id`, marked used this frame.
+    #[inline]
+    pub(crate) fn get(&self, id: TileId) -> Option<&Tile> {
+        let t = self.tiles.get(&id)?;
+        if t.used.load(Ordering::Relaxed) != self.frame {
+            t.used.store(self.frame, Ordering::Relaxed);
+        }
+        Some(t)
+    }
+
+    /// The side of a bordered tile buffer.
+    #[inline]
+    pub(crate) fn stride(&self) -> usize {
+        self.cfg.tile as usize + 2
+    }
+
+    /// Record that `id` could not be decoded: drawn from its ancestor from now on, and
+    /// one notice.
+    pub fn fail(&mut self, id: TileId, reason: &str) {
+        if self.failed.insert(id) {
+            let first = self.failed.len() == 1;
+            self.notices.push(format!(
+                "{}: {reason}; drawn from a coarser level{}",
+                self.cfg.tile_path(id).display(),
+                if first { "" } else { " (another tile)" }
+            ));
+        }
+    }
+
+    /// Insert the decoded texels of `id` (`w × h` row-major 0RGB, the tile's own
+    /// dimensions), fill its border, refill its decoded neighbours' borders, and evict
+    /// the least recently used tiles over the budget.
+    ///
+    /// # Errors
+    /// When `px` is not the tile's size (then nothing changes).
+    pub fn insert(&mut self, id: TileId, px: &[u32]) -> Result<(), String> {
+        let (w, h) = self.cfg.tile_dims(id);
+        if px.len() != (w as usize) * (h as usize) || w == 0 || h == 0 {
+            return Err(format!("{} texels, not {w}×{h}", px.len()));
+        }
+        let s = self.stride();
+        let mut buf = vec![0u32; s * s];
+        for (row, src) in buf[s..]
+            .chunks_exact_mut(s)
+            .zip(px.chunks_exact(w as usize))
+        {
+            row[1..=w as usize].copy_from_slice(src);
+        }
+        let tile = Tile {
+            w,
+            h,
+            px: buf,
+            used: AtomicU64::new(self.frame),
+            pinned: id.level == 1,
+        };
+        if let Some(old) = self.tiles.insert(id, tile) {
+            self.bytes -= old.px.len() * 4;
+        }
+        self.bytes += s * s * 4;
+        self.decoded += 1;
+        self.failed.remove(&id);
+        // Twice: a border across a face edge is a bilinear sample of the neighbour face,
+        // which near a corner reads that face's own border (refilled in the first pass).
+        let mut refill: Vec<TileId> = self
+            .neighbours(id)
+            .into_iter()
+            .filter(|n| self.tiles.contains_key(n))
+            .collect();
+        refill.sort_unstable();
+        refill.push(id);
+        for _ in 0..2 {
+            for &n in &refill {
+                self.fill_border(n);
+            }
+        }
+        self.evict(Some(id));
+        Ok(())
+    }
+
+    /// Tiles whose border may read `id`: the eight around it on its face, and where it
+    /// touches a face edge the decoded tiles of the same level along the other faces'
+    /// edges.
+    fn neighbours(&self, id: TileId) -> Vec<TileId> {
+        let n = self.cfg.tiles_across(id.level as u32) as i64;
+        let mut out = Vec::new();
+        for dy in -1i64..=1 {
+            for dx in -1i64..=1 {
+                let (x, y) = (id.x as i64 + dx, id.y as i64 + dy);
+                if (dx, dy) != (0, 0) && (0..n).contains(&x) && (0..n).contains(&y) {
+                    out.push(TileId {
+                        x: x as u32,
+                        y: y as u32,
+                        ..id
+                    });
+                }
+            }
+        }
+        let edge = |t: &TileId| t.x == 0 || t.y == 0 || t.x as i64 == n - 1 || t.y as i64 == n - 1;
+        if edge(&id) {
+            out.extend(
+                self.tiles
+                    .keys()
+                    .filter(|t| t.level == id.level && t.face != id.face && edge(t))
+                    .copied(),
+            );
+        }
+        out
+    }
+
+    fn evict(&mut self, keep: Option<TileId>) {
+        if self.bytes <= self.budget {
+            return;
+        }
+        let mut order: Vec<(u64, TileId)> = self
+            .tiles
+            .iter()
+            .filter(|(id, t)| !t.pinned && Some(**id) != keep)
+            .map(|(id, t)| (t.used.load(Ordering::Relaxed), *id))
+            .collect();
+        order.sort_unstable();
+        for (_, id) in order {
+            if self.bytes <= self.budget {
+                break;
+            }
+            if let Some(t) = self.tiles.remove(&id) {
+                self.bytes -= t.px.len() * 4;
+                self.evicted += 1;
+            }
+        }
+    }
+
+    /// Fill the border of decoded tile `id` from its neighbours (or their ancestors).
+    fn fill_border(&mut self, id: TileId) {
+        let Some(t) = self.tiles.get(&id) else { return };
+        let (w, h) = (t.w as i64, t.h as i64);
+        let (x0, y0) = (
+            id.x as i64 * self.cfg.tile as i64,
+            id.y as i64 * self.cfg.tile as i64,
+        );
+        let s = self.stride();
+        let mut ring = Vec::with_capacity(2 * (w + h + 4) as usize);
+        let mut at = |bx: i64, by: i64| {
+            let v = self.texel(id.level as u32, id.face, x0 + bx - 1, y0 + by - 1);
+            ring.push((by as usize * s + bx as usize, v));
+        };
+        for bx in 0..=w + 1 {
+            at(bx, 0);
+            at(bx, h + 1);
+        }
+        for by in 1..=h {
+            at(0, by);
+            at(w + 1, by);
+        }
+        let t = self.tiles.get_mut(&id).expect("present");
+        for (i, v) in ring {
+            t.px[i] = v;
+        }
+        // The texels right of and below a short tile's border repeat it (positions inside
+        // the tile never read them; a position rounded a hair past the edge reads the
+        // border's value).
+        let (w, h) = (w as usize, h as usize);
+        for row in t.px.chunks_exact_mut(s).take(h + 2) {
+            let edge = row[w + 1];
+            row[w + 2..].fill(edge);
+        }
+        let last = (h + 1) * s;
+        let (top, rest) = t.px.split_at_mut(last + s);
+        let edge = &top[last..];
+        for row in rest.chunks_exact_mut(s) {
+            row.copy_from_slice(edge);
+        }
+    }
+
+    /// Texel `(ix, iy)` of `face` at `level`, where the indices may lie one texel outside
+    /// the face (then: the neighbouring face's bilinear sample in that direction), from
+    /// the tile holding it or its nearest decoded ancestor.
+    fn texel(&self, level: u32, face: Face, ix: i64, iy: i64) -> u32 {
+        let size = self.cfg.level_size(level) as i64;
+        if (0..size).contains(&ix) && (0..size).contains(&iy) {
+            let t = self.cfg.tile as i64;
+            let id = TileId {
+                level: level as u8,
+                face,
+                x: (ix / t) as u32,
+                y: (iy / t) as u32,
+            };
+            if let Some(tile) = self.tiles.get(&id) {
+                let s = self.stride();
+                return tile.px[((iy % t) + 1) as usize * s + (ix % t) as usize + 1];
+            }
+            if level > 1 {
+                let sc = self.cfg.level_size(level - 1) as f64 / size as f64;
+                return self.bilinear(
+                    level - 1,
+                    face,
+                    (ix as f64 + 0.5) * sc,
+                    (iy as f64 + 0.5) * sc,
+                    false,
+                );
+            }
+            return self.cfg.background;
+        }
+        let half = size as f64 / 2.0;
+        let s = 2.0 * (ix as f64 + 0.5) / size as f64 - 1.0;
+        let tt = 1.0 - 2.0 * (iy as f64 + 0.5) / size as f64;
+        let d = face_dir(face, s, tt);
+        let f2 = face_of(d);
+        let (u, v) = face_uv(f2, d, half);
+        self.bilinear(level, f2, u, v, false)
+    }
+
+    /// The decoded tile at `level` holding face position `(u, v)` (clamped into the
+    /// face), or the nearest ancestor's: `(tile, its level, its tile id)`.
+    #[inline]
+    pub(crate) fn tile_at(
+        &self,
+        level: u32,
+        face: Face,
+        u: f64,
+        v: f64,
+    ) -> Option<(&Tile, u32, TileId)> {
+        let mut l = level;
+        let top = self.cfg.level_size(level) as f64;
+        loop {
+            let size = self.cfg.level_size(l);
+            let sc = size as f64 / top;
+            let n = self.cfg.tiles_across(l);
+            let t = self.cfg.tile as f64;
+            let col = (((u * sc).max(0.0) / t) as u32).min(n - 1);
+            let row = (((v * sc).max(0.0) / t) as u32).min(n - 1);
+            let id = TileId {
+                level: l as u8,
+                face,
+                x: col,
+                y: row,
+            };
+            if let Some(tile) = self.get(id) {
+                return Some((tile, l, id));
+            }
+            if l <= 1 {
+                return None;
+            }
+            l -= 1;
+        }
+    }
+
+    /// Per-pixel bilinear at face position `(u, v)` of `level` (face texels of that
+    /// level), from the tile there or the nearest decoded ancestor; `count`: a frame's
+    /// read (hit/miss counted). The arithmetic of `CubeMap::bilinear` on the tile's
+    /// bordered texels.
+    pub(crate) fn bilinear(&self, level: u32, face: Face, u: f64, v: f64, count: bool) -> u32 {
+        let size = self.cfg.level_size(level) as f64;
+        let (u, v) = (u.max(0.0).min(size), v.max(0.0).min(size));
+        let Some((tile, l, id)) = self.tile_at(level, face, u, v) else {
+            return self.cfg.background;
+        };
+        if count {
+            self.count(l == level);
+        }
+        let sc = self.cfg.level_size(l) as f64 / size;
+        let t = self.cfg.tile as f64;
+        let (lu, lv) = (u * sc - id.x as f64 * t, v * sc - id.y as f64 * t);
+        let (lu, lv) = (
+            lu.max(0.0).min(tile.w as f64),
+            lv.max(0.0).min(tile.h as f64),
+        );
+        let uu = (lu * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
+        let vv = (lv * FX_ONE as f64 + 0.5) as i64 + FX_HALF;
+        let (x0, y0) = ((uu >> FX_BITS) as usize, (vv >> FX_BITS) as usize);
+        let fx = ((uu >> (FX_BITS - 8)) & 0xFF) as u32;
+        let fy = ((vv >> (FX_BITS - 8)) & 0xFF) as u32;
+        let s = self.stride();
+        let i = y0 * s + x0;
+        let (r0, r1) = (&tile.px[i..i + 2], &tile.px[i + s..i + s + 2]);
+        lerp_px(lerp_px(r0[0], r0[1], fx), lerp_px(r1[0], r1[1], fx), fy)
+    }
+
+    /// Per-pixel nearest at face position `(u, v)` of `level`.
+    pub(crate) fn nearest(&self, level: u32, face: Face, u: f64, v: f64, count: bool) -> u32 {
+        let size = self.cfg.level_size(level) as f64;
+        let Some((tile, l, id)) = self.tile_at(level, face, u, v) else {
+            return self.cfg.background;
+        };
+        if count {
+            self.count(l == level);
+        }
+        let sc = self.cfg.level_size(l) as f64 / size;
+        let t = self.cfg.tile as f64;
+        let x = ((u * sc - id.x as f64 * t).max(0.0) as usize).min(tile.w as usize - 1);
+        let y = ((v * sc - id.y as f64 * t).max(0.0) as usize).min(tile.h as usize - 1);
+        tile.px[(y + 1) * self.stride() + x + 1]
+    }
+}
