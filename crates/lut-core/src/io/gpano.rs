@@ -63,6 +63,10 @@ pub struct GPano {
     pub cropped_area_image_height_pixels: Option<f64>,
     /// `PoseHeadingDegrees`.
     pub pose_heading_degrees: Option<f64>,
+    /// `PosePitchDegrees` (the horizon's pitch: Pannellum's `horizonPitch`).
+    pub pose_pitch_degrees: Option<f64>,
+    /// `PoseRollDegrees` (the horizon's roll: Pannellum's `horizonRoll`).
+    pub pose_roll_degrees: Option<f64>,
     /// `ProjectionType`, when given.
     pub projection_type: Option<String>,
     /// `InitialViewHeadingDegrees` (compass heading of the start view).
@@ -80,7 +84,7 @@ const VIEW_FIELDS: [&str; 3] = [
     "InitialHorizontalFOVDegrees",
 ];
 
-const FIELDS: [&str; 11] = [
+const FIELDS: [&str; 13] = [
     "FullPanoWidthPixels",
     "FullPanoHeightPixels",
     "CroppedAreaLeftPixels",
@@ -88,6 +92,8 @@ const FIELDS: [&str; 11] = [
     "CroppedAreaImageWidthPixels",
     "CroppedAreaImageHeightPixels",
     "PoseHeadingDegrees",
+    "PosePitchDegrees",
+    "PoseRollDegrees",
     "ProjectionType",
     "InitialViewHeadingDegrees",
     "InitialViewPitchDegrees",
@@ -139,6 +145,8 @@ impl GPano {
             "CroppedAreaImageWidthPixels" => &mut self.cropped_area_image_width_pixels,
             "CroppedAreaImageHeightPixels" => &mut self.cropped_area_image_height_pixels,
             "PoseHeadingDegrees" => &mut self.pose_heading_degrees,
+            "PosePitchDegrees" => &mut self.pose_pitch_degrees,
+            "PoseRollDegrees" => &mut self.pose_roll_degrees,
             "InitialViewHeadingDegrees" => &mut self.initial_view_heading_degrees,
             "InitialViewPitchDegrees" => &mut self.initial_view_pitch_degrees,
             "InitialHorizontalFOVDegrees" => &mut self.initial_horizontal_fov_degrees,
@@ -166,7 +174,10 @@ impl GPano {
             return Ok(());
         }
         let name = FIELDS.iter().find(|f| **f == field).copied().unwrap_or("?");
-        let heading = field == "PoseHeadingDegrees";
+        let heading = matches!(
+            field,
+            "PoseHeadingDegrees" | "PosePitchDegrees" | "PoseRollDegrees"
+        );
         let value: f64 = text.parse().map_err(|_| GPanoError::Value {
             field: name,
             value: text.to_string(),

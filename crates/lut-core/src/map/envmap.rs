@@ -210,6 +210,9 @@ impl EnvMap {
 
     /// Stored pixel (x, y), `x < W`, `y < H` (for a partial map: of the stored crop,
     /// `x <` [`EnvMap::stored_width`]).
+    ///
+    /// # Panics
+    /// When (x, y) lies outside the stored pixels and their padding column and row.
     #[inline]
     pub fn pixel(&self, x: u32, y: u32) -> u32 {
         self.data[y as usize * (self.width as usize + 1) + x as usize]

@@ -4,6 +4,7 @@
 
 pub(crate) mod crop;
 pub(crate) mod envmap;
+pub(crate) mod level;
 pub(crate) mod pyramid;
 pub(crate) mod sample;
 pub(crate) mod synth;

@@ -1,0 +1,665 @@
+//! Tours (issue 30): the Pannellum and Marzipano test tours open with their scenes,
+//! hotspots and start views; a saved tour round-trips; `viewer tour check` finds each
+//! planted problem with its place; bad input opens the rest of the tour.
+
+use std::path::{Path, PathBuf};
+
+mod common;
+use common::{s, viewer};
+use viewer::tour::{self, Angles, HotspotKind, Source, TargetAngle, Tour};
+
+fn data(rel: &str) -> PathBuf {
+    test_support::repo_root().join("tests/data/tours").join(rel)
+}
+
+fn tmpdir(name: &str) -> PathBuf {
+    common::tmpdir("viewer-tours", name)
+}
+
+fn close(a: f64, b: f64, eps: f64, what: &str) {
+    assert!((a - b).abs() <= eps, "{what}: {a} vs {b}");
+}
+
+#[test]
+fn the_pannellum_tour_opens_with_its_scenes_hotspots_and_start_views() {
+    let l = tour::load(&data("pannellum/tour.json")).unwrap();
+    assert!(l.problems.is_empty(), "{:?}", l.problems);
+    let t = &l.tour;
+    assert_eq!(t.first_scene, "courtyard");
+    assert_eq!(t.fade_ms, Some(1000.0));
+    let ids: Vec<_> = t.scenes.iter().map(|s| s.id.as_str()).collect();
+    assert_eq!(ids, ["courtyard", "interior", "courtyardCube"]);
+    let c = t.scene("courtyard").unwrap();
+    assert_eq!(c.source, Source::Equirect("courtyard.jpg".into()));
+    assert_eq!(
+        c.start,
+        Angles {
+            yaw: 20.0,
+            pitch: -5.0,
+            hfov: 90.0
+        }
+    );
+    assert_eq!(c.north_offset, 30.0);
+    assert_eq!(c.title.as_deref(), Some("Courtyard"));
+    assert_eq!(c.hotspots.len(), 3);
+    let h = &c.hotspots[0];
+    assert_eq!(
+        (h.yaw, h.pitch, h.text.as_str()),
+        (60.0, -2.0, "Into the room")
+    );
+    let HotspotKind::Scene { scene_id, target } = &h.kind else {
+        panic!("{h:?}")
+    };
+    assert_eq!(scene_id, "interior");
+    assert_eq!(target.yaw, TargetAngle::SameAzimuth);
+    assert_eq!(target.pitch, TargetAngle::Value(0.0));
+    assert_eq!(target.hfov, TargetAngle::Scene);
+    assert_eq!(
+        c.hotspots[1].kind,
+        HotspotKind::Info {
+            url: Some("https://hdrihaven.com".into())
+        }
+    );
+    // Defaults: Pannellum's pitch 0 where the scene gives none; "./" kept.
+    let i = t.scene("interior").unwrap();
+    assert_eq!(
+        i.start,
+        Angles {
+            yaw: -30.0,
+            pitch: 0.0,
+            hfov: 100.0
+        }
+    );
+    assert_eq!(i.source, Source::Equirect("./interior.jpg".into()));
+    let cube = t.scene("courtyardCube").unwrap();
+    let Source::Cube(faces) = &cube.source else {
+        panic!("{:?}", cube.source)
+    };
+    assert_eq!(faces[4].as_deref(), Some("cube/up.jpg"));
+    assert_eq!(cube.start, tour::DEFAULT_START);
+    // Members not interpreted are kept (saved back).
+    assert_eq!(t.default_extra["author"], "lutpano tests");
+}
+
+#[test]
+fn arrival_follows_pannellums_rules_including_same_azimuth() {
+    let t = tour::load(&data("pannellum/tour.json")).unwrap().tour;
+    let c = t.scene("courtyard").unwrap();
+    let now = Angles {
+        yaw: 50.0,
+        pitch: 12.0,
+        hfov: 75.0,
+    };
+    // sameAzimuth: the same compass direction (north 30 here, 120 there), pitch given,
+    // hfov the target's own.
+    let (i, a) = t.arrival(c, now, &c.hotspots[0]).unwrap();
+    assert_eq!(t.scenes[i].id, "interior");
+    assert_eq!(
+        a,
+        Angles {
+            yaw: 50.0 + 30.0 - 120.0,
+            pitch: 0.0,
+            hfov: 100.0
+        }
+    );
+    // Values, wrapped: 200 -> -160.
+    let int = t.scene("interior").unwrap();
+    let (_, a) = t.arrival(int, now, &int.hotspots[0]).unwrap();
+    assert_eq!(
+        a,
+        Angles {
+            yaw: -160.0,
+            pitch: -10.0,
+            hfov: 70.0
+        }
+    );
+    // "same": the current view's yaw and hfov; pitch the target's own.
+    let cube = t.scene("courtyardCube").unwrap();
+    let (_, a) = t.arrival(cube, now, &cube.hotspots[0]).unwrap();
+    assert_eq!(
+        a,
+        Angles {
+            yaw: 50.0,
+            pitch: -5.0,
+            hfov: 75.0
+        }
+    );
+    // Info hotspots go nowhere.
+    assert!(t.arrival(c, now, &c.hotspots[1]).is_none());
+}
+
+#[test]
+fn the_marzipano_tour_opens_with_angles_converted() {
+    let l = tour::load(&data("marzipano/data.js")).unwrap();
+    assert!(l.problems.is_empty(), "{:?}", l.problems);
+    let t = &l.tour;
+    assert_eq!(t.title.as_deref(), Some("Test tour"));
+    assert_eq!(t.first_scene, "0-courtyard");
+    let c = &t.scenes[0];
+    assert_eq!(c.title.as_deref(), Some("Courtyard"));
+    // Radians to degrees; Marzipano's pitch is positive down.
+    close(c.start.yaw, 20.0, 1e-9, "start yaw");
+    close(c.start.pitch, -5.0, 1e-9, "start pitch");
+    // fov 75° vertical at 16:9.
+    let hfov = 2.0
+        * ((37.5f64).to_radians().tan() * 16.0 / 9.0)
+            .atan()
+            .to_degrees();
+    close(c.start.hfov, hfov, 1e-9, "start hfov");
+    let Source::MarzipanoTiles {
+        dir,
+        levels,
+        face_size,
+    } = &c.source
+    else {
+        panic!()
+    };
+    assert_eq!(
+        (dir.as_str(), levels.as_slice(), *face_size),
+        ("tiles/0-courtyard", &[(64, 64, false)][..], 64)
+    );
+    let link = &c.hotspots[0];
+    close(link.yaw, 60.0, 1e-9, "link yaw");
+    close(link.pitch, -2.0, 1e-9, "link pitch");
+    assert_eq!(link.text, "Interior", "a link's text is its target's name");
+    assert!(matches!(&link.kind, HotspotKind::Scene { scene_id, .. } if scene_id == "1-interior"));
+    let info = &c.hotspots[1];
+    close(info.pitch, 10.0, 1e-9, "info pitch");
+    assert_eq!(info.text, "Courtyard: CC0, Greg Zaal.");
+    // The second scene is written as a JavaScript literal (unquoted keys, trailing commas).
+    let i = &t.scenes[1];
+    close(i.start.yaw, -30.0, 1e-9, "yaw");
+    close(i.hotspots[0].yaw, -120.0, 1e-9, "link yaw");
+}
+
+fn same_content(a: &Tour, b: &Tour) {
+    assert_eq!(a.first_scene, b.first_scene);
+    assert_eq!(a.fade_ms, b.fade_ms);
+    assert_eq!(a.default_extra, b.default_extra);
+    assert_eq!(a.scenes.len(), b.scenes.len());
+    for (x, y) in a.scenes.iter().zip(&b.scenes) {
+        assert_eq!((&x.id, &x.title, &x.source), (&y.id, &y.title, &y.source));
+        assert_eq!(
+            (x.start, x.north_offset, x.horizon),
+            (y.start, y.north_offset, y.horizon)
+        );
+        assert_eq!(x.extra, y.extra);
+        assert_eq!(x.hotspots.len(), y.hotspots.len(), "{}", x.id);
+        for (h, k) in x.hotspots.iter().zip(&y.hotspots) {
+            assert_eq!(
+                (h.yaw, h.pitch, &h.text, &h.kind, &h.extra),
+                (k.yaw, k.pitch, &k.text, &k.kind, &k.extra)
+            );
+        }
+    }
+}
+
+#[test]
+fn a_saved_tour_round_trips() {
+    let d = tmpdir("roundtrip");
+    let mut t = tour::load(&data("pannellum/tour.json")).unwrap().tour;
+    // With a horizon and an edit, so those are saved too.
+    t.scenes[1].horizon = tour::Horizon {
+        pitch: 3.5,
+        roll: -2.0,
+    };
+    t.scenes[0].hotspots[1].yaw = -41.25;
+    let out = d.join("saved.json");
+    let left_out = tour::pannellum::save(&t, &out).unwrap();
+    assert!(left_out.is_empty());
+    let back = tour::load(&out).unwrap();
+    assert!(back.problems.is_empty(), "{:?}", back.problems);
+    same_content(&t, &back.tour);
+    // Saved again: the same text (stable).
+    let again = d.join("again.json");
+    tour::pannellum::save(&back.tour, &again).unwrap();
+    assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&again).unwrap());
+    // What Pannellum reads: the documented members.
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    assert_eq!(v["default"]["firstScene"], "courtyard");
+    assert_eq!(v["scenes"]["interior"]["horizonPitch"], 3.5);
+    assert_eq!(
+        v["scenes"]["courtyard"]["hotSpots"][0]["targetYaw"],
+        "sameAzimuth"
+    );
+    assert_eq!(v["scenes"]["courtyardCube"]["type"], "cubemap");
+}
+
+#[test]
+fn a_single_scene_config_opens_as_a_one_scene_tour() {
+    let d = tmpdir("single");
+    let f = d.join("pano.json");
+    std::fs::write(
+        &f,
+        r#"{"type": "equirectangular", "panorama": "a.jpg", "yaw": 10, "horizonRoll": 4,
+            "hotSpots": [{"pitch": 1, "yaw": 2, "type": "info", "text": "hi"}]}"#,
+    )
+    .unwrap();
+    let l = tour::load(&f).unwrap();
+    assert!(l.problems.is_empty(), "{:?}", l.problems);
+    assert_eq!(l.tour.scenes.len(), 1);
+    assert_eq!(l.tour.first_scene, "pano");
+    assert_eq!(l.tour.scenes[0].horizon.roll, 4.0);
+    assert_eq!(l.tour.scenes[0].hotspots[0].text, "hi");
+}
+
+/// A tour with one planted problem per scene or hotspot; `needle` in its line.
+const PLANTED: &str = r#"{
+  "default": {"firstScene": "a", "hfov": 80},
+  "scenes": {
+    "a": {"panorama": "a.jpg", "hotSpots": [
+      {"pitch": 0, "yaw": 10, "type": "scene", "sceneId": "nowhere"},
+      {"pitch": 400, "yaw": 10, "type": "info"},
+      {"pitch": 0, "yaw": 10, "type": "teleport"},
+      {"pitch": 0, "yaw": 20, "type": "scene", "sceneId": "b", "targetYaw": "north"},
+      {"yaw": 5, "type": "info"},
+      {"pitch": 0, "yaw": 30, "type": "scene", "sceneId": "b"}
+    ]},
+    "b": {"panorama": "../outside.jpg"},
+    "c": {"type": "sphere", "panorama": "c.jpg"},
+    "d": {"panorama": "missing.jpg", "hfov": -5, "pitch": 1e300},
+    "e": {"type": "cubemap", "cubeMap": ["f.jpg", "r.jpg"]},
+    "f": {"panorama": "http://example.com/x.jpg"},
+    "g": {"panorama": "a.jpg"}
+  }
+}"#;
+
+#[test]
+fn planted_problems_each_get_a_message_with_their_place_and_the_rest_opens() {
+    let d = tmpdir("planted");
+    let f = d.join("t.json");
+    std::fs::write(&f, PLANTED).unwrap();
+    std::fs::write(d.join("a.jpg"), b"not checked by reading").unwrap();
+    let l = tour::load(&f).unwrap();
+    let msgs: Vec<String> = l.problems.iter().map(|p| p.to_string()).collect();
+    let has = |line: usize, needle: &str| {
+        assert!(
+            msgs.iter()
+                .any(|m| m.contains(&format!("t.json:{line}:")) && m.contains(needle)),
+            "line {line} '{needle}' not in {msgs:#?}"
+        )
+    };
+    has(5, "links to scene \"nowhere\", which is not in the tour");
+    has(6, "400 is not in [-90, 90]");
+    has(7, "unknown hotspot type \"teleport\"");
+    has(8, "targetYaw: is not a number, \"same\" or \"sameAzimuth\"");
+    has(9, "scenes.a.hotSpots[4].pitch: missing");
+    has(12, "leaves the tour's folder");
+    has(13, "unknown type \"sphere\"");
+    has(14, "scenes.d.hfov: -5 is not in");
+    has(14, "scenes.d.pitch: 1e300 is not in");
+    has(15, "not an array of six faces");
+    has(16, "is a URL");
+    // The link to the scene left out ("b") is named too.
+    has(10, "links to scene \"b\"");
+    // The rest opens: a (with its good hotspots), d (with defaults), g.
+    let ids: Vec<_> = l.tour.scenes.iter().map(|s| s.id.as_str()).collect();
+    assert_eq!(ids, ["a", "d", "g"]);
+    let a = l.tour.scene("a").unwrap();
+    assert_eq!(a.hotspots.len(), 3, "{:?}", a.hotspots);
+    assert_eq!(a.start.hfov, 80.0, "default's hfov applies");
+    let dd = l.tour.scene("d").unwrap();
+    assert_eq!((dd.start.hfov, dd.start.pitch), (80.0, 0.0));
+}
+
+#[test]
+fn a_hundred_thousand_hotspots_are_cut_with_one_message() {
+    let d = tmpdir("many");
+    let f = d.join("t.json");
+    let hs: Vec<String> = (0..100_000)
+        .map(|i| format!("{{\"pitch\": 0, \"yaw\": {}, \"type\": \"info\"}}", i % 360))
+        .collect();
+    std::fs::write(
+        &f,
+        format!(
+            "{{\"panorama\": \"a.jpg\", \"hotSpots\": [{}]}}",
+            hs.join(",\n")
+        ),
+    )
+    .unwrap();
+    let l = tour::load(&f).unwrap();
+    assert_eq!(l.problems.len(), 1, "{:?}", l.problems);
+    assert!(
+        l.problems[0].message.contains("100000 hotspots"),
+        "{}",
+        l.problems[0]
+    );
+    assert_eq!(l.tour.scenes[0].hotspots.len(), tour::MAX_HOTSPOTS);
+}
+
+#[test]
+fn syntax_errors_and_non_tours_are_one_line_with_the_line() {
+    let d = tmpdir("syntax");
+    for (name, text, needle) in [
+        (
+            "a.json",
+            "{\n\"scenes\": {\n\"x\": {\"panorama\": \"a.jpg\",}\n",
+            "t.json:4",
+        ),
+        ("b.json", "[1, 2]", "not an object"),
+        ("c.js", "var X = {};", "no `APP_DATA =`"),
+        ("d.js", "var APP_DATA = {scenes: 3};", "no scenes array"),
+    ] {
+        let f = d.join(name);
+        std::fs::write(&f, text).unwrap();
+        let e = format!("{:#}", tour::load(&f).unwrap_err());
+        let needle = needle.replace("t.json", name);
+        assert!(e.contains(&needle) && !e.contains('\n'), "{name}: {e}");
+    }
+}
+
+fn check_lines(path: &Path) -> (bool, Vec<String>, String) {
+    let o = viewer(&["tour", "check", s(path)]);
+    let out = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .map(str::to_string)
+        .collect();
+    (
+        o.status.success(),
+        out,
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn tour_check_passes_the_test_tours() {
+    for t in ["pannellum/tour.json", "marzipano/data.js"] {
+        let (ok, out, err) = check_lines(&data(t));
+        assert!(ok, "{t}: {out:?} {err}");
+        assert!(out.last().unwrap().contains("no problems"), "{out:?}");
+    }
+}
+
+#[test]
+fn tour_check_finds_each_planted_problem_one_line_each() {
+    let d = tmpdir("check");
+    // The test tour's files, then one problem planted at a time.
+    let src = data("pannellum");
+    for f in ["courtyard.jpg", "interior.jpg"] {
+        std::fs::copy(src.join(f), d.join(f)).unwrap();
+    }
+    std::fs::create_dir_all(d.join("cube")).unwrap();
+    for f in ["front", "right", "back", "left", "up", "down"] {
+        std::fs::copy(
+            src.join(format!("cube/{f}.jpg")),
+            d.join(format!("cube/{f}.jpg")),
+        )
+        .unwrap();
+    }
+    let good = std::fs::read_to_string(src.join("tour.json")).unwrap();
+    let t = d.join("tour.json");
+    std::fs::write(&t, &good).unwrap();
+    assert!(check_lines(&t).0, "the copy is clean");
+    for (what, from, to, needle) in [
+        (
+            "a missing file",
+            "\"courtyard.jpg\"",
+            "\"gone.jpg\"",
+            "tour.json:11: scenes.courtyard.panorama: \"gone.jpg\": no such file",
+        ),
+        (
+            "a missing cube face",
+            "cube/up.jpg",
+            "cube/top.jpg",
+            "scenes.courtyardCube.cubeMap[4]: \"cube/top.jpg\": no such file",
+        ),
+        (
+            "a link to no scene",
+            "\"sceneId\": \"interior\"",
+            "\"sceneId\": \"hall\"",
+            "tour.json:17: scenes.courtyard.hotSpots[0].sceneId: links to scene \"hall\"",
+        ),
+        (
+            "a bad first scene",
+            "\"firstScene\": \"courtyard\"",
+            "\"firstScene\": \"lobby\"",
+            "tour.json:3: default.firstScene: scene \"lobby\" is not in the tour",
+        ),
+        (
+            "a path leaving the folder",
+            "\"./interior.jpg\"",
+            "\"../interior.jpg\"",
+            "scenes.interior.panorama: \"../interior.jpg\" leaves the tour's folder",
+        ),
+        (
+            "an unknown type",
+            "\"type\": \"cubemap\"",
+            "\"type\": \"cube\"",
+            "scenes.courtyardCube.type: unknown type \"cube\"",
+        ),
+        (
+            "an absurd number",
+            "\"northOffset\": 120",
+            "\"northOffset\": 1e9",
+            "scenes.interior.northOffset: 1e9 is not in",
+        ),
+        (
+            "an unreachable scene",
+            "\"sceneId\": \"courtyardCube\"",
+            "\"sceneId\": \"courtyard\"",
+            "scenes.courtyardCube: no link leads here from the first scene",
+        ),
+    ] {
+        std::fs::write(&t, good.replacen(from, to, 1)).unwrap();
+        let (ok, out, err) = check_lines(&t);
+        assert!(!ok, "{what}: passed");
+        assert!(
+            out.iter().any(|l| l.contains(needle)),
+            "{what}: '{needle}' not in {out:#?}"
+        );
+        assert!(err.contains("problem"), "{what}: {err}");
+        assert!(!err.contains("panicked"));
+    }
+}
+
+#[test]
+fn tour_convert_writes_a_pannellum_config_beside_the_tour() {
+    let d = tmpdir("convert");
+    let t = d.join("tour.json");
+    std::fs::copy(data("pannellum/tour.json"), &t).unwrap();
+    let out = d.join("out.json");
+    let o = viewer(&["tour", "convert", s(&t), "-o", s(&out)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let back = tour::load(&out).unwrap();
+    same_content(&tour::load(&t).unwrap().tour, &back.tour);
+    // Elsewhere: refused (the paths are relative to the tour), exit 2, nothing written.
+    let other = tmpdir("convert-other").join("x.json");
+    let o = viewer(&["tour", "convert", s(&t), "-o", s(&other)]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!other.exists());
+}
+
+/// The LUT path on a re-levelled map against the exact rotated reference: each output
+/// pixel's ray, rotated into the tilted image (Pannellum's rotation), sampled bilinear
+/// in f64 from the original map. The re-levelled map's texel centres are exact; the
+/// renderer's sampling positions on it keep their 0.05 px bound; what differs is the
+/// second bilinear interpolation (the map resampled once, then the frame), bounded here.
+#[test]
+fn a_levelled_horizon_matches_the_exact_rotated_reference() {
+    use lut_core::{
+        bilinear_f64, equirect_uv, grid_map, horizon_rotation, level_horizon, Camera, Frame,
+        Projection, RenderOptions, Renderer, View,
+    };
+    let map = grid_map(1024, 512, Projection::Equirect).unwrap();
+    let (hp, hr) = (8.0, -12.0);
+    let level = level_horizon(&map, hp, hr).unwrap();
+    let m = horizon_rotation(hp, hr);
+    let mut r = Renderer::new(&level);
+    let (w, h) = (320u32, 200u32);
+    for (yaw, pitch, hfov) in [(0.0, 0.0, 90.0), (75.0, 30.0, 60.0), (-140.0, -50.0, 110.0)] {
+        let view = View::new(yaw, pitch, hfov).unwrap();
+        let mut out = vec![0u32; (w * h) as usize];
+        let mut f = Frame::new(&mut out, w, h).unwrap();
+        r.render(&level, view, &RenderOptions::default(), &mut f)
+            .unwrap();
+        let cam = Camera::new(view, w, h);
+        let exact = |m: glam::DMat3| {
+            let mut reference = vec![0u32; (w * h) as usize];
+            for y in 0..h {
+                for x in 0..w {
+                    let d = m * cam.ray(x as f64 + 0.5, y as f64 + 0.5).unwrap().normalize();
+                    let (u, v) = equirect_uv(d, map.width(), map.height());
+                    let c = bilinear_f64(&map, u, v);
+                    let q = |v: f64| v.round().clamp(0.0, 255.0) as u32;
+                    reference[(y * w + x) as usize] = (q(c[0]) << 16) | (q(c[1]) << 8) | q(c[2]);
+                }
+            }
+            reference
+        };
+        let reference = exact(m);
+        // The control: the inverse rotation (a sign error) must be far off.
+        let wrong = test_support::pixels::psnr(&out, &exact(m.transpose()));
+        let mut worst = 0.0f64;
+        for (a, b) in out.iter().zip(&reference) {
+            for s in [0, 8, 16] {
+                worst = worst.max((((a >> s) & 0xFF) as f64 - ((b >> s) & 0xFF) as f64).abs());
+            }
+        }
+        let p = test_support::pixels::psnr(&out, &reference);
+        // Measured: 34-35 dB on this grid (its lines are 1-2 texels wide, the worst case
+        // for a second interpolation); the inverse rotation is > 15 dB worse.
+        eprintln!("view {yaw}/{pitch}/{hfov}: PSNR {p:.1} dB, worst channel {worst}, inverse rotation {wrong:.1} dB");
+        assert!(
+            p > 32.0,
+            "view {yaw}/{pitch}/{hfov}: PSNR {p:.1} dB (worst channel {worst})"
+        );
+        assert!(
+            wrong < p - 15.0,
+            "the inverse rotation is as close: {wrong:.1} dB"
+        );
+    }
+}
+
+/// A GPano file whose pose says the camera was tilted opens level: the map loaded is the
+/// re-levelled one.
+#[test]
+fn a_gpano_file_with_pose_opens_level() {
+    let d = tmpdir("gpano-pose");
+    let src = std::fs::read(test_support::repo_root().join("assets/courtyard.jpg")).unwrap();
+    let xmp = lut_core::xmp_packet(&[
+        ("ProjectionType", "equirectangular"),
+        ("PosePitchDegrees", "6"),
+        ("PoseRollDegrees", "-9"),
+    ]);
+    let tilted = d.join("tilted.jpg");
+    std::fs::write(&tilted, lut_core::insert_xmp(&src, &xmp).unwrap()).unwrap();
+    let opts = lut_core::LoadOptions::default();
+    let (opened, _) = lut_core::load_partial(&tilted, &opts, None, &mut |_| {}).unwrap();
+    let plain = lut_core::load_map(
+        &test_support::repo_root().join("assets/courtyard.jpg"),
+        &opts,
+        &mut |_| {},
+    )
+    .unwrap();
+    let expected = lut_core::level_horizon(&plain, 6.0, -9.0).unwrap();
+    let (w, h) = (plain.width(), plain.height());
+    let mut differs = 0;
+    for y in 0..h {
+        for x in 0..w {
+            assert_eq!(opened.pixel(x, y), expected.pixel(x, y), "({x}, {y})");
+            differs += usize::from(opened.pixel(x, y) != plain.pixel(x, y));
+        }
+    }
+    assert!(differs > (w * h / 2) as usize, "the pose changed the map");
+}
+
+/// `render --tour --scene`: the markers sit on their hotspots' directions (within 1 px)
+/// in every output projection, and are not drawn where the view does not show them.
+#[test]
+fn render_tour_scene_markers_sit_on_their_directions() {
+    use viewer::tour::markers::{INFO_COLOR, SCENE_COLOR};
+    let d = tmpdir("markers");
+    // A grey panorama, so the markers are the only colours.
+    let grey = image::RgbImage::from_pixel(256, 128, image::Rgb([128, 128, 128]));
+    grey.save(d.join("grey.jpg")).unwrap();
+    let t = d.join("t.json");
+    std::fs::write(
+        &t,
+        r#"{"default": {"firstScene": "s"}, "scenes": {"s": {"panorama": "grey.jpg",
+          "hotSpots": [
+            {"pitch": 10, "yaw": 20, "type": "scene", "sceneId": "s"},
+            {"pitch": -25, "yaw": -35, "type": "info", "text": "i"},
+            {"pitch": 0, "yaw": 180, "type": "info", "text": "behind"}]}}}"#,
+    )
+    .unwrap();
+    let tour = tour::load(&t).unwrap().tour;
+    let scene = tour.scene("s").unwrap();
+    let (w, h) = (400u32, 300u32);
+    for (proj, hfov) in [
+        ("rectilinear", 100.0),
+        ("stereographic", 200.0),
+        ("fisheye", 180.0),
+        ("equisolid", 160.0),
+        ("pannini", 150.0),
+    ] {
+        let out = d.join(format!("{proj}.png"));
+        let o = viewer(&[
+            "render",
+            "--tour",
+            s(&t),
+            "--scene",
+            "s",
+            "-o",
+            s(&out),
+            "--size",
+            "400x300",
+            "--view-projection",
+            proj,
+            "--hfov",
+            &hfov.to_string(),
+            "--yaw",
+            "0",
+        ]);
+        assert!(
+            o.status.success(),
+            "{proj}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let img = image::open(&out).unwrap().to_rgb8();
+        let vp = match lut_core::parse_name::<lut_core::ViewProjection>(proj).unwrap() {
+            lut_core::ViewProjection::Pannini(_) => {
+                lut_core::ViewProjection::Pannini(lut_core::PANNINI_D_DEFAULT)
+            }
+            p => p,
+        };
+        let view = lut_core::View::with_projection(0.0, 0.0, hfov, vp).unwrap();
+        for (i, color) in [(0usize, SCENE_COLOR), (1, INFO_COLOR), (2, INFO_COLOR)] {
+            let hs = &scene.hotspots[i];
+            let expect = tour::markers::place(view, w, h, hs.yaw, hs.pitch);
+            // The centroid of the marker's fill colour.
+            let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+            for (x, y, p) in img.enumerate_pixels() {
+                let c = ((p[0] as u32) << 16) | ((p[1] as u32) << 8) | p[2] as u32;
+                let near = |a: u32, b: u32| {
+                    (0..3).all(|k| ((a >> (8 * k)) & 0xFF).abs_diff((b >> (8 * k)) & 0xFF) <= 2)
+                };
+                if near(c, color) {
+                    if let Some((ex, ey)) = expect {
+                        // Only this hotspot's pixels (the two info markers are far apart).
+                        if (x as f64 + 0.5 - ex).hypot(y as f64 + 0.5 - ey) > 20.0 {
+                            continue;
+                        }
+                    }
+                    sx += x as f64 + 0.5;
+                    sy += y as f64 + 0.5;
+                    n += 1.0;
+                }
+            }
+            match expect {
+                Some((ex, ey)) => {
+                    assert!(n > 20.0, "{proj}: hotspot {i} not drawn");
+                    let (cx, cy) = (sx / n, sy / n);
+                    assert!(
+                        (cx - ex).hypot(cy - ey) <= 1.0,
+                        "{proj}: hotspot {i} at ({cx:.2}, {cy:.2}), direction at ({ex:.2}, {ey:.2})"
+                    );
+                }
+                None => assert!(i == 2, "{proj}: hotspot {i} should be shown"),
+            }
+        }
+        // Behind the viewer (yaw 180) in the rectilinear view: not drawn anywhere.
+        if proj == "rectilinear" {
+            assert!(tour::markers::place(view, w, h, 180.0, 0.0).is_none());
+        }
+    }
+}
