@@ -1,6 +1,7 @@
 //! `viewer lux`: the JSON interface exactly as documented, the CIE 171:2006 reference case
-//! through the command line, aims and several sources against the closed form, and clean
-//! one-line failures.
+//! through the command line, aims and several sources against the closed form (with
+//! `--direct-only`, and the same with every reflectance 0), the inter-reflections added on
+//! top, and clean one-line failures.
 
 mod common;
 
@@ -14,7 +15,16 @@ fn iso() -> String {
         .to_string()
 }
 
+/// `viewer lux --json` with the direct light only (the closed forms' case).
 fn run_json(args: &[&str]) -> serde_json::Value {
+    let direct = run_json_with(&[&["--direct-only"], args].concat());
+    // Black surfaces give exactly the same numbers.
+    let black = run_json_with(&[&["--reflectances", "0,0,0"], args].concat());
+    assert_eq!(direct, black);
+    direct
+}
+
+fn run_json_with(args: &[&str]) -> serde_json::Value {
     let mut a = vec!["lux", "--json"];
     a.extend_from_slice(args);
     let out = viewer(&a);
@@ -53,7 +63,9 @@ fn json_is_exactly_the_documented_interface() {
     assert_eq!(obj.keys().collect::<Vec<_>>(), ["points"]);
     let p = &v["points"][0];
     let keys: Vec<&String> = p.as_object().unwrap().keys().collect();
-    assert_eq!(keys, ["at", "lux", "normal"]);
+    assert_eq!(keys, ["at", "direct", "indirect", "lux", "normal"]);
+    assert_eq!(p["indirect"], serde_json::json!(0.0));
+    assert_eq!(p["direct"], p["lux"]);
     assert_eq!(p["at"], serde_json::json!([0.0, 0.0, 0.0]));
     assert_eq!(p["normal"], serde_json::json!([0.0, 1.0, 0.0]));
     // CIE 171:2006: isotropic 10 000 lm, 3 m above the point: 88.42 lx.
@@ -141,16 +153,64 @@ fn several_sources_and_a_multiplier_add_up() {
 }
 
 #[test]
+fn inter_reflections_add_to_the_direct_light() {
+    // The default reflectances (0.2, 0.5, 0.7): the direct part is unchanged, the
+    // indirect is positive and lux is their sum; a point under the light reads more.
+    let light = format!("{}@0,2.5,0", iso());
+    let args = [
+        "--room",
+        "6x5x2.8",
+        "--light",
+        &light,
+        "--at",
+        "0,0,0",
+        "--at",
+        "1,0.75,0.5:0,1,0",
+    ];
+    let direct = run_json(&args);
+    let lit = run_json_with(&args);
+    for k in 0..2 {
+        let (d, p) = (&direct["points"][k], &lit["points"][k]);
+        let (ed, dd, di, e) = (
+            d["lux"].as_f64().unwrap(),
+            p["direct"].as_f64().unwrap(),
+            p["indirect"].as_f64().unwrap(),
+            p["lux"].as_f64().unwrap(),
+        );
+        assert_eq!(dd, ed);
+        assert!(
+            di > 1.0 && (e - (dd + di)).abs() < 1e-9 * e && e > ed,
+            "{p}"
+        );
+    }
+    // Reflectances outside [0, 1) are refused.
+    for bad in ["1,0.5,0.7", "0.2,-0.1,0.7", "0.2,0.5", "a,b,c"] {
+        let e = fails(&[&args[..], &["--reflectances", bad]].concat());
+        assert!(e.contains("reflectance"), "{e}");
+    }
+}
+
+#[test]
 fn text_output_lists_each_point() {
     let light = format!("{}@0,3,0", iso());
     let out = viewer(&[
-        "lux", "--room", "10x10x4", "--light", &light, "--at", "0,0,0", "--at", "5,2,0",
+        "lux",
+        "--direct-only",
+        "--room",
+        "10x10x4",
+        "--light",
+        &light,
+        "--at",
+        "0,0,0",
+        "--at",
+        "5,2,0",
     ]);
     assert!(out.status.success());
     let t = String::from_utf8_lossy(&out.stdout);
     let lines: Vec<&str> = t.lines().collect();
     assert_eq!(lines.len(), 3, "{t}");
-    assert!(lines[1].ends_with("88.42"), "{t}");
+    assert!(lines[1].contains(" 88.42 "), "{t}");
+    assert!(lines[1].ends_with(" 0"), "no indirect light: {t}");
     assert!(lines[2].contains("(-1.000, 0.000, 0.000)"), "{t}");
 }
 

@@ -35,6 +35,7 @@ use crate::cube::{face_dir, CubeMap, Face};
 use crate::geom::camera::lat_long_to_dir;
 use crate::geom::projection::Projection;
 use crate::map::envmap::EnvMap;
+use crate::panorama::Panorama;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -63,6 +64,12 @@ pub fn lit_map_bytes(map: &EnvMap) -> usize {
 pub fn lit_cube_bytes(cube: &CubeMap) -> usize {
     let base = cube.bytes();
     base + base / 3
+}
+
+/// The bytes a lit copy of `pano` takes, its pyramids included ([`lit_map_bytes`],
+/// [`lit_cube_bytes`]).
+pub fn lit_panorama_bytes(pano: &Panorama) -> usize {
+    pano.with_pixels(lit_map_bytes, lit_cube_bytes)
 }
 
 fn check_budget(bytes: usize) -> Result<(), LightError> {
@@ -193,7 +200,7 @@ impl IlluminanceMap {
         opts.check()?;
         check_budget(lit_map_bytes(map))?;
         let grid = MapTexels::new(*self.room(), map);
-        let colour = ShadeRow::detect();
+        let colour = ShadeRow::active();
         let (src, stride) = map.padded();
         let (w, h) = (map.stored_width() as usize, map.stored_height() as usize);
         let mut data = vec![0u32; src.len()];
@@ -231,6 +238,24 @@ impl IlluminanceMap {
         Ok(lit)
     }
 
+    /// The lit copy of `pano`, a panorama of the same kind and geometry sharing its
+    /// tables ([`IlluminanceMap::bake_map`] or [`IlluminanceMap::bake_cube`]), stopped
+    /// when `cancel` is set (checked before each band of rows).
+    ///
+    /// # Errors
+    /// As [`IlluminanceMap::bake_map_cancellable`] ([`lit_panorama_bytes`]).
+    pub fn bake_panorama(
+        &self,
+        pano: &Panorama,
+        opts: &ShadeOptions,
+        cancel: &AtomicBool,
+    ) -> Result<Panorama, LightError> {
+        pano.try_derive(
+            |map| self.bake_map_cancellable(map, opts, cancel),
+            |cube| self.bake_cube_cancellable(cube, opts, cancel),
+        )
+    }
+
     /// The lit copy of `cube` (every face texel lit as `opts` says, see the module docs;
     /// each face's border from its lit neighbours, as [`CubeMap::from_faces`] makes it).
     /// Its pyramid is built here when `cube`'s has been.
@@ -254,7 +279,7 @@ impl IlluminanceMap {
     ) -> Result<CubeMap, LightError> {
         opts.check()?;
         check_budget(lit_cube_bytes(cube))?;
-        let colour = ShadeRow::detect();
+        let colour = ShadeRow::active();
         let n = cube.face_size() as usize;
         let half = n as f64 / 2.0;
         let room = *self.room();

@@ -199,7 +199,13 @@ impl IesFile {
             file: name.clone(),
             reason,
         })?;
-        IesFile::parse(&text, &name)
+        // Behind the one containment: a parser's panic is the file's error.
+        crate::guard::catch_quiet(|| IesFile::parse(&text, &name)).unwrap_or_else(|panic| {
+            Err(IesError::Io {
+                file: name.clone(),
+                reason: format!("the parser failed on it (an internal error: {panic})"),
+            })
+        })
     }
 
     /// Parse the text of an IES file; `file` names it in errors.

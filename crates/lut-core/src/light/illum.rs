@@ -164,74 +164,93 @@ impl IlluminanceMap {
                 )
             })
             .collect();
-        let mut faces = Vec::with_capacity(6);
-        let mut total = 0usize;
-        for face in RoomFace::ALL {
-            let (ua, va) = face.plane_axes();
-            let (size_u, size_v) = (hi[ua] - lo[ua], hi[va] - lo[va]);
-            let tiles_u = (size_u / opts.tile).ceil().max(1.0) as usize;
-            let tiles_v = (size_v / opts.tile).ceil().max(1.0) as usize;
-            let (tile_u, tile_v) = (size_u / tiles_u as f64, size_v / tiles_v as f64);
-            let plane = room.plane(face);
-            // The lights that can reach this face: the directions toward its plane are the
-            // half-space around −n; a lit cone of half-angle c around the aim misses it
-            // when the aim is more than 90° + c from −n.
-            let toward = -face.inward_normal();
-            let reach: Vec<_> = lights
-                .iter()
-                .filter(|(_, aim, cone, _)| {
-                    let angle = aim.dot(toward).clamp(-1.0, 1.0).acos().to_degrees();
-                    angle < 90.0 + cone + 1.0
-                })
-                .collect();
-            let mut tiles = Vec::with_capacity(tiles_u * tiles_v);
-            for tv in 0..tiles_v {
-                for tu in 0..tiles_u {
-                    let (a0, b0) = (lo[ua] + tu as f64 * tile_u, lo[va] + tv as f64 * tile_v);
-                    // The distance from the tile's rectangle to each light that reaches
-                    // the face, times that light's spacing per metre.
-                    let s = reach
-                        .iter()
-                        .map(|(l, _, _, per_metre)| {
-                            let du = l[ua] - l[ua].clamp(a0, a0 + tile_u);
-                            let dv = l[va] - l[va].clamp(b0, b0 + tile_v);
-                            let dn = l[face.axis()] - plane;
-                            per_metre * (du * du + dv * dv + dn * dn).sqrt()
-                        })
-                        .fold(f64::INFINITY, f64::min)
-                        .clamp(opts.min_spacing, opts.max_spacing);
-                    let nu = (tile_u / s).ceil().max(1.0) as usize + 1;
-                    let nv = (tile_v / s).ceil().max(1.0) as usize + 1;
-                    let spacing = (tile_u / (nu - 1) as f64).max(tile_v / (nv - 1) as f64);
-                    tiles.push(Tile {
-                        nu: nu as u32,
-                        nv: nv as u32,
-                        su: ((nu - 1) as f64 / tile_u) as f32,
-                        sv: ((nv - 1) as f64 / tile_v) as f32,
-                        spacing: spacing as f32,
-                        max_len: spacing as f32,
-                        offset: total as u32,
-                    });
-                    total += nu * nv;
+        // The nodes' memory and the work (nodes × luminaires) are bounded whatever the
+        // room's size (limits::MAX_ILLUM_NODES, MAX_ILLUM_WORK): past the budget the
+        // tiles and spacings grow together until the map fits it.
+        let budget = crate::geom::limits::MAX_ILLUM_NODES
+            .min(crate::geom::limits::MAX_ILLUM_WORK / lights.len().max(1));
+        let layout = |o: &MapOptions| -> (Vec<FaceGrid>, usize) {
+            let mut faces = Vec::with_capacity(6);
+            let mut total = 0usize;
+            for face in RoomFace::ALL {
+                let (ua, va) = face.plane_axes();
+                let (size_u, size_v) = (hi[ua] - lo[ua], hi[va] - lo[va]);
+                let tiles_u = (size_u / o.tile).ceil().max(1.0) as usize;
+                let tiles_v = (size_v / o.tile).ceil().max(1.0) as usize;
+                let (tile_u, tile_v) = (size_u / tiles_u as f64, size_v / tiles_v as f64);
+                let plane = room.plane(face);
+                // The lights that can reach this face: the directions toward its plane are the
+                // half-space around −n; a lit cone of half-angle c around the aim misses it
+                // when the aim is more than 90° + c from −n.
+                let toward = -face.inward_normal();
+                let reach: Vec<_> = lights
+                    .iter()
+                    .filter(|(_, aim, cone, _)| {
+                        let angle = aim.dot(toward).clamp(-1.0, 1.0).acos().to_degrees();
+                        angle < 90.0 + cone + 1.0
+                    })
+                    .collect();
+                let mut tiles = Vec::with_capacity(tiles_u * tiles_v);
+                for tv in 0..tiles_v {
+                    for tu in 0..tiles_u {
+                        let (a0, b0) = (lo[ua] + tu as f64 * tile_u, lo[va] + tv as f64 * tile_v);
+                        // The distance from the tile's rectangle to each light that reaches
+                        // the face, times that light's spacing per metre.
+                        let s = reach
+                            .iter()
+                            .map(|(l, _, _, per_metre)| {
+                                let du = l[ua] - l[ua].clamp(a0, a0 + tile_u);
+                                let dv = l[va] - l[va].clamp(b0, b0 + tile_v);
+                                let dn = l[face.axis()] - plane;
+                                per_metre * (du * du + dv * dv + dn * dn).sqrt()
+                            })
+                            .fold(f64::INFINITY, f64::min)
+                            .clamp(o.min_spacing, o.max_spacing);
+                        let nu = (tile_u / s).ceil().max(1.0) as usize + 1;
+                        let nv = (tile_v / s).ceil().max(1.0) as usize + 1;
+                        let spacing = (tile_u / (nu - 1) as f64).max(tile_v / (nv - 1) as f64);
+                        tiles.push(Tile {
+                            nu: nu as u32,
+                            nv: nv as u32,
+                            su: ((nu - 1) as f64 / tile_u) as f32,
+                            sv: ((nv - 1) as f64 / tile_v) as f32,
+                            spacing: spacing as f32,
+                            max_len: spacing as f32,
+                            offset: total as u32,
+                        });
+                        total += nu * nv;
+                    }
                 }
+                faces.push(FaceGrid {
+                    face,
+                    u_axis: ua,
+                    v_axis: va,
+                    u0: lo[ua],
+                    v0: lo[va],
+                    u0_rel: lo[ua] - room.camera_position()[ua],
+                    v0_rel: lo[va] - room.camera_position()[va],
+                    tiles_u,
+                    tiles_v,
+                    inv_tile_u: 1.0 / tile_u,
+                    inv_tile_v: 1.0 / tile_v,
+                    tile_u,
+                    tile_v,
+                    tiles,
+                });
             }
-            faces.push(FaceGrid {
-                face,
-                u_axis: ua,
-                v_axis: va,
-                u0: lo[ua],
-                v0: lo[va],
-                u0_rel: lo[ua] - room.camera_position()[ua],
-                v0_rel: lo[va] - room.camera_position()[va],
-                tiles_u,
-                tiles_v,
-                inv_tile_u: 1.0 / tile_u,
-                inv_tile_v: 1.0 / tile_v,
-                tile_u,
-                tile_v,
-                tiles,
-            });
-        }
+            (faces, total)
+        };
+        let mut o = *opts;
+        let (mut faces, total) = loop {
+            let (faces, total) = layout(&o);
+            if total <= budget {
+                break (faces, total);
+            }
+            let grow = ((total as f64 / budget as f64).sqrt() * 1.05).max(1.05);
+            o.tile *= grow;
+            o.min_spacing *= grow;
+            o.max_spacing *= grow;
+        };
         // Split the values into one slice per tile, then fill the tiles in parallel.
         let mut values = vec![0f32; total];
         let mut jobs = Vec::new();

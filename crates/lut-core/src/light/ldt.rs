@@ -210,7 +210,13 @@ impl LdtFile {
             file: name.clone(),
             reason,
         })?;
-        LdtFile::parse(&text, &name)
+        // Behind the one containment: a parser's panic is the file's error.
+        crate::guard::catch_quiet(|| LdtFile::parse(&text, &name)).unwrap_or_else(|panic| {
+            Err(LdtError::Io {
+                file: name.clone(),
+                reason: format!("the parser failed on it (an internal error: {panic})"),
+            })
+        })
     }
 
     /// Parse the text of an EULUMDAT file; `file` names it in errors.

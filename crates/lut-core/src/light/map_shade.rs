@@ -298,7 +298,7 @@ impl IlluminanceMap {
                 .is_rectilinear()
                 .then(|| Rays::new(self, cam)),
             opts: *opts,
-            colour: ShadeRow::detect(),
+            colour: ShadeRow::active(),
         })
     }
 

@@ -18,6 +18,10 @@
 //!   (ambient + exposure · ΣE), with a false-colour illuminance overlay. The exact path.
 //! * [`illum`]: the illuminance map, E computed once per lighting change over the room's
 //!   faces, which frames sample (`map_shade`): the interactive path.
+//! * [`radiosity`]: inter-reflections: the faces' reflectances, patches, closed-form
+//!   form factors and the radiosity solve; the indirect illuminance at any point.
+//! * [`grid`]: EN 12464-1 calculation grids and their figures (Em, Emin, Emax, U0, Ud).
+//! * [`ugr`]: CIE 117's Unified Glare Rating from the files' luminous areas.
 //! * [`bake`]: the lit panorama, every texel lit once from the illuminance map, so a pan
 //!   of the lit room is an unlit frame of the lit copy.
 //!
@@ -26,28 +30,34 @@
 //! See `docs/lights.md` for the design.
 
 pub mod bake;
+pub mod grid;
 pub mod ies;
 pub mod illum;
 pub mod ldt;
 mod level;
 mod map_shade;
 pub mod photometry;
+pub mod radiosity;
 pub mod room;
 pub mod shade;
 mod shade_table;
 pub mod table;
+pub mod ugr;
 
-pub use bake::{lit_cube_bytes, lit_map_bytes, BAKE_MAX_BYTES};
+pub use bake::{lit_cube_bytes, lit_map_bytes, lit_panorama_bytes, BAKE_MAX_BYTES};
+pub use grid::{border_band, en12464_spacing, AreaStats, CalcGrid, MAX_GRID_POINTS};
 pub use ies::{IesError, IesFile, IesFormat, PhotometricType, Tilt, TiltData};
 pub use illum::{IlluminanceMap, MapOptions};
 pub use ldt::{LampSet, LdtError, LdtFile, LdtSymmetry, LdtType};
 pub use map_shade::{FrameShader, BLOCK as MAP_SHADE_BLOCK};
 pub use photometry::{detect_format, LightFileFormat, Photometry, PhotometrySource};
+pub use radiosity::{DirectLight, FormFactors, Patch, Radiosity, Reflectances, MAX_PATCHES};
 pub use room::{Room, RoomFace};
 pub use shade::{
     false_color, false_color_position, lux_at, shade_frame, LightScene, Luminaire, ShadeOptions,
 };
 pub use table::{Interpolation, LightTable, Symmetry, TableOptions};
+pub use ugr::{ugr, GlareTerm, LuminousArea, Ugr};
 
 /// Largest photometric file read, in bytes. Real IES and EULUMDAT files are well under
 /// 1 MB; the largest table the parsers accept (4 M values) fits in this.
@@ -58,6 +68,19 @@ pub const MAX_FILE_BYTES: u64 = 64 << 20;
 /// files use): every byte becomes the character of the same number, so header text keeps
 /// its accents and the numbers are unchanged. The `Err` is the reason, for the caller's
 /// error type.
+/// A parser or table builder that panicked on a file: the file's [`LightError::Io`].
+impl From<crate::guard::DecoderPanic> for LightError {
+    fn from(p: crate::guard::DecoderPanic) -> LightError {
+        LightError::Io {
+            file: p.path.display().to_string(),
+            reason: format!(
+                "the file is damaged or of a kind the reader cannot handle (it failed on it: {})",
+                p.message
+            ),
+        }
+    }
+}
+
 pub(crate) fn read_text(path: &std::path::Path) -> Result<String, String> {
     use std::io::Read;
     let f = crate::file::open_regular(path).map_err(|e| e.to_string())?;
@@ -117,6 +140,10 @@ pub enum LightError {
     /// The EULUMDAT file is unreadable or malformed.
     #[error(transparent)]
     Ldt(#[from] LdtError),
+    /// A number that sizes work or memory is beyond its limit
+    /// ([`crate::limits`]): room sides, luminaires, multipliers.
+    #[error(transparent)]
+    Limit(#[from] crate::guard::LimitError),
     /// The file could not be read.
     #[error("{file}: cannot read: {reason}")]
     Io {
@@ -223,6 +250,16 @@ pub enum LightError {
     /// A bake was cancelled (its lighting changed while it ran): nothing was made.
     #[error("the bake was cancelled")]
     Cancelled,
+    /// A computation would need more of something than its budget allows.
+    #[error("{what}: {count} needed, more than the limit of {max}")]
+    TooMany {
+        /// What ("radiosity patches", "grid points").
+        what: &'static str,
+        /// How many were needed.
+        count: usize,
+        /// The limit.
+        max: usize,
+    },
     /// The frame buffer does not hold width × height pixels.
     #[error("frame holds {len} pixels but {width}x{height} needs {needed}")]
     BufferSize {

@@ -157,7 +157,8 @@ impl Photometry {
             file: name.clone(),
             reason,
         })?;
-        Photometry::parse(&text, &name)
+        // Behind the one containment: a parser's panic is the file's error.
+        crate::guard::contain(path, || Photometry::parse(&text, &name))
     }
 
     /// Parse text as IES or EULUMDAT by its content; `name` names it in errors and its

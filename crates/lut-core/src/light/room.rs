@@ -147,6 +147,8 @@ impl Room {
                     value,
                 });
             }
+            // The limits module: a room typed in millimetres is refused, not built.
+            crate::guard::check_limit(name, value, crate::geom::limits::MAX_ROOM_SIDE, " m")?;
         }
         if !(camera_height > 0.0 && camera_height < height) {
             return Err(LightError::BadOption {

@@ -91,6 +91,8 @@ pub struct LightScene {
     room: Room,
     lights: Vec<Luminaire>,
     placed: Vec<Placed>,
+    /// The inter-reflections ([`LightScene::with_reflectances`]), if any.
+    indirect: Option<Arc<super::radiosity::Radiosity>>,
 }
 
 impl LightScene {
@@ -101,6 +103,12 @@ impl LightScene {
     /// [`LightError::BadOption`] for a non-finite position or angle or a negative or
     /// non-finite multiplier.
     pub fn new(room: Room, lights: Vec<Luminaire>) -> Result<LightScene, LightError> {
+        crate::guard::check_limit(
+            "luminaires",
+            lights.len(),
+            crate::geom::limits::MAX_LIGHTS,
+            "",
+        )?;
         let mut placed = Vec::with_capacity(lights.len());
         for (index, l) in lights.iter().enumerate() {
             for (name, value) in [
@@ -118,6 +126,12 @@ impl LightScene {
                     });
                 }
             }
+            crate::guard::check_limit(
+                "light multiplier",
+                l.multiplier,
+                crate::geom::limits::MAX_LIGHT_MULTIPLIER,
+                "",
+            )?;
             if !(l.multiplier.is_finite() && l.multiplier >= 0.0) {
                 return Err(LightError::BadOption {
                     name: "light multiplier",
@@ -149,7 +163,40 @@ impl LightScene {
             room,
             lights,
             placed,
+            indirect: None,
         })
+    }
+
+    /// The same scene with inter-reflections: the room's surfaces reflect diffusely with
+    /// `reflectances`, solved by radiosity ([`super::radiosity`]); all zero gives the
+    /// direct light only (no solve).
+    ///
+    /// # Errors
+    /// [`LightError::BadOption`] for a reflectance outside [0, 1).
+    pub fn with_reflectances(
+        mut self,
+        reflectances: super::radiosity::Reflectances,
+    ) -> Result<LightScene, LightError> {
+        reflectances.check()?;
+        self.indirect = None;
+        if !reflectances.is_zero() {
+            self.indirect = Some(super::radiosity::Radiosity::solve_cached(
+                &self,
+                reflectances,
+            )?);
+        }
+        Ok(self)
+    }
+
+    /// The inter-reflections solved for this scene, if any.
+    pub fn radiosity(&self) -> Option<&super::radiosity::Radiosity> {
+        self.indirect.as_deref()
+    }
+
+    /// The exact indirect illuminance at `p` with unit normal `n` (0 without
+    /// inter-reflections): [`super::radiosity::Radiosity::indirect_at`].
+    pub fn indirect(&self, p: DVec3, n: DVec3) -> f64 {
+        self.indirect.as_ref().map_or(0.0, |r| r.indirect_at(p, n))
     }
 
     /// The room.
@@ -163,9 +210,22 @@ impl LightScene {
     }
 
     /// Illuminance in lux at surface point `p` with unit normal `n` (facing into the
-    /// room): Σ multiplier · tilt factor · I(direction) · cos(incidence) / d².
+    /// room): the direct light ([`LightScene::direct`]) plus, with inter-reflections, the
+    /// indirect (on the room's faces interpolated between the radiosity patches, see
+    /// [`super::radiosity::Radiosity::indirect_fast`]).
     #[inline]
     pub fn illuminance(&self, p: DVec3, n: DVec3) -> f64 {
+        let e = self.direct(p, n);
+        match &self.indirect {
+            Some(r) => e + r.indirect_fast(p, n),
+            None => e,
+        }
+    }
+
+    /// Direct illuminance in lux at surface point `p` with unit normal `n` (facing into
+    /// the room): Σ multiplier · tilt factor · I(direction) · cos(incidence) / d².
+    #[inline]
+    pub fn direct(&self, p: DVec3, n: DVec3) -> f64 {
         let mut e = 0.0;
         for l in &self.placed {
             let to_light = l.pos - p;
@@ -415,6 +475,41 @@ pub fn lux_at(scene: &LightScene, cam: &Camera, px: f64, py: f64) -> f64 {
     };
     let (p, n) = scene.scene_point(dir);
     scene.illuminance(p, n)
+}
+
+/// The solve gathers from the scene's direct light (the trait keeps radiosity.rs from
+/// importing this file).
+impl super::radiosity::DirectLight for LightScene {
+    fn room(&self) -> &Room {
+        LightScene::room(self)
+    }
+
+    fn direct(&self, p: DVec3, n: DVec3) -> f64 {
+        LightScene::direct(self, p, n)
+    }
+
+    fn lit_positions(&self) -> Vec<DVec3> {
+        self.luminaires()
+            .iter()
+            .filter(|l| l.multiplier > 0.0)
+            .map(|l| l.position)
+            .collect()
+    }
+
+    fn cache_key(&self) -> Vec<(usize, [f64; 3], f64, f64, f64)> {
+        self.luminaires()
+            .iter()
+            .map(|l| {
+                (
+                    Arc::as_ptr(&l.table) as usize,
+                    l.position.to_array(),
+                    l.yaw_deg,
+                    l.pitch_deg,
+                    l.multiplier,
+                )
+            })
+            .collect()
+    }
 }
 
 #[cfg(test)]

@@ -36,57 +36,12 @@
 
 use super::ies::{IesFile, PhotometricType, TiltData};
 use super::ldt::LdtFile;
+pub use super::level::Interpolation;
 use super::level::{Edge, Edges, Grid, Level, LevelSpec};
 use super::photometry::Photometry;
 pub use super::photometry::Symmetry;
 use super::LightError;
-use crate::named::Named;
 use glam::DVec3;
-
-/// How a table value is filtered between measured angles (claim 3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Interpolation {
-    /// Bilinear: continuous, never overshoots, exact at the measured angles.
-    #[default]
-    Linear,
-    /// Catmull-Rom (bicubic over 4 × 4 values, the form Blender Cycles uses for IES
-    /// lights): smooth slopes, exact at the measured angles; may overshoot near sharp
-    /// cut-offs, and is clamped at zero.
-    CatmullRom,
-}
-
-impl Named for Interpolation {
-    const ALL: &'static [Interpolation] = &[Interpolation::Linear, Interpolation::CatmullRom];
-
-    fn name(self) -> &'static str {
-        match self {
-            Interpolation::Linear => "linear",
-            Interpolation::CatmullRom => "catmull-rom",
-        }
-    }
-
-    fn help(self) -> &'static str {
-        match self {
-            Interpolation::Linear => "bilinear between measured angles (default)",
-            Interpolation::CatmullRom => "bicubic Catmull-Rom (as Blender Cycles), clamped at 0",
-        }
-    }
-}
-
-impl std::fmt::Display for Interpolation {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for Interpolation {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        crate::named::parse_name(s)
-            .ok_or_else(|| crate::named::unknown_name::<Interpolation>("light interpolation", s))
-    }
-}
 
 /// Options for building a [`LightTable`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -310,7 +265,10 @@ impl LightTable {
     /// # Errors
     /// As [`Photometry::load`] and [`LightTable::from_photometry`].
     pub fn load(path: &std::path::Path) -> Result<LightTable, LightError> {
-        LightTable::from_photometry(&Photometry::load(path)?, &TableOptions::default())
+        let p = Photometry::load(path)?;
+        crate::guard::contain(path, || {
+            LightTable::from_photometry(&p, &TableOptions::default())
+        })
     }
 
     /// The goniometer type.

@@ -1,7 +1,8 @@
 //! `viewer lux`: the illuminance at points of the room, computed per point (the per-pixel
 //! path's arithmetic: E = Σ I(direction) · cos(incidence) / d² through each luminaire's
-//! table), for checking numbers against a standard's test cases or a planner's
-//! calculation.
+//! table, plus the light the room's surfaces reflect, from the radiosity solve by exact
+//! point-to-patch form factors), for checking numbers against a standard's test cases or
+//! a planner's calculation.
 
 use crate::args::values::finite;
 use crate::lighting::RoomArgs;
@@ -27,7 +28,8 @@ pub struct LuxArgs {
     /// lies on (within 1 mm); give it for any other point (a work plane: ...:0,1,0).
     #[arg(long = "at", value_parser = parse_point, allow_hyphen_values = true, required = true)]
     pub at: Vec<PointSpec>,
-    /// Print JSON: {"points": [{"at": [x, y, z], "normal": [nx, ny, nz], "lux": E}]}.
+    /// Print JSON: {"points": [{"at": [x, y, z], "normal": [nx, ny, nz], "lux": E,
+    /// "direct": Ed, "indirect": Ei}]} (E = Ed + Ei).
     #[arg(long)]
     pub json: bool,
 }
@@ -75,8 +77,13 @@ pub struct Reading {
     pub at: [f64; 3],
     /// The unit normal used.
     pub normal: [f64; 3],
-    /// Illuminance in lux.
+    /// Illuminance in lux: `direct` + `indirect`.
     pub lux: f64,
+    /// The luminaires' light, lux.
+    pub direct: f64,
+    /// The light reflected by the room's surfaces (inter-reflections), lux; 0 with
+    /// `--direct-only`.
+    pub indirect: f64,
 }
 
 #[derive(Serialize)]
@@ -106,7 +113,12 @@ pub fn readings(a: &LuxArgs) -> Result<Vec<Reading>> {
         let at = DVec3::from(p.at);
         let arg = format!("--at {},{},{}", p.at[0], p.at[1], p.at[2]);
         let normal = match p.normal {
-            Some(n) if room.contains(at) => DVec3::from(n).normalize(),
+            // Scaled by its largest component first: a normal of denormal numbers (whose
+            // squared length underflows to 0) has a direction all the same.
+            Some(n) if room.contains(at) => {
+                let n = DVec3::from(n);
+                (n / n.abs().max_element()).normalize()
+            }
             // Outside: the same error as without a normal.
             Some(_) => {
                 let (lo, hi) = room.bounds();
@@ -124,10 +136,20 @@ pub fn readings(a: &LuxArgs) -> Result<Vec<Reading>> {
                 e => crate::usage!("{arg}: {e}"),
             })?,
         };
+        let (direct, indirect) = (scene.direct(at, normal), scene.indirect(at, normal));
+        let lux = direct + indirect;
+        if !lux.is_finite() {
+            return Err(crate::usage!(
+                "{arg}: the illuminance is not a finite number ({lux}): the luminaires' \
+                 intensities times the multipliers are out of range"
+            ));
+        }
         out.push(Reading {
             at: p.at,
             normal: normal.to_array(),
-            lux: scene.illuminance(at, normal),
+            lux,
+            direct,
+            indirect,
         });
     }
     Ok(out)
@@ -135,16 +157,19 @@ pub fn readings(a: &LuxArgs) -> Result<Vec<Reading>> {
 
 /// The readings as text: one line per point.
 pub fn text(readings: &[Reading]) -> String {
-    let mut s =
-        String::from("point  at (x, y, z) m                  normal                    lux\n");
+    let mut s = String::from(
+        "point  at (x, y, z) m                  normal                    lux        direct     indirect\n",
+    );
     for (i, r) in readings.iter().enumerate() {
         let v = |a: [f64; 3]| format!("({:.3}, {:.3}, {:.3})", a[0], a[1], a[2]);
         s += &format!(
-            "{:<6} {:<30} {:<24} {}\n",
+            "{:<6} {:<30} {:<24} {:<10} {:<10} {}\n",
             i + 1,
             v(r.at),
             v(r.normal),
-            lux_text(r.lux)
+            lux_text(r.lux),
+            lux_text(r.direct),
+            lux_text(r.indirect)
         );
     }
     s
@@ -161,15 +186,18 @@ fn lux_text(lux: f64) -> String {
 
 /// The readings as JSON on one line: `{"points": [{"at": [...], "normal": [...],
 /// "lux": E}]}`.
-pub fn json(readings: &[Reading]) -> String {
-    serde_json::to_string(&Report { points: readings }).expect("readings serialize")
+///
+/// # Errors
+/// A number that is not finite ([`crate::exit::finite_json`]).
+pub fn json(readings: &[Reading]) -> Result<String> {
+    crate::exit::finite_json(&Report { points: readings }, false)
 }
 
 /// Run `viewer lux`.
 pub fn run(a: LuxArgs) -> Result<()> {
     let r = readings(&a)?;
     if a.json {
-        crate::outln!("{}", json(&r))?;
+        crate::outln!("{}", json(&r)?)?;
     } else {
         crate::outln!("{}", text(&r).trim_end_matches('\n'))?;
     }
@@ -211,12 +239,15 @@ mod tests {
         let r = [Reading {
             at: [1.0, 0.0, 2.0],
             normal: [0.0, 1.0, 0.0],
-            lux: 88.42,
+            lux: 100.0,
+            direct: 88.42,
+            indirect: 11.58,
         }];
-        let v: serde_json::Value = serde_json::from_str(&json(&r)).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&json(&r).unwrap()).unwrap();
         assert_eq!(
             v,
-            serde_json::json!({"points": [{"at": [1.0, 0.0, 2.0], "normal": [0.0, 1.0, 0.0], "lux": 88.42}]})
+            serde_json::json!({"points": [{"at": [1.0, 0.0, 2.0], "normal": [0.0, 1.0, 0.0],
+                "lux": 100.0, "direct": 88.42, "indirect": 11.58}]})
         );
     }
 }

@@ -29,11 +29,10 @@ pub fn file_kind(path: &Path) -> FileKind {
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("ies") || e.eq_ignore_ascii_case("ldt"));
     let mut head = Vec::new();
-    let regular = std::fs::metadata(path).is_ok_and(|m| m.is_file());
-    let read = regular
-        && std::fs::File::open(path)
-            .and_then(|f| f.take(HEAD_BYTES).read_to_end(&mut head))
-            .is_ok();
+    // The one check for every input path: regular files only, never blocking.
+    let read = lut_core::open_regular(path)
+        .and_then(|f| f.take(HEAD_BYTES).read_to_end(&mut head))
+        .is_ok();
     if read {
         let text = String::from_utf8_lossy(&head);
         if is_scene(&text) {

@@ -7,7 +7,7 @@
 //! immediate feedback while a value is dragged), refined on the next frame.
 
 use super::state::{LightsKey, LightsState};
-use crate::scene::{render_scene_lit, SceneRef};
+use crate::scene::render_scene_lit;
 use lut_core::{Camera, IlluminanceMap, MapOptions, RenderOptions, RenderReport, View};
 use std::sync::Arc;
 
@@ -99,7 +99,7 @@ impl std::fmt::Display for LitRenderError {
 impl std::error::Error for LitRenderError {}
 
 impl LightsState {
-    /// Render `view` of `scene` into `frame` (`width × height`), lit from the
+    /// Render `view` of `pano` into `frame` (`width × height`), lit from the
     /// illuminance map in `cache` (updated first, see [`LitCache::update`]) as the rows
     /// are drawn ([`render_scene_lit`]); unlit with no luminaire. The pixels are those
     /// of rendering, then [`LightsState::light_frame_with`].
@@ -112,7 +112,7 @@ impl LightsState {
         &mut self,
         cache: &mut LitCache,
         progressive: bool,
-        scene: SceneRef<'_>,
+        pano: &mut lut_core::Panorama,
         view: View,
         opts: &RenderOptions,
         frame: &mut [u32],
@@ -129,7 +129,7 @@ impl LightsState {
             ),
             None => None,
         };
-        render_scene_lit(scene, view, opts, frame, width, height, shader.as_ref())
+        render_scene_lit(pano, view, opts, frame, width, height, shader.as_ref())
             .map_err(LitRenderError::Render)
     }
 

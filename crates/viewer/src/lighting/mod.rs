@@ -25,7 +25,7 @@ pub use state::{
 };
 
 use crate::args::named;
-use crate::args::values::finite;
+use crate::args::values::{finite, parse_finite, parse_multiplier};
 use anyhow::{Context, Result};
 use clap::Args;
 use lut_core::{Interpolation, View};
@@ -54,22 +54,29 @@ pub struct RoomArgs {
     #[arg(long, value_parser = parse_room)]
     pub room: Option<(f64, f64, f64)>,
     /// Camera height above the floor in metres (default 1.6).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
     pub camera_height: Option<f64>,
     /// The room's turn about the vertical axis in degrees: its front wall faces this yaw
     /// of the panorama (default 0).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
     pub room_yaw: Option<f64>,
     /// The room's centre X,Z in metres from the point below the camera, when the camera
     /// is not in the middle of the room (default 0,0).
     #[arg(long, value_parser = parse_center, allow_hyphen_values = true)]
     pub room_center: Option<(f64, f64)>,
-    /// Multiply every luminaire's intensity (default 1).
-    #[arg(long)]
+    /// Multiply every luminaire's intensity (default 1; at most 1000000).
+    #[arg(long, value_parser = parse_multiplier)]
     pub light_multiplier: Option<f64>,
     /// How luminaire tables interpolate between measured angles (default linear).
     #[arg(long, value_parser = named::<Interpolation>())]
     pub light_interpolation: Option<Interpolation>,
+    /// Diffuse reflectances of the floor, walls and ceiling, F,W,C, each in [0, 1)
+    /// (default 0.2,0.5,0.7): the light they reflect is added (inter-reflections).
+    #[arg(long, value_parser = parse_reflectances)]
+    pub reflectances: Option<lut_core::Reflectances>,
+    /// Direct light only: no inter-reflections (the numbers of a black room).
+    #[arg(long)]
+    pub direct_only: bool,
 }
 
 /// Options that light a rendered room panorama (flattened into `viewer render` and the
@@ -80,16 +87,16 @@ pub struct LightArgs {
     #[command(flatten)]
     pub room: RoomArgs,
     /// Illuminance in lux that reproduces the panorama's own brightness (default 300).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
     pub exposure_lux: Option<f64>,
     /// Light factor with no luminaire (0 = black, 1 = as photographed; default 0.15).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
     pub ambient: Option<f64>,
     /// Overlay a false-colour illuminance map (log scale, 3 decades).
     #[arg(long)]
     pub false_color: bool,
     /// Illuminance at the top (red) of the false-colour scale in lux (default 1000).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
     pub false_color_max: Option<f64>,
     /// Draw the room box as a wireframe and the luminaires as markers over the view, to
     /// fit the room to the photograph's walls, floor and ceiling (the window's "Show
@@ -155,11 +162,41 @@ fn parse_room(s: &str) -> Result<(f64, f64, f64), String> {
         .collect::<Option<Vec<f64>>>()
         .as_deref()
     {
-        Some(&[w, d, h]) => Ok((w, d, h)),
+        Some(&[w, d, h]) => {
+            // The limits module, before any work (a room typed in millimetres).
+            for side in [w, d, h] {
+                lut_core::check_limit("room side", side, lut_core::limits::MAX_ROOM_SIDE, " m")
+                    .map_err(|e| e.to_string())?;
+            }
+            Ok((w, d, h))
+        }
         _ => Err(format!(
-            "room '{s}' must be WIDTHxDEPTHxHEIGHT in metres, e.g. 5x4x2.7"
+            "room '{}' must be WIDTHxDEPTHxHEIGHT in metres, e.g. 5x4x2.7",
+            lut_core::shown(s)
         )),
     }
+}
+
+/// Parse `--reflectances F,W,C` (floor, walls, ceiling), each in [0, 1).
+///
+/// # Errors
+/// A message quoting `s` and saying what is wrong.
+pub fn parse_reflectances(s: &str) -> Result<lut_core::Reflectances, String> {
+    let v = s
+        .split(',')
+        .map(finite)
+        .collect::<Option<Vec<f64>>>()
+        .filter(|v| v.len() == 3)
+        .ok_or_else(|| {
+            format!("reflectances '{s}' must be FLOOR,WALLS,CEILING, e.g. 0.2,0.5,0.7")
+        })?;
+    let r = lut_core::Reflectances {
+        floor: v[0],
+        walls: v[1],
+        ceiling: v[2],
+    };
+    r.check().map_err(|e| format!("reflectances '{s}': {e}"))?;
+    Ok(r)
 }
 
 fn parse_center(s: &str) -> Result<(f64, f64), String> {
@@ -218,6 +255,20 @@ impl RoomArgs {
         if let Some(i) = self.light_interpolation {
             st.set_interpolation(i)?;
         }
+        // The limits module: counted before any file is read.
+        lut_core::check_limit(
+            "luminaires",
+            st.lights.len() + self.lights.len(),
+            lut_core::limits::MAX_LIGHTS,
+            "",
+        )
+        .map_err(|e| crate::usage!("--light: {e}"))?;
+        if let Some(r) = self.reflectances {
+            st.reflectances = r;
+        }
+        if self.direct_only {
+            st.indirect = false;
+        }
         for spec in &self.lights {
             let table = st.table_for(&spec.file)?;
             st.lights.push(LightEntry {
@@ -241,10 +292,11 @@ impl RoomArgs {
     pub fn state(&self) -> Result<LightsState> {
         let mut st = self.base()?;
         self.apply(&mut st)?;
+        // Values, as for `render` (LightArgs::state): usage errors, the same exit
+        // status for the same option in every command.
         st.room_box()
-            .map_err(anyhow::Error::msg)
-            .context("--room/--camera-height/--room-yaw/--room-center")?;
-        st.scene().map_err(anyhow::Error::msg)?;
+            .map_err(|e| crate::usage!("--room/--camera-height/--room-yaw/--room-center: {e}"))?;
+        st.direct_scene().map_err(|e| crate::usage!("{e}"))?;
         Ok(st)
     }
 

@@ -152,12 +152,56 @@ pub struct SceneFile {
     pub auto_exposure: bool,
     /// Light factor with no luminaire.
     pub ambient: f64,
+    /// Diffuse reflectances of the surfaces (default floor 0.2, walls 0.5, ceiling 0.7).
+    #[serde(default)]
+    pub reflectances: SceneReflectances,
+    /// Inter-reflections on (default true; false: the direct light only).
+    #[serde(default = "yes")]
+    pub indirect: bool,
     /// The false-colour overlay.
     #[serde(default)]
     pub false_color: bool,
     /// Top of the false-colour scale, lux.
     #[serde(default = "thousand")]
     pub false_color_max: f64,
+}
+
+/// The surfaces' diffuse reflectances, each in [0, 1).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneReflectances {
+    /// The floor.
+    pub floor: f64,
+    /// The four walls.
+    pub walls: f64,
+    /// The ceiling.
+    pub ceiling: f64,
+}
+
+impl Default for SceneReflectances {
+    fn default() -> Self {
+        lut_core::Reflectances::default().into()
+    }
+}
+
+impl From<lut_core::Reflectances> for SceneReflectances {
+    fn from(r: lut_core::Reflectances) -> Self {
+        SceneReflectances {
+            floor: r.floor,
+            walls: r.walls,
+            ceiling: r.ceiling,
+        }
+    }
+}
+
+impl From<SceneReflectances> for lut_core::Reflectances {
+    fn from(r: SceneReflectances) -> Self {
+        lut_core::Reflectances {
+            floor: r.floor,
+            walls: r.walls,
+            ceiling: r.ceiling,
+        }
+    }
 }
 
 fn linear() -> String {
@@ -177,7 +221,8 @@ pub fn is_scene(text: &str) -> bool {
 /// Whether the file at `path` is a scene file (reads at most its first 64 KiB).
 pub fn is_scene_file(path: &Path) -> bool {
     use std::io::Read;
-    let Ok(f) = std::fs::File::open(path) else {
+    // Regular files only: a FIFO must not block the drop handler or the command line.
+    let Ok(f) = lut_core::open_regular(path) else {
         return false;
     };
     let mut head = Vec::new();
@@ -271,6 +316,8 @@ impl SceneFile {
             exposure_lux: state.exposure_lux,
             auto_exposure: state.auto_exposure,
             ambient: state.ambient,
+            reflectances: state.reflectances.into(),
+            indirect: state.indirect,
             false_color: state.false_color,
             false_color_max: state.false_color_max,
         }
@@ -283,10 +330,33 @@ impl SceneFile {
     /// format or version this viewer does not read, a view's hfov no projection takes,
     /// a view's pitch beyond ±90° or a yaw that is not finite.
     pub fn load(path: &Path) -> Result<SceneFile> {
-        let text = std::fs::read_to_string(path)
+        // The one reader for small input files: regular files only (a FIFO never
+        // blocks), at most MAX_SCENE_FILE_BYTES.
+        let bytes = lut_core::read_regular(path, lut_core::limits::MAX_SCENE_FILE_BYTES)
             .with_context(|| format!("{}: cannot read", path.display()))?;
-        let scene: SceneFile = serde_json::from_str(&text)
-            .with_context(|| format!("{}: not a valid scene file", path.display()))?;
+        SceneFile::parse(&bytes, path)
+    }
+
+    /// Parse and check a scene file's bytes; `path` names it in errors (as
+    /// [`SceneFile::load`], which reads the file first).
+    ///
+    /// # Errors
+    /// As [`SceneFile::load`], but for reading the file.
+    pub fn parse(bytes: &[u8], path: &Path) -> Result<SceneFile> {
+        let text = std::str::from_utf8(bytes).map_err(|e| {
+            anyhow::anyhow!(
+                "{}: not a valid scene file: not UTF-8 text ({e})",
+                path.display()
+            )
+        })?;
+        // Behind the one containment, as every decoder.
+        let scene: SceneFile = lut_core::contain(path, || {
+            serde_json::from_str::<SceneFile>(text)
+                .with_context(|| format!("{}: not a valid scene file", path.display()))
+        })?;
+        scene
+            .check_limits()
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         if scene.format != FORMAT {
             bail!(
                 "{}: \"format\" is '{}', expected '{FORMAT}'",
@@ -331,6 +401,45 @@ impl SceneFile {
             );
         }
         Ok(scene)
+    }
+
+    /// The limits module's checks on the numbers of a scene that size work: the room's
+    /// sides, the number of luminaires (before any of their files is read), the
+    /// multipliers.
+    ///
+    /// # Errors
+    /// The first number over its limit, named with the limit.
+    pub fn check_limits(&self) -> std::result::Result<(), lut_core::LimitError> {
+        use lut_core::{check_limit, limits};
+        let r = &self.room;
+        for (name, v) in [
+            ("\"room\": \"width\"", r.width),
+            ("\"room\": \"depth\"", r.depth),
+            ("\"room\": \"height\"", r.height),
+        ] {
+            check_limit(name, v.abs(), limits::MAX_ROOM_SIDE, " m")?;
+        }
+        check_limit(
+            "\"lights\": luminaires",
+            self.lights.len(),
+            limits::MAX_LIGHTS,
+            "",
+        )?;
+        check_limit(
+            "\"light_multiplier\"",
+            self.light_multiplier.abs(),
+            limits::MAX_LIGHT_MULTIPLIER,
+            "",
+        )?;
+        for (i, l) in self.lights.iter().enumerate() {
+            check_limit(
+                &format!("light {}: \"multiplier\"", i + 1),
+                l.multiplier.abs(),
+                limits::MAX_LIGHT_MULTIPLIER,
+                "",
+            )?;
+        }
+        Ok(())
     }
 
     /// Write the scene as pretty JSON, atomically (a temporary file renamed over the
@@ -388,6 +497,8 @@ impl SceneFile {
             exposure_lux: self.exposure_lux,
             auto_exposure: self.auto_exposure,
             ambient: self.ambient,
+            reflectances: self.reflectances.into(),
+            indirect: self.indirect,
             false_color: self.false_color,
             false_color_max: self.false_color_max,
             ..LightsState::default()

@@ -2,7 +2,9 @@
 //! `viewer render --light ...` builds from its options, turned into the `lut_core::light`
 //! scene and shading options. Pure data (no window), so the conversions are unit-tested.
 
-use lut_core::{Interpolation, LightScene, LightTable, Luminaire, Room, ShadeOptions};
+use lut_core::{
+    Interpolation, LightScene, LightTable, Luminaire, Reflectances, Room, ShadeOptions,
+};
 use lut_core::{Photometry, TableOptions};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -72,6 +74,10 @@ pub struct LightsState {
     pub auto_exposure: bool,
     /// Light factor with no luminaire.
     pub ambient: f64,
+    /// The surfaces' diffuse reflectances (floor, walls, ceiling).
+    pub reflectances: Reflectances,
+    /// Inter-reflections on (off: the direct light only, `--direct-only`).
+    pub indirect: bool,
     /// Overlay the false-colour illuminance map.
     pub false_color: bool,
     /// Top of the false-colour scale in lux.
@@ -106,6 +112,8 @@ impl Default for LightsState {
             exposure_lux: DEFAULT_EXPOSURE_LUX,
             auto_exposure: false,
             ambient: d.ambient,
+            reflectances: Reflectances::default(),
+            indirect: true,
             false_color: false,
             false_color_max: d.false_color_max_lux,
             error: None,
@@ -127,6 +135,7 @@ pub struct LightsKey {
     room_yaw: f64,
     room_center: (f64, f64),
     multiplier: f64,
+    reflectances: Option<[f64; 3]>,
     shade: Option<ShadeOptions>,
 }
 
@@ -236,7 +245,8 @@ impl LightsState {
             );
         }
         self.room_box().map_err(anyhow::Error::msg)?;
-        self.scene().map_err(anyhow::Error::msg)?;
+        self.reflectances.check()?;
+        self.direct_scene().map_err(anyhow::Error::msg)?;
         Ok(())
     }
 
@@ -273,6 +283,24 @@ impl LightsState {
     /// # Errors
     /// A bad room or camera height, a light outside the room, a non-finite value.
     pub fn scene(&self) -> Result<Option<LightScene>, String> {
+        let Some(scene) = self.direct_scene()? else {
+            return Ok(None);
+        };
+        if !self.indirect {
+            return Ok(Some(scene));
+        }
+        scene
+            .with_reflectances(self.reflectances)
+            .map(Some)
+            .map_err(|e| e.to_string())
+    }
+
+    /// The scene with the direct light only (no inter-reflections solved): what a check
+    /// of the room and luminaires needs, `None` with no luminaire.
+    ///
+    /// # Errors
+    /// As [`LightsState::scene`].
+    pub fn direct_scene(&self) -> Result<Option<LightScene>, String> {
         if self.lights.is_empty() {
             return Ok(None);
         }
@@ -297,6 +325,16 @@ impl LightsState {
         LightScene::new(room, lights)
             .map(Some)
             .map_err(|e| e.to_string())
+    }
+
+    /// The reflectances the light is computed with: [`LightsState::reflectances`], or
+    /// all zero when inter-reflections are off.
+    pub fn effective_reflectances(&self) -> Reflectances {
+        if self.indirect {
+            self.reflectances
+        } else {
+            Reflectances::ZERO
+        }
     }
 
     /// Set the exposure from the illuminance map of these lights (when
@@ -359,6 +397,11 @@ impl LightsState {
             room_yaw: self.room_yaw,
             room_center: self.room_center,
             multiplier: self.multiplier,
+            reflectances: self.indirect.then_some([
+                self.reflectances.floor,
+                self.reflectances.walls,
+                self.reflectances.ceiling,
+            ]),
             shade: (!self.lights.is_empty()).then(|| self.shade_options()),
         }
     }

@@ -1,7 +1,8 @@
 //! The panel's "Lights" section: scene files, the room fitted to the photograph (size,
 //! camera height, turn, centre; "Show room" draws it over the view), the luminaires
 //! (selected in the list or by a click on their marker; position, aim, multiplier, on/off,
-//! remove), the exposure (automatic or set), interpolation and false colours.
+//! remove), the exposure (automatic or set), the surfaces' reflectances (inter-reflections),
+//! interpolation and false colours.
 
 use super::ui::{named_combo, PanelModel, PanelOutput};
 use crate::lighting::format_lux;
@@ -75,7 +76,7 @@ fn room_fields(ui: &mut egui::Ui, l: &mut crate::lighting::LightsState) {
             ui.add(
                 egui::DragValue::new(v)
                     .speed(0.01)
-                    .range(0.5..=100.0)
+                    .range(0.5..=lut_core::limits::MAX_ROOM_SIDE)
                     .max_decimals(2),
             )
             .on_hover_text("Width (X) × depth (Z) × height (Y), metres");
@@ -203,6 +204,22 @@ fn shading_fields(ui: &mut egui::Ui, l: &mut crate::lighting::LightsState) {
         ui.label("Ambient");
         ui.add(egui::Slider::new(&mut l.ambient, 0.0..=1.0));
         ui.end_row();
+        ui.label("Reflected");
+        ui.checkbox(&mut l.indirect, "inter-reflections")
+            .on_hover_text("Add the light the floor, walls and ceiling reflect (radiosity)");
+        ui.end_row();
+        if l.indirect {
+            for (name, v) in [
+                ("Floor ρ", &mut l.reflectances.floor),
+                ("Walls ρ", &mut l.reflectances.walls),
+                ("Ceiling ρ", &mut l.reflectances.ceiling),
+            ] {
+                ui.label(name);
+                ui.add(egui::Slider::new(v, 0.0..=0.95))
+                    .on_hover_text("Diffuse reflectance of the surface, 0 (black) to 0.95");
+                ui.end_row();
+            }
+        }
         ui.label("Interpolation");
         let mut interp = l.interpolation;
         named_combo(ui, "light_interp", &mut interp);
