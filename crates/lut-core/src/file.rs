@@ -77,6 +77,28 @@ pub fn open_regular(path: &Path) -> io::Result<File> {
     }
 }
 
+/// Read the whole of `path`, a regular file (opened as by [`open_regular`]: never
+/// blocks on a FIFO), refusing one larger than `max_bytes` before reading it all. The
+/// one reader for every small input file: scene files, settings, tours, tile configs.
+///
+/// # Errors
+/// As [`open_regular`], the read's own error, or [`io::ErrorKind::InvalidData`] for a
+/// file over `max_bytes` ("larger than N bytes, the limit for ...").
+pub fn read_regular(path: &Path, max_bytes: u64) -> io::Result<Vec<u8>> {
+    use std::io::Read;
+    let f = open_regular(path)?;
+    let mut bytes = Vec::new();
+    f.take(max_bytes.saturating_add(1))
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("the file size exceeds the limit of {max_bytes} bytes for this kind of file"),
+        ));
+    }
+    Ok(bytes)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -92,6 +114,11 @@ mod tests {
         assert!(e.to_string().contains("a folder"), "{e}");
         let missing = open_regular(&dir.path().join("missing")).unwrap_err();
         assert_eq!(missing.kind(), io::ErrorKind::NotFound);
+        assert_eq!(read_regular(&p, 1).unwrap(), b"x");
+        std::fs::write(&p, "xyz").unwrap();
+        let e = read_regular(&p, 2).unwrap_err();
+        assert!(e.to_string().contains("limit of 2 bytes"), "{e}");
+        assert!(read_regular(dir.path(), 10).is_err());
     }
 
     #[cfg(unix)]
@@ -107,6 +134,10 @@ mod tests {
         // No writer: a blocking open would never return.
         let e = open_regular(&fifo).unwrap_err();
         assert!(e.to_string().contains("FIFO"), "{e}");
+        assert!(read_regular(&fifo, 10)
+            .unwrap_err()
+            .to_string()
+            .contains("FIFO"));
         let e = open_regular(Path::new("/dev/null")).unwrap_err();
         assert!(e.to_string().contains("character device"), "{e}");
         // Through a symbolic link too.

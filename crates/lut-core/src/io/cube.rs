@@ -294,18 +294,17 @@ pub fn load_face_files(
             check_face_size(&path.display().to_string(), w)
         }
     };
-    let decoded: Vec<Result<Decoded, CubeError>> = slots
+    // Every slot is filled (a missing face was reported above): the six paths in face
+    // order.
+    let paths: Vec<&PathBuf> = slots.iter().flatten().map(|(p, _)| *p).collect();
+    let decoded: Vec<Result<Decoded, CubeError>> = paths
         .par_iter()
-        .map(|s| {
-            let (p, _) = s.expect("all six checked above");
-            read_image(p, check_square(p))
-        })
+        .map(|p| read_image(p, check_square(p)))
         .collect();
     let mut faces: [Vec<u32>; 6] = Default::default();
     let mut first: Option<(&PathBuf, u32)> = None;
-    for (k, r) in decoded.into_iter().enumerate() {
+    for (k, (r, path)) in decoded.into_iter().zip(paths.iter().copied()).enumerate() {
         let (w, _, px) = r?;
-        let path = slots[k].map(|(p, _)| p).expect("present");
         match first {
             None => first = Some((path, w)),
             Some((fp, fs)) if fs != w => {

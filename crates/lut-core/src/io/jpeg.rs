@@ -52,7 +52,7 @@ pub(crate) fn check_jpeg_size(
         return Err(MapError::Decode {
             path: what.into(),
             reason: format!(
-                "the JPEG header claims {width}x{height} pixels, but its {len} bytes can hold \
+                "the JPEG header claims {width}x{height} pixels, but its {len} bytes of image data can hold \
                  at most about {} pixels (every 8x8 block costs at least one bit): the file \
                  is truncated or corrupt",
                 jpeg_max_pixels(len)
@@ -65,51 +65,108 @@ pub(crate) fn check_jpeg_size(
 /// The offset of the end-of-image marker that closes the JPEG stream in `bytes`, found
 /// by walking its segments and scans (so data after the marker, such as the video of a
 /// "motion photo", does not matter), or `None` when the data ends first.
+#[cfg(test)]
 pub(crate) fn end_of_image(bytes: &[u8]) -> Option<usize> {
-    if !bytes.starts_with(&[0xFF, 0xD8]) {
-        return None;
-    }
-    let mut i = 2;
-    loop {
-        // Find the next marker: 0xFF (fill bytes allowed) then a non-zero code.
-        while *bytes.get(i)? != 0xFF {
-            i += 1; // stray bytes between segments (lenient, as the decoder)
+    walk(bytes).0
+}
+
+/// The bytes of entropy-coded image data in `bytes` (every scan's, up to the end marker
+/// or the end of the data): what [`check_jpeg_size`] measures, so padding in metadata
+/// segments or after the image does not count.
+#[cfg(test)]
+pub(crate) fn scan_bytes(bytes: &[u8]) -> u64 {
+    walk(bytes).1
+}
+
+/// Walk the segments and scans: the end marker's offset (if reached) and the bytes of
+/// entropy-coded data seen.
+fn walk(bytes: &[u8]) -> (Option<usize>, u64) {
+    let mut scan = 0u64;
+    let eoi = (|| {
+        if !bytes.starts_with(&[0xFF, 0xD8]) {
+            return None;
         }
-        while *bytes.get(i + 1)? == 0xFF {
-            i += 1;
-        }
-        let marker = *bytes.get(i + 1)?;
-        match marker {
-            0xD9 => return Some(i),
-            0x00 | 0x01 | 0xD0..=0xD7 => {
-                i += 2;
-                continue;
+        let mut i = 2;
+        loop {
+            // Find the next marker: 0xFF (fill bytes allowed) then a non-zero code.
+            while *bytes.get(i)? != 0xFF {
+                i += 1; // stray bytes between segments (lenient, as the decoder)
             }
-            _ => {}
-        }
-        let len = usize::from(u16::from_be_bytes([*bytes.get(i + 2)?, *bytes.get(i + 3)?]));
-        i += 2 + len;
-        if marker == 0xDA {
-            // Entropy-coded data: runs to the next marker that is not a stuffed 0xFF00
-            // or a restart marker.
-            loop {
-                if *bytes.get(i)? == 0xFF {
-                    match *bytes.get(i + 1)? {
-                        0x00 | 0xD0..=0xD7 => i += 2,
-                        0xFF => i += 1,
-                        _ => break,
-                    }
-                } else {
-                    i += 1;
+            while *bytes.get(i + 1)? == 0xFF {
+                i += 1;
+            }
+            let marker = *bytes.get(i + 1)?;
+            match marker {
+                0xD9 => return Some(i),
+                0x00 | 0x01 | 0xD0..=0xD7 => {
+                    i += 2;
+                    continue;
                 }
+                _ => {}
+            }
+            let len = usize::from(u16::from_be_bytes([*bytes.get(i + 2)?, *bytes.get(i + 3)?]));
+            i += 2 + len;
+            if marker == 0xDA {
+                // Entropy-coded data: runs to the next marker that is not a stuffed
+                // 0xFF00 or a restart marker.
+                let start = i;
+                let end = loop {
+                    let Some(&b) = bytes.get(i) else {
+                        break i.min(bytes.len());
+                    };
+                    if b == 0xFF {
+                        match bytes.get(i + 1) {
+                            Some(0x00 | 0xD0..=0xD7) => i += 2,
+                            Some(0xFF) => i += 1,
+                            Some(_) => break i,
+                            None => break bytes.len(),
+                        }
+                    } else {
+                        i += 1;
+                    }
+                };
+                scan += end.saturating_sub(start) as u64;
+                bytes.get(i)?;
             }
         }
-    }
+    })();
+    (eoi, scan)
+}
+
+/// Zero bytes put after the image data in place of the end marker ([`prepare`]): more
+/// than the decoder reads ahead (8 bytes), so a complete image never reads past them.
+const PAD: usize = 16;
+
+/// Make a whole JPEG file ready for [`Jpeg::new`], in place, and check what its data can
+/// hold: the stream must reach its end-of-image marker; the marker (and anything after
+/// it) is replaced by [`PAD`] zero bytes and the buffer ends there. zune-jpeg, on
+/// reaching a marker before the image's last row, feeds zero bits for the rest — even in
+/// strict mode — and "decodes" the missing rows as a repeated pattern; with no marker it
+/// reaches the end of the buffer instead, which strict mode refuses. So a header claiming
+/// more lines than the data holds is an error naming the file (at most [`PAD`] bytes of
+/// zero bits, a few blocks of the last row, can go unnoticed). Returns the bytes of
+/// entropy-coded data ([`scan_bytes`]).
+///
+/// # Errors
+/// [`MapError::Decode`] naming `what` when the stream ends before its end marker.
+pub(crate) fn prepare(bytes: &mut Vec<u8>, what: &str) -> Result<u64, MapError> {
+    let (eoi, scan) = walk(bytes);
+    let Some(eoi) = eoi else {
+        return Err(MapError::Decode {
+            path: what.into(),
+            reason: format!(
+                "the file ends before its end-of-image marker (truncated after {} bytes)",
+                bytes.len()
+            ),
+        });
+    };
+    bytes.truncate(eoi);
+    bytes.extend_from_slice(&[0; PAD]);
+    Ok(scan)
 }
 
 /// A JPEG whose headers have been read: its size and the 8-bit colour type it decodes to.
 pub(crate) struct Jpeg<'a> {
-    bytes: &'a [u8],
     decoder: zune_jpeg::JpegDecoder<ZCursor<&'a [u8]>>,
     /// Width in pixels.
     pub width: u32,
@@ -119,38 +176,12 @@ pub(crate) struct Jpeg<'a> {
     pub color: ColorType,
 }
 
-/// `f`, with a panic inside it returned as `Err` (its message) instead of unwinding
-/// further, and not printed. zune-jpeg 0.5.15's AVX2 IDCT unwraps an output slice that
-/// some damaged files make too short (found by the `map_jpeg` fuzz target;
-/// `tests/damaged.rs`, `a_jpeg_that_trips_the_decoder_is_refused`): a bug in the decoder
-/// must refuse the file, not end the process.
-///
-/// The message is kept off stderr by a panic hook installed once that stays quiet for
-/// panics on a thread inside this function and hands every other panic to the hook
-/// that was there before (so other threads' panics print as they did).
+/// `f`, with a panic inside it returned as `Err` (its message), not printed: the
+/// crate's one containment ([`crate::guard::catch_quiet`]). zune-jpeg 0.5.15's AVX2 IDCT
+/// unwraps an output slice that some damaged files make too short (found by the
+/// `map_jpeg` fuzz target; `tests/damaged.rs`, `a_jpeg_that_trips_the_decoder_is_refused`).
 fn without_panics<T>(f: impl FnOnce() -> T) -> Result<T, String> {
-    use std::cell::Cell;
-    thread_local! {
-        static QUIET: Cell<bool> = const { Cell::new(false) };
-    }
-    static HOOK: std::sync::Once = std::sync::Once::new();
-    HOOK.call_once(|| {
-        let before = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if !QUIET.with(Cell::get) {
-                before(info);
-            }
-        }));
-    });
-    let was = QUIET.with(|q| q.replace(true));
-    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
-    QUIET.with(|q| q.set(was));
-    r.map_err(|p| {
-        p.downcast_ref::<&str>()
-            .map(|s| (*s).to_string())
-            .or_else(|| p.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "an internal error".to_string())
-    })
+    crate::guard::catch_quiet(f)
 }
 
 fn reason(e: &DecodeErrors) -> String {
@@ -166,7 +197,7 @@ fn reason(e: &DecodeErrors) -> String {
 }
 
 impl<'a> Jpeg<'a> {
-    /// Read the headers of the JPEG in `bytes`.
+    /// Read the headers of the JPEG in `bytes` (a whole file made ready by [`prepare`]).
     ///
     /// # Errors
     /// [`MapError::Decode`] naming `what` for headers that do not parse.
@@ -203,7 +234,6 @@ impl<'a> Jpeg<'a> {
             .jpeg_set_out_colorspace(out);
         decoder.set_options(strict);
         Ok(Jpeg {
-            bytes,
             decoder,
             width: u32::try_from(w).unwrap_or(u32::MAX),
             height: u32::try_from(h).unwrap_or(u32::MAX),
@@ -228,17 +258,8 @@ impl<'a> Jpeg<'a> {
                 path: what.into(),
                 reason: reason(&e),
             })?;
-        // The decoder does not notice data missing from the last row of blocks, nor a
-        // missing end: the stream must be complete.
-        if end_of_image(self.bytes).is_none() {
-            return Err(MapError::Decode {
-                path: what.into(),
-                reason: format!(
-                    "the file ends before its end-of-image marker (truncated after {} bytes)",
-                    self.bytes.len()
-                ),
-            });
-        }
+        // Data missing from the last rows reaches the end of the buffer (`prepare`), which
+        // strict mode refuses above.
         Ok(())
     }
 }
@@ -259,7 +280,9 @@ mod tests {
     }
 
     fn decode(bytes: &[u8]) -> Result<Vec<u8>, MapError> {
-        let j = Jpeg::new(bytes, "t.jpg")?;
+        let mut bytes = bytes.to_vec();
+        prepare(&mut bytes, "t.jpg")?;
+        let j = Jpeg::new(&bytes, "t.jpg")?;
         let mut out = vec![0u8; j.width as usize * j.height as usize * 3];
         j.decode_into(&mut out, "t.jpg")?;
         Ok(out)
@@ -296,6 +319,46 @@ mod tests {
                 "{cut}: {msg}"
             );
         }
+    }
+
+    /// `bytes` with the frame header's height set to `h`.
+    fn claim_height(bytes: &[u8], h: u16) -> Vec<u8> {
+        let mut v = bytes.to_vec();
+        let sof = v.windows(2).position(|w| w == [0xFF, 0xC0]).expect("SOF0");
+        v[sof + 5..sof + 7].copy_from_slice(&h.to_be_bytes());
+        v
+    }
+
+    #[test]
+    fn a_header_claiming_more_lines_than_the_data_is_refused() {
+        let bytes = jpeg(64, 32);
+        assert!(decode(&claim_height(&bytes, 32)).is_ok());
+        for h in [40, 48, 64, 640] {
+            let e = decode(&claim_height(&bytes, h)).expect_err("filled in");
+            let msg = e.to_string();
+            assert!(
+                msg.contains("t.jpg") && msg.contains("truncated"),
+                "{h}: {msg}"
+            );
+        }
+        // Fewer lines than the data: the image is what the header says (as libjpeg).
+        assert!(decode(&claim_height(&bytes, 16)).is_ok());
+    }
+
+    #[test]
+    fn only_image_data_counts_toward_the_size_bound() {
+        let bytes = jpeg(64, 32);
+        let scan = scan_bytes(&bytes);
+        assert!(scan > 100 && scan < bytes.len() as u64 - 100, "{scan}");
+        // Padding in comment segments or after the end marker is not image data.
+        let mut padded = bytes[..2].to_vec();
+        for _ in 0..20 {
+            padded.extend_from_slice(&[0xFF, 0xFE, 0xFF, 0xFF]);
+            padded.extend(std::iter::repeat_n(b'x', 0xFFFD));
+        }
+        padded.extend_from_slice(&bytes[2..]);
+        padded.extend(std::iter::repeat_n(0u8, 1 << 20));
+        assert_eq!(scan_bytes(&padded), scan);
     }
 
     #[test]

@@ -48,7 +48,7 @@ use crate::error::{MapError, SizeProblem};
 use crate::geom::limits::{MAX_MAP_PIXELS, MAX_MAP_WIDTH};
 use crate::geom::projection::Projection;
 use crate::io::exr::Exr;
-use crate::io::jpeg::{check_jpeg_size, Jpeg};
+use crate::io::jpeg::{check_jpeg_size, prepare, Jpeg};
 use crate::map::envmap::{check_map_size, EnvMap};
 use crate::map::tone::{tone_map, Tone};
 use image::{ColorType, DynamicImage, ImageDecoder, Limits};
@@ -287,13 +287,44 @@ fn image_limits(max_pixels: u64) -> Limits {
     l
 }
 
+/// A decoder that panicked: the file's [`MapError::Decode`].
+impl From<crate::guard::DecoderPanic> for MapError {
+    fn from(p: crate::guard::DecoderPanic) -> MapError {
+        MapError::Decode {
+            path: p.path,
+            reason: format!(
+                "the file is damaged or of a kind the decoder cannot handle (the decoder failed \
+                 on it: {})",
+                p.message
+            ),
+        }
+    }
+}
+
+/// Decode an image from `src` behind the crate's one containment
+/// ([`crate::guard::contain`]): a panic in any decoder (PNG, JPEG, HDR, EXR, TIFF, and
+/// whatever `image` reads) is the file's error, never the end of the process or the
+/// loading thread.
 pub(crate) fn decode_reader<R: BufRead + Seek>(
+    src: R,
+    len: u64,
+    what: &str,
+    opts: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+) -> Result<EnvMap, MapError> {
+    crate::guard::contain(Path::new(what), || {
+        decode_contained(src, len, what, opts, progress)
+    })
+}
+
+fn decode_contained<R: BufRead + Seek>(
     mut src: R,
     len: u64,
     what: &str,
     opts: &LoadOptions,
     progress: &mut dyn FnMut(LoadProgress),
 ) -> Result<EnvMap, MapError> {
+    crate::guard::fault_point("decoder");
     let err = |reason: String| MapError::Decode {
         path: what.into(),
         reason,
@@ -380,10 +411,13 @@ fn decode_jpeg<R: BufRead + Seek>(
     .read_to_end(&mut bytes)
     .map_err(|e| err(e.to_string()))?;
     sink.bytes_phase.set(None);
+    // The stream must be whole; its image data (not the file's metadata or padding)
+    // bounds the size the header may claim (io/jpeg.rs).
+    let scan = prepare(&mut bytes, what)?;
     let jpeg = Jpeg::new(&bytes, what)?;
     let (w, h) = (jpeg.width, jpeg.height);
+    check_jpeg_size(what, w.into(), h.into(), scan)?;
     let projection = check_decoded(what, w, h, opts)?;
-    check_jpeg_size(what, w.into(), h.into(), bytes.len() as u64)?;
     sink.report(LoadPhase::Reading, Some(1.0));
     sink.report(LoadPhase::Decoding, None);
     let ct = jpeg.color;

@@ -110,6 +110,19 @@ fn place_partial(
         let mut m = decode(opts)?;
         m.set_pose_heading_deg(heading);
         m.set_start_view(start);
+        // A camera held tilted (GPano PosePitchDegrees/PoseRollDegrees): the map is
+        // re-levelled once here (map/level.rs), so it opens level.
+        let pose = meta.as_ref().map(|g| {
+            (
+                g.pose_pitch_degrees.unwrap_or(0.0),
+                g.pose_roll_degrees.unwrap_or(0.0),
+            )
+        });
+        if let Some((p, r)) = pose.filter(|&(p, r)| p != 0.0 || r != 0.0) {
+            if let Some(level) = crate::map::level::level_horizon(&m, p, r) {
+                m = level;
+            }
+        }
         return Ok((m, CoverageSource::Full));
     }
     // Decoded as "elliptical" only so that any aspect ratio is accepted and the padding
