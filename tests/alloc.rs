@@ -1,7 +1,7 @@
 //! The LUT renderer allocates nothing per frame after the first (single-threaded; with
 //! threads the only allocations are rayon's own job bookkeeping).
 
-use lut_core::{Frame, Scene};
+use lut_core::Frame;
 use lut_core::{Projection, RenderOptions, Renderer, View};
 use test_support::alloc::Counting;
 
@@ -21,7 +21,7 @@ fn no_allocation_per_frame_after_the_first() {
     // First frames build the tables (both kinds) and size the scratch.
     for hfov in [90.0, 40.0] {
         r.render(
-            Scene::Map(&map),
+            &map,
             View::new(0.0, 0.0, hfov).unwrap(),
             &opts,
             &mut Frame::new(&mut out, w, h).unwrap(),
@@ -37,7 +37,7 @@ fn no_allocation_per_frame_after_the_first() {
         (1e6, 45.0, 59.0),
     ] {
         r.render(
-            Scene::Map(&map),
+            &map,
             View::new(yaw, pitch, hfov).unwrap(),
             &opts,
             &mut Frame::new(&mut out, w, h).unwrap(),

@@ -9,7 +9,7 @@ use glam::DVec3;
 use lut_core::LoadOptions;
 use lut_core::{render_exact, Camera, EnvMap, Projection, Sampler, View};
 use lut_core::{CubeError, CubeMap, CubeRenderer, Face, Layout, Naming, Transform};
-use lut_core::{Frame, RenderOptions, Renderer, Scene};
+use lut_core::{Frame, Panorama, RenderOptions};
 use std::path::{Path, PathBuf};
 use test_support::pixels::{max_channel_diff, psnr, to_rgb};
 
@@ -89,9 +89,9 @@ fn render(
     threads: bool,
 ) -> Vec<u32> {
     let mut out = vec![0u32; (w * h) as usize];
-    Renderer::default()
+    // Through the one render entry (a panorama of a copy of the faces).
+    Panorama::cube(cube.clone())
         .render(
-            Scene::Cube(cube),
             view,
             &RenderOptions {
                 sampler: s,

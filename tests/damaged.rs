@@ -410,3 +410,73 @@ fn cube_face_files_are_listed_as_the_loader_reads_them() {
     );
     assert!(lut_core::load_cube(&[dir.path().to_path_buf()], None, None).is_ok());
 }
+
+/// A small real JPEG whose frame header claims `w × h`, with `pad` bytes of comment
+/// segments before the frame header (padding that is not image data).
+fn jpeg_claiming(w: u16, h: u16, pad: usize) -> Vec<u8> {
+    let img =
+        image::RgbImage::from_fn(64, 32, |x, y| image::Rgb([(x * 7) as u8, (y * 5) as u8, 9]));
+    let mut real = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut real, 90)
+        .encode(img.as_raw(), 64, 32, image::ExtendedColorType::Rgb8)
+        .unwrap();
+    let sof = real.windows(2).position(|w| w == [0xFF, 0xC0]).unwrap();
+    real[sof + 5..sof + 7].copy_from_slice(&h.to_be_bytes());
+    real[sof + 7..sof + 9].copy_from_slice(&w.to_be_bytes());
+    let mut out = real[..2].to_vec();
+    let mut left = pad;
+    while left > 0 {
+        let n = left.min(0xFFFD);
+        out.extend_from_slice(&[0xFF, 0xFE]);
+        out.extend_from_slice(&u16::try_from(n + 2).unwrap().to_be_bytes());
+        out.extend(std::iter::repeat_n(b'x', n));
+        left -= n;
+    }
+    out.extend_from_slice(&real[2..]);
+    out
+}
+
+#[test]
+fn a_padded_jpeg_claiming_a_huge_size_commits_memory_for_its_data_only() {
+    let _g = GLOBAL.exclusive();
+    // 1.2 MB of comments: the file is large enough for 32768 x 16384 by the file-size
+    // bound, but its image data is a few kilobytes.
+    let bytes = jpeg_claiming(32768, 16384, 1_200_000);
+    assert!(bytes.len() > 1_200_000);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("padded-32k.jpg");
+    std::fs::write(&path, &bytes).unwrap();
+    let (r, peak) = GLOBAL.peak_during(|| load(&path));
+    let msg = r.unwrap_err().to_string();
+    assert!(
+        msg.contains("padded-32k.jpg") && msg.contains("32768x16384") && msg.contains("image data"),
+        "{msg}"
+    );
+    // The file itself is read (1.2 MB); nothing of the claimed size (2 GiB) is.
+    assert!(
+        peak < 8 << 20,
+        "{peak} bytes allocated for a refused padded file"
+    );
+}
+
+#[test]
+fn a_jpeg_claiming_more_lines_than_its_data_is_refused() {
+    // The data holds 32 lines; the header claims more: refused, never filled in with a
+    // repeated pattern. (The same image with its own height loads.)
+    let any_shape = |bytes: &[u8], name: &str| {
+        let opts = LoadOptions {
+            projection: Some(Projection::Elliptical),
+            ..LoadOptions::default()
+        };
+        lut_core::decode_map(bytes, name, &opts, &mut |_| {})
+    };
+    assert!(any_shape(&jpeg_claiming(64, 32, 0), "ok.jpg").is_ok());
+    for h in [40, 64, 256, 4096] {
+        let e = any_shape(&jpeg_claiming(64, h, 0), "short.jpg").expect_err("filled in");
+        let msg = e.to_string();
+        assert!(
+            msg.contains("short.jpg") && msg.contains("truncated"),
+            "{h}: {msg}"
+        );
+    }
+}

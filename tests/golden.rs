@@ -16,8 +16,7 @@
 //! hfov 1).
 
 use lut_core::{
-    grid_map, CubeMap, CubeRenderer, EnvMap, Projection, RenderOptions, Renderer, Sampler, Scene,
-    View,
+    grid_map, CubeMap, CubeRenderer, EnvMap, Projection, RenderOptions, Renderer, Sampler, View,
 };
 use test_support::golden::compare_to_truth;
 use test_support::pixels::{diff, linear_to_srgb, psnr, srgb_to_linear};
@@ -32,7 +31,7 @@ fn lut_and_exact(
     w: u32,
     h: u32,
 ) -> (Vec<u32>, Vec<u32>) {
-    let (lut, _) = render_frame(r, Scene::Map(map), view, opts, w, h);
+    let (lut, _) = render_frame(r, map, view, opts, w, h);
     (lut, exact_frame(map, view, opts.sampler, w, h))
 }
 
@@ -230,7 +229,7 @@ fn golden_partial() {
 fn golden_cube() {
     let map = grid_map(1024, 512, Projection::Equirect).unwrap();
     let cube = CubeMap::from_envmap(&map, 512, Sampler::Bilinear).unwrap();
-    let mut r = Renderer::default();
+    let mut cube = lut_core::Panorama::cube(cube);
     for (case, yaw, pitch, hfov, w, h) in [
         ("corner", 45.0, 35.0, 100.0, 96, 64),
         ("down", 10.0, -80.0, 90.0, 96, 64),
@@ -243,7 +242,7 @@ fn golden_cube() {
                 cube: kind,
                 ..RenderOptions::default()
             };
-            let (out, rep) = render_frame(&mut r, Scene::Cube(&cube), view, &opts, w, h);
+            let (out, rep) = test_support::render::pano_frame(&mut cube, view, &opts, w, h);
             assert_eq!(rep.path, lut_core::RenderPath::Cube(kind));
             imgs.push(out);
         }
@@ -289,14 +288,7 @@ fn golden_lit() {
     let mut r = Renderer::new(&map);
     let (w, h) = (96u32, 64u32);
     let view = View::new(30.0, -35.0, 110.0).unwrap();
-    let (mut img, _) = render_frame(
-        &mut r,
-        Scene::Map(&map),
-        view,
-        &RenderOptions::default(),
-        w,
-        h,
-    );
+    let (mut img, _) = render_frame(&mut r, &map, view, &RenderOptions::default(), w, h);
     let albedo = img.clone();
     let (rw, rd, rh, cam_h) = (6.0, 8.0, 3.0, 1.5);
     let room = lut_core::Room::new(rw, rd, rh, cam_h).unwrap();
@@ -390,7 +382,7 @@ fn scaled_maps_show_no_dark_seam() {
                         sampler,
                         ..RenderOptions::default()
                     };
-                    let (img, _) = render_frame(&mut r, Scene::Map(&map), view, &opts, 240, 135);
+                    let (img, _) = render_frame(&mut r, &map, view, &opts, 240, 135);
                     let darkest = img
                         .iter()
                         .enumerate()

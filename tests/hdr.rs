@@ -3,7 +3,6 @@
 
 use lut_core::tone_map;
 use lut_core::LoadOptions;
-use lut_core::Scene;
 use lut_core::{EnvMap, Projection, RenderOptions, Renderer, Tone, View};
 use std::path::PathBuf;
 use test_support::render::render_frame;
@@ -42,14 +41,7 @@ fn sample_exrs_load_clamped_and_toned() {
         // Renders without trouble.
         let mut r = Renderer::new(&map);
         let view = View::new(10.0, 5.0, 90.0).unwrap();
-        render_frame(
-            &mut r,
-            Scene::Map(&map),
-            view,
-            &RenderOptions::default(),
-            64,
-            32,
-        );
+        render_frame(&mut r, &map, view, &RenderOptions::default(), 64, 32);
     }
 }
 

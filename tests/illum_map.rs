@@ -443,8 +443,8 @@ fn frames_lit_as_they_are_drawn_equal_render_then_shade() {
     // rendering, then `IlluminanceMap::shade_frame`, for every renderer, sampler, view
     // projection, thread count and a height that is not a multiple of the band.
     use lut_core::{
-        grid_map, CubeMap, Frame, Projection, RenderOptions, Renderer, RendererKind, Sampler,
-        Scene, ViewProjection, HOOK_BAND_ROWS,
+        grid_map, CubeMap, Frame, Panorama, Projection, RenderOptions, RendererKind, Sampler,
+        ViewProjection, HOOK_BAND_ROWS,
     };
     use std::sync::Mutex;
     let scene = ring(&bench_table());
@@ -457,7 +457,7 @@ fn frames_lit_as_they_are_drawn_equal_render_then_shade() {
         View::new(-100.0, 35.0, 50.0).unwrap(),
         View::with_projection(30.0, -60.0, 200.0, ViewProjection::Fisheye).unwrap(),
     ];
-    let mut renderer = Renderer::new(&pano);
+    let (mut pano, mut cube) = (Panorama::map(pano), Panorama::cube(cube));
     for view in views {
         for (kind, sampler) in [
             (RendererKind::Lut, Sampler::Bilinear),
@@ -481,16 +481,12 @@ fn frames_lit_as_they_are_drawn_equal_render_then_shade() {
                     false_color,
                     ..ShadeOptions::default()
                 };
-                let what = if on_cube {
-                    Scene::Cube(&cube)
-                } else {
-                    Scene::Map(&pano)
-                };
+                let what = if on_cube { &mut cube } else { &mut pano };
                 let label = format!("{view:?} {kind:?} {sampler:?} {threads} {false_color}");
                 let cam = Camera::new(view, w, h);
                 let mut want = vec![0u32; (w * h) as usize];
                 let mut f = Frame::new(&mut want, w, h).unwrap();
-                renderer.render(what, view, &opts, &mut f).unwrap();
+                what.render(view, &opts, &mut f).unwrap();
                 map.shade_frame(&cam, &mut want, w, h, &shade).unwrap();
                 let shader = map.frame_shader(&cam, &shade).unwrap();
                 let bands = Mutex::new(Vec::new());
@@ -500,9 +496,7 @@ fn frames_lit_as_they_are_drawn_equal_render_then_shade() {
                 };
                 let mut got = vec![0u32; (w * h) as usize];
                 let mut f = Frame::new(&mut got, w, h).unwrap();
-                renderer
-                    .render_with(what, view, &opts, &mut f, &hook)
-                    .unwrap();
+                what.render_with(view, &opts, &mut f, &hook).unwrap();
                 assert!(want == got, "{label}: the pixels differ");
                 // Every row in exactly one band; bands aligned, whole multiples of the
                 // alignment but the last.
@@ -563,4 +557,46 @@ fn a_band_lights_only_its_rows() {
     // Beyond the frame: nothing to do.
     shader.shade_band(70, &mut off[..wu]);
     assert_eq!(off[..wu], base[..wu]);
+}
+
+/// Issue 32, class 1: the limits module bounds the room and the luminaire count, and the
+/// map's nodes stay within `MAX_ILLUM_NODES` (and the work within `MAX_ILLUM_WORK`)
+/// however large the room: past the budget the nodes grow coarser, not more.
+#[test]
+fn room_size_and_luminaire_count_are_bounded() {
+    use lut_core::limits::{MAX_ILLUM_NODES, MAX_ILLUM_WORK, MAX_LIGHTS, MAX_ROOM_SIDE};
+    let e = Room::new(4170.0, 2990.0, 2700.0, 1.5).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "room width 4170 m exceeds the limit of 100 m"
+    );
+    assert!(Room::new(1e300, 5.0, 3.0, 1.5).is_err());
+    let office = load("ldt/office_louvre_2x28w.ldt");
+    // The largest room: one light, then many.
+    let room = Room::new(MAX_ROOM_SIDE, MAX_ROOM_SIDE, MAX_ROOM_SIDE, 1.5).unwrap();
+    let one = LightScene::new(room, vec![lum(&office, [0.0, 50.0, 0.0], 0.0, -90.0)]).unwrap();
+    let map = IlluminanceMap::build(&one, &MapOptions::default()).unwrap();
+    assert!(map.nodes() <= MAX_ILLUM_NODES, "{}", map.nodes());
+    assert!(
+        map.nodes() > MAX_ILLUM_NODES / 8,
+        "the budget is used: {}",
+        map.nodes()
+    );
+    // The map still agrees with the per-pixel illuminance where it is smooth (the
+    // floor right below the light, within 2 %).
+    let p = DVec3::new(0.0, 0.0, 0.0);
+    let exact = one.illuminance(p, DVec3::Y);
+    let got = map.illuminance_at(RoomFace::Floor, p);
+    assert!((got - exact).abs() <= 0.02 * exact, "{got} vs {exact}");
+    let lights: Vec<_> = (0..50)
+        .map(|i| lum(&office, [f64::from(i) - 25.0, 50.0, 0.0], 0.0, -90.0))
+        .collect();
+    let many = LightScene::new(room, lights).unwrap();
+    let map = IlluminanceMap::build(&many, &MapOptions::preview()).unwrap();
+    assert!(map.nodes() * 50 <= MAX_ILLUM_WORK, "{}", map.nodes());
+    // Too many luminaires: refused with the limit, before any work.
+    let too_many = vec![lum(&office, [0.0, 2.0, 0.0], 0.0, -90.0); MAX_LIGHTS + 1];
+    let e = LightScene::new(Room::new(5.0, 5.0, 3.0, 1.5).unwrap(), too_many).unwrap_err();
+    assert_eq!(e.to_string(), "luminaires 201 exceeds the limit of 200");
+    assert!(matches!(e, LightError::Limit(_)));
 }

@@ -16,9 +16,10 @@
 use glam::DVec3;
 use lut_core::{
     grid_map, lat_long_to_dir, lit_map_bytes, shade_frame, Camera, Coverage, CubeMap, EnvMap,
-    Frame, IlluminanceMap, LightError, LightScene, MapOptions, Projection, RenderOptions, Renderer,
-    Room, Sampler, Scene, ShadeOptions, View, ViewProjection, BAKE_MAX_BYTES,
+    Frame, IlluminanceMap, LightError, LightScene, MapOptions, Panorama, Projection, RenderOptions,
+    Room, Sampler, ShadeOptions, View, ViewProjection, BAKE_MAX_BYTES,
 };
+use std::sync::atomic::AtomicBool;
 use test_support::light_fixtures::{bench_table, lum, ring, views};
 use test_support::pixels::{linear_to_srgb, max_channel_diff, srgb_to_linear};
 
@@ -215,14 +216,14 @@ struct Case<'a> {
     label: &'a str,
     scene: &'a LightScene,
     shade: &'a ShadeOptions,
-    unlit: Scene<'a>,
-    lit: Scene<'a>,
+    unlit: &'a Panorama,
+    lit: &'a Panorama,
 }
 
 impl Case<'_> {
     /// [`frames_against_per_pixel`], then [`check`] with `(share, mean)`.
-    fn check(&self, renderer: &mut Renderer, sampler: Sampler, views: &[View], tol: (f64, f64)) {
-        let frames = frames_against_per_pixel(self, renderer, sampler, views);
+    fn check(&self, sampler: Sampler, views: &[View], tol: (f64, f64)) {
+        let frames = frames_against_per_pixel(self, sampler, views);
         check(self.label, sampler, &frames, tol.0, tol.1);
     }
 }
@@ -243,12 +244,7 @@ struct Frames {
 
 /// Frames of `lit` against frames of `unlit` lit per pixel (`shade_frame`) with `shade`,
 /// for the views and sampler given (320 × 200 pixels).
-fn frames_against_per_pixel(
-    case: &Case<'_>,
-    renderer: &mut Renderer,
-    sampler: Sampler,
-    views: &[View],
-) -> Vec<Frames> {
+fn frames_against_per_pixel(case: &Case<'_>, sampler: Sampler, views: &[View]) -> Vec<Frames> {
     let Case {
         scene,
         shade,
@@ -256,6 +252,8 @@ fn frames_against_per_pixel(
         lit,
         ..
     } = *case;
+    // Handles on the same pixels and tables, drawn here.
+    let (mut unlit, mut lit) = (unlit.share(), lit.share());
     let (w, h) = (320u32, 200u32);
     let ropts = RenderOptions {
         sampler,
@@ -266,18 +264,12 @@ fn frames_against_per_pixel(
         .map(|&view| {
             let cam = Camera::new(view, w, h);
             let mut want = vec![0u32; (w * h) as usize];
-            renderer
-                .render(
-                    unlit,
-                    view,
-                    &ropts,
-                    &mut Frame::new(&mut want, w, h).unwrap(),
-                )
+            unlit
+                .render(view, &ropts, &mut Frame::new(&mut want, w, h).unwrap())
                 .unwrap();
             shade_frame(scene, &cam, &mut want, w, h, shade).unwrap();
             let mut got = vec![0u32; (w * h) as usize];
-            renderer
-                .render(lit, view, &ropts, &mut Frame::new(&mut got, w, h).unwrap())
+            lit.render(view, &ropts, &mut Frame::new(&mut got, w, h).unwrap())
                 .unwrap();
             let diffs: Vec<u32> = want
                 .iter()
@@ -376,28 +368,29 @@ fn check(label: &str, sampler: Sampler, frames: &[Frames], share: f64, mean: f64
 
 #[test]
 fn frames_of_the_lit_map_match_frames_lit_per_pixel() {
-    let pano = grid_map(2048, 1024, Projection::Equirect).unwrap();
-    let mut renderer = Renderer::new(&pano);
+    let pano = Panorama::map(grid_map(2048, 1024, Projection::Equirect).unwrap());
+    let no = AtomicBool::new(false);
     for (label, scene) in [("ring", ring(&bench_table())), ("walls", walls())] {
         let map = IlluminanceMap::build(&scene, &MapOptions::default()).unwrap();
-        lut_core::build_frame_levels(&pano);
+        lut_core::build_frame_levels(pano.as_map().unwrap());
         let shade = auto(&map);
-        let baked = map.bake_map(&pano, &shade).unwrap();
+        let baked = map.bake_panorama(&pano, &shade, &no).unwrap();
         // Built with the copy, as the source's were: its pyramid and its levels' own.
-        assert!(baked.pyramid_bytes() > 0 && baked.pyramid()[0].pyramid_bytes() > 0);
+        let b = baked.as_map().unwrap();
+        assert!(b.pyramid_bytes() > 0 && b.pyramid()[0].pyramid_bytes() > 0);
         let case = Case {
             label,
             scene: &scene,
             shade: &shade,
-            unlit: Scene::Map(&pano),
-            lit: Scene::Map(&baked),
+            unlit: &pano,
+            lit: &baked,
         };
         for sampler in [Sampler::Bilinear, Sampler::Nearest, Sampler::Trilinear] {
             let tol = match sampler {
                 Sampler::Trilinear => (0.985, 0.6),
                 _ => (0.99, 0.5),
             };
-            case.check(&mut renderer, sampler, &views(), tol);
+            case.check(sampler, &views(), tol);
         }
         // Curved view projections: a frame of the lit copy is an ordinary frame.
         let curved: Vec<View> = [
@@ -408,7 +401,7 @@ fn frames_of_the_lit_map_match_frames_lit_per_pixel() {
         .iter()
         .map(|&(y, p, f, proj)| View::with_projection(y, p, f, proj).unwrap())
         .collect();
-        case.check(&mut renderer, Sampler::Bilinear, &curved, (0.985, 0.6));
+        case.check(Sampler::Bilinear, &curved, (0.985, 0.6));
     }
 }
 
@@ -428,17 +421,17 @@ fn cube_and_partial_maps() {
     .unwrap();
     let map = IlluminanceMap::build(&scene, &MapOptions::default()).unwrap();
     let shade = auto(&map);
-    let lit_cube = map.bake_cube(&cube, &shade).unwrap();
-    let mut renderer = Renderer::default();
+    let lit_cube = Panorama::cube(map.bake_cube(&cube, &shade).unwrap());
+    let cube = Panorama::cube(cube);
     for sampler in [Sampler::Bilinear, Sampler::Nearest] {
         Case {
             label: "cube",
             scene: &scene,
             shade: &shade,
-            unlit: Scene::Cube(&cube),
-            lit: Scene::Cube(&lit_cube),
+            unlit: &cube,
+            lit: &lit_cube,
         }
-        .check(&mut renderer, sampler, &views(), (0.99, 0.5));
+        .check(sampler, &views(), (0.99, 0.5));
     }
     // A partial map: 200° × 100° of the walls room, across the ±180° seam.
     let scene = walls();
@@ -452,7 +445,7 @@ fn cube_and_partial_maps() {
     let shade = auto(&map);
     let lit_part = map.bake_map(&part, &shade).unwrap();
     assert_eq!(lit_part.crop(), part.crop());
-    let mut renderer = Renderer::new(&part);
+    let (part, lit_part) = (Panorama::map(part), Panorama::map(lit_part));
     let views: Vec<View> = [
         (150.0, -20.0, 90.0),
         (100.0, -50.0, 70.0),
@@ -465,10 +458,10 @@ fn cube_and_partial_maps() {
         label: "partial",
         scene: &scene,
         shade: &shade,
-        unlit: Scene::Map(&part),
-        lit: Scene::Map(&lit_part),
+        unlit: &part,
+        lit: &lit_part,
     }
-    .check(&mut renderer, Sampler::Bilinear, &views, (0.98, 0.7));
+    .check(Sampler::Bilinear, &views, (0.98, 0.7));
 }
 
 #[test]

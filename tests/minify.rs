@@ -3,11 +3,11 @@
 //! the exact render supersampled 8×8 per pixel (the truth for a box-filtered pixel), for
 //! the LUT renderer and the exact renderer alike, and must not hurt when magnifying.
 
+use lut_core::Frame;
 use lut_core::{
     render_exact, render_exact_supersampled, EnvMap, Projection, RenderOptions, Renderer,
     RendererKind, Sampler, View,
 };
-use lut_core::{Frame, Scene};
 use test_support::pixels::psnr;
 use test_support::render::render_frame;
 
@@ -33,7 +33,7 @@ fn lut(map: &EnvMap, view: View, sampler: Sampler, w: u32, h: u32) -> Vec<u32> {
         sampler,
         ..RenderOptions::default()
     };
-    render_frame(&mut Renderer::new(map), Scene::Map(map), view, &opts, w, h).0
+    render_frame(&mut Renderer::new(map), map, view, &opts, w, h).0
 }
 
 /// The exact render supersampled 8×8 per pixel (bilinear sub-samples, box filter).
@@ -120,7 +120,7 @@ fn bilinear_level_reads_the_matching_level() {
         let mut r = Renderer::new(map);
         r.set_bilinear_level(true);
         assert!(r.bilinear_level());
-        render_frame(&mut r, Scene::Map(map), view, &opts, w, h).0
+        render_frame(&mut r, map, view, &opts, w, h).0
     };
     // Magnified: level 0, identical bytes.
     let view = View::new(33.0, 12.0, 20.0).unwrap();
@@ -153,7 +153,7 @@ fn bilinear_level_reads_the_matching_level() {
     let mut r = Renderer::new(&map);
     for on in [true, false, true] {
         r.set_bilinear_level(on);
-        let f = render_frame(&mut r, Scene::Map(&map), view, &opts, w, h).0;
+        let f = render_frame(&mut r, &map, view, &opts, w, h).0;
         let want = if on {
             lut(level3, view, Sampler::Bilinear, w, h)
         } else {
@@ -173,7 +173,7 @@ fn bilinear_level_reads_the_matching_level() {
     let mut px = vec![0u32; (w * h) as usize];
     r.set_bilinear_level(true);
     r.render_with(
-        Scene::Map(&map),
+        &map,
         view,
         &opts,
         &mut Frame::new(&mut px, w, h).unwrap(),
@@ -189,7 +189,7 @@ fn bilinear_level_reads_the_matching_level() {
             ..RenderOptions::default()
         };
         r.set_bilinear_level(true);
-        let f = render_frame(&mut r, Scene::Map(&map), view, &o, w, h).0;
+        let f = render_frame(&mut r, &map, view, &o, w, h).0;
         assert!(f == lut(&map, view, s, w, h), "{s:?}");
     }
 }
@@ -211,7 +211,7 @@ fn still_level_reads_the_level_no_pixel_is_magnified_on() {
         let mut r = Renderer::new(&map);
         assert!(!r.still_level(), "off by default");
         r.set_still_level(true);
-        render_frame(&mut r, Scene::Map(&map), view, &opts(renderer), w, h).0
+        render_frame(&mut r, &map, view, &opts(renderer), w, h).0
     };
     // Magnified (hfov 20 over 160 columns: 0.2 map pixels per screen pixel): the map.
     let view = View::new(33.0, 12.0, 20.0).unwrap();
@@ -269,7 +269,7 @@ fn still_level_reads_the_level_no_pixel_is_magnified_on() {
         sampler: Sampler::Trilinear,
         ..RenderOptions::default()
     };
-    let got = render_frame(&mut r, Scene::Map(&map), view, &tri, w, h).0;
+    let got = render_frame(&mut r, &map, view, &tri, w, h).0;
     assert!(got == lut(level3, view, Sampler::Trilinear, w, h));
     let (l4, m4) = (&level3.pyramid()[0], &map.pyramid()[3]);
     assert_eq!((l4.width(), l4.height()), (m4.width(), m4.height()));
@@ -284,7 +284,7 @@ fn still_level_reads_the_level_no_pixel_is_magnified_on() {
         sampler: Sampler::Nearest,
         ..RenderOptions::default()
     };
-    let f = render_frame(&mut r, Scene::Map(&map), view, &o, w, h).0;
+    let f = render_frame(&mut r, &map, view, &o, w, h).0;
     assert!(f == lut(&map, view, Sampler::Nearest, w, h));
 }
 
@@ -344,7 +344,7 @@ fn trilinear_beyond_the_wide_table_takes_the_exact_level_of_detail() {
     let view = View::new(0.0, 0.0, 170.0).unwrap();
     let (tri, report) = render_frame(
         &mut Renderer::new(&map),
-        Scene::Map(&map),
+        &map,
         view,
         &RenderOptions {
             sampler: Sampler::Trilinear,

@@ -6,7 +6,6 @@
 
 use lut_core::exact_uv;
 use lut_core::LoadOptions;
-use lut_core::Scene;
 use lut_core::{dir_to_lat_long, Camera};
 use lut_core::{insert_xmp, xmp_packet};
 use lut_core::{
@@ -115,7 +114,7 @@ fn render_at(
         index_step: IndexStep::Fixed(4),
         ..RenderOptions::default()
     };
-    render_frame(&mut Renderer::new(map), Scene::Map(map), view, &opts, w, h).0
+    render_frame(&mut Renderer::new(map), map, view, &opts, w, h).0
 }
 
 /// Where the exact position of each output pixel of a `w × h` frame lies relative to the

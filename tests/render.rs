@@ -4,9 +4,9 @@
 //! The bound asserted is the product's stated one: **0.05 source pixels** (angular metric,
 //! see `lut_core::accuracy`), everywhere, poles and seam included.
 
+use lut_core::Frame;
 use lut_core::Surface;
 use lut_core::{compare_positions, ErrorStats};
-use lut_core::{Frame, Scene};
 use lut_core::{IndexStep, LutChoice, Projection, RenderOptions, Renderer, Sampler, View};
 use proptest::prelude::*;
 use std::collections::HashMap;
@@ -243,20 +243,10 @@ fn threads_are_byte_identical() {
                 threads: true,
                 ..RenderOptions::default()
             };
-            r.render(
-                Scene::Map(&map),
-                view,
-                &o1,
-                &mut Frame::new(&mut a, w, h).unwrap(),
-            )
-            .unwrap();
-            r.render(
-                Scene::Map(&map),
-                view,
-                &o2,
-                &mut Frame::new(&mut b, w, h).unwrap(),
-            )
-            .unwrap();
+            r.render(&map, view, &o1, &mut Frame::new(&mut a, w, h).unwrap())
+                .unwrap();
+            r.render(&map, view, &o2, &mut Frame::new(&mut b, w, h).unwrap())
+                .unwrap();
             assert!(
                 a == b,
                 "threads changed the output at view {y},{pi},{hf} {sampler:?}"
@@ -298,14 +288,7 @@ fn odd_and_tiny_sizes() {
     let mut r = Renderer::new(&map);
     for (w, h) in [(1, 1), (1, 7), (7, 1), (3, 3), (17, 5), (257, 1), (1, 300)] {
         let view = View::new(33.0, 12.0, 75.0).unwrap();
-        render_frame(
-            &mut r,
-            Scene::Map(&map),
-            view,
-            &RenderOptions::default(),
-            w,
-            h,
-        );
+        render_frame(&mut r, &map, view, &RenderOptions::default(), w, h);
         let st = measure(
             512,
             256,
@@ -333,12 +316,7 @@ fn bad_requests_are_errors_not_panics() {
         ..RenderOptions::default()
     };
     assert!(r
-        .render(
-            Scene::Map(&map),
-            view,
-            &bad,
-            &mut Frame::new(&mut out, 5, 2).unwrap()
-        )
+        .render(&map, view, &bad, &mut Frame::new(&mut out, 5, 2).unwrap())
         .is_err());
 }
 
@@ -350,7 +328,7 @@ fn report_names_the_path() {
     let mut out = vec![0u32; 64 * 48];
     let rep = |r: &mut Renderer, out: &mut Vec<u32>, hf: f64| {
         r.render(
-            Scene::Map(&map),
+            &map,
             View::new(0.0, 0.0, hf).unwrap(),
             &RenderOptions::default(),
             &mut Frame::new(out, 64, 48).unwrap(),

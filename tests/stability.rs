@@ -6,7 +6,7 @@
 //! the sampling-position error within the stated 0.05 px of the exact map.
 
 use lut_core::compare_positions;
-use lut_core::{Frame, Scene};
+use lut_core::Frame;
 use lut_core::{IndexStep, Projection, RenderOptions, Renderer, View};
 use test_support::render::render_frame;
 
@@ -121,7 +121,7 @@ fn pole_rows_and_seam_columns_render() {
                 sampler,
                 ..RenderOptions::default()
             };
-            render_frame(&mut r, Scene::Map(&map), view, &opts, 64, 64);
+            render_frame(&mut r, &map, view, &opts, 64, 64);
         }
         check(
             &mut r,
@@ -187,13 +187,8 @@ fn trilinear_on_degenerate_sizes_and_odd_maps() {
                         sampler,
                         ..RenderOptions::default()
                     };
-                    r.render(
-                        Scene::Map(&map),
-                        view,
-                        &opts,
-                        &mut Frame::new(out, w, h).unwrap(),
-                    )
-                    .unwrap();
+                    r.render(&map, view, &opts, &mut Frame::new(out, w, h).unwrap())
+                        .unwrap();
                 }
                 // Magnified (hfov 0.2 on a 1024-wide map: a screen pixel covers at most
                 // 0.57 map pixels, even a 1-pixel-wide frame): level 0 only.

@@ -17,7 +17,7 @@
 
 use lut_core::{compare_positions, grid_map, CubeMap, EnvMap, ErrorStats, Named, Projection};
 use lut_core::{Camera, Renderer, View, ViewProjection};
-use lut_core::{RenderOptions, RenderPath, RendererKind, Sampler, Scene, ViewError};
+use lut_core::{RenderOptions, RenderPath, RendererKind, Sampler, ViewError};
 use proptest::prelude::*;
 use std::f64::consts::PI;
 use test_support::pixels::{diff, psnr};
@@ -563,7 +563,7 @@ fn grid_images_match_the_exact_renderer() {
                     renderer: RendererKind::Grid,
                     ..RenderOptions::default()
                 };
-                let (img, _) = render_frame(&mut r, Scene::Map(&map), view, &opts, w, h);
+                let (img, _) = render_frame(&mut r, &map, view, &opts, w, h);
                 let ex = exact_frame(&map, view, sampler, w, h);
                 let d = diff(&img, &ex);
                 let what = format!("{vp} {view:?} {}", sampler.name());
@@ -596,7 +596,7 @@ fn pixels_without_a_direction_show_the_background() {
                 renderer,
                 ..RenderOptions::default()
             };
-            let (img, _) = render_frame(&mut r, Scene::Map(&map), view, &opts, w, h);
+            let (img, _) = render_frame(&mut r, &map, view, &opts, w, h);
             // Disc radius W/2 = 60: the corners (≈ 67 px from the centre) are outside.
             for (x, y) in [(0, 0), (119, 0), (0, 59), (119, 59)] {
                 assert_eq!(
@@ -620,11 +620,11 @@ fn pixels_without_a_direction_show_the_background() {
 fn cube_maps_in_every_projection() {
     let map = grid_map(1024, 512, Projection::Equirect).unwrap();
     let cube = CubeMap::from_envmap(&map, 512, Sampler::Bilinear).unwrap();
-    let mut r = Renderer::default();
+    let mut cube = lut_core::Panorama::cube(cube);
     for vp in projections() {
         let view = View::with_projection(45.0, 35.0, hfov_at(vp, 0.7), vp).unwrap();
         let opts = RenderOptions::default();
-        let (img, rep) = render_frame(&mut r, Scene::Cube(&cube), view, &opts, 96, 64);
+        let (img, rep) = test_support::render::pano_frame(&mut cube, view, &opts, 96, 64);
         let ex = exact_frame(&map, view, Sampler::Bilinear, 96, 64);
         let (p, d) = (psnr(&img, &ex), diff(&img, &ex));
         assert!(p >= 30.0 && d.mean <= 3.0, "{vp}: {p:.1} dB {d:?}");
@@ -663,7 +663,7 @@ fn partial_panoramas_in_other_projections() {
     ] {
         let view = View::with_projection(150.0, pitch, hfov, vp).unwrap();
         let opts = RenderOptions::default();
-        let (img, _) = render_frame(&mut r, Scene::Map(&map), view, &opts, 96, 64);
+        let (img, _) = render_frame(&mut r, &map, view, &opts, 96, 64);
         let ex = exact_frame(&map, view, Sampler::Bilinear, 96, 64);
         assert!(
             img.contains(&0x203040) && img.iter().any(|&p| p != 0x203040),
@@ -690,7 +690,7 @@ fn grid_trilinear_close_to_exact_trilinear() {
             sampler: Sampler::Trilinear,
             ..RenderOptions::default()
         };
-        let (img, _) = render_frame(&mut r, Scene::Map(&map), view, &opts, 96, 64);
+        let (img, _) = render_frame(&mut r, &map, view, &opts, 96, 64);
         let ex = exact_frame(&map, view, Sampler::Trilinear, 96, 64);
         let p = psnr(&img, &ex);
         assert!(p >= 35.0, "{vp}: {p:.1} dB");
@@ -722,7 +722,7 @@ fn heat_map_max_is_the_measured_max() {
         ),
     ] {
         let opts = grid_opts(renderer);
-        let em = lut_core::ErrorMap::measure(&mut r, Scene::Map(&map), view, &opts, w, h).unwrap();
+        let em = lut_core::ErrorMap::measure(&mut r, &map, view, &opts, w, h).unwrap();
         let (pos, _) = r
             .positions(2048, 1024, Projection::Equirect, view, &opts, w, h)
             .unwrap();
@@ -746,28 +746,16 @@ fn heat_map_max_is_the_measured_max() {
         assert_eq!(em.errors[i], Some(em.stats.max));
         assert_eq!(em.colors()[i], lut_core::heat_color(em.stats.max));
         // The exact renderer measures nothing.
-        let ex = lut_core::ErrorMap::measure(
-            &mut r,
-            Scene::Map(&map),
-            view,
-            &grid_opts(RendererKind::Exact),
-            w,
-            h,
-        )
-        .unwrap();
+        let ex =
+            lut_core::ErrorMap::measure(&mut r, &map, view, &grid_opts(RendererKind::Exact), w, h)
+                .unwrap();
         assert_eq!((ex.stats.max, ex.stats.mean), (0.0, 0.0));
     }
     let cube = CubeMap::from_envmap(&map, 64, Sampler::Bilinear).unwrap();
     let view = View::with_projection(0.0, 0.0, 360.0, ViewProjection::Fisheye).unwrap();
-    let em = lut_core::ErrorMap::measure(
-        &mut r,
-        Scene::Cube(&cube),
-        view,
-        &RenderOptions::default(),
-        64,
-        32,
-    )
-    .unwrap();
+    let em = lut_core::Panorama::cube(cube)
+        .error_map(view, &RenderOptions::default(), 64, 32)
+        .unwrap();
     assert_eq!(em.stats.max, 0.0);
     // Outside the 360° fisheye's disc there is no direction: background.
     assert_eq!(em.errors[0], None);
@@ -781,7 +769,7 @@ fn heat_map_max_is_the_measured_max() {
     let level = &map.pyramid()[2];
     assert_eq!(level.width(), 256);
     let measure = |r: &mut Renderer, m: &lut_core::EnvMap| {
-        lut_core::ErrorMap::measure(r, Scene::Map(m), view, &opts, 48, 36).unwrap()
+        lut_core::ErrorMap::measure(r, m, view, &opts, 48, 36).unwrap()
     };
     let mut r = Renderer::new(&map);
     let on_map = measure(&mut r, &map);

@@ -1,7 +1,7 @@
 //! The command line: `viewer [PANORAMA]` opens the window; the subcommands render,
 //! convert, summarize IES files and measure.
 
-use crate::commands::{bench, bench_load, convert, ies, lux, render};
+use crate::commands::{bench, bench_load, convert, ies, lux, render, report, tile, tour};
 use clap::{Parser, Subcommand};
 
 /// CPU panorama viewer: scanline-coherent LUT rendering (US 5,748,194).
@@ -32,11 +32,19 @@ pub enum Command {
     Ies(ies::IesArgs),
     /// Illuminance in lux at points of the room from its luminaires.
     Lux(lux::LuxArgs),
+    /// Lighting report against EN 12464-1: grids, Em/Emin/U0 per area, UGR; text, JSON,
+    /// PNG and HTML.
+    Report(Box<report::ReportArgs>),
     /// Measure speed against error for every renderer configuration.
     Bench(bench::BenchArgs),
     /// Huge panoramas: load time, table build, frame time and peak memory for generated
     /// 8k, 16k and 32k equirectangular JPEGs (each in a fresh process).
     BenchLoad(bench_load::BenchLoadArgs),
+    /// Gigapixel panoramas: write a Pannellum multires pyramid (tiled cube faces) of a
+    /// panorama, read in row bands, memory bounded whatever its size.
+    Tile(Box<tile::TileArgs>),
+    /// Tours (Pannellum configs, Marzipano data.js): check, convert to Pannellum.
+    Tour(tour::TourArgs),
 }
 
 #[cfg(test)]

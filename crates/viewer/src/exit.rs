@@ -109,6 +109,43 @@ macro_rules! errln {
     };
 }
 
+/// The first place in `v` that holds `null` (as a JSON path, `$.points[0].lux`).
+fn first_null(v: &serde_json::Value, at: &str) -> Option<String> {
+    match v {
+        serde_json::Value::Null => Some(at.to_string()),
+        serde_json::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| first_null(x, &format!("{at}[{i}]"))),
+        serde_json::Value::Object(m) => m
+            .iter()
+            .find_map(|(k, x)| first_null(x, &format!("{at}.{k}"))),
+        _ => None,
+    }
+}
+
+/// `value` as JSON for output (one line, or pretty), refusing a result that holds a
+/// number that is not finite (serde_json writes NaN and infinities as `null`): the one
+/// check every JSON output goes through, so JSON output never holds `null` for a number.
+/// Output types use no `null` of their own (absent fields are skipped).
+///
+/// # Errors
+/// A usage error naming the field: the command line (or the file it names) asked for
+/// something whose answer is not a finite number.
+pub fn finite_json<T: serde::Serialize>(value: &T, pretty: bool) -> anyhow::Result<String> {
+    let v = serde_json::to_value(value)?;
+    if let Some(at) = first_null(&v, "$") {
+        return Err(crate::usage!(
+            "the result {at} is not a finite number: the values given are out of range"
+        ));
+    }
+    Ok(if pretty {
+        serde_json::to_string_pretty(&v)?
+    } else {
+        serde_json::to_string(&v)?
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -125,5 +162,43 @@ mod tests {
         assert!(is_broken_pipe(&e));
         assert_eq!(code(&e), 1);
         assert!(!is_broken_pipe(&anyhow::anyhow!("x")));
+    }
+
+    #[test]
+    fn json_output_never_holds_null_for_a_number() {
+        #[derive(serde::Serialize)]
+        struct R {
+            lux: f64,
+            normal: [f64; 3],
+        }
+        let ok = finite_json(
+            &R {
+                lux: 1.5,
+                normal: [0.0, 1.0, 0.0],
+            },
+            false,
+        )
+        .unwrap();
+        assert_eq!(ok, r#"{"lux":1.5,"normal":[0.0,1.0,0.0]}"#);
+        for (r, at) in [
+            (
+                R {
+                    lux: f64::INFINITY,
+                    normal: [0.0; 3],
+                },
+                "$.lux",
+            ),
+            (
+                R {
+                    lux: 0.0,
+                    normal: [0.0, f64::NAN, 0.0],
+                },
+                "$.normal[1]",
+            ),
+        ] {
+            let e = finite_json(&r, true).unwrap_err();
+            assert_eq!(code(&e), 2);
+            assert!(e.to_string().contains(at), "{e}");
+        }
     }
 }

@@ -6,6 +6,7 @@
 //! * `viewer ies ...` summarizes and samples an IES photometric file.
 //! * `viewer bench ...` measures speed against error.
 //! * `viewer bench-load ...` measures loading and panning huge (8k-32k) maps.
+//! * `viewer tile ...` writes a Pannellum multires pyramid ([`tile::write_pyramid`]).
 //!
 //! Modules:
 //! * [`cli`]: the command line; [`commands`]: one module per subcommand.
@@ -20,6 +21,8 @@
 //!   into, inputs never overwritten).
 //! * [`exit`]: exit statuses (0, 1 for files, 2 for usage), usage errors, standard
 //!   output without panics; [`signals`]: temporary files removed on SIGINT/SIGTERM.
+//! * [`tour`]: tours (Pannellum configs, Marzipano data.js): the model, readers, writer,
+//!   check and hotspot markers.
 //! * [`window`]: winit + softbuffer + egui, all drawn on the CPU.
 
 #![warn(missing_docs)]
@@ -35,4 +38,8 @@ pub mod output;
 pub mod panorama;
 pub mod scene;
 pub mod signals;
+pub mod tour;
 pub mod window;
+
+/// `viewer tile`: the multires pyramid generator (also for benches and tests).
+pub use commands::tile;

@@ -5,10 +5,13 @@
 use clap::Parser;
 use std::process::ExitCode;
 use viewer::cli::{Cli, Command};
-use viewer::commands::{bench, bench_load, convert, ies, lux, render};
+use viewer::commands::{bench, bench_load, convert, ies, lux, render, report, tile, tour};
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return clap_error(&e),
+    };
     if cli.command.is_none() {
         // The window: one heap arena, which its trims reach whole (glibc; see
         // `viewer::window::heap`). Before any other thread exists: glibc fixes its arena
@@ -26,8 +29,11 @@ fn main() -> ExitCode {
         Some(Command::Convert(a)) => convert::run(a),
         Some(Command::Ies(a)) => ies::run(a),
         Some(Command::Lux(a)) => lux::run(a),
+        Some(Command::Report(a)) => report::run(*a),
         Some(Command::Bench(a)) => bench::run(a),
         Some(Command::BenchLoad(a)) => bench_load::run(a),
+        Some(Command::Tile(a)) => tile::run(*a),
+        Some(Command::Tour(a)) => tour::run(a),
         None => viewer::window::run(cli.open),
     };
     // Lines still in standard output's buffer: a full disk shows here.
@@ -37,8 +43,25 @@ fn main() -> ExitCode {
         // The reader of our output went away: nothing is wrong with the command.
         Err(e) if viewer::exit::is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            viewer::errln!("viewer: {e:#}");
+            // Every message path echoes input the same way: control characters escaped,
+            // long names and numbers shortened (lut_core::one_line).
+            viewer::errln!("{}", lut_core::one_line(&format!("viewer: {e:#}")));
             ExitCode::from(viewer::exit::code(&e))
         }
     }
+}
+
+/// Clap's own message (help and version to standard output as they are; errors to
+/// standard error, each line escaped and shortened like every message, exit 2).
+fn clap_error(e: &clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+        let _ = e.print();
+        return ExitCode::SUCCESS;
+    }
+    let text = e.render().to_string();
+    for line in text.trim_end().lines() {
+        viewer::errln!("{}", lut_core::one_line(line));
+    }
+    ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
 }

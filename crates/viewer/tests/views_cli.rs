@@ -7,8 +7,7 @@ use std::path::{Path, PathBuf};
 mod common;
 use common::{s, viewer};
 use lut_core::{
-    ErrorMap, LoadOptions, Projection, RenderOptions, Renderer, RendererKind, Scene, View,
-    ViewProjection,
+    ErrorMap, LoadOptions, Projection, RenderOptions, Renderer, RendererKind, View, ViewProjection,
 };
 
 fn tmpdir(name: &str) -> PathBuf {
@@ -91,7 +90,7 @@ fn renders_every_projection_as_lut_core_does() {
         let view = View::with_projection(0.0, pitch, hfov, proj).unwrap();
         let (want, _) = test_support::render::render_frame(
             &mut r,
-            Scene::Map(&map),
+            &map,
             view,
             &RenderOptions::default(),
             160,
@@ -211,7 +210,7 @@ fn error_map_and_verbose_report_the_measured_error() {
             },
             ..RenderOptions::default()
         };
-        let em = ErrorMap::measure(&mut r, Scene::Map(&map), view, &opts, 300, 150).unwrap();
+        let em = ErrorMap::measure(&mut r, &map, view, &opts, 300, 150).unwrap();
         let line = viewer::heatmap::summary(&em);
         assert!(err.contains(&line), "{line} not in: {err}");
         assert!(

@@ -42,6 +42,29 @@ pub fn parse_angle(s: &str) -> Result<f64, String> {
     }
 }
 
+/// A finite number (a clap value parser): NaN, infinities and numbers beyond `f64` are
+/// refused on the command line (exit 2) by every command alike.
+pub fn parse_finite(s: &str) -> Result<f64, String> {
+    finite(s).ok_or_else(|| format!("'{}' is not a finite number", lut_core::shown(s)))
+}
+
+/// A luminaire multiplier: finite, at least 0 and at most
+/// [`lut_core::limits::MAX_LIGHT_MULTIPLIER`].
+pub fn parse_multiplier(s: &str) -> Result<f64, String> {
+    let v = parse_finite(s)?;
+    if v < 0.0 {
+        return Err(format!("'{s}' is negative: give a factor of 0 or more"));
+    }
+    lut_core::check_limit(
+        "light multiplier",
+        v,
+        lut_core::limits::MAX_LIGHT_MULTIPLIER,
+        "",
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(v)
+}
+
 /// An exposure in stops (a finite number).
 pub fn parse_stops(s: &str) -> Result<f64, String> {
     finite(s).ok_or_else(|| format!("exposure '{s}' is not a finite number of stops"))

@@ -9,8 +9,8 @@ use crate::args::{parse_size, MaxPixelsArg};
 use crate::output::write_image_atomic;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
+use lut_core::Frame;
 use lut_core::TableKind;
-use lut_core::{Frame, Scene};
 use lut_core::{LoadPhase, Projection, RenderOptions, Renderer, Sampler, Tone, View};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -342,8 +342,11 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
     let t1 = Instant::now();
     let mut renderer = Renderer::new(&map);
     let surface = RenderOptions::default().surface;
-    let mut table_bytes = renderer.table(surface, TableKind::Wide).bytes() as u64;
-    table_bytes += renderer.table(surface, TableKind::High).bytes() as u64;
+    // (`Renderer::new` gave the renderer the map's geometry: the tables are built.)
+    let mut table_bytes = 0u64;
+    for kind in [TableKind::Wide, TableKind::High] {
+        table_bytes += renderer.table(surface, kind).map_or(0, |t| t.bytes()) as u64;
+    }
     let tables_s = t1.elapsed().as_secs_f64();
 
     let (w, h) = a.size;
@@ -362,7 +365,7 @@ fn measure(path: &Path, a: &BenchLoadArgs) -> Result<Sample> {
         for i in 0..=n {
             let view = View::new(f64::from(i) * 360.0 / f64::from(n), 10.0, a.hfov)?;
             let t = Instant::now();
-            renderer.render(Scene::Map(&map), view, &o, &mut Frame::new(&mut out, w, h)?)?;
+            renderer.render(&map, view, &o, &mut Frame::new(&mut out, w, h)?)?;
             if i > 0 {
                 // frame 0 warms the caches
                 ms.push(t.elapsed().as_secs_f64() * 1e3);

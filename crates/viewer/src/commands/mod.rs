@@ -1,4 +1,4 @@
-//! The subcommands: `viewer render`, `convert`, `ies`, `lux`, `bench` and `bench-load`. Each
+//! The subcommands: `viewer render`, `convert`, `ies`, `lux`, `report`, `bench`, `bench-load` and `tile`. Each
 //! module has the command's arguments (a clap `Args` struct) and its `run`.
 
 pub mod bench;
@@ -7,3 +7,6 @@ pub mod convert;
 pub mod ies;
 pub mod lux;
 pub mod render;
+pub mod report;
+pub mod tile;
+pub mod tour;

@@ -7,10 +7,11 @@ use crate::heatmap::{summary, write_error_map};
 use crate::lighting::{LightArgs, LitRenderError};
 use crate::output::{check_not_input, output_kind, write_image};
 use crate::panorama::{coverage_text, heading_text, load_cube, load_panorama_partial};
-use crate::scene::{measure_errors, Scene};
+use crate::scene::measure_errors;
 use crate::usage;
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
+use lut_core::Panorama;
 use lut_core::{
     IndexStep, LutChoice, RenderOptions, RenderReport, RendererKind, Sampler, Surface, View,
     ViewProjection, PANNINI_D_DEFAULT,
@@ -24,6 +25,9 @@ pub struct RenderArgs {
     /// layout image with --projection cube. When omitted, the --scene file's panorama,
     /// else the bundled sample.
     pub panorama: Vec<PathBuf>,
+    /// Decoded tiles kept in memory when the panorama is a tiled pyramid (MiB).
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(16..=1 << 20))]
+    pub cache_mib: u64,
     /// Output image: .png or .jpg/.jpeg (by the name), written atomically; a device or
     /// FIFO (e.g. /dev/stdout) is written into as PNG.
     #[arg(short, long)]
@@ -106,6 +110,20 @@ pub struct RenderArgs {
     /// Luminaires lighting the scene.
     #[command(flatten)]
     pub lights: LightArgs,
+    /// A level horizon: the pitch of the panorama's horizon in degrees (Pannellum's
+    /// horizonPitch, GPano's PosePitchDegrees), rotated away before projection
+    /// (equirectangular maps; the map is re-levelled once at load, docs/tours.md).
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub horizon_pitch: Option<f64>,
+    /// A level horizon: the roll of the panorama's horizon in degrees (Pannellum's
+    /// horizonRoll, GPano's PoseRollDegrees).
+    #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
+    pub horizon_roll: Option<f64>,
+    /// A tour (Pannellum config or Marzipano data.js): render its scene named by --scene
+    /// (default: its first scene) at the scene's start view and horizon, with its hotspot
+    /// markers (the options given override the view).
+    #[arg(long, value_name = "T.json")]
+    pub tour: Option<PathBuf>,
 }
 
 /// Pannini's d: a finite number (the range is checked with the view).
@@ -184,20 +202,39 @@ impl RenderArgs {
 
     /// The panorama these arguments name: a cube map, or a map placed by `--coverage` or
     /// its GPano XMP.
-    fn load(&self, scene_pano: Vec<PathBuf>) -> Result<Scene> {
+    fn load(&self, scene_pano: Vec<PathBuf>) -> Result<Panorama> {
         let input = &self.input;
         let panorama = if self.panorama.is_empty() {
             &scene_pano
         } else {
             &self.panorama
         };
+        if let [one] = panorama.as_slice() {
+            if crate::panorama::is_tiled(one) {
+                if input.coverage.is_some() {
+                    return Err(usage!(
+                        "--coverage applies to equirectangular panoramas, not tiled pyramids"
+                    ));
+                }
+                // The CLI waits for every tile a frame reads: the same bytes every run.
+                let pano = crate::panorama::open_tiled(one, self.cache_mib)?;
+                return Ok(Panorama::tiled(pano, true));
+            }
+        }
         if input.projection.value.reads_cube(panorama) {
             if input.coverage.is_some() {
                 return Err(usage!(
                     "--coverage applies to equirectangular panoramas, not cube maps"
                 ));
             }
-            return Ok(Scene::cube(load_cube(panorama, input.cube)?));
+            if self.horizon_pitch.is_some_and(|p| p != 0.0)
+                || self.horizon_roll.is_some_and(|r| r != 0.0)
+            {
+                return Err(usage!(
+                    "--horizon-pitch and --horizon-roll apply to equirectangular panoramas, not cube maps"
+                ));
+            }
+            return Ok(Panorama::cube(load_cube(panorama, input.cube)?));
         }
         if panorama.len() > 1 {
             return Err(usage!(
@@ -214,12 +251,36 @@ impl RenderArgs {
             input.coverage,
             &mut |_| {},
         )?;
-        Ok(Scene::map(map))
+        Ok(Panorama::map(crate::tour::render::level(
+            map,
+            self.horizon_pitch,
+            self.horizon_roll,
+        )?))
     }
 }
 
 /// Run `viewer render`.
-pub fn run(a: RenderArgs) -> Result<()> {
+pub fn run(mut a: RenderArgs) -> Result<()> {
+    // --tour: --scene names the tour's scene (its panorama, view, horizon, markers).
+    let tour_scene = match a.tour.clone() {
+        Some(t) => Some(crate::tour::render::prepare(&mut a, &t)?),
+        None => None,
+    };
+    let out = frame_with(&a, tour_scene.as_ref())?;
+    write_image(&a.output, &out, a.size.0, a.size.1)
+}
+
+/// The frame `viewer render` writes (rendered, lit, with the overlays asked for), 0RGB,
+/// `a.size`; the output's name is checked but nothing is written.
+///
+/// # Errors
+/// As [`run`].
+pub fn frame(a: &RenderArgs) -> Result<Vec<u32>> {
+    frame_with(a, None)
+}
+
+/// [`frame`], with a tour scene's hotspot markers drawn over it.
+fn frame_with(a: &RenderArgs, tour_scene: Option<&crate::tour::TourScene>) -> Result<Vec<u32>> {
     let (scene_pano, scene_view) = a.lights.room.scene_panorama()?;
     let mut view = a.view(a.lights.room.scene.as_deref().zip(scene_view))?;
     if a.view_limit && !view.projection().is_rectilinear() {
@@ -249,10 +310,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
         ));
     }
     let mut scene = a.load(scene_pano)?;
-    if let Scene::Map { renderer, .. } = &mut scene {
-        renderer.set_still_level(a.still_level);
-    }
-    if let (true, Some(map)) = (a.view_limit, scene.env_map()) {
+    scene.set_still_level(a.still_level);
+    if let (true, Some(map)) = (a.view_limit, scene.as_map()) {
         view = lut_core::limit_view(view, w, h, &map.coverage());
     }
     let mut out = vec![0u32; w as usize * h as usize];
@@ -263,7 +322,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         .render_lit(
             &mut lit,
             false,
-            scene.as_mut(),
+            &mut scene,
             view,
             &a.options(),
             &mut out,
@@ -276,14 +335,14 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let lit_ms = t0.elapsed().as_secs_f64() * 1e3;
     let error_map = if a.verbose || a.error_map.is_some() {
         Some(
-            measure_errors(scene.as_mut(), view, &a.options(), w, h)
+            measure_errors(&mut scene, view, &a.options(), w, h)
                 .context("cannot measure the sampling-position error")?,
         )
     } else {
         None
     };
     if a.verbose {
-        print_report(&a, &scene, &report, view);
+        print_report(a, &scene, &report, view);
         if let Some(em) = &error_map {
             crate::errln!("{}", summary(em));
         }
@@ -308,15 +367,17 @@ pub fn run(a: RenderArgs) -> Result<()> {
         crate::lighting::legend::draw_legend(&mut out, w, h, lights.false_color_max)
             .map_err(anyhow::Error::msg)?;
     }
-    write_image(&a.output, &out, w, h)?;
-    Ok(())
+    if let Some(ts) = tour_scene {
+        crate::tour::markers::draw(ts, view, &mut out, w, h);
+    }
+    Ok(out)
 }
 
 /// `-v`: what rendered the frame, on stderr.
-fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View) {
+fn print_report(a: &RenderArgs, scene: &Panorama, report: &RenderReport, view: View) {
     let (w, h) = a.size;
-    match scene {
-        Scene::Map { map, .. } => {
+    match scene.as_map() {
+        Some(map) => {
             let steps = if report.path == lut_core::RenderPath::Grid {
                 format!("grid cells {}..{} px", report.min_step, report.max_step)
             } else {
@@ -356,9 +417,10 @@ fn print_report(a: &RenderArgs, scene: &Scene, report: &RenderReport, view: View
                 crate::errln!("view centre {hd}");
             }
         }
-        Scene::Cube(cube) => crate::errln!(
-            "rendered {w}x{h} from a cube map of {}px faces",
-            cube.face_size()
+        None => crate::errln!(
+            "rendered {w}x{h} from a {} map of {}px faces",
+            scene.kind().name(),
+            scene.size().0
         ),
     }
 }

@@ -337,12 +337,16 @@ impl Document {
 
     /// A load failed: keep what is shown, say why; with nothing shown, open the sample.
     fn failed(&mut self, e: String, source: Option<Source>, exposure_ev: f64) -> Vec<Effect> {
+        // Escaped and shortened like every echoed message (lut_core::one_line).
+        let e = lut_core::one_line(&e);
         let mut fx = vec![Effect::Stderr(format!("viewer: {e}"))];
         self.error = Some(e);
         // A projection chosen next retries this file.
+        let was_sample = source == Some(Source::Sample);
         self.projection_source = source;
-        if self.current.is_none() {
-            // Nothing to keep showing: fall back to the bundled sample.
+        if self.current.is_none() && !was_sample {
+            // Nothing to keep showing: fall back to the bundled sample (once: a sample
+            // that fails too leaves the error on show, never a loop of loads).
             fx.push(self.start_load(Source::Sample, None, exposure_ev, true));
             self.keep_error = true;
         }

@@ -986,7 +986,7 @@ mod tests {
             let opts = c.settings.render_options(Level::Full);
             let report = r
                 .render(
-                    lut_core::Scene::Map(&map),
+                    &map,
                     c.look().view(),
                     &opts,
                     &mut lut_core::Frame::new(&mut out, w as u32, h as u32).expect("frame"),

@@ -3,8 +3,7 @@
 //! types: the event loop runs [`load`] on a thread and forwards its reports.
 
 use super::ui::LoadStep;
-use crate::scene::Scene;
-use lut_core::{Coverage, EnvMap, Layout, LoadOptions, Naming, Projection};
+use lut_core::{Coverage, EnvMap, Layout, LoadOptions, Naming, Panorama, PanoramaKind, Projection};
 use std::path::PathBuf;
 
 /// Where a panorama comes from.
@@ -106,7 +105,7 @@ impl Source {
 /// A loaded panorama with its renderer (tables built on the loading thread).
 pub struct Loaded {
     /// The map or cube map.
-    pub scene: Scene,
+    pub scene: Panorama,
     /// Where it came from.
     pub source: Source,
     /// The projection it was opened with (`None`: auto).
@@ -120,28 +119,31 @@ pub struct Loaded {
 impl Loaded {
     /// Size and projection for `--print-view`: "W×H projection" (a cube: its face size).
     pub fn describe(&self) -> (u32, u32, &'static str) {
-        match &self.scene {
-            Scene::Map { map, .. } => (map.width(), map.height(), map.projection().name()),
-            Scene::Cube(c) => (c.face_size(), c.face_size(), "cube"),
-        }
+        let (w, h) = self.scene.size();
+        let kind = match self.scene.as_map() {
+            Some(map) => map.projection().name(),
+            None => self.scene.kind().name(),
+        };
+        (w, h, kind)
     }
 
     /// The map readout: name, size, projection and memory.
     pub fn label(&self) -> String {
         let (w, h, proj) = self.describe();
         let name = self.source.short_name();
-        match &self.scene {
-            Scene::Cube(_) => format!("{name} (cube, {w}px faces)"),
-            Scene::Map { map, .. } => format!(
+        match self.scene.kind() {
+            PanoramaKind::Cube => format!("{name} (cube, {w}px faces)"),
+            PanoramaKind::Tiled => format!("{name} (tiled pyramid, {w}px faces)"),
+            _ => format!(
                 "{name} ({w}×{h}, {proj}, {} in memory)",
-                format_bytes(map.bytes())
+                format_bytes(self.scene.bytes())
             ),
         }
     }
 
     /// The map, if the panorama is one.
     pub fn map(&self) -> Option<&EnvMap> {
-        self.scene.env_map()
+        self.scene.as_map()
     }
 }
 
@@ -187,6 +189,23 @@ pub fn load(
         ..
     } = req;
     let hdr = matches!(&source, Source::File(p) if super::export::is_hdr_path(p));
+    // A tiled pyramid (a folder with config.json, or the .json): level 1 decoded here,
+    // the rest on its decoding threads as frames ask for it (frames never wait).
+    if let Some(p) = source
+        .single_path()
+        .filter(|p| crate::panorama::is_tiled(p))
+    {
+        progress(LoadStep::Decoding, None);
+        let pano = crate::panorama::open_tiled(p, super::prefs::TILE_CACHE_MIB)
+            .map_err(|e| format!("{e:#}"))?;
+        return Ok(Box::new(Loaded {
+            scene: Panorama::tiled(pano, false),
+            source,
+            projection: opts.projection,
+            hdr: false,
+            exposure_ev: opts.tone.exposure_ev,
+        }));
+    }
     let path = match &source {
         Source::Cube { paths, layout } => {
             progress(LoadStep::Decoding, None);
@@ -197,11 +216,11 @@ pub fn load(
             let cube = crate::panorama::load_cube(paths, cube).map_err(|e| format!("{e:#}"))?;
             // The face pyramid (the window's default sampler is trilinear) now, so the
             // first frames do not wait for it.
-            progress(LoadStep::Tables, Some(0.0));
-            cube.pyramid();
-            progress(LoadStep::Tables, Some(1.0));
+            let mut scene = Panorama::cube(cube);
+            let surface = lut_core::RenderOptions::default().surface;
+            scene.prepare(surface, &mut |f| progress(LoadStep::Tables, Some(f)));
             return Ok(Box::new(Loaded {
-                scene: Scene::cube(cube),
+                scene,
                 source,
                 projection: opts.projection,
                 hdr: false,
@@ -220,17 +239,10 @@ pub fn load(
     // Build both tables and the pyramid (the window's default sampler is trilinear), and
     // the levels' own pyramids (zoomed-out still frames are drawn from a level,
     // `Renderer::set_still_level`), now, so the first frames do not wait for them.
-    progress(LoadStep::Tables, Some(0.0));
-    let mut scene = Scene::map(map);
-    if let Scene::Map { map, renderer } = &mut scene {
-        let surface = lut_core::RenderOptions::default().surface;
-        renderer.table(surface, lut_core::TableKind::Wide);
-        progress(LoadStep::Tables, Some(0.3));
-        renderer.table(surface, lut_core::TableKind::High);
-        progress(LoadStep::Tables, Some(0.5));
-        lut_core::build_frame_levels(map);
-    }
-    progress(LoadStep::Tables, Some(1.0));
+    lut_core::fault_point("loader");
+    let mut scene = Panorama::map(map);
+    let surface = lut_core::RenderOptions::default().surface;
+    scene.prepare(surface, &mut |f| progress(LoadStep::Tables, Some(f)));
     Ok(Box::new(Loaded {
         scene,
         source,
@@ -357,7 +369,7 @@ mod tests {
                 (LoadStep::Tables, Some(1.0))
             ]
         );
-        let Scene::Cube(cube) = &loaded.scene else {
+        let Some(cube) = loaded.scene.as_cube() else {
             panic!("a cube folder loads as a cube");
         };
         assert!(

@@ -110,11 +110,9 @@ pub fn run(mut a: OpenArgs) -> anyhow::Result<()> {
         a.pitch = a.pitch.or(Some(v.pitch));
         a.hfov = a.hfov.or(Some(v.hfov));
     }
-    for p in &a.panorama {
-        // Fail before opening a window for a path that is not there at all; a file that
-        // exists but does not decode is reported in the window instead.
-        std::fs::metadata(p).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
-    }
+    // A panorama that cannot be opened, missing or damaged alike, is the loader's error:
+    // the window opens with the bundled sample and shows the error (one behaviour for
+    // both; docs/reliability.md, class 8), as when a bad file is dropped or opened later.
     if a.panorama.len() > 1 && matches!(a.input.projection.value, ProjectionArg::Map(_)) {
         return Err(crate::usage!(
             "{} files given: a single panorama takes one file (six faces are a cube map)",

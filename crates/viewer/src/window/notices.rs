@@ -50,6 +50,9 @@ impl Notices {
     }
 
     fn post(&mut self, level: Level, text: String, t: f64) -> u64 {
+        // Every notice is escaped and shortened the same way (lut_core::one_line): text
+        // from input (file names, keys, values) never reaches the screen raw.
+        let text = lut_core::one_line(&text);
         // The same text again (a key held down) refreshes the old notice.
         self.list.retain(|n| n.text != text);
         self.next_id += 1;

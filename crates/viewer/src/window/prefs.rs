@@ -5,8 +5,12 @@
 //! [`CONFIG_DIR_ENV`] overrides it, which the tests use so they never touch the real
 //! home). Option values are stored by their panel names (`lut_core::Named`).
 //!
-//! A missing file gives the defaults; a file that cannot be read gives the defaults and a
-//! message (the window shows it), and is replaced on the next save.
+//! The file is read field by field (docs/reliability.md, class 7): a missing file gives
+//! the defaults; a field with a value of the wrong type or out of range falls back to its
+//! default alone (the window says which); fields this version does not know (written by
+//! a newer one) are kept and written back. A file that was not read whole (bad JSON, a
+//! mistyped field) is first copied beside as `settings.json.bak`; a file that cannot be
+//! read at all (no permission, not a regular file) is never replaced.
 
 use super::input::DragStyle;
 use super::quality::AaMode;
@@ -14,6 +18,9 @@ use anyhow::{Context, Result};
 use lut_core::Sampler;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+/// The tiled pyramids' cache budget (MiB; `viewer render --cache-mib` for the CLI).
+pub const TILE_CACHE_MIB: u64 = 1024;
 
 /// Environment variable naming the config folder (tests, portable setups).
 pub const CONFIG_DIR_ENV: &str = "LUTPANO_CONFIG_DIR";
@@ -27,7 +34,7 @@ pub const DEFAULT_ZOOM_LIMIT: f64 = 2.0;
 
 /// The settings kept between runs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(default)]
 pub struct Prefs {
     /// The engineering panel is shown.
     pub panel: bool,
@@ -57,7 +64,16 @@ pub struct Prefs {
     pub recent: Vec<PathBuf>,
     /// The folder "Save view…" last wrote to.
     pub save_dir: Option<PathBuf>,
+    /// Fields this version does not know, kept as read and written back.
+    #[serde(skip)]
+    pub extra: serde_json::Map<String, serde_json::Value>,
+    /// The file on disk could not be read at all: it is never replaced.
+    #[serde(skip)]
+    pub keep_file: bool,
 }
+
+/// The backup of a settings file that was not read whole, beside it.
+pub const BACKUP_NAME: &str = "settings.json.bak";
 
 impl Default for Prefs {
     fn default() -> Self {
@@ -76,6 +92,8 @@ impl Default for Prefs {
             export_scale: s.export_scale,
             recent: Vec::new(),
             save_dir: None,
+            extra: serde_json::Map::new(),
+            keep_file: false,
         }
     }
 }
@@ -110,29 +128,133 @@ pub fn config_dir() -> Option<PathBuf> {
 }
 
 impl Prefs {
-    /// The settings in `dir`: the defaults when there are none yet; the defaults and a
-    /// message naming the file when it cannot be read or parsed.
+    /// The settings in `dir`, read field by field: the defaults when there are none yet;
+    /// otherwise every field that reads, the defaults for the others and a message naming
+    /// the file and the fields that did not (the file then kept as [`BACKUP_NAME`]).
     pub fn load(dir: &Path) -> (Prefs, Option<String>) {
         let path = dir.join(FILE_NAME);
-        let text = match std::fs::read_to_string(&path) {
-            Ok(t) => t,
+        // The one reader for small input files: regular files only (a FIFO never blocks).
+        let bytes = match lut_core::read_regular(&path, lut_core::limits::MAX_SETTINGS_FILE_BYTES) {
+            Ok(b) => b,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return (Prefs::default(), None),
-            Err(e) => return (Prefs::default(), Some(bad(&path, &e.to_string()))),
+            Err(e) => {
+                let p = Prefs {
+                    keep_file: true,
+                    ..Prefs::default()
+                };
+                let msg = format!(
+                    "settings {} not read ({e}); using the defaults, and the file is left as it is",
+                    path.display()
+                );
+                return (p, Some(msg));
+            }
         };
-        match serde_json::from_str::<Prefs>(&text) {
-            Ok(p) => (p.sanitized(), None),
-            Err(e) => (Prefs::default(), Some(bad(&path, &e.to_string()))),
+        let (prefs, problems) = Prefs::parse(&bytes, &path);
+        if problems.is_empty() {
+            return (prefs, None);
+        }
+        // Not read whole: keep the file beside before it can ever be replaced.
+        let backup = dir.join(BACKUP_NAME);
+        let kept = match std::fs::write(&backup, &bytes) {
+            Ok(()) => format!("the file is kept as {}", backup.display()),
+            Err(e) => {
+                let p = Prefs {
+                    keep_file: true,
+                    ..prefs
+                };
+                let msg = format!(
+                    "settings {}: {}; and {BACKUP_NAME} cannot be written ({e}): the file is left as it is",
+                    path.display(),
+                    problems.join("; ")
+                );
+                return (p, Some(msg));
+            }
+        };
+        let msg = format!(
+            "settings {}: {}: the rest is read, those take their defaults; {kept}",
+            path.display(),
+            problems.join("; ")
+        );
+        (prefs, Some(msg))
+    }
+
+    /// The settings in a file's bytes, read field by field ([`Prefs::from_fields`]), and
+    /// what did not read (empty when all of it did); `path` names the file in a
+    /// decoder's error. Behind the one containment, as every decoder.
+    pub fn parse(bytes: &[u8], path: &Path) -> (Prefs, Vec<String>) {
+        let parsed = lut_core::contain(path, || {
+            serde_json::from_slice::<serde_json::Value>(bytes).map_err(anyhow::Error::from)
+        });
+        match parsed {
+            Ok(serde_json::Value::Object(fields)) => Prefs::from_fields(fields),
+            Ok(_) => (Prefs::default(), vec!["not a JSON object".to_string()]),
+            Err(e) => (Prefs::default(), vec![format!("{e:#}")]),
         }
     }
 
-    /// Write the settings to `dir` (created if missing), atomically.
+    /// The JSON [`Prefs::save`] writes: the known fields and the kept unknown ones.
     ///
     /// # Errors
-    /// The folder cannot be created or the file written (naming it).
+    /// None in practice (every field serializes).
+    pub fn to_json(&self) -> Result<String> {
+        let mut value = serde_json::to_value(self)?;
+        if let serde_json::Value::Object(m) = &mut value {
+            for (k, v) in &self.extra {
+                m.entry(k.clone()).or_insert_with(|| v.clone());
+            }
+        }
+        Ok(serde_json::to_string_pretty(&value)?)
+    }
+
+    /// The settings from a JSON object's fields, each read on its own: a known field
+    /// whose value does not read (or is out of range) keeps its default and is named in
+    /// the problems; unknown fields go to [`Prefs::extra`].
+    pub fn from_fields(fields: serde_json::Map<String, serde_json::Value>) -> (Prefs, Vec<String>) {
+        let defaults = match serde_json::to_value(Prefs::default()) {
+            Ok(serde_json::Value::Object(m)) => m,
+            _ => serde_json::Map::new(),
+        };
+        let mut accepted = defaults.clone();
+        let mut problems = Vec::new();
+        let mut extra = serde_json::Map::new();
+        for (key, value) in fields {
+            if !defaults.contains_key(&key) {
+                extra.insert(key, value);
+                continue;
+            }
+            let mut trial = accepted.clone();
+            trial.insert(key.clone(), value.clone());
+            match serde_json::from_value::<Prefs>(serde_json::Value::Object(trial)) {
+                Ok(p) if p.clone().sanitized() == p => {
+                    accepted.insert(key, value);
+                }
+                Ok(_) => problems.push(format!("\"{}\" is out of range", lut_core::shown(&key))),
+                Err(e) => problems.push(format!("\"{}\": {e}", lut_core::shown(&key))),
+            }
+        }
+        let mut p: Prefs =
+            serde_json::from_value(serde_json::Value::Object(accepted)).unwrap_or_default();
+        p.extra = extra;
+        (p.sanitized(), problems)
+    }
+
+    /// Write the settings to `dir` (created if missing), atomically, with the fields
+    /// this version does not know as they were read.
+    ///
+    /// # Errors
+    /// The folder cannot be created or the file written (naming it), or the file on disk
+    /// could not be read when loaded (it is never replaced then).
     pub fn save(&self, dir: &Path) -> Result<()> {
+        if self.keep_file {
+            anyhow::bail!(
+                "settings {} not saved: the file could not be read when the window started, \
+                 so it is left as it is",
+                dir.join(FILE_NAME).display()
+            );
+        }
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create the config folder {}", dir.display()))?;
-        let json = serde_json::to_string_pretty(self)?;
+        let json = self.to_json()?;
         crate::output::write_image_atomic(&dir.join(FILE_NAME), |w| {
             w.write_all(json.as_bytes())?;
             Ok(())
@@ -172,13 +294,6 @@ impl Prefs {
     }
 }
 
-fn bad(path: &Path, why: &str) -> String {
-    format!(
-        "settings {} not read ({why}); using the defaults",
-        path.display()
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -202,6 +317,7 @@ mod tests {
             export_scale: 4,
             recent: vec![],
             save_dir: Some(PathBuf::from("/pictures")),
+            ..Prefs::default()
         };
         p.add_recent(PathBuf::from("/a/one.jpg"));
         p.add_recent(PathBuf::from("/a/two.jpg"));
@@ -223,16 +339,21 @@ mod tests {
     fn bad_files_give_the_defaults_and_say_why() {
         let tmp = tempfile::tempdir().unwrap();
         let path = tmp.path().join(FILE_NAME);
+        let bak = tmp.path().join(BACKUP_NAME);
         for (text, why) in [
             ("{not json", "key must be a string"),
+            ("[1, 2]", "not a JSON object"),
             (r#"{"aa": "Sometimes"}"#, "unknown value 'Sometimes'"),
-            (r#"{"colour": 3}"#, "unknown field"),
         ] {
             std::fs::write(&path, text).unwrap();
+            let _ = std::fs::remove_file(&bak);
             let (p, msg) = Prefs::load(tmp.path());
             assert_eq!(p, Prefs::default());
             let msg = msg.expect("a message");
             assert!(msg.contains(FILE_NAME) && msg.contains(why), "{msg}");
+            // Kept beside before anything can replace it.
+            assert_eq!(std::fs::read_to_string(&bak).unwrap(), text);
+            assert!(msg.contains(BACKUP_NAME), "{msg}");
         }
         // Missing fields take their defaults; values out of range are reset.
         std::fs::write(
@@ -241,7 +362,7 @@ mod tests {
         )
         .unwrap();
         let (p, msg) = Prefs::load(tmp.path());
-        assert_eq!(msg, None);
+        assert!(msg.unwrap().contains("out of range"));
         assert!(p.panel);
         let d = Prefs::default();
         assert_eq!(
@@ -251,6 +372,63 @@ mod tests {
         // `null` switches the zoom limit off.
         std::fs::write(&path, r#"{"zoom_limit": null}"#).unwrap();
         assert_eq!(Prefs::load(tmp.path()).0.zoom_limit, None);
+    }
+
+    #[test]
+    fn settings_are_read_field_by_field_and_unknown_fields_kept() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join(FILE_NAME);
+        // One mistyped value, a field from a newer version, and good fields.
+        std::fs::write(
+            &path,
+            r#"{"panel": true, "aa": 7, "recent": ["/a/one.jpg"], "save_dir": "/out",
+                "tours": {"last": "t.json"}, "export_scale": 2}"#,
+        )
+        .unwrap();
+        let (p, msg) = Prefs::load(tmp.path());
+        let msg = msg.expect("the mistyped field is named");
+        assert!(
+            msg.contains("\"aa\"") && !msg.contains("\"panel\""),
+            "{msg}"
+        );
+        assert!(p.panel);
+        assert_eq!(p.aa, Prefs::default().aa);
+        assert_eq!(p.recent, vec![PathBuf::from("/a/one.jpg")]);
+        assert_eq!(p.save_dir, Some(PathBuf::from("/out")));
+        assert_eq!(p.export_scale, 2);
+        assert!(tmp.path().join(BACKUP_NAME).exists());
+        // The unknown field is written back.
+        p.save(tmp.path()).unwrap();
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        assert_eq!(v["tours"]["last"], "t.json");
+        assert_eq!(v["recent"][0], "/a/one.jpg");
+        let (q, msg) = Prefs::load(tmp.path());
+        assert_eq!(msg, None);
+        assert_eq!(q, p);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn an_unreadable_settings_file_never_blocks_and_is_never_replaced() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join(FILE_NAME);
+        let status = std::process::Command::new("mkfifo")
+            .arg(&path)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let dir = tmp.path().to_path_buf();
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || tx.send(Prefs::load(&dir)).unwrap());
+        let (p, msg) = rx
+            .recv_timeout(std::time::Duration::from_secs(10))
+            .expect("a FIFO as settings.json must not block");
+        assert!(msg.unwrap().contains("FIFO"));
+        assert!(p.keep_file);
+        assert!(p.save(tmp.path()).is_err());
+        use std::os::unix::fs::FileTypeExt;
+        assert!(std::fs::metadata(&path).unwrap().file_type().is_fifo());
     }
 
     #[test]

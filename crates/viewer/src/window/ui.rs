@@ -23,6 +23,8 @@ pub const BUTTON_LABELS: [&str; 7] = ["⬆", "⬅", "R", "➡", "⬇", "+", "−
 /// panorama is shown, so nothing of the previous one is left).
 #[derive(Debug, Clone, Default)]
 pub struct Readouts {
+    /// A tiled pyramid's cache counters, tiles pending and the last frame's path.
+    pub tiles: Option<(lut_core::CacheStats, usize, RenderPath)>,
     /// Renderer path of the last rendered frame.
     pub path: Option<RenderPath>,
     /// Bytes of the table(s) in use.
@@ -274,6 +276,8 @@ pub fn path_label(p: Option<RenderPath>) -> &'static str {
         Some(RenderPath::Exact) => "exact (no LUT)",
         Some(RenderPath::Cube(_)) => "cube map",
         Some(RenderPath::CubeProjected) => "cube map (per pixel)",
+        Some(RenderPath::Tiles { coarser: false, .. }) => "tiled pyramid",
+        Some(RenderPath::Tiles { coarser: true, .. }) => "tiled pyramid (tiles loading: coarser)",
         None => "none yet",
     }
 }
@@ -301,13 +305,38 @@ pub fn readout_rows(look: &Look, r: &Readouts) -> Vec<(&'static str, String)> {
         ));
     }
     rows.push(("in use", in_use_label(r)));
+    let coarser = matches!(
+        r.tiles,
+        Some((_, _, RenderPath::Tiles { coarser: true, .. }))
+    );
     rows.push((
         "quality",
         match (r.level, r.sampler) {
+            (Some(l), Some(s)) if coarser => {
+                format!("{} ({}), coarser than wanted", s.name(), l.label())
+            }
             (Some(l), Some(s)) => format!("{} ({})", s.name(), l.label()),
             _ => "none yet".into(),
         },
     ));
+    if let Some((st, pending, path)) = &r.tiles {
+        if let RenderPath::Tiles { level, .. } = path {
+            rows.push(("tile level", format!("{level}")));
+        }
+        rows.push((
+            "tile cache",
+            format!(
+                "{} tiles, {:.1} of {:.0} MiB, hit rate {:.1} %",
+                st.tiles,
+                st.bytes as f64 / 1048576.0,
+                st.budget as f64 / 1048576.0,
+                st.hit_rate() * 100.0
+            ),
+        ));
+        if *pending > 0 {
+            rows.push(("tiles", format!("loading {pending} tiles")));
+        }
+    }
     rows.push(("table", kib(r.table_bytes)));
     if r.pixels > 0 && r.exact_pixels > 0 {
         rows.push((

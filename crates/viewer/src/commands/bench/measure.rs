@@ -8,13 +8,12 @@ use super::configs::{
 use super::export::Export;
 use super::progress;
 use super::report::{Row, RunInfo};
-use crate::scene::{render_scene, SceneRef};
+use crate::scene::render_scene;
 use anyhow::{bail, Context, Result};
 use lut_core::exact_uv;
 use lut_core::position_error;
-use lut_core::CubeMap;
 use lut_core::{
-    Camera, EnvMap, Frame, Named, Projection, Renderer, RendererKind, Sampler, Scene, View,
+    Camera, EnvMap, Frame, Named, Panorama, Projection, Renderer, RendererKind, Sampler, View,
 };
 use rayon::prelude::*;
 use std::path::Path;
@@ -45,7 +44,7 @@ pub struct Ctx<'a> {
     /// The map.
     pub map: &'a EnvMap,
     /// The map converted to a cube (when the cube renderers are measured).
-    pub cube: Option<&'a CubeMap>,
+    pub cube: Option<&'a Panorama>,
     /// The map's pixels unpadded ([`gather_source`]).
     pub src: &'a [u32],
     /// The set.
@@ -125,26 +124,16 @@ fn render_config(
     out: &mut [u32],
 ) -> Result<()> {
     let (w, h) = (ctx.w, ctx.h);
-    let (scene, opts) = match cfg {
+    match cfg {
         Config::Exact(s) => {
             lut_core::render_exact(ctx.map, view, s, &mut Frame::new(out, w, h)?, true);
-            return Ok(());
         }
-        Config::Gather => {
-            gather(ctx.src, idx, out, w as usize, ctx.map.background());
-            return Ok(());
-        }
+        Config::Gather => gather(ctx.src, idx, out, w as usize, ctx.map.background()),
         Config::Lut(..) | Config::LutSurface(..) | Config::Grid(_) => {
             let Some(opts) = position_opts(cfg, ctx.set.table) else {
                 bail!("internal: no options for {cfg:?}");
             };
-            (
-                SceneRef::Map {
-                    map: ctx.map,
-                    renderer,
-                },
-                opts,
-            )
+            renderer.render(ctx.map, view, &opts, &mut Frame::new(out, w, h)?)?;
         }
         Config::Cube(s, r) => {
             let Some(cube) = ctx.cube else {
@@ -156,10 +145,10 @@ fn render_config(
                 threads: true,
                 ..lut_core::RenderOptions::default()
             };
-            (SceneRef::Cube(cube), opts)
+            // A handle on the same faces (an `Arc`): nothing is copied.
+            render_scene(&mut cube.share(), view, &opts, out, w, h)?;
         }
-    };
-    render_scene(scene, view, &opts, out, w, h)?;
+    }
     Ok(())
 }
 
@@ -445,13 +434,13 @@ pub fn minify_set(
         let opts = minify_opts(kind, sampler);
         let (mut err, mut times) = (0u64, Vec::new());
         for (v, truth) in views.iter().zip(&truths) {
-            renderer.render(Scene::Map(map), *v, &opts, &mut Frame::new(&mut out, w, h)?)?;
+            renderer.render(map, *v, &opts, &mut Frame::new(&mut out, w, h)?)?;
             err += sse(&out, truth);
         }
         for _ in 0..passes {
             for v in &views {
                 let t = Instant::now();
-                renderer.render(Scene::Map(map), *v, &opts, &mut Frame::new(&mut out, w, h)?)?;
+                renderer.render(map, *v, &opts, &mut Frame::new(&mut out, w, h)?)?;
                 times.push(t.elapsed().as_secs_f64() * 1e3);
             }
         }
@@ -526,7 +515,8 @@ mod tests {
     #[test]
     fn errors_of_a_small_set() {
         let map = lut_core::grid_map(256, 128, Projection::Equirect).unwrap();
-        let cube = CubeMap::from_envmap(&map, 32, Sampler::Bilinear).unwrap();
+        let cube =
+            Panorama::cube(lut_core::CubeMap::from_envmap(&map, 32, Sampler::Bilinear).unwrap());
         let src = gather_source(&map);
         let set = ViewSet {
             table: lut_core::TableKind::Wide,

@@ -244,10 +244,12 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         let mut tables = Tables::default();
         for (i, kind) in [TableKind::Wide, TableKind::High].into_iter().enumerate() {
             let t = Instant::now();
-            let table = renderer.table(surface, kind);
-            tables.build_ms[i] = t.elapsed().as_secs_f64() * 1e3;
-            tables.bytes[i] = table.bytes();
-            tables.unfolded[i] = table.unfolded_bytes();
+            // (`Renderer::new` gave the renderer the map's geometry: the table is built.)
+            if let Some(table) = renderer.table(surface, kind) {
+                tables.build_ms[i] = t.elapsed().as_secs_f64() * 1e3;
+                tables.bytes[i] = table.bytes();
+                tables.unfolded[i] = table.unfolded_bytes();
+            }
         }
         tables
     };
@@ -270,7 +272,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
             "cube {size}² faces converted in {:.1} s",
             t.elapsed().as_secs_f64()
         ));
-        Some(c)
+        Some(lut_core::Panorama::cube(c))
     };
     let src: Vec<u32> = if a.only_default {
         Vec::new()

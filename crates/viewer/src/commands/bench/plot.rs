@@ -85,7 +85,11 @@ struct PeerRow {
 }
 
 fn read_text(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))
+    // Regular files only (a FIFO never blocks), at most 256 MiB.
+    let bytes = lut_core::read_regular(path, 256 << 20)
+        .map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))?;
+    String::from_utf8(bytes)
+        .map_err(|e| anyhow!("{}: cannot read: not UTF-8 text ({e})", path.display()))
 }
 
 /// The rows a `viewer bench --json` run wrote to `path`.

@@ -67,12 +67,20 @@ impl App {
         let spawned = std::thread::Builder::new()
             .name("viewer-load".into())
             .spawn(move || {
-                let result = crate::window::loader::load(req, &mut |step, fraction| {
-                    let _ = proxy.send_event(AppEvent::Load(LoadEvent::Progress {
-                        id,
-                        step,
-                        fraction,
-                    }));
+                // Behind the one containment: a panic anywhere in the loading (a decoder,
+                // the tables) is this load's error, shown by the window, never a thread
+                // that dies and a progress bar that waits for ever.
+                let result = lut_core::catch_quiet(|| {
+                    crate::window::loader::load(req, &mut |step, fraction| {
+                        let _ = proxy.send_event(AppEvent::Load(LoadEvent::Progress {
+                            id,
+                            step,
+                            fraction,
+                        }));
+                    })
+                })
+                .unwrap_or_else(|panic| {
+                    Err(format!("loading failed (an internal error: {panic})"))
                 });
                 let _ = proxy.send_event(AppEvent::Load(LoadEvent::Done { id, result }));
             });
@@ -359,7 +367,7 @@ impl App {
             .render_lit(
                 &mut self.lit,
                 false,
-                cur.scene.as_mut(),
+                &mut cur.scene,
                 view,
                 &opts,
                 &mut buf,

@@ -3,7 +3,7 @@
 //! with egui, and decide when the next frame is due.
 
 use super::{App, SceneKey};
-use crate::scene::{measure_errors, render_scene, render_scene_lit, SceneRef};
+use crate::scene::{measure_errors, render_scene, render_scene_lit};
 use crate::window::dialogs::Chosen;
 use crate::window::input::{resolution_hfov, wheel_notches, Held, Look, WIDE_HFOV_MAX};
 use crate::window::keys::{KeyAction, Route};
@@ -420,10 +420,6 @@ impl App {
         let Some(cur) = self.doc.current_mut() else {
             return;
         };
-        if let SceneRef::Map { renderer, .. } = cur.scene.as_mut() {
-            renderer.set_bilinear_level(bilinear_level);
-            renderer.set_still_level(true);
-        }
         fit(&mut self.scene, rect.w as usize * rect.h as usize);
         let t0 = Instant::now();
         let view = look.view();
@@ -442,10 +438,12 @@ impl App {
             _ => None,
         };
         let lit_while_drawn = shader.is_some();
-        let scene = match self.baked.scene_ref(&mut cur.scene) {
+        let scene = match self.baked.copy_mut() {
             Some(lit_copy) if from_baked => lit_copy,
-            _ => cur.scene.as_mut(),
+            _ => &mut cur.scene,
         };
+        scene.set_bilinear_level(bilinear_level);
+        scene.set_still_level(true);
         let result = if k == 1 {
             render_scene_lit(
                 scene,
@@ -487,9 +485,23 @@ impl App {
         }
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         self.times.record(level, ms, pixels);
-        // A frame read from a pyramid level is not the still frame: one is due.
-        self.ctl.rendered(degraded || bilinear_level);
+        // A frame read from a pyramid level is not the still frame: one is due. A frame of
+        // a tiled pyramid drawn coarser than wanted (tiles still decoding) is redrawn too.
+        let tiles_loading = matches!(report.path, RenderPath::Tiles { coarser: true, .. });
+        self.ctl
+            .rendered(degraded || bilinear_level || tiles_loading);
         self.renders.push_back(Instant::now());
+        let tiles = match self.doc.current().and_then(|c| c.scene.tiles_status()) {
+            Some((stats, pending, notices)) => {
+                // One notice per tile that could not be decoded (drawn from its ancestor).
+                for n in notices {
+                    let t = self.now();
+                    self.notices.error(n, t);
+                }
+                Some((stats, pending))
+            }
+            None => None,
+        };
         let r = &mut self.doc.readouts;
         r.table_bytes = report.table_bytes;
         r.exact_pixels = report.exact_pixels;
@@ -509,10 +521,11 @@ impl App {
         };
         r.render_ms = ms;
         r.scene = (rect.w, rect.h);
+        r.tiles = tiles.map(|(stats, pending)| (stats, pending, report.path));
         r.level = Some(level);
         r.sampler = Some(opts.sampler);
         r.full_ms = self.times.full_ms(pixels);
-        self.scene_key = Some(key);
+        self.scene_key = (!tiles_loading).then_some(key);
         if self.print_view {
             let _ = crate::outln!(
                 "view yaw={:.4} pitch={:.4} hfov={:.4} path={path} sampler={} level={} fast={} \
@@ -550,7 +563,7 @@ impl App {
             return;
         };
         let (sw, sh) = (rect.w.div_ceil(k), rect.h.div_ceil(k));
-        match measure_errors(cur.scene.as_mut(), view, opts, sw, sh) {
+        match measure_errors(&mut cur.scene, view, opts, sw, sh) {
             Ok(em) => {
                 let colors = em.colors();
                 if k == 1 {

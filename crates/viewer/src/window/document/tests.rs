@@ -2,7 +2,6 @@
 //! (or failed, or superseded), drops, errors kept and cleared, what the readouts show.
 
 use super::*;
-use crate::scene::Scene;
 use lut_core::Projection;
 use std::path::Path;
 
@@ -14,7 +13,7 @@ fn file(name: &str) -> Source {
 fn loaded(source: Source, w: u32, hdr: bool, exposure_ev: f64) -> Box<Loaded> {
     let map = lut_core::grid_map(w, w / 2, Projection::Equirect).unwrap();
     Box::new(Loaded {
-        scene: Scene::map(map),
+        scene: lut_core::Panorama::map(map),
         source,
         projection: None,
         hdr,
@@ -215,6 +214,35 @@ fn a_failed_first_load_opens_the_sample_and_keeps_the_error() {
 }
 
 #[test]
+fn a_failed_sample_after_a_failed_load_does_not_loop() {
+    // Issue 32: a missing file (as any damaged one) falls back to the sample; when the
+    // sample fails too (a loader panic turned into an error), the error stays on show
+    // and no further load starts: never a loop of loads or an endless progress bar.
+    let mut d = Document::new(None, 1000, None);
+    let r = request(d.open(file("missing.jpg"), None, StartArgs::default(), 0.0));
+    let fx = d.on_event(done(r.id, Err("missing.jpg: No such file".into())), 0.0);
+    let sample = loads(&fx)[0].clone();
+    assert_eq!(sample.source, Source::Sample);
+    let fx = d.on_event(
+        done(
+            sample.id,
+            Err("loading failed (an internal error: x)".into()),
+        ),
+        0.0,
+    );
+    assert!(loads(&fx).is_empty(), "no second fallback: {fx:?}");
+    assert_eq!(d.error(), Some("loading failed (an internal error: x)"));
+    // Messages are escaped and shortened like every echoed line.
+    let r = request(d.open(file("b.png"), None, StartArgs::default(), 0.0));
+    d.on_event(done(r.id, Err("b\u{1b}[2J.png\nbad".into())), 0.0);
+    assert!(
+        !d.error().unwrap().chars().any(char::is_control),
+        "{:?}",
+        d.error()
+    );
+}
+
+#[test]
 fn the_next_success_clears_a_kept_error() {
     let mut d = doc();
     let r = request(d.open(file("bad.png"), None, StartArgs::default(), 0.0));
@@ -337,16 +365,14 @@ fn opened_files_start_at_their_own_view_reloads_keep_it() {
     };
     let r = request(d.open(file("a.jpg"), None, args, 0.0));
     // The file's own start view, partly overridden by the command line.
+    let mut map = lut_core::grid_map(64, 32, Projection::Equirect).unwrap();
+    map.set_start_view(Some(StartView {
+        yaw_deg: -100.0,
+        pitch_deg: 12.0,
+        hfov_deg: Some(70.0),
+    }));
     let mut a = loaded(file("a.jpg"), 64, false, 0.0);
-    if let Scene::Map { map, .. } = &mut a.scene {
-        std::sync::Arc::get_mut(map)
-            .unwrap()
-            .set_start_view(Some(StartView {
-                yaw_deg: -100.0,
-                pitch_deg: 12.0,
-                hfov_deg: Some(70.0),
-            }));
-    }
+    a.scene = lut_core::Panorama::map(map);
     let fx = d.on_event(done(r.id, Ok(a)), 0.0);
     let want = StartView {
         yaw_deg: 30.0,
