@@ -61,6 +61,7 @@ const NOT_NUMERIC: &[&str] = &[
     "--error-map",
     "--index-step",
     "--lut-surface",
+    "--tour",
 ];
 
 /// One command and its cheap base arguments (`{iso}`, `{png}`, `{out}` replaced).
@@ -86,6 +87,10 @@ const LIGHT_OPTS: &[(&str, &[&str])] = &[
     ("--room-yaw", &["{}"]),
     ("--room-center", &["{},0", "0,{}"]),
     ("--light-multiplier", &["{}"]),
+    (
+        "--reflectances",
+        &["{},0.5,0.7", "0.2,{},0.7", "0.2,0.5,{}"],
+    ),
 ];
 
 const RENDER_OPTS: &[(&str, &[&str])] = &[
@@ -103,6 +108,9 @@ const RENDER_OPTS: &[(&str, &[&str])] = &[
     ("--exposure-lux", &["{}"]),
     ("--ambient", &["{}"]),
     ("--false-color-max", &["{}"]),
+    ("--cache-mib", &["{}"]),
+    ("--horizon-pitch", &["{}"]),
+    ("--horizon-roll", &["{}"]),
 ];
 
 fn commands() -> Vec<Cmd> {

@@ -67,7 +67,7 @@ pub(crate) fn check_jpeg_size(
 /// "motion photo", does not matter), or `None` when the data ends first.
 #[cfg(test)]
 pub(crate) fn end_of_image(bytes: &[u8]) -> Option<usize> {
-    walk(bytes).0
+    walk(bytes).eoi
 }
 
 /// The bytes of entropy-coded image data in `bytes` (every scan's, up to the end marker
@@ -75,13 +75,23 @@ pub(crate) fn end_of_image(bytes: &[u8]) -> Option<usize> {
 /// segments or after the image does not count.
 #[cfg(test)]
 pub(crate) fn scan_bytes(bytes: &[u8]) -> u64 {
-    walk(bytes).1
+    walk(bytes).scan
 }
 
-/// Walk the segments and scans: the end marker's offset (if reached) and the bytes of
-/// entropy-coded data seen.
-fn walk(bytes: &[u8]) -> (Option<usize>, u64) {
+/// What [`walk`] finds in a JPEG stream.
+struct Walk {
+    /// The end marker's offset, if the stream reaches it.
+    eoi: Option<usize>,
+    /// Bytes of entropy-coded data seen.
+    scan: u64,
+    /// A progressive frame header (SOF2, SOF6, SOF10, SOF14) was seen.
+    progressive: bool,
+}
+
+/// Walk the segments and scans.
+fn walk(bytes: &[u8]) -> Walk {
     let mut scan = 0u64;
+    let mut progressive = false;
     let eoi = (|| {
         if !bytes.starts_with(&[0xFF, 0xD8]) {
             return None;
@@ -103,6 +113,9 @@ fn walk(bytes: &[u8]) -> (Option<usize>, u64) {
                     continue;
                 }
                 _ => {}
+            }
+            if matches!(marker, 0xC2 | 0xC6 | 0xCA | 0xCE) {
+                progressive = true;
             }
             let len = usize::from(u16::from_be_bytes([*bytes.get(i + 2)?, *bytes.get(i + 3)?]));
             i += 2 + len;
@@ -130,7 +143,11 @@ fn walk(bytes: &[u8]) -> (Option<usize>, u64) {
             }
         }
     })();
-    (eoi, scan)
+    Walk {
+        eoi,
+        scan,
+        progressive,
+    }
 }
 
 /// Zero bytes put after the image data in place of the end marker ([`prepare`]): more
@@ -144,13 +161,19 @@ const PAD: usize = 16;
 /// strict mode — and "decodes" the missing rows as a repeated pattern; with no marker it
 /// reaches the end of the buffer instead, which strict mode refuses. So a header claiming
 /// more lines than the data holds is an error naming the file (at most [`PAD`] bytes of
-/// zero bits, a few blocks of the last row, can go unnoticed). Returns the bytes of
-/// entropy-coded data ([`scan_bytes`]).
+/// zero bits, a few blocks of the last row, can go unnoticed). A progressive file keeps its
+/// end marker (the decoder finishes its scans there and refuses a stream without one;
+/// every scan covers the whole image, so a missing scan is missing detail, not rows).
+/// Returns the bytes of entropy-coded data ([`scan_bytes`]).
 ///
 /// # Errors
 /// [`MapError::Decode`] naming `what` when the stream ends before its end marker.
 pub(crate) fn prepare(bytes: &mut Vec<u8>, what: &str) -> Result<u64, MapError> {
-    let (eoi, scan) = walk(bytes);
+    let Walk {
+        eoi,
+        scan,
+        progressive,
+    } = walk(bytes);
     let Some(eoi) = eoi else {
         return Err(MapError::Decode {
             path: what.into(),
@@ -160,7 +183,7 @@ pub(crate) fn prepare(bytes: &mut Vec<u8>, what: &str) -> Result<u64, MapError> 
             ),
         });
     };
-    bytes.truncate(eoi);
+    bytes.truncate(if progressive { eoi + 2 } else { eoi });
     bytes.extend_from_slice(&[0; PAD]);
     Ok(scan)
 }
