@@ -3,7 +3,7 @@
 
 use crate::error::ViewError;
 use crate::geom::limits::MAX_OUTPUT_SIDE;
-use crate::geom::view_projection::ViewProjection;
+use crate::geom::view_projection::{ViewProjection, PANNINI_D_MAX};
 use glam::DVec3;
 
 /// A validated view: angles in degrees as the user gives them, normalized, and the
@@ -56,6 +56,73 @@ impl View {
             projection,
         })
     }
+
+    /// A rectilinear view from any angles: the infallible form of [`View::new`]. Yaw is
+    /// wrapped into (−180, 180], pitch clamped to [−90, 90] and hfov into the projection's
+    /// range, as [`View::clamped_in`] does.
+    pub fn clamped(yaw_deg: f64, pitch_deg: f64, hfov_deg: f64) -> View {
+        View::clamped_in(yaw_deg, pitch_deg, hfov_deg, ViewProjection::Rectilinear)
+    }
+
+    /// A view in `projection` from any angles: the infallible form of
+    /// [`View::with_projection`]. Yaw is wrapped into (−180, 180], pitch clamped to
+    /// [−90, 90], hfov clamped to [[`View::HFOV_MIN`], the widest the projection takes]
+    /// (just short of it where that end is open), and a Pannini d into
+    /// [0, [`PANNINI_D_MAX`]].
+    ///
+    /// Angles that are not numbers do not pass through: a NaN yaw or pitch (and an
+    /// infinite yaw, which has no direction) becomes 0, a NaN hfov the default view's
+    /// 90° (clamped as above), a NaN Pannini d 0. Infinite pitch and hfov clamp to their
+    /// ends. The result always holds finite, in-range angles, so
+    /// [`View::with_projection`] accepts them unchanged.
+    pub fn clamped_in(
+        yaw_deg: f64,
+        pitch_deg: f64,
+        hfov_deg: f64,
+        projection: ViewProjection,
+    ) -> View {
+        let projection = match projection {
+            ViewProjection::Pannini(d) if d.is_nan() => ViewProjection::Pannini(0.0),
+            ViewProjection::Pannini(d) => ViewProjection::Pannini(d.clamp(0.0, PANNINI_D_MAX)),
+            p => p,
+        };
+        let yaw = if yaw_deg.is_finite() {
+            wrap_deg(yaw_deg)
+        } else {
+            0.0
+        };
+        let pitch = if pitch_deg.is_nan() {
+            0.0
+        } else {
+            pitch_deg.clamp(-90.0, 90.0)
+        };
+        let hfov = if hfov_deg.is_nan() { 90.0 } else { hfov_deg };
+        let (max, _) = projection.hfov_max();
+        let mut hfov = hfov.clamp(View::HFOV_MIN, max);
+        if projection.check(hfov).is_err() {
+            // Past the widest end (open, or where the focal length vanishes): the widest
+            // accepted hfov below it, by bisection from the narrowest (always accepted).
+            let (mut ok, mut bad) = (View::HFOV_MIN, hfov);
+            for _ in 0..64 {
+                let mid = 0.5 * (ok + bad);
+                if projection.check(mid).is_ok() {
+                    ok = mid;
+                } else {
+                    bad = mid;
+                }
+            }
+            hfov = ok;
+        }
+        View {
+            yaw,
+            pitch,
+            hfov,
+            projection,
+        }
+    }
+
+    /// The narrowest hfov [`View::clamped`] gives, degrees.
+    pub const HFOV_MIN: f64 = 1e-3;
 
     /// This view in another output projection (same yaw, pitch and hfov).
     ///
@@ -276,6 +343,76 @@ pub fn lat_long_to_dir(lambda: f64, phi: f64) -> DVec3 {
     let (sl, cl) = lambda.sin_cos();
     let (sp, cp) = phi.sin_cos();
     DVec3::new(cp * sl, sp, cp * cl)
+}
+
+#[cfg(test)]
+mod clamped_tests {
+    use super::*;
+
+    /// `View::clamped` wraps yaw into (−180, 180] and clamps pitch and hfov, agreeing with
+    /// `View::new` wherever that accepts the angles.
+    #[test]
+    fn clamped_wraps_and_clamps() {
+        let v = View::clamped(540.0, 100.0, 200.0);
+        assert_eq!((v.yaw_deg(), v.pitch_deg()), (180.0, 90.0));
+        assert!(
+            v.hfov_deg() < 180.0 && v.hfov_deg() > 179.9,
+            "{}",
+            v.hfov_deg()
+        );
+        let v = View::clamped(-190.0, -95.0, 0.0);
+        assert_eq!((v.yaw_deg(), v.pitch_deg()), (170.0, -90.0));
+        assert_eq!(v.hfov_deg(), View::HFOV_MIN);
+        assert_eq!(View::clamped(-180.0, 0.0, 90.0).yaw_deg(), 180.0);
+        for (y, p, h) in [
+            (10.0, 20.0, 90.0),
+            (-179.5, -89.0, 1.0),
+            (725.0, 45.0, 179.0),
+        ] {
+            assert_eq!(
+                View::clamped(y, p, h),
+                View::new(y, p, h).unwrap(),
+                "{y} {p} {h}"
+            );
+        }
+        // The widest end of each projection: accepted by the fallible form.
+        for p in [
+            ViewProjection::Rectilinear,
+            ViewProjection::Stereographic,
+            ViewProjection::Pannini(1.0),
+            ViewProjection::Pannini(f64::INFINITY),
+        ] {
+            let v = View::clamped_in(0.0, 0.0, f64::INFINITY, p);
+            let back = View::with_projection(0.0, 0.0, v.hfov_deg(), v.projection());
+            assert_eq!(back, Ok(v), "{p:?}");
+            assert!(
+                v.hfov_deg() > 0.99 * v.projection().hfov_max().0,
+                "{p:?} {v:?}"
+            );
+        }
+    }
+
+    /// NaN does not pass through: it becomes the documented value, every angle of the
+    /// result is finite, and the fallible form accepts it.
+    #[test]
+    fn clamped_replaces_nan() {
+        let nan = f64::NAN;
+        let v = View::clamped(nan, nan, nan);
+        assert_eq!((v.yaw_deg(), v.pitch_deg(), v.hfov_deg()), (0.0, 0.0, 90.0));
+        let v = View::clamped(f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY);
+        assert_eq!((v.yaw_deg(), v.pitch_deg()), (0.0, -90.0));
+        assert!(v.hfov_deg().is_finite());
+        let v = View::clamped_in(30.0, nan, 400.0, ViewProjection::Pannini(nan));
+        assert_eq!(v.projection(), ViewProjection::Pannini(0.0));
+        assert_eq!((v.yaw_deg(), v.pitch_deg()), (30.0, 0.0));
+        for v in [v, View::clamped(nan, 1.0, 1.0)] {
+            assert!(v.yaw_deg().is_finite() && v.pitch_deg().is_finite());
+            assert!(v.hfov_deg().is_finite());
+            let back =
+                View::with_projection(v.yaw_deg(), v.pitch_deg(), v.hfov_deg(), v.projection());
+            assert_eq!(back, Ok(v));
+        }
+    }
 }
 
 #[cfg(test)]

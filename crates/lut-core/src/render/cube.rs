@@ -38,7 +38,7 @@
 
 use super::exact::render_exact;
 use super::frame::Frame;
-use super::kernel::{active, FaceBuf, FaceRun, Texels};
+use super::kernel::{active, ChunkWeights, FaceBuf, FaceRun, Texels};
 use super::rows::{rows_per_task, Loan};
 use super::setup::check_step;
 use super::{RenderOptions, RenderPath, RenderReport};
@@ -318,7 +318,11 @@ impl Fetch for TrilinearFetch {
         let blended = |c: usize| (fracs[c] != 0).then_some(levels[c].1);
         for (k, cs) in same_runs(levels.len(), blended) {
             let (t, sub, px) = on(k, &cs);
-            active().face_rows_blend(&t, &sub, &mut out[px], (C, &fracs[cs]), buf);
+            let w = ChunkWeights {
+                chunk: C,
+                fracs: &fracs[cs],
+            };
+            active().face_rows_blend(&t, &sub, &mut out[px], w, buf);
         }
         (buf.levels, buf.fracs) = (levels, fracs);
     }
@@ -434,7 +438,7 @@ fn render_with<S: Fetch>(
             let y = bi * rows_per_band + r;
             match renderer {
                 CubeRenderer::Basic => basic_row(cube, frame, s, y, line),
-                CubeRenderer::Accelerated => accel_row(cube, frame, s, y, line, (segs, buf)),
+                CubeRenderer::Accelerated => accel_row(cube, frame, s, y, line, segs, buf),
             }
         }
     };
@@ -531,7 +535,8 @@ fn accel_row<S: Fetch>(
     s: S,
     y: usize,
     line: &mut [u32],
-    (segs, buf): (&mut Vec<Seg>, &mut FaceBuf),
+    segs: &mut Vec<Seg>,
+    buf: &mut FaceBuf,
 ) {
     let w = line.len();
     let p = frame.row(frame.dy(y));

@@ -6,6 +6,7 @@
 
 use super::frame::Frame;
 use super::rows::for_each_row;
+use super::setup::MapGeometry;
 use crate::geom::camera::{Camera, View};
 use crate::geom::fixed::to_fx;
 use crate::geom::mapping::{exact_uv, exact_uv_at};
@@ -61,13 +62,13 @@ pub(crate) struct ExactFootprint {
 }
 
 impl ExactFootprint {
-    /// For `view` of a `map_w × map_h` map in `proj` on a `width × height` output.
-    pub(crate) fn new(view: View, width: u32, height: u32, map: (u32, u32, Projection)) -> Self {
+    /// For `view` of `map` on a `width × height` output.
+    pub(crate) fn new(view: View, width: u32, height: u32, map: MapGeometry) -> Self {
         ExactFootprint {
             cam: Camera::new(view, width, height),
-            proj: map.2,
-            mw: map.0 as f64,
-            mh: map.1 as f64,
+            proj: map.projection,
+            mw: map.width as f64,
+            mh: map.height as f64,
         }
     }
 

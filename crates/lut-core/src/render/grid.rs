@@ -70,7 +70,7 @@
 //! the exact pixels and the smallest and largest cell side (in `min_step`/`max_step`).
 
 use super::scanline::emit;
-use super::setup::Setup;
+use super::setup::{Lv, LvStep, Setup};
 use super::sink::{RowSinks, Sink};
 use crate::geom::accuracy::u_scale;
 use crate::geom::camera::{Camera, View};
@@ -200,6 +200,16 @@ impl Valid {
             }
         }
     }
+}
+
+/// An interpolated cell to draw: its top-left pixel (`x0`, `y0`), its side `g` in
+/// pixels, and its corner nodes `k` (as [`Leaf::Interp`]).
+#[derive(Debug, Clone, Copy)]
+struct InterpCell {
+    x0: u32,
+    y0: u32,
+    g: u32,
+    k: [(f64, f64); 4],
 }
 
 /// What a cell becomes.
@@ -565,7 +575,13 @@ impl<'a> Grid<'a> {
             let xs = x0 as usize..((x0 + cg).min(self.w)) as usize;
             match leaf {
                 Leaf::Interp(k) => {
-                    self.draw_interp(rows, w, y0, (x0, cy0, cg), k, sinks, footprint);
+                    let cell = InterpCell {
+                        x0,
+                        y0: cy0,
+                        g: cg,
+                        k,
+                    };
+                    self.draw_interp(rows, w, y0, cell, sinks, footprint);
                 }
                 Leaf::Exact(px) => {
                     for r in ys {
@@ -638,17 +654,16 @@ impl<'a> Grid<'a> {
 
     /// Draw an interpolated cell: each of its rows one span from the left edge's
     /// position to (one pixel short of) the right edge's.
-    #[allow(clippy::too_many_arguments)]
     fn draw_interp<R: RowSinks>(
         &self,
         rows: &mut [R::Px],
         w: usize,
         band_y0: u32,
-        (x0, y0, g): (u32, u32, u32),
-        k: [(f64, f64); 4],
+        cell: InterpCell,
         sinks: &R,
         footprint: bool,
     ) {
+        let InterpCell { x0, y0, g, k } = cell;
         let gf = g as f64;
         let m = (x0 + g).min(self.w) - x0;
         let fp = if footprint {
@@ -683,8 +698,14 @@ impl<'a> Grid<'a> {
                 self.row_scale,
                 x0 as i64,
                 m as i64,
-                (to_fx(left.0), to_fx(left.1)),
-                (to_fx(step.0), to_fx(step.1)),
+                Lv {
+                    l: to_fx(left.0),
+                    v: to_fx(left.1),
+                },
+                LvStep {
+                    dl: to_fx(step.0),
+                    dv: to_fx(step.1),
+                },
                 &mut s,
             );
         }

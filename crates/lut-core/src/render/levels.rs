@@ -32,9 +32,9 @@
 
 use crate::geom::camera::View;
 use crate::geom::mapping::exact_uv_at;
-use crate::geom::projection::Projection;
 use crate::map::envmap::EnvMap;
 use crate::render::exact::ExactFootprint;
+use crate::render::setup::MapGeometry;
 #[cfg(doc)]
 use crate::render::Renderer;
 use std::f64::consts::TAU;
@@ -105,7 +105,7 @@ pub(crate) fn frame_min_footprint(
     view: View,
     width: u32,
     height: u32,
-    geometry: (u32, u32, Projection),
+    geometry: MapGeometry,
 ) -> f64 {
     let fp = ExactFootprint::new(view, width, height, geometry);
     let at = |x: f64, y: f64| -> Option<f64> {
@@ -138,6 +138,7 @@ mod tests {
     use crate::geom::mapping::exact_uv_at;
     use crate::geom::projection::Projection;
     use crate::render::exact::ExactFootprint;
+    use crate::render::setup::MapGeometry;
 
     /// The smallest footprint of a frame, sampled on 17 × 9 points, against the minimum
     /// over every pixel centre of the frame: never more than 3 % above it (the samples
@@ -147,7 +148,11 @@ mod tests {
     /// it is the one the brute-force minimum gives.
     #[test]
     fn frame_min_footprint_is_the_frames_smallest() {
-        let geometry = (2048, 1024, Projection::Equirect);
+        let geometry = MapGeometry {
+            width: 2048,
+            height: 1024,
+            projection: Projection::Equirect,
+        };
         for (yaw, pitch, hfov, w, h) in [
             (10.0, 0.0, 90.0, 64, 48),
             (0.0, 45.0, 100.0, 96, 64),

@@ -59,7 +59,7 @@ use kernel::{level_texels, texels};
 use rowpass::{pixel_row, position_row, tri_row, LutRow};
 use rows::{for_each_band_init, for_each_row, for_each_row_init, post_bands};
 use scanline::{RowScratch, ScratchLoan, ROW_SCALE_ONE};
-use setup::{check_step, prepare, Scan, Setup};
+use setup::{check_step, prepare, MapGeometry, Scan, Setup};
 use sink::{Batch, PixelRows, PosRows, RowSinks, TriRows, TriSink};
 use std::sync::Arc;
 
@@ -72,7 +72,7 @@ pub use options::*;
 pub struct Renderer {
     /// The tables built so far (shared with the renderers made by [`Renderer::share`]).
     tables: Vec<(Surface, TableKind, Arc<LutTable>)>,
-    geometry: Option<(u32, u32, Projection)>,
+    geometry: Option<MapGeometry>,
     scans: Vec<Scan>,
     /// Row scale per map row (Q.30: multiplied by Λ up to W/2, so Q.16 would lose up to
     /// 0.06 px), for elliptical and diamond maps.
@@ -88,7 +88,8 @@ pub struct Renderer {
     level: Option<Box<Renderer>>,
 }
 
-/// The table of `surface` and `kind` among `tables` (built by [`Renderer::table`]).
+/// The table of `surface` and `kind` among `tables` (built by [`Renderer::table`]; every
+/// caller builds it first, with the geometry set, so the look-up always finds it).
 fn find(
     tables: &[(Surface, TableKind, Arc<LutTable>)],
     surface: Surface,
@@ -105,7 +106,7 @@ impl Renderer {
     /// A renderer for `map`'s geometry. Tables are built on first use and kept.
     pub fn new(map: &EnvMap) -> Renderer {
         let mut r = Renderer::default();
-        r.set_geometry(map.width(), map.height(), map.projection());
+        r.set_geometry(geometry_of(map));
         r
     }
 
@@ -157,11 +158,12 @@ impl Renderer {
         self.still_level
     }
 
-    fn set_geometry(&mut self, w: u32, h: u32, p: Projection) {
-        if self.geometry == Some((w, h, p)) {
+    fn set_geometry(&mut self, g: MapGeometry) {
+        if self.geometry == Some(g) {
             return;
         }
-        self.geometry = Some((w, h, p));
+        self.geometry = Some(g);
+        let (h, p) = (g.height, g.projection);
         self.tables.clear();
         self.row_scale.clear();
         if p.scaled_rows() {
@@ -190,7 +192,11 @@ impl Renderer {
     /// geometry; `None` before it has one (a `Renderer::default()` that has drawn no
     /// frame: [`Renderer::new`] sets it, and so does each frame).
     pub fn table(&mut self, surface: Surface, kind: TableKind) -> Option<&LutTable> {
-        let (w, h, p) = self.geometry?;
+        let MapGeometry {
+            width: w,
+            height: h,
+            projection: p,
+        } = self.geometry?;
         let i = match self
             .tables
             .iter()
@@ -251,17 +257,19 @@ impl Renderer {
         (k > 0).then(|| map.level(k).0)
     }
 
-    /// Per-frame setup for the geometry set last: builds the table `opts` selects (if
-    /// needed) and fills one [`Scan`] per row (see `setup.rs`).
+    /// Per-frame setup for `geometry` (set with `Renderer::set_geometry` before):
+    /// builds the table `opts` selects (if needed) and fills one [`Scan`] per row (see
+    /// `setup.rs`).
     fn prepare_frame(
         &mut self,
+        geometry: MapGeometry,
         view: View,
         opts: &RenderOptions,
         width: u32,
         height: u32,
     ) -> (Setup, RenderReport) {
         let kind = Self::table_kind(view, opts);
-        let geometry = self.geometry.expect("geometry set before a frame");
+        debug_assert_eq!(self.geometry, Some(geometry));
         let _ = self.table(opts.surface, kind);
         let table = find(&self.tables, opts.surface, kind);
         prepare(
@@ -364,11 +372,12 @@ impl Renderer {
             render_exact(map, view, opts.sampler, frame, opts.threads);
             return Ok((RenderReport::exact(pixels), false));
         }
-        self.set_geometry(map.width(), map.height(), map.projection());
+        let geometry = geometry_of(map);
+        self.set_geometry(geometry);
         if uses_grid(view, opts) {
             return Ok((self.render_grid(map, view, opts, frame), false));
         }
-        let (setup, report) = self.prepare_frame(view, opts, width, height);
+        let (setup, report) = self.prepare_frame(geometry, view, opts, width, height);
         let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
@@ -431,7 +440,7 @@ impl Renderer {
                     fr: setup,
                     row_scale,
                 };
-                pixel_row::<BILINEAR, CROP>(lut, scratch, (map, &t), row);
+                pixel_row::<BILINEAR, CROP>(lut, scratch, map, &t, row);
             };
             match hook {
                 Some(post) => {
@@ -508,8 +517,13 @@ impl Renderer {
         threads: bool,
     ) -> Result<RenderReport, ViewError> {
         check_size(width, height)?;
-        self.set_geometry(map_w, map_h, projection);
-        let setup = Setup::new(width, (map_w, map_h, projection), 0.0);
+        let geometry = MapGeometry {
+            width: map_w,
+            height: map_h,
+            projection,
+        };
+        self.set_geometry(geometry);
+        let setup = Setup::new(width, geometry, 0.0);
         let grid = Grid::new(view, width, height, &setup, &self.row_scale);
         Ok(grid_report(grid.build(threads), width, height))
     }
@@ -534,7 +548,12 @@ impl Renderer {
     ) -> Result<(Positions, RenderReport), ViewError> {
         check_size(width, height)?;
         check_step(opts.index_step)?;
-        self.set_geometry(map_w, map_h, projection);
+        let geometry = MapGeometry {
+            width: map_w,
+            height: map_h,
+            projection,
+        };
+        self.set_geometry(geometry);
         let pixels = width as u64 * height as u64;
         let mut out = vec![None; pixels as usize];
         if opts.renderer == RendererKind::Exact {
@@ -548,12 +567,12 @@ impl Renderer {
             return Ok((out, RenderReport::exact(pixels)));
         }
         if uses_grid(view, opts) {
-            let setup = Setup::new(width, (map_w, map_h, projection), 0.0);
+            let setup = Setup::new(width, geometry, 0.0);
             let grid = Grid::new(view, width, height, &setup, &self.row_scale);
             let stats = grid.render(&mut out, &PosRows, opts.threads, false);
             return Ok((out, grid_report(stats, width, height)));
         }
-        let (setup, report) = self.prepare_frame(view, opts, width, height);
+        let (setup, report) = self.prepare_frame(geometry, view, opts, width, height);
         let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
@@ -586,9 +605,13 @@ pub(crate) fn run_hook(frame: &mut Frame<'_>, opts: &RenderOptions, hook: BandHo
     post_bands(frame.pixels_mut(), w, HOOK_BAND_ROWS, opts.threads, hook);
 }
 
-/// The map geometry the renderers use: (width, height, projection) of the full panorama.
-fn geometry_of(map: &EnvMap) -> (u32, u32, Projection) {
-    (map.width(), map.height(), map.projection())
+/// The map geometry the renderers use: the full panorama's.
+fn geometry_of(map: &EnvMap) -> MapGeometry {
+    MapGeometry {
+        width: map.width(),
+        height: map.height(),
+        projection: map.projection(),
+    }
 }
 
 /// True when the grid draws a map frame: asked for, or a view the table cannot draw.

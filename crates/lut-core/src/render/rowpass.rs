@@ -19,15 +19,15 @@
 //! The pixels sample exactly the positions [`row_pass`] writes; `Renderer::positions`
 //! reads the same buffers, so the measured sampling error is this pass's.
 
-use super::kernel::{active, wrap_q8, Level, SpanQ8, Texels};
+use super::kernel::{active, wrap_q8, Level, Q16Start, Q16Step, SpanAt, SpanQ8, Texels};
 use super::scanline::{blend_pays, render_row, with_nodes};
-use super::scanline::{RowScratch, Scratch, BLEND_NODES};
-use super::setup::{Scan, Setup, Unfold};
+use super::scanline::{RowScratch, BLEND_NODES};
+use super::setup::{Lv, LvStep, Scan, Setup, Unfold};
 use super::sink::Sink;
 use super::sink::{PixelSink, PosSink, TriSink};
 use super::steps::STEP_REGIONS;
 use super::walk::{read_at, span_step, wrap_u, Half, HalfBuf, HalfRun, HALF_CHUNK};
-use crate::geom::fixed::{Fx, FX_ONE};
+use crate::geom::fixed::FX_ONE;
 use crate::lut::LutTable;
 use crate::map::envmap::EnvMap;
 use crate::map::sample::lerp_px;
@@ -44,10 +44,14 @@ pub(crate) fn row_pass<S: Sink>(
     scan: &Scan,
     table: &LutTable,
     fr: &Setup,
-    (scratch, buf): (&mut Scratch, &mut HalfBuf),
+    scratch: &mut RowScratch,
     sink: &mut S,
     mut run: impl FnMut(&mut S, HalfRun<'_>),
 ) {
+    let RowScratch {
+        nodes: scratch,
+        row: buf,
+    } = scratch;
     let Some(h) = Half::exact_rest(scan, fr, sink) else {
         return;
     };
@@ -91,14 +95,18 @@ pub(crate) fn row_pass<S: Sink>(
             let lim = step_limit(fr, n as usize);
             while d + n <= stop {
                 c += dc;
-                let p1 = un.apply(nodes.lookup_q(c));
-                let (l1, step) = span_step(fr, p0, p1, n, shift);
+                let p1 = un.apply(nodes.lookup_q(c).into());
+                let (p1, step) = span_step(fr, p0, p1, n, shift);
                 if S::LOD {
-                    let lod = sink.span_lod(step.0, step.1, r);
+                    let lod = sink.span_lod(step, r);
                     buf.push_lod((d - c0) as u32, lod);
                 }
-                fill_within(fr, buf, ((d - c0) as usize, n as usize), p0, step, lim);
-                p0 = (l1, p1.1);
+                let at = BufSpan {
+                    k: (d - c0) as usize,
+                    m: n as usize,
+                };
+                fill_within(fr, buf, at, p0, step, lim);
+                p0 = p1;
                 d += n;
                 if d - c0 >= HALF_CHUNK as i64 {
                     flush(buf, sink, c0, d - c0);
@@ -110,13 +118,17 @@ pub(crate) fn row_pass<S: Sink>(
                 let d1 = (d + n).min(dn);
                 let p1 = read_at(scan, nodes, &h, &un, d1);
                 let m = d1 - d;
-                let (l1, step) = span_step(fr, p0, p1, m, shift);
+                let (p1, step) = span_step(fr, p0, p1, m, shift);
                 if S::LOD {
-                    let lod = sink.span_lod(step.0, step.1, r);
+                    let lod = sink.span_lod(step, r);
                     buf.push_lod((d - c0) as u32, lod);
                 }
-                fill(fr, buf, (d - c0) as usize, m as usize, p0, step);
-                p0 = (l1, p1.1);
+                let at = BufSpan {
+                    k: (d - c0) as usize,
+                    m: m as usize,
+                };
+                fill(fr, buf, at, p0, step);
+                p0 = p1;
                 d = d1;
                 if d - c0 >= HALF_CHUNK as i64 {
                     flush(buf, sink, c0, d - c0);
@@ -126,23 +138,36 @@ pub(crate) fn row_pass<S: Sink>(
         }
         // The last pixel, a span of one.
         if S::LOD {
-            let lod = sink.span_lod(0, 0, r);
+            let lod = sink.span_lod(LvStep::default(), r);
             buf.push_lod((d - c0) as u32, lod);
         }
-        fill(fr, buf, (d - c0) as usize, 1, p0, (0, 0));
+        let at = BufSpan {
+            k: (d - c0) as usize,
+            m: 1,
+        };
+        fill(fr, buf, at, p0, LvStep::default());
         flush(buf, sink, c0, d + 1 - c0);
     });
 }
 
-/// Q.8 positions of `m` pixels from (Λ, V) by (dΛ, dV) (Q.16) at `k` of `buf`: u =
-/// Λ + W/2 + yaw wrapped into [0, W) at the start, v = H/2 − V, and the mirror image's
-/// u = W/2 + yaw − Λ (`Setup::mirror_fx` − u). Recorded as a span for
-/// `kernel::expand` (`i32` lanes relative to the starts' whole Q.8 values); a span that
-/// travels too far for them (a map width or more: far zoomed out on a tiny map) is
+/// Where a span's pixels go in the half-row buffers: `m` pixels from position `k`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BufSpan {
+    /// The first pixel's position in the buffers.
+    pub(crate) k: usize,
+    /// Pixels.
+    pub(crate) m: usize,
+}
+
+/// Q.8 positions of `at.m` pixels from `start` (Λ, V) by `step` (dΛ, dV) (Q.16) at
+/// `at.k` of `buf`: u = Λ + W/2 + yaw wrapped into [0, W) at the start, v = H/2 − V, and
+/// the mirror image's u = W/2 + yaw − Λ (`Setup::mirror_fx` − u). Recorded as a span
+/// for `kernel::expand` (`i32` lanes relative to the starts' whole Q.8 values); a span
+/// that travels too far for them (a map width or more: far zoomed out on a tiny map) is
 /// written here, u wrapped per pixel.
 #[inline(always)]
-fn fill(fr: &Setup, buf: &mut HalfBuf, k: usize, m: usize, (l, vv): (Fx, Fx), step: (Fx, Fx)) {
-    fill_within(fr, buf, (k, m), (l, vv), step, step_limit(fr, m));
+fn fill(fr: &Setup, buf: &mut HalfBuf, at: BufSpan, start: Lv, step: LvStep) {
+    fill_within(fr, buf, at, start, step, step_limit(fr, at.m));
 }
 
 /// The largest |dΛ|, |dV| (Q.16 per pixel) a span of `m` pixels may step and still be
@@ -157,14 +182,10 @@ fn step_limit(fr: &Setup, m: usize) -> u64 {
 
 /// [`fill`] with the span's [`step_limit`] given.
 #[inline(always)]
-fn fill_within(
-    fr: &Setup,
-    buf: &mut HalfBuf,
-    (k, m): (usize, usize),
-    (l, vv): (Fx, Fx),
-    (dl, dvv): (Fx, Fx),
-    lim: u64,
-) {
+fn fill_within(fr: &Setup, buf: &mut HalfBuf, at: BufSpan, start: Lv, step: LvStep, lim: u64) {
+    let BufSpan { k, m } = at;
+    let Lv { l, v: vv } = start;
+    let LvStep { dl, dv: dvv } = step;
     let wfx = fr.map_w_fx;
     let mut u = wrap_u(l + fr.off_fx, wfx);
     // (As unsigned: below 0 or from W on.)
@@ -181,7 +202,14 @@ fn fill_within(
     // Lanes run up to 16 past the span. (|v| < 2³², as table entries and H/2 are i32:
     // v >> 8 fits.)
     if dl.unsigned_abs().max(dv.unsigned_abs()) <= lim {
-        buf.spans[buf.n_spans] = SpanQ8::from_q16((k, m), (u, v, ul), (dl, dv));
+        buf.spans[buf.n_spans] = SpanQ8::from_q16(
+            SpanAt {
+                k: k as u32,
+                m: m as u32,
+            },
+            Q16Start { u, v, ul },
+            Q16Step { du: dl, dv },
+        );
         buf.n_spans += 1;
         return;
     }
@@ -219,7 +247,8 @@ pub(crate) struct LutRow<'a> {
 pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
     lut: LutRow<'_>,
     scratch: &mut RowScratch,
-    (map, t): (&EnvMap, &Texels<'_>),
+    map: &EnvMap,
+    t: &Texels<'_>,
     row: &mut [u32],
 ) {
     let LutRow {
@@ -235,9 +264,8 @@ pub(crate) fn pixel_row<const BILINEAR: bool, const CROP: bool>(
         return;
     }
     let wq = (map.width() as i32) << 8;
-    let RowScratch { nodes, row: buf } = scratch;
     let t = &t.toward_next_scanline(scan.next_dv);
-    row_pass(scan, table, fr, (nodes, buf), &mut s, |s, r| {
+    row_pass(scan, table, fr, scratch, &mut s, |s, r| {
         let n = r.u.len();
         if CROP {
             crop_run(s, t, wq, r);
@@ -266,16 +294,15 @@ pub(crate) fn tri_row(lut: LutRow<'_>, scratch: &mut RowScratch, s: &mut TriSink
     }
     let levels = s.levels;
     let wq = (s.map.width() as i32) << 8;
-    let RowScratch { nodes, row: buf } = scratch;
     if s.map.crop().is_some() {
         let (map, crop) = (s.map, crop_levels(s.map, levels));
-        row_pass(scan, table, fr, (nodes, buf), s, |s, r| {
+        row_pass(scan, table, fr, scratch, s, |s, r| {
             crop_tri_run(map, &crop, wq, r, s.row);
         });
         return;
     }
     let dv = scan.next_dv;
-    row_pass(scan, table, fr, (nodes, buf), s, |s, r| {
+    row_pass(scan, table, fr, scratch, s, |s, r| {
         tri_run(levels, wq, dv, r, s.row);
     });
 }
@@ -304,7 +331,7 @@ fn resolve(lod: i32, last: usize) -> (usize, u32) {
 /// `EnvMap::trilinear` at the position (u wrapped into the map) with the span's level of
 /// detail.
 fn tri_run(levels: &[Texels], wq: i32, dv: i32, r: HalfRun<'_>, row: &mut [u32]) {
-    tri_groups(levels.len() - 1, r, row, |k, w, (u, v), out| {
+    tri_groups(levels.len() - 1, r, row, |k, w, Uv { u, v }, out| {
         let t = &levels[k].toward_next_scanline(dv);
         let lv = Level {
             k: k as u32,
@@ -329,14 +356,22 @@ enum Out<'a> {
     Right(&'a mut [u32]),
 }
 
-/// The grouping of [`tri_run`] over levels `0..=last`: `pass(k, w, (u, v), out)` samples
-/// level k bilinearly at the level-0 positions (u, v) into `out`, written (`w` `None`)
+/// The level-0 positions of a group of [`tri_groups`] (Q.8, indexed alike; the left
+/// half's u for its pass).
+#[derive(Debug, Clone, Copy)]
+struct Uv<'a> {
+    u: &'a [i32],
+    v: &'a [i32],
+}
+
+/// The grouping of [`tri_run`] over levels `0..=last`: `pass(k, w, uv, out)` samples
+/// level k bilinearly at the level-0 positions `uv` into `out`, written (`w` `None`)
 /// or blended in by the weights `w` (one per position).
 fn tri_groups(
     last: usize,
     r: HalfRun<'_>,
     row: &mut [u32],
-    mut pass: impl FnMut(usize, Option<&[u32]>, (&[i32], &[i32]), Out<'_>),
+    mut pass: impl FnMut(usize, Option<&[u32]>, Uv<'_>, Out<'_>),
 ) {
     let n = r.u.len();
     let segs = r.segs;
@@ -351,8 +386,8 @@ fn tri_groups(
         let (a, b) = (segs[i].start as usize, end(e));
         let (u, ul, v) = (&r.u[a..b], &r.ul[a..b], &r.v[a..b]);
         let (left, right) = (r.left_end - b..r.left_end - a, r.right + a..r.right + b);
-        pass(ka, None, (ul, v), Out::Left(&mut row[left]));
-        pass(ka, None, (u, v), Out::Right(&mut row[right]));
+        pass(ka, None, Uv { u: ul, v }, Out::Left(&mut row[left]));
+        pass(ka, None, Uv { u, v }, Out::Right(&mut row[right]));
         // The second level over the segments from the first to the last with a weight.
         let weighted = |j: &usize| resolve(segs[*j].lod, last).1 != 0;
         let (Some(f), Some(l)) = ((i..e).find(weighted), (i..e).rev().find(weighted)) else {
@@ -371,8 +406,8 @@ fn tri_groups(
         let w = Some(&r.w[..b - a]);
         let (u, ul, v) = (&r.u[a..b], &r.ul[a..b], &r.v[a..b]);
         let (left, right) = (r.left_end - b..r.left_end - a, r.right + a..r.right + b);
-        pass(ka + 1, w, (ul, v), Out::Left(&mut row[left]));
-        pass(ka + 1, w, (u, v), Out::Right(&mut row[right]));
+        pass(ka + 1, w, Uv { u: ul, v }, Out::Left(&mut row[left]));
+        pass(ka + 1, w, Uv { u, v }, Out::Right(&mut row[right]));
     }
 }
 
@@ -460,15 +495,15 @@ impl<'a> CropLevel<'a> {
 /// chunk by chunk: a chunk whose samples all read stored texels away from the stored
 /// rectangle's edge goes to the row kernels at positions moved onto the texels, one
 /// wholly in the background is the background, the others go per pixel.
-#[allow(clippy::too_many_arguments)]
 fn crop_level_pass<const MIRROR: bool, const BLEND: bool>(
     map: &EnvMap,
     lv: &CropLevel<'_>,
     wq: i32,
-    (u, v): (&[i32], &[i32]),
+    uv: Uv<'_>,
     w: &[u32],
     out: &mut [u32],
 ) {
+    let Uv { u, v } = uv;
     let n = out.len();
     let bg = map.background();
     let (mut su, mut sv) = ([0i32; CROP_CHUNK], [0i32; CROP_CHUNK]);
@@ -624,8 +659,7 @@ pub(crate) fn position_row(
         render_row(scan, table, fr, row_scale, &mut scratch.nodes, &mut s);
         return;
     };
-    let RowScratch { nodes, row: buf } = scratch;
-    row_pass(scan, table, fr, (nodes, buf), &mut s, |s, r| {
+    row_pass(scan, table, fr, scratch, &mut s, |s, r| {
         // As the row kernels sample them: Q.8, u wrapped into the map; the left half
         // first (the centre pixel of an odd width is the right half's).
         let px = |u: i32, v: i32| Some((u.rem_euclid(wq) as f64 / 256.0, v as f64 / 256.0));

@@ -5,9 +5,9 @@
 //! steps continuously. The rest (pole zones, beyond the table) is evaluated exactly.
 //! Spans go to a [`Sink`].
 
-use super::kernel::active;
+use super::kernel::{active, SpanJob};
 use super::rows::Loan;
-use super::setup::{Scan, Setup, Unfold};
+use super::setup::{Lv, LvStep, Scan, Setup, Unfold};
 use super::sink::Sink;
 use super::steps::STEP_REGIONS;
 use super::walk::{read_at, span_step, wrap_u, Half, HalfBuf, Nodes};
@@ -76,10 +76,11 @@ pub(crate) fn render_row<S: Sink>(
     };
     with_nodes!(scan, table, &h, scratch, |nodes| {
         let mut spans = RightSpans::new(scan, nodes, fr, &h);
-        while let Some((d, m, p0, step, r)) = spans.next(scan, fr) {
-            sink.footprint(step.0, step.1, r);
-            emit_mirror(fr, row_scale, w - h.xa - d - m, m, p0, step, sink);
-            emit(fr, row_scale, h.xa + d, m, p0, step, sink);
+        while let Some(s) = spans.next(scan, fr) {
+            let (d, m) = (s.d, s.m);
+            sink.footprint(s.step, s.region);
+            emit_mirror(fr, row_scale, w - h.xa - d - m, m, s.start, s.step, sink);
+            emit(fr, row_scale, h.xa + d, m, s.start, s.step, sink);
         }
     });
 }
@@ -155,17 +156,33 @@ pub(super) fn blend_pays(scan: &Scan, nodes: usize, pixels: usize) -> bool {
     4 * nodes * 256 * STEP_REGIONS <= quarters * pixels * per_256
 }
 
+/// One span of a half: pixels `xa + d..xa + d + m`, starting at `start` and stepping by
+/// `step` per pixel, in step region `region`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RightSpan {
+    /// The first pixel's offset from the half's first pixel.
+    pub(super) d: i64,
+    /// Pixels.
+    pub(super) m: i64,
+    /// (Λ, V) at the first pixel.
+    pub(super) start: Lv,
+    /// (dΛ, dV) per pixel.
+    pub(super) step: LvStep,
+    /// The step region the span lies in.
+    pub(super) region: usize,
+}
+
 /// The right half's spans, outward from its first pixel: [`RightSpans::next`] gives
-/// `(d, m, (Λ, V), (dΛ, dV), region)` for pixels `xa + d..xa + d + m` (Λ unwrapped
-/// from span to span), the last pixel as a span of one with no step. (An iterator the
-/// callers loop over, rather than a closure: it stays inlined.)
+/// each [`RightSpan`] (Λ unwrapped from span to span), the last pixel as a span of one
+/// with no step. (An iterator the callers loop over, rather than a closure: it stays
+/// inlined.)
 pub(super) struct RightSpans<'n, N: Nodes> {
     nodes: &'n N,
     h: Half,
     u: Unfold,
     d: i64,
     r: usize,
-    p0: (Fx, Fx),
+    p0: Lv,
     done: bool,
 }
 
@@ -184,20 +201,21 @@ impl<'n, N: Nodes> RightSpans<'n, N> {
         }
     }
 
-    #[allow(clippy::type_complexity)]
     #[inline(always)]
-    pub(super) fn next(
-        &mut self,
-        scan: &Scan,
-        fr: &Setup,
-    ) -> Option<(i64, i64, (Fx, Fx), (Fx, Fx), usize)> {
+    pub(super) fn next(&mut self, scan: &Scan, fr: &Setup) -> Option<RightSpan> {
         let (d, h) = (self.d, &self.h);
         if d == h.dn {
             if self.done {
                 return None;
             }
             self.done = true;
-            return Some((d, 1, self.p0, (0, 0), self.r));
+            return Some(RightSpan {
+                d,
+                m: 1,
+                start: self.p0,
+                step: LvStep::default(),
+                region: self.r,
+            });
         }
         while self.r + 1 < STEP_REGIONS && d >= h.e[self.r + 1] {
             self.r += 1;
@@ -206,11 +224,17 @@ impl<'n, N: Nodes> RightSpans<'n, N> {
         let d1 = (d + (1 << shift)).min(h.dn);
         let p1 = read_at(scan, self.nodes, h, &self.u, d1);
         let m = d1 - d;
-        let p0 = self.p0;
-        let (l1, step) = span_step(fr, p0, p1, m, shift);
+        let start = self.p0;
+        let (p1, step) = span_step(fr, start, p1, m, shift);
         self.d = d1;
-        self.p0 = (l1, p1.1);
-        Some((d, m, p0, step, self.r))
+        self.p0 = p1;
+        Some(RightSpan {
+            d,
+            m,
+            start,
+            step,
+            region: self.r,
+        })
     }
 }
 
@@ -222,12 +246,19 @@ fn emit_mirror<S: Sink>(
     row_scale: &[i64],
     x: i64,
     m: i64,
-    (l, vv): (Fx, Fx),
-    (dl, dvv): (Fx, Fx),
+    start: Lv,
+    step: LvStep,
     sink: &mut S,
 ) {
-    let (l_end, v_end) = (l + (m - 1) * dl, vv + (m - 1) * dvv);
-    emit(fr, row_scale, x, m, (-l_end, v_end), (dl, -dvv), sink);
+    let end = Lv {
+        l: -(start.l + (m - 1) * step.dl),
+        v: start.v + (m - 1) * step.dv,
+    };
+    let step = LvStep {
+        dl: step.dl,
+        dv: -step.dv,
+    };
+    emit(fr, row_scale, x, m, end, step, sink);
 }
 
 /// Emit `m` pixels from `x` on, starting at (Λ, V) and stepping by (dΛ, dV) (also the
@@ -238,12 +269,12 @@ pub(crate) fn emit<S: Sink>(
     row_scale: &[i64],
     x: i64,
     m: i64,
-    start: (Fx, Fx),
-    step: (Fx, Fx),
+    start: Lv,
+    step: LvStep,
     sink: &mut S,
 ) {
-    let (l, vv) = start;
-    let (dl, dvv) = step;
+    let Lv { l, v: vv } = start;
+    let LvStep { dl, dv: dvv } = step;
     // v = H/2 − V
     let mut v = fr.half_map_h_fx - vv;
     let dv = -dvv;
@@ -282,7 +313,15 @@ pub(crate) fn emit<S: Sink>(
             v += dv;
         }
     } else {
-        sink.span(x, m, u, v, dl, dv, wfx);
+        let job = SpanJob {
+            x: x as u32,
+            len: m as u32,
+            u,
+            v,
+            du: dl,
+            dv,
+        };
+        sink.span(job, wfx);
     }
 }
 

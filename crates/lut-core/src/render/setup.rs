@@ -5,7 +5,7 @@
 //! (near a pole, or beyond the table's field of view), and for trilinear sampling its
 //! vertical footprint. Yaw is one column offset added to u.
 
-use super::steps::{step_for, StepBounds, ADAPTIVE_MAX_STEP, STEP_REGIONS};
+use super::steps::{step_for, StepBounds, StepLine, XRange, ADAPTIVE_MAX_STEP, STEP_REGIONS};
 use super::{IndexStep, RenderOptions, RenderPath, RenderReport};
 use crate::error::ViewError;
 use crate::geom::camera::{Camera, View};
@@ -14,6 +14,46 @@ use crate::geom::projection::Projection;
 use crate::lut::{LutTable, Surface, TableKind};
 use crate::map::sample::Sampler;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+/// The map a renderer draws from, as its geometry: the full panorama's size in pixels
+/// and its projection (a partial map's full size).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct MapGeometry {
+    /// Width in pixels.
+    pub(crate) width: u32,
+    /// Height in pixels.
+    pub(crate) height: u32,
+    /// The map's projection.
+    pub(crate) projection: Projection,
+}
+
+/// A point of the table's plane: Λ (map pixels of longitude from the view's centre
+/// column, yaw 0) and V (map pixels above the horizon), both Q.16.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct Lv {
+    /// Λ, Q.16 map pixels.
+    pub(crate) l: Fx,
+    /// V, Q.16 map pixels.
+    pub(crate) v: Fx,
+}
+
+impl From<(Fx, Fx)> for Lv {
+    /// A table read `(Λ, V)` ([`crate::lut::Band::lookup_q`]).
+    #[inline(always)]
+    fn from((l, v): (Fx, Fx)) -> Lv {
+        Lv { l, v }
+    }
+}
+
+/// The per-pixel step of a span in the table's plane: dΛ and dV, Q.16 map pixels per
+/// output pixel.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct LvStep {
+    /// dΛ per pixel, Q.16.
+    pub(crate) dl: Fx,
+    /// dV per pixel, Q.16.
+    pub(crate) dv: Fx,
+}
 
 /// Per-scanline setup, computed once per frame.
 #[derive(Debug, Clone, Copy, Default)]
@@ -78,9 +118,10 @@ pub(crate) struct Setup {
 }
 
 impl Setup {
-    /// The constants of a frame `w_out` pixels wide of a `mw × mh` map in `proj`, turned
-    /// by `yaw` radians (0 for renderers whose positions already include the yaw).
-    pub(crate) fn new(w_out: u32, (mw, mh, proj): (u32, u32, Projection), yaw: f64) -> Setup {
+    /// The constants of a frame `w_out` pixels wide of `map`, turned by `yaw` radians (0
+    /// for renderers whose positions already include the yaw).
+    pub(crate) fn new(w_out: u32, map: MapGeometry, yaw: f64) -> Setup {
+        let (mw, mh, proj) = (map.width, map.height, map.projection);
         let (mwf, mhf) = (mw as f64, mh as f64);
         let yaw_px = yaw / TAU * mwf;
         Setup {
@@ -112,7 +153,7 @@ const PARALLEL_SETUP_ROWS: usize = 64;
 pub(crate) fn prepare(
     table: &LutTable,
     kind: TableKind,
-    (mw, mh, proj): (u32, u32, Projection),
+    map: MapGeometry,
     scans: &mut Vec<Scan>,
     view: View,
     opts: &RenderOptions,
@@ -121,8 +162,9 @@ pub(crate) fn prepare(
 ) -> (Setup, RenderReport) {
     let cam = Camera::new(view, width, height);
     let f = cam.focal;
-    let (mwf, mhf) = (mw as f64, mh as f64);
-    let frame = Setup::new(width, (mw, mh, proj), view.yaw());
+    let (mwf, mhf) = (map.width as f64, map.height as f64);
+    let proj = map.projection;
+    let frame = Setup::new(width, map, view.yaw());
     let nominal = match opts.index_step {
         IndexStep::Fixed(n) => n,
         IndexStep::Adaptive => ADAPTIVE_MAX_STEP,
@@ -213,12 +255,19 @@ pub(crate) fn prepare(
                 scan.zone_hi = zh;
                 t_min = xz * scan.t_per_x;
             }
-            let (sn, c) = (a.sin().abs(), a.cos().abs());
+            let line = StepLine {
+                s: a.sin().abs(),
+                c: a.cos().abs(),
+                t_min,
+                dt: scan.t_per_x,
+            };
             let reg_x = half_w / STEP_REGIONS as f64;
             for (r, shift) in scan.shifts.iter_mut().enumerate() {
-                let (x_lo, x_hi) = (r as f64 * reg_x, (r + 1) as f64 * reg_x);
-                let (dt, hint) = (scan.t_per_x, 1 << hint[r]);
-                let n = step_for(&bounds, (sn, c), t_min, x_lo, x_hi, dt, nominal, hint);
+                let xs = XRange {
+                    lo: r as f64 * reg_x,
+                    hi: (r + 1) as f64 * reg_x,
+                };
+                let n = step_for(&bounds, line, xs, nominal, 1 << hint[r]);
                 *shift = n.trailing_zeros() as u8;
             }
         }
@@ -297,13 +346,12 @@ fn vertical_footprints(scans: &mut [Scan], table: &LutTable, fr: &Setup, threads
             };
             *f = match other {
                 Some(o) if usable(row) && usable(o) => {
-                    let (l0, v0) = read(row, table, fr, x);
-                    let (l1, v1) = read(o, table, fr, x);
-                    let mut dl = (l1 - l0).unsigned_abs() as i64;
+                    let (p0, p1) = (read(row, table, fr, x), read(o, table, fr, x));
+                    let mut dl = (p1.l - p0.l).unsigned_abs() as i64;
                     if dl > fr.half_map_w_fx {
                         dl = (fr.map_w_fx - dl).abs();
                     }
-                    (dl.max((v1 - v0).abs()) as f64 / FX_ONE as f64) as f32
+                    (dl.max((p1.v - p0.v).abs()) as f64 / FX_ONE as f64) as f32
                 }
                 _ => (row.row_angle * px_per_rad) as f32,
             };
@@ -367,11 +415,11 @@ fn exact_count(s: &Scan, w: i64) -> u64 {
 
 /// Unfolded table read at pixel x: (Λ, V) in Q.16 for the yaw-0 frame.
 #[inline]
-pub(crate) fn read(scan: &Scan, table: &LutTable, fr: &Setup, x: i64) -> (Fx, Fx) {
+pub(crate) fn read(scan: &Scan, table: &LutTable, fr: &Setup, x: i64) -> Lv {
     let a = 2 * x + 1 - fr.w_out as i64;
     let band = table.band(scan.band, scan.wa);
     let u = Unfold::new(scan, fr, a < 0);
-    u.apply(band.lookup_q(a.abs() * scan.node_per_2x))
+    u.apply(band.lookup_q(a.abs() * scan.node_per_2x).into())
 }
 
 /// The one-eighth unfolding of one half of a scanline, hoisted out of its reads: Λ =
@@ -397,11 +445,11 @@ impl Unfold {
     }
 
     #[inline(always)]
-    pub(crate) fn apply(&self, (l, v): (Fx, Fx)) -> (Fx, Fx) {
-        (
-            ((l ^ self.neg_l) - self.neg_l) + self.off_l,
-            (v ^ self.neg_v) - self.neg_v,
-        )
+    pub(crate) fn apply(&self, p: Lv) -> Lv {
+        Lv {
+            l: ((p.l ^ self.neg_l) - self.neg_l) + self.off_l,
+            v: (p.v ^ self.neg_v) - self.neg_v,
+        }
     }
 }
 

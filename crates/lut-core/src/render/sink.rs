@@ -6,8 +6,9 @@
 use super::exact::{sample_at, sample_at_lod, ExactFootprint};
 use super::kernel::{
     nearest_span_direct, sample_span_cropped, sample_spans, texels, trilinear_spans, SpanJob,
-    Steps, Texels, MAX_JOBS,
+    Texels, MAX_JOBS,
 };
+use super::setup::LvStep;
 use super::steps::STEP_REGIONS;
 use super::walk::wrap_u;
 use crate::geom::fixed::{from_fx, Fx, FX_ONE};
@@ -18,26 +19,25 @@ use crate::map::sample::Sampler;
 /// Where a renderer writes: pixels, or (for measurement) sampling positions.
 pub(crate) trait Sink {
     fn put(&mut self, x: usize, u: Fx, v: Fx);
-    /// `m` pixels from `x` on at (u + i·du, v + i·dv), u wrapped per pixel into [0, W)
-    /// (`w_fx` = W in Q.16); v inside the map.
-    #[allow(clippy::too_many_arguments)]
+    /// The span `s`: `s.len` pixels from `s.x` on at (u + i·du, v + i·dv), u wrapped per
+    /// pixel into [0, W) (`w_fx` = W in Q.16); v inside the map.
     #[inline(always)]
-    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, w_fx: Fx) {
-        put_run(self, x, m, (u, v), (du, dv), w_fx);
+    fn span(&mut self, s: SpanJob, w_fx: Fx) {
+        put_run(self, s, w_fx);
     }
     fn background(&mut self, x: usize);
     fn exact(&mut self, x: usize, uv: Option<(f64, f64)>);
     /// The per-pixel step (dΛ, dV) of the span about to be emitted (its horizontal
     /// footprint): the trilinear sink picks its pyramid level from it.
     #[inline(always)]
-    fn footprint(&mut self, _dl: Fx, _dv: Fx, _region: usize) {}
+    fn footprint(&mut self, _step: LvStep, _region: usize) {}
     /// Whether the row pass asks this sink for each span's level of detail
     /// ([`Sink::span_lod`]: the trilinear sink).
     const LOD: bool = false;
     /// The level of detail (Q.8) of a span with step (dΛ, dV) in `region` (as
     /// [`Sink::footprint`] sets it).
     #[inline(always)]
-    fn span_lod(&mut self, _dl: Fx, _dv: Fx, _region: usize) -> i32 {
+    fn span_lod(&mut self, _step: LvStep, _region: usize) -> i32 {
         0
     }
     /// The pixel footprint (level-0 map pixels) of the spans that follow, known as a whole
@@ -69,24 +69,16 @@ impl Batch {
 
     /// Queue a span with its level of detail (trilinear); `true` when the batch is full
     /// (flush it).
-    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn push_lod(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, lod: i32) -> bool {
+    fn push_lod(&mut self, s: SpanJob, lod: i32) -> bool {
         self.lods[self.n] = lod;
-        self.push(x, m, u, v, du, dv)
+        self.push(s)
     }
 
     /// Queue a span (nearest or bilinear: no level); `true` when the batch is full.
     #[inline(always)]
-    fn push(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx) -> bool {
-        self.jobs[self.n] = SpanJob {
-            x: x as u32,
-            len: m as u32,
-            u,
-            v,
-            du,
-            dv,
-        };
+    fn push(&mut self, s: SpanJob) -> bool {
+        self.jobs[self.n] = s;
         self.n += 1;
         self.n == MAX_JOBS
     }
@@ -113,19 +105,13 @@ impl Batch {
 
 /// [`Sink::span`] pixel by pixel through [`Sink::put`].
 #[inline(always)]
-pub(crate) fn put_run<S: Sink + ?Sized>(
-    s: &mut S,
-    x: usize,
-    m: usize,
-    uv: (Fx, Fx),
-    d: (Fx, Fx),
-    w_fx: Fx,
-) {
-    let (mut u, mut v) = uv;
+pub(crate) fn put_run<S: Sink + ?Sized>(s: &mut S, job: SpanJob, w_fx: Fx) {
+    let (x, m) = (job.x as usize, job.len as usize);
+    let (mut u, mut v) = (job.u, job.v);
     for i in 0..m {
         s.put(x + i, wrap_u(u, w_fx), v);
-        u += d.0;
-        v += d.1;
+        u += job.du;
+        v += job.dv;
     }
 }
 
@@ -175,15 +161,14 @@ impl<const BILINEAR: bool, const CROP: bool> Sink for PixelSink<'_, BILINEAR, CR
         };
     }
     #[inline(always)]
-    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, _w_fx: Fx) {
+    fn span(&mut self, s: SpanJob, _w_fx: Fx) {
+        let (x, m) = (s.x as usize, s.len as usize);
         if CROP {
-            let steps = Steps { u, v, du, dv };
-            sample_span_cropped::<BILINEAR>(self.map, &mut self.row[x..x + m], steps);
+            sample_span_cropped::<BILINEAR>(self.map, &mut self.row[x..x + m], s.steps());
         } else if !BILINEAR && m < NEAREST_DIRECT {
             let out = &mut self.row[x..x + m];
-            let steps = Steps { u, v, du, dv };
-            nearest_span_direct(self.map, self.texels.as_ref(), out, steps);
-        } else if self.batch.push(x, m, u, v, du, dv) {
+            nearest_span_direct(self.map, self.texels.as_ref(), out, s.steps());
+        } else if self.batch.push(s) {
             self.batch.flush::<BILINEAR>(self.map, self.row);
         }
     }
@@ -245,13 +230,13 @@ impl Sink for TriSink<'_> {
         self.row[x] = self.map.trilinear(u, v, self.lod);
     }
     #[inline(always)]
-    fn span(&mut self, x: usize, m: usize, u: Fx, v: Fx, du: Fx, dv: Fx, w_fx: Fx) {
+    fn span(&mut self, s: SpanJob, w_fx: Fx) {
         if self.map.crop.is_some() {
             // A partial map: per pixel (`EnvMap::trilinear` reads its levels as the
             // padded full map's; the span kernels know full maps only).
-            return put_run(self, x, m, (u, v), (du, dv), w_fx);
+            return put_run(self, s, w_fx);
         }
-        if self.batch.push_lod(x, m, u, v, du, dv, self.lod) {
+        if self.batch.push_lod(s, self.lod) {
             self.batch.flush_trilinear(self.map, self.levels, self.row);
         }
     }
@@ -273,14 +258,14 @@ impl Sink for TriSink<'_> {
         self.row[x] = sample_at_lod(self.map, uv, lod);
     }
     #[inline(always)]
-    fn footprint(&mut self, dl: Fx, dv: Fx, region: usize) {
-        let fx = dl.unsigned_abs().max(dv.unsigned_abs()) as f64 / FX_ONE as f64;
+    fn footprint(&mut self, step: LvStep, region: usize) {
+        let fx = step.dl.unsigned_abs().max(step.dv.unsigned_abs()) as f64 / FX_ONE as f64;
         self.set_lod(lod_q8(fx.max(self.fy[region] as f64)));
     }
     const LOD: bool = true;
     #[inline(always)]
-    fn span_lod(&mut self, dl: Fx, dv: Fx, region: usize) -> i32 {
-        self.footprint(dl, dv, region);
+    fn span_lod(&mut self, step: LvStep, region: usize) -> i32 {
+        self.footprint(step, region);
         self.lod
     }
     #[inline(always)]

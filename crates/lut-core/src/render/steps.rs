@@ -26,9 +26,28 @@ pub(crate) struct StepBounds {
     pub(crate) coupling: f64,
 }
 
+/// A scanline as the step bounds see it (see [`step_for`]): its folded angle a as
+/// `s` = |sin a| and `c` = |cos a|, `dt` the change of t per pixel, and `t_min` the |t|
+/// below which pixels are evaluated exactly (the pole zone; 0 for none).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepLine {
+    pub(crate) s: f64,
+    pub(crate) c: f64,
+    pub(crate) t_min: f64,
+    pub(crate) dt: f64,
+}
+
+/// Where a region's spans start: |X| ∈ [`lo`, `hi`], pixels from the screen's centre
+/// column.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct XRange {
+    pub(crate) lo: f64,
+    pub(crate) hi: f64,
+}
+
 /// The longest power-of-two step ≤ `nominal` whose linear-interpolation error is bounded
-/// by [`SPAN_ERROR_BUDGET`] for every span that starts at |X| ∈ [x_lo, x_hi] (pixels from
-/// the screen's centre column) on this scanline.
+/// by [`SPAN_ERROR_BUDGET`] for every span that starts in `xs` = |X| ∈ [x_lo, x_hi]
+/// (pixels from the screen's centre column) on the scanline `line`.
 ///
 /// Along a scanline at folded angle `a` (s = sin a, c = cos a) the direction is
 /// (t, s, c), λ = atan2(t, c), φ = atan2(s, ρ) with ρ = √(t²+c²), and t = X/ρ_screen
@@ -47,20 +66,10 @@ pub(crate) struct StepBounds {
 /// top) and is the same as from the top: a step that fits makes every shorter one fit
 /// (its interval lies inside the longer one's, so its bound is no larger, up to
 /// rounding, while its error term is a quarter).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn step_for(
-    b: &StepBounds,
-    sc: (f64, f64),
-    t_min: f64,
-    x_lo: f64,
-    x_hi: f64,
-    dt: f64,
-    nominal: u32,
-    hint: u32,
-) -> u32 {
+pub(crate) fn step_for(b: &StepBounds, line: StepLine, xs: XRange, nominal: u32, hint: u32) -> u32 {
     debug_assert!(nominal.is_power_of_two() && hint.is_power_of_two());
     let top = nominal.max(1);
-    let fits = |n: u32| step_fits(b, sc, t_min, (x_lo, x_hi), dt, n);
+    let fits = |n: u32| step_fits(b, line, xs, n);
     let mut n = hint.clamp(1, top);
     if fits(n) {
         while n < top && fits(2 * n) {
@@ -77,20 +86,14 @@ pub(crate) fn step_for(
     }
 }
 
-/// Whether a step of `n` pixels keeps the error bound for spans starting at |X| ∈
-/// [x_lo, x_hi] ([`step_for`]; a step of 1 always does).
-fn step_fits(
-    b: &StepBounds,
-    sc: (f64, f64),
-    t_min: f64,
-    (x_lo, x_hi): (f64, f64),
-    dt: f64,
-    n: u32,
-) -> bool {
+/// Whether a step of `n` pixels keeps the error bound for spans starting in `xs`
+/// ([`step_for`]; a step of 1 always does).
+fn step_fits(b: &StepBounds, line: StepLine, xs: XRange, n: u32) -> bool {
+    let StepLine { t_min, dt, .. } = line;
     let reach = n as f64;
-    let t_lo = ((x_lo - reach) * dt).max(t_min).max(0.0);
-    let t_hi = ((x_hi + reach) * dt).max(t_lo);
-    let bound = span_bound(b, sc, t_lo, t_hi);
+    let t_lo = ((xs.lo - reach) * dt).max(t_min).max(0.0);
+    let t_hi = ((xs.hi + reach) * dt).max(t_lo);
+    let bound = span_bound(b, line, t_lo, t_hi);
     let len = reach * dt;
     n == 1 || (bound.is_finite() && len * len / 8.0 * bound <= SPAN_ERROR_BUDGET)
 }
@@ -98,16 +101,9 @@ fn step_fits(
 /// [`step_for`] searched from the top, as it was before the hint (the reference the
 /// hinted search is tested against).
 #[cfg(test)]
-pub(crate) fn step_from_top(
-    b: &StepBounds,
-    sc: (f64, f64),
-    t_min: f64,
-    xs: (f64, f64),
-    dt: f64,
-    nominal: u32,
-) -> u32 {
+pub(crate) fn step_from_top(b: &StepBounds, line: StepLine, xs: XRange, nominal: u32) -> u32 {
     let mut n = nominal.max(1);
-    while !step_fits(b, sc, t_min, xs, dt, n) {
+    while !step_fits(b, line, xs, n) {
         n >>= 1;
     }
     n
@@ -115,7 +111,8 @@ pub(crate) fn step_from_top(
 
 /// Bound on the second derivative (in source pixels per unit t²) of the map position
 /// along a scanline over |t| ∈ [t_lo, t_hi] (see [`step_for`]).
-fn span_bound(b: &StepBounds, (s, c): (f64, f64), t_lo: f64, t_hi: f64) -> f64 {
+fn span_bound(b: &StepBounds, line: StepLine, t_lo: f64, t_hi: f64) -> f64 {
+    let StepLine { s, c, .. } = line;
     let lam_tt = if c <= 0.0 {
         if t_lo > 0.0 {
             0.0
@@ -164,9 +161,10 @@ mod tests {
                 v2: v2.exp2() - 1.0,
                 coupling: cpl,
             };
-            let sc = (a.sin(), a.cos());
-            let want = step_from_top(&b, sc, t_min, (x_lo, x_lo + w), dt, nominal);
-            let got = step_for(&b, sc, t_min, x_lo, x_lo + w, dt, nominal, 1 << hint_log);
+            let line = StepLine { s: a.sin(), c: a.cos(), t_min, dt };
+            let xs = XRange { lo: x_lo, hi: x_lo + w };
+            let want = step_from_top(&b, line, xs, nominal);
+            let got = step_for(&b, line, xs, nominal, 1 << hint_log);
             prop_assert_eq!(got, want);
         }
     }

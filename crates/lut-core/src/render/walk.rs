@@ -7,7 +7,7 @@
 //! (nor the sinks), so `render/` has no file circle.
 
 use super::kernel::{active, Positions, SpanQ8};
-use super::setup::{Scan, Setup, Unfold};
+use super::setup::{Lv, LvStep, Scan, Setup, Unfold};
 use super::steps::STEP_REGIONS;
 use crate::geom::fixed::Fx;
 use crate::lut::{Band, Blended};
@@ -105,34 +105,34 @@ impl Nodes for Blended<'_> {
 
 /// The unfolded read at offset d of the half `h`.
 #[inline(always)]
-pub(super) fn read_at<N: Nodes>(scan: &Scan, nodes: &N, h: &Half, u: &Unfold, d: i64) -> (Fx, Fx) {
-    u.apply(nodes.lookup_q((h.a0 + 2 * d) * scan.node_per_2x))
+pub(super) fn read_at<N: Nodes>(scan: &Scan, nodes: &N, h: &Half, u: &Unfold, d: i64) -> Lv {
+    u.apply(nodes.lookup_q((h.a0 + 2 * d) * scan.node_per_2x).into())
 }
 
-/// The span from (l0, v0) to the next read (l1, v1) over `m` pixels (`shift`: log2 of
-/// the region's step, used when m is the whole step): Λ unwrapped across the ±180° seam
-/// (a jump of one map width), and the per-pixel steps.
+/// The span from `p0` to the next read `p1` over `m` pixels (`shift`: log2 of the
+/// region's step, used when m is the whole step): `p1` with Λ unwrapped across the ±180°
+/// seam (a jump of one map width), and the per-pixel step.
 #[inline(always)]
-pub(super) fn span_step(
-    fr: &Setup,
-    (l0, v0): (Fx, Fx),
-    (l1, v1): (Fx, Fx),
-    m: i64,
-    shift: u32,
-) -> (Fx, (Fx, Fx)) {
-    let d = l1 - l0;
-    let mut l1 = l1;
+pub(super) fn span_step(fr: &Setup, p0: Lv, p1: Lv, m: i64, shift: u32) -> (Lv, LvStep) {
+    let d = p1.l - p0.l;
+    let mut l1 = p1.l;
     if d > fr.half_map_w_fx {
         l1 -= fr.map_w_fx;
     } else if d < -fr.half_map_w_fx {
         l1 += fr.map_w_fx;
     }
     let step = if m == 1i64 << shift {
-        ((l1 - l0) >> shift, (v1 - v0) >> shift)
+        LvStep {
+            dl: (l1 - p0.l) >> shift,
+            dv: (p1.v - p0.v) >> shift,
+        }
     } else {
-        ((l1 - l0) / m, (v1 - v0) / m)
+        LvStep {
+            dl: (l1 - p0.l) / m,
+            dv: (p1.v - p0.v) / m,
+        }
     };
-    (l1, step)
+    (Lv { l: l1, v: p1.v }, step)
 }
 
 /// `u` (at most one period `w` outside `0..w`) wrapped into `0..w`.

@@ -152,8 +152,8 @@ pub use select::{
 };
 pub use span::{SpanJob, Steps, Window, MAX_JOBS, TRILINEAR_CHUNK};
 
-pub(crate) use face::{FaceBuf, FaceRun};
-pub(crate) use row::{wrap_q8, Level, Positions, SpanQ8};
+pub(crate) use face::{ChunkWeights, FaceBuf, FaceRun};
+pub(crate) use row::{wrap_q8, Level, Positions, Q16Start, Q16Step, SpanAt, SpanQ8};
 pub(crate) use select::active;
 pub(crate) use shade::{Light, ShadeTable};
 pub(crate) use span::{nearest_span_direct, sample_span_cropped, sample_spans, trilinear_spans};

@@ -166,6 +166,14 @@ fn positions<const BILINEAR: bool>(
     len > 0 && (top - 128) >> 8 >= n as i32
 }
 
+/// Trilinear's second-level weights along a face run: pixel `j` is blended by
+/// `fracs[j / chunk]` (0..=255), one weight per chunk of `chunk` pixels.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ChunkWeights<'a> {
+    pub(crate) chunk: usize,
+    pub(crate) fracs: &'a [u32],
+}
+
 /// Bilinear samples along a run blended into `out` with kernel `k`: pixel `j` gets
 /// `lerp_px(out[j], sample, fracs[j / chunk])` (trilinear's second level, one weight per
 /// chunk of pixels).
@@ -175,9 +183,10 @@ fn run_blend(
     t: &Texels,
     r: &FaceRun,
     out: &mut [u32],
-    (chunk, fracs): (usize, &[u32]),
+    weights: ChunkWeights<'_>,
     buf: &mut FaceBuf,
 ) {
+    let ChunkWeights { chunk, fracs } = weights;
     debug_assert!(t.width == t.height && t.width >= 2, "bordered face texels");
     let (len, n) = (out.len(), face_side(t));
     assert!(
@@ -220,21 +229,21 @@ impl SelectedKernel {
     }
 
     /// Trilinear's second level: bilinear samples of one cube face along a run blended
-    /// into `out` (pixel `j` by `fracs[j / chunk]`, 0..=255); otherwise as
+    /// into `out` (pixel `j` by `weights.fracs[j / weights.chunk]`, 0..=255); otherwise as
     /// [`SelectedKernel::face_rows`].
     ///
     /// # Panics
-    /// When `fracs` holds fewer than a weight per chunk, or `chunk` is 0.
+    /// When `weights.fracs` holds fewer than a weight per chunk, or `weights.chunk` is 0.
     #[inline]
     pub(crate) fn face_rows_blend(
         self,
         t: &Texels,
         r: &FaceRun,
         out: &mut [u32],
-        (chunk, fracs): (usize, &[u32]),
+        weights: ChunkWeights<'_>,
         buf: &mut FaceBuf,
     ) {
-        run_blend(self, t, r, out, (chunk, fracs), buf)
+        run_blend(self, t, r, out, weights, buf)
     }
 }
 
@@ -480,8 +489,16 @@ mod tests {
         for k in Kernel::available() {
             let mut o = vec![0xDEAD_BEEFu32; len + 4];
             o[1..=len].copy_from_slice(&under);
-            k.selected()
-                .face_rows_blend(&t, r, &mut o[1..=len], (chunk, &fracs), &mut buf);
+            k.selected().face_rows_blend(
+                &t,
+                r,
+                &mut o[1..=len],
+                ChunkWeights {
+                    chunk,
+                    fracs: &fracs,
+                },
+                &mut buf,
+            );
             assert!(o[0] == 0xDEAD_BEEF && o[len + 1..].iter().all(|&x| x == 0xDEAD_BEEF));
             assert_eq!(
                 &o[1..=len],

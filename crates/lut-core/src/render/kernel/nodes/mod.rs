@@ -16,6 +16,16 @@ use crate::lut::Band;
 #[cfg(target_arch = "x86_64")]
 mod x86;
 
+/// The band's two table rows over a run of nodes, and the blend weight of the lower one
+/// (`wa`, Q.16, 0..=2^16), as `Band::rows` gives them.
+#[cfg(target_arch = "x86_64")]
+#[derive(Debug, Clone, Copy)]
+struct NodeRows<'a> {
+    top: &'a [[i32; 2]],
+    bot: &'a [[i32; 2]],
+    wa: i64,
+}
+
 impl SelectedKernel {
     /// Blend the band's nodes `k0..k0 + out.len()` into `out`: what `Band::blend_nodes`
     /// (the scalar twin) writes, bit for bit.
@@ -24,7 +34,7 @@ impl SelectedKernel {
         #[cfg(target_arch = "x86_64")]
         {
             let (top, bot, wa) = band.rows(k0, out.len());
-            if x86::blend(self, (top, bot, wa), out) {
+            if x86::blend(self, NodeRows { top, bot, wa }, out) {
                 return;
             }
         }

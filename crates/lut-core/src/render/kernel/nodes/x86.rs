@@ -8,16 +8,13 @@
 
 #![allow(unsafe_code)]
 
+use super::NodeRows;
 use crate::render::kernel::select::{Kernel, SelectedKernel};
 use std::arch::x86_64::*;
 
 /// Blend with a SIMD kernel; `false` (nothing written) for the others.
 #[inline(always)]
-pub(super) fn blend(
-    k: SelectedKernel,
-    rows: (&[[i32; 2]], &[[i32; 2]], i64),
-    out: &mut [[i32; 2]],
-) -> bool {
+pub(super) fn blend(k: SelectedKernel, rows: NodeRows<'_>, out: &mut [[i32; 2]]) -> bool {
     match k.0 {
         // SAFETY: `k` is a `SelectedKernel`, made only when the CPU runs the kernel (an
         // AVX-512 CPU runs AVX2).
@@ -28,7 +25,8 @@ pub(super) fn blend(
 }
 
 #[target_feature(enable = "avx2")]
-fn avx2((top, bot, wa): (&[[i32; 2]], &[[i32; 2]], i64), out: &mut [[i32; 2]]) {
+fn avx2(rows: NodeRows<'_>, out: &mut [[i32; 2]]) {
+    let NodeRows { top, bot, wa } = rows;
     let n = out.len();
     let (top, bot) = (&top[..n], &bot[..n]);
     // wa/2^16, exact (wa ≤ 2^16).

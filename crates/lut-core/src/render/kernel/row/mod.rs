@@ -77,20 +77,43 @@ pub(crate) struct SpanQ8 {
     pub(crate) ll: i32,
 }
 
+/// Where a [`SpanQ8`] writes: `m` pixels of the position buffers from `k`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct SpanAt {
+    /// The first pixel's index in the buffers.
+    pub(crate) k: u32,
+    /// Pixels.
+    pub(crate) m: u32,
+}
+
+/// A span's first position, Q.16 map pixels: `u`, `v`, and `ul` for the mirror image (0
+/// where there is none).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Q16Start {
+    pub(crate) u: i64,
+    pub(crate) v: i64,
+    pub(crate) ul: i64,
+}
+
+/// A span's step per pixel, Q.16 map pixels (the mirror image's u steps by −`du`). Each
+/// must fit an `i32`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Q16Step {
+    pub(crate) du: i64,
+    pub(crate) dv: i64,
+}
+
 impl SpanQ8 {
-    /// The span of `m` pixels from buffer position `k` whose Q.16 positions start at
-    /// (`u`, `v`), and `ul` for the mirror image (0 where there is none), and step by
-    /// (`du`, `dv`) a pixel (the mirror image by −`du`): each start split into its whole
-    /// Q.8 value and its low byte, as the lanes take them. The steps must fit an `i32`.
+    /// The span of `at.m` pixels from buffer position `at.k` whose Q.16 positions start
+    /// at `start` and step by `step` a pixel: each start split into its whole Q.8 value
+    /// and its low byte, as the lanes take them.
     #[inline(always)]
-    pub(crate) fn from_q16(
-        (k, m): (usize, usize),
-        (u, v, ul): (i64, i64, i64),
-        (du, dv): (i64, i64),
-    ) -> SpanQ8 {
+    pub(crate) fn from_q16(at: SpanAt, start: Q16Start, step: Q16Step) -> SpanQ8 {
+        let Q16Start { u, v, ul } = start;
+        let Q16Step { du, dv } = step;
         SpanQ8 {
-            k: k as u32,
-            m: m as u32,
+            k: at.k,
+            m: at.m,
             hu: (u >> 8) as i32,
             lu: (u & 0xFF) as i32,
             du: du as i32,

@@ -109,7 +109,7 @@ fn last_index<const BILINEAR: bool>(t: &Texels) -> usize {
 /// With `dv` not 0 (the run's [`next_scanline`]), also the two rows from [`next_rows`]
 /// on, into L2.
 #[inline(always)]
-fn prefetch<const BILINEAR: bool>(t: &Texels, (u, v): (&[i32], &[i32]), j: usize, k: u32, dv: i32) {
+fn prefetch<const BILINEAR: bool>(t: &Texels, u: &[i32], v: &[i32], j: usize, k: u32, dv: i32) {
     if let (Some(&u), Some(&v)) = (u.get(j), v.get(j)) {
         let stride = t.stride() as isize;
         let (x, y) = ((u >> (8 + k)) as isize, (v >> (8 + k)) as isize);
@@ -366,7 +366,7 @@ macro_rules! row_kernels {
             let mut j = 0;
             while j + N <= n {
                 while ahead < j + N + pfa {
-                    prefetch::<BILINEAR>(t, (u, v), ahead, k, next);
+                    prefetch::<BILINEAR>(t, u, v, ahead, k, next);
                     ahead += every;
                 }
                 let (cu, cv): (&[i32; N], &[i32; N]) = (
