@@ -594,3 +594,138 @@ fn misnamed_files_load_by_content_both_ways() {
     let e = Photometry::load(&dir.path().join("missing.ldt")).unwrap_err();
     assert!(matches!(e, LightError::Io { .. }), "{e:?}");
 }
+
+// ---------------------------------------------------------------- measurement tilt
+
+/// The fixture's text with its tilt during measurement (line 25) set to `deg`.
+fn with_tilt(name: &str, deg: f64) -> String {
+    let text = read(&ldt_path(name));
+    let mut lines: Vec<&str> = text.split('\n').collect();
+    assert_eq!(lines[24].trim(), "0", "{name}: line 25 is the tilt");
+    let t = format!("{deg}");
+    lines[24] = &t;
+    lines.join("\n")
+}
+
+/// One table per tilt from the same fixture: the full-resolution table only, so
+/// `LightScene::direct` reads exactly `candela` (no distance series).
+fn tilted_table(name: &str, deg: f64) -> std::sync::Arc<LightTable> {
+    let f = LdtFile::parse(&with_tilt(name, deg), name).unwrap();
+    assert_eq!(f.measurement_tilt, deg);
+    let o = TableOptions {
+        max_levels: 1,
+        ..TableOptions::default()
+    };
+    std::sync::Arc::new(LightTable::from_ldt(&f, &o).unwrap())
+}
+
+/// A file measured tilted by θ, placed with some aim, lights every point as the same
+/// file measured level would if its table were turned by θ about the C0-C180 axis: the
+/// direction from the light in its own frame (x right, y up, z aim), rotated by hand
+/// into the goniometer's frame, m = (x cos θ − z sin θ, y, x sin θ + z cos θ), gives
+/// γ = acos m_z and C = atan2(−m_x, m_y) (the table's convention), and E = I(γ, C) ·
+/// cos(incidence) / d². Checked on a file without symmetry and a bilateral one, tilts of
+/// both signs, aims down and sideways, at points on every face of the room.
+#[test]
+fn the_measurement_tilt_turns_the_table_about_the_c0_c180_axis() {
+    use glam::DVec3;
+    use lut_core::{LightScene, Luminaire, Room};
+    let room = Room::new(6.0, 5.0, 3.0, 1.5).unwrap();
+    let (lo, hi) = room.bounds();
+    for name in ["no_symmetry.ldt", "bilateral_c0_c180.ldt"] {
+        let level = tilted_table(name, 0.0);
+        assert_eq!(level.measurement_tilt_deg(), 0.0);
+        for theta in [15.0f64, -30.0] {
+            let t = tilted_table(name, theta);
+            assert_eq!(t.measurement_tilt_deg(), theta);
+            for (yaw, pitch) in [(0.0, -90.0), (40.0, -60.0), (-120.0, -20.0)] {
+                let mut l = Luminaire::new(t.clone(), DVec3::new(0.4, 2.6, -0.3));
+                l.yaw_deg = yaw;
+                l.pitch_deg = pitch;
+                let (r, u, a) = l.mount_frame();
+                let scene = LightScene::new(room, vec![l.clone()]).unwrap();
+                let (st, ct) = theta.to_radians().sin_cos();
+                let mut lit = 0;
+                for k in 0..400 {
+                    // Points spread over the six faces.
+                    let s = (k as f64 * 0.618_034).fract();
+                    let q = (k as f64 * 0.414_214).fract();
+                    let (p, n) = match k % 6 {
+                        0 => (DVec3::new(lo.x + s * 6.0, lo.y, lo.z + q * 5.0), DVec3::Y),
+                        1 => (DVec3::new(lo.x + s * 6.0, hi.y, lo.z + q * 5.0), -DVec3::Y),
+                        2 => (DVec3::new(lo.x, lo.y + s * 3.0, lo.z + q * 5.0), DVec3::X),
+                        3 => (DVec3::new(hi.x, lo.y + s * 3.0, lo.z + q * 5.0), -DVec3::X),
+                        4 => (DVec3::new(lo.x + s * 6.0, lo.y + q * 3.0, lo.z), DVec3::Z),
+                        _ => (DVec3::new(lo.x + s * 6.0, lo.y + q * 3.0, hi.z), -DVec3::Z),
+                    };
+                    let to = p - l.position;
+                    let d = to.length();
+                    if d > 3.9 {
+                        continue; // within the reference distance: the table as measured
+                    }
+                    let w = to / d;
+                    let (x, y, z) = (w.dot(r), w.dot(u), w.dot(a));
+                    let m = DVec3::new(x * ct - z * st, y, x * st + z * ct);
+                    let gamma = m.z.clamp(-1.0, 1.0).acos().to_degrees();
+                    let c = (-m.x).atan2(m.y).to_degrees().rem_euclid(360.0);
+                    let cos_i = (-w).dot(n).max(0.0);
+                    let want = level.candela(gamma, c) * cos_i / (d * d);
+                    let got = scene.direct(p, n);
+                    assert!(
+                        (got - want).abs() <= 1e-9 * want.max(1.0),
+                        "{name} θ {theta} aim ({yaw}, {pitch}) at {p}: {got} vs {want}"
+                    );
+                    lit += usize::from(want > 0.0);
+                }
+                assert!(lit > 50, "{name} θ {theta}: only {lit} lit points compared");
+            }
+        }
+    }
+}
+
+/// The sense, on a rotationally symmetric file: measured tilted by θ and hung aimed
+/// straight down (yaw 0), its beam axis (the table's nadir) leans θ toward +X (the
+/// luminaire's C270 side), so it lights the room exactly as the level file aimed there:
+/// yaw 90 (toward +X), pitch θ − 90.
+#[test]
+fn a_tilted_rotational_file_hung_level_lights_as_the_level_file_aimed_over() {
+    use glam::DVec3;
+    use lut_core::{LightScene, Luminaire, Room};
+    let room = Room::new(6.0, 6.0, 3.0, 1.5).unwrap();
+    let name = "rotational_label_lines.ldt";
+    let theta = 20.0;
+    let pos = DVec3::new(0.0, 2.9, 0.0);
+    let tilted =
+        LightScene::new(room, vec![Luminaire::new(tilted_table(name, theta), pos)]).unwrap();
+    let mut aimed = Luminaire::new(tilted_table(name, 0.0), pos);
+    aimed.yaw_deg = 90.0;
+    aimed.pitch_deg = theta - 90.0;
+    let aimed = LightScene::new(room, vec![aimed]).unwrap();
+    let level = LightScene::new(room, vec![Luminaire::new(tilted_table(name, 0.0), pos)]).unwrap();
+    let mut differs = 0;
+    for i in 0..=24 {
+        for j in 0..=24 {
+            let p = DVec3::new(-2.9 + 0.2417 * i as f64, 0.0, -2.9 + 0.2417 * j as f64);
+            let (a, b) = (tilted.direct(p, DVec3::Y), aimed.direct(p, DVec3::Y));
+            assert!((a - b).abs() <= 1e-9 * b.max(1.0), "{p}: {a} vs {b}");
+            let c = level.direct(p, DVec3::Y);
+            differs += usize::from((a - c).abs() > 1e-3 * c.max(1.0));
+        }
+    }
+    // And the tilt changes the light (the test would pass vacuously otherwise).
+    assert!(differs > 100, "{differs}");
+    // The brightest floor point moves toward +X: the beam axis meets the floor at
+    // x = h tan θ.
+    let peak = |s: &LightScene| {
+        (0..=580)
+            .map(|i| -2.9 + 0.01 * i as f64)
+            .max_by(|&x, &y| {
+                let e = |x: f64| s.direct(DVec3::new(x, 0.0, 0.0), DVec3::Y);
+                e(x).total_cmp(&e(y))
+            })
+            .unwrap()
+    };
+    let (xl, xt) = (peak(&level), peak(&tilted));
+    assert!(xl.abs() < 0.05, "{xl}");
+    assert!(xt > 0.2, "the tilted file's peak is at x = {xt}");
+}

@@ -47,8 +47,10 @@
 //!
 //! LORL, DFF and the direct ratios are kept as read: the intensities already carry the
 //! luminaire's losses (integrated, they give LORL % of the lamp flux). The measurement
-//! tilt (line 25) is kept as metadata: the table is in the measurement frame, so a
-//! luminaire aimed straight down reproduces it as measured.
+//! tilt (line 25) is applied where the luminaire is placed: the table is in the
+//! goniometer's frame, in which the luminaire was tilted by this angle, and a placed
+//! luminaire's aim is its own frame
+//! ([`LightTable::measurement_tilt_deg`](super::LightTable::measurement_tilt_deg)).
 //!
 //! Lines end in CR LF or LF; a decimal comma is read as a decimal point; header text may
 //! be ISO-8859-1. Every error names the file, the 1-based line, what was expected and (for

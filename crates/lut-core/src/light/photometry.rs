@@ -299,6 +299,17 @@ impl Photometry {
         }
     }
 
+    /// The luminaire's tilt during measurement in degrees (EULUMDAT line 25; 0 for IES
+    /// files, which have no such field): the table is in the goniometer's frame, in
+    /// which the luminaire's datum axis was raised by this angle on its C90 side. See
+    /// [`LightTable::measurement_tilt_deg`](super::LightTable::measurement_tilt_deg).
+    pub fn measurement_tilt_deg(&self) -> f64 {
+        match &self.source {
+            PhotometrySource::Ies(_) => 0.0,
+            PhotometrySource::Ldt(f) => f.measurement_tilt,
+        }
+    }
+
     /// The file format's name: the IES edition ("LM-63-2002", ...) or "EULUMDAT".
     pub fn format_name(&self) -> &'static str {
         match &self.source {

@@ -50,9 +50,26 @@ impl Luminaire {
         }
     }
 
-    /// The light's frame (right, up, aim) as unit world vectors: the camera's rotation,
-    /// pitch about X then yaw about Y. Aimed down at yaw 0, "up" points along +Z.
+    /// The frame its table's angles are measured in (right, up, aim) as unit world
+    /// vectors: [`Luminaire::mount_frame`], turned by the file's tilt during measurement
+    /// θ ([`LightTable::measurement_tilt_deg`], EULUMDAT only) about the up axis (the
+    /// C0-C180 axis), so the luminaire's own nadir lies at γ = θ in the table's C90
+    /// plane: right' = cos θ·right − sin θ·aim, aim' = sin θ·right + cos θ·aim. With no
+    /// tilt it is the mount frame.
     pub fn frame(&self) -> (DVec3, DVec3, DVec3) {
+        let (r, u, a) = self.mount_frame();
+        let t = self.table.measurement_tilt_deg();
+        if t == 0.0 {
+            return (r, u, a);
+        }
+        let (st, ct) = t.to_radians().sin_cos();
+        (r * ct - a * st, u, r * st + a * ct)
+    }
+
+    /// The luminaire's own frame (right, up, aim) as unit world vectors, from its yaw and
+    /// pitch: the camera's rotation, pitch about X then yaw about Y. Aimed down at yaw 0,
+    /// "up" points along +Z.
+    pub fn mount_frame(&self) -> (DVec3, DVec3, DVec3) {
         let (sp, cp) = self.pitch_deg.clamp(-90.0, 90.0).to_radians().sin_cos();
         let (sy, cy) = self.yaw_deg.to_radians().sin_cos();
         let rot = |v: DVec3| {
@@ -66,7 +83,7 @@ impl Luminaire {
     /// The lamp's tilt in degrees: for type C the angle between the aim and straight
     /// down, for types A/B the angle between the aim and the horizontal.
     pub fn tilt_deg(&self) -> f64 {
-        let (_, _, f) = self.frame();
+        let (_, _, f) = self.mount_frame();
         match self.table.photometric_type() {
             PhotometricType::C => (-f.y).clamp(-1.0, 1.0).acos().to_degrees(),
             _ => f.y.clamp(-1.0, 1.0).asin().to_degrees().abs(),
@@ -186,6 +203,15 @@ impl LightScene {
             )?);
         }
         Ok(self)
+    }
+
+    /// The same scene with inter-reflections solved elsewhere (on another thread, say):
+    /// `radiosity` should be a solve of this room ([`super::radiosity::Radiosity::solve`]
+    /// of this scene, or of the same room with luminaires since moved, as a stand-in
+    /// until their own solve is done).
+    pub fn with_radiosity(mut self, radiosity: Arc<super::radiosity::Radiosity>) -> LightScene {
+        self.indirect = Some(radiosity);
+        self
     }
 
     /// The inter-reflections solved for this scene, if any.

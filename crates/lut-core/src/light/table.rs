@@ -89,6 +89,8 @@ pub struct LightTable {
     d_ref: f64,
     d_ref2: f64,
     tilt: Option<TiltData>,
+    /// EULUMDAT's tilt during measurement, degrees (0 for IES).
+    measurement_tilt: f64,
     /// The smallest step between measured angles, degrees (either axis).
     finest_step: f64,
     /// Type C: the γ beyond which every value is 0 (the lit cone's half-angle); 180
@@ -256,6 +258,7 @@ impl LightTable {
             d_ref,
             d_ref2: d_ref * d_ref,
             tilt: p.tilt.clone(),
+            measurement_tilt: p.measurement_tilt_deg(),
         })
     }
 
@@ -310,6 +313,19 @@ impl LightTable {
     /// Tilt data of a `TILT=INCLUDE` file.
     pub fn tilt(&self) -> Option<&TiltData> {
         self.tilt.as_ref()
+    }
+
+    /// The luminaire's tilt during measurement in degrees (EULUMDAT line 25; 0 for IES
+    /// files). CIE S 017 (17-25-112): the angle between a datum axis of the luminaire
+    /// (nominally horizontal in use) and the horizontal when it was mounted on the
+    /// goniometer; positive raises its C90 side, as a road luminaire is raised toward the
+    /// carriageway. The table is in the goniometer's frame; a placed luminaire's aim is its
+    /// own (datum) frame, so [`Luminaire::frame`](super::Luminaire::frame) turns the table
+    /// by this angle about the C0-C180 axis: a luminaire aimed straight down sends the
+    /// table's nadir ray this far toward its C270 side, and one aimed to undo the tilt
+    /// reproduces the table as measured.
+    pub fn measurement_tilt_deg(&self) -> f64 {
+        self.measurement_tilt
     }
 
     /// Number of tables in the distance series.
