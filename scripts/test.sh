@@ -64,6 +64,8 @@ if [ -f scripts/window-smoke.sh ]; then
   # the binary the test run just built (optimized, overflow checks on): no second build
   VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-smoke.sh
 fi
+echo "== tour window test under Xvfb (a hotspot clicked, back and forward)"
+VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-tour.sh
 echo "== window soak under Xvfb (one minute of random input, drops and the memory curve)"
 t0=$SECONDS
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-soak.sh --duration 60

@@ -15,6 +15,7 @@
 mod actions;
 mod frame;
 mod lights;
+mod tour;
 
 use lights::SceneDrag;
 
@@ -143,6 +144,10 @@ struct App {
     scene_file: Option<PathBuf>,
     /// The luminaires' marker positions as last printed (`--print-view`).
     printed_markers: String,
+    /// The tour open, if any (`crate::window::tour`).
+    tour: Option<super::tour::TourNav>,
+    /// The tour's scene and hotspot positions as last printed (`--print-view`).
+    printed_tour: String,
 }
 
 /// Open the window and run until it is closed.
@@ -215,6 +220,8 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         scene_drag: None,
         scene_file: args.lights.room.scene.clone(),
         printed_markers: String::new(),
+        tour: None,
+        printed_tour: String::new(),
     };
     app.take_prefs();
     app.ctl.settings.view_limit = !args.no_view_limit;
@@ -231,6 +238,11 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         yaw: args.yaw,
         pitch: args.pitch,
         hfov: args.hfov,
+    };
+    // A tour file: its first scene (a tour that does not open is the command's error).
+    let source = match args.panorama.as_slice() {
+        [one] if super::tour::is_tour(one) => Some(app.start_tour(one.clone())?),
+        _ => source,
     };
     let open = app.doc.open(
         source.unwrap_or(Source::Sample),
@@ -422,6 +434,7 @@ impl ApplicationHandler<AppEvent> for App {
                     el.exit();
                 }
             }
+            WindowEvent::DroppedFile(path) if super::tour::is_tour(&path) => self.open_tour(path),
             WindowEvent::DroppedFile(path) => self.doc.drop_path(path),
             WindowEvent::Resized(_) | WindowEvent::ScaleFactorChanged { .. } => {
                 g.window.request_redraw()

@@ -231,6 +231,7 @@ impl Document {
             },
             naming: self.naming,
             coverage,
+            horizon: None,
         })
     }
 

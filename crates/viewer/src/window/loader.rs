@@ -170,6 +170,9 @@ pub struct LoadRequest {
     pub naming: Option<Naming>,
     /// `--coverage`, when it applies to this source.
     pub coverage: Option<Coverage>,
+    /// A tour scene's horizon to level (pitch, roll, degrees): full equirectangular
+    /// maps are re-levelled once here; other panoramas are shown as they are.
+    pub horizon: Option<(f64, f64)>,
 }
 
 /// The loading thread's work: read, decode, convert, build tables, reporting each step
@@ -186,6 +189,7 @@ pub fn load(
         opts,
         naming,
         coverage,
+        horizon,
         ..
     } = req;
     let hdr = matches!(&source, Source::File(p) if super::export::is_hdr_path(p));
@@ -240,6 +244,10 @@ pub fn load(
     // the levels' own pyramids (zoomed-out still frames are drawn from a level,
     // `Renderer::set_still_level`), now, so the first frames do not wait for them.
     lut_core::fault_point("loader");
+    let map = match horizon {
+        Some((p, r)) => lut_core::level_horizon(&map, p, r).unwrap_or(map),
+        None => map,
+    };
     let mut scene = Panorama::map(map);
     let surface = lut_core::RenderOptions::default().surface;
     scene.prepare(surface, &mut |f| progress(LoadStep::Tables, Some(f)));
@@ -272,6 +280,7 @@ mod tests {
             opts: LoadOptions::default(),
             naming: None,
             coverage: None,
+            horizon: None,
         }
     }
 

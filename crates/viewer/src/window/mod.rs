@@ -15,6 +15,8 @@
 //! * [`paint`]: the scene and the UI composed on the CPU into one 0RGB buffer; the
 //!   upscaling of degraded frames; the window icon.
 //! * [`export`]: HDR exposure steps and the "Save view…" size and file name (pure).
+//! * [`tour`]: a tour's hotspots over the scene, links followed with a glide and a
+//!   crossfade, back and forward, the scene list.
 //! * [`heap`]: freed heap memory given back to the system when the window settles, so
 //!   that a long session's resident memory does not creep up (glibc).
 //! * `app`: the winit event loop and softbuffer surface; it runs the document's effects.
@@ -39,6 +41,7 @@ pub mod overlay;
 pub mod paint;
 pub mod prefs;
 pub mod quality;
+pub mod tour;
 pub mod ui;
 
 use crate::args::{parse_angle, parse_size, InputArgs, MaxPixelsArg, ProjectionArg};

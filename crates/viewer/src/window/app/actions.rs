@@ -7,7 +7,6 @@ use super::{App, AppEvent};
 use crate::window::dialogs::Chosen;
 use crate::window::document::{Effect, LoadEvent};
 use crate::window::folder::{self, Step};
-use crate::window::input::{Look, HFOV_HOME};
 use crate::window::keys::{KeyAction, EXPOSURE_KEY_STEP_EV};
 use crate::window::loader::{LoadRequest, Source};
 use crate::window::quality::Level;
@@ -48,8 +47,9 @@ impl App {
                     // The new panorama's zoom range first: the old one's limit must not
                     // clamp the new start view.
                     self.update_zoom_range();
-                    let hfov = v.hfov_deg.unwrap_or(HFOV_HOME);
-                    self.ctl.set_home(Look::new(v.yaw_deg, v.pitch_deg, hfov));
+                    // A tour's scene arrives at the view its link names.
+                    let home = self.tour_start_view(v);
+                    self.ctl.set_home(home);
                 }
                 Effect::Opened(p) => {
                     let p = std::path::absolute(&p).unwrap_or(p);
@@ -62,7 +62,9 @@ impl App {
     }
 
     /// Run `req` on a loading thread that reports to the event loop.
-    fn spawn_load(&mut self, req: LoadRequest) {
+    fn spawn_load(&mut self, mut req: LoadRequest) {
+        // A tour scene's horizon is levelled as it loads.
+        req.horizon = self.tour.as_ref().and_then(|t| t.horizon_for(&req.source));
         let (id, proxy) = (req.id, self.proxy.clone());
         let spawned = std::thread::Builder::new()
             .name("viewer-load".into())
@@ -239,6 +241,9 @@ impl App {
 
     /// Open a file or folder (the Open dialog, the recent list, the folder's neighbours).
     fn open_path(&mut self, p: PathBuf) {
+        if crate::window::tour::is_tour(&p) {
+            return self.open_tour(p);
+        }
         let fx = self.doc.open_path(p, self.ctl.settings.exposure_ev);
         self.apply(fx.into_iter().collect());
     }

@@ -85,6 +85,8 @@ impl App {
             )
         };
         req.cursor = resp.hover_pos().map(to_px);
+        let tour_cursor = resp.hover_pos().map(|p| (to_px(p), p));
+        self.tour_ui(ui, rect, tour_cursor, size, t);
         let primary = egui::PointerButton::Primary;
         if resp.drag_started_by(primary) {
             let origin = ui
@@ -106,7 +108,10 @@ impl App {
         }
         if resp.clicked_by(primary) {
             if let Some(p) = resp.interact_pointer_pos() {
-                self.click_scene(to_px(p), size);
+                // On a tour's hotspot the click is the hotspot's.
+                if !self.tour_click(to_px(p), size, t) {
+                    self.click_scene(to_px(p), size);
+                }
             }
         }
         if self.ctl.dragging() {
@@ -243,7 +248,11 @@ impl App {
             _ => None,
         };
         self.ctl.set_limit(limit);
-        let frame = self.ctl.frame(t);
+        // A tour's glide toward a clicked link moves the view (drawn as motion).
+        let gliding = self.tour_glide(t);
+        let mut frame = self.ctl.frame(t);
+        let tour_moving = self.tour.as_ref().is_some_and(|n| n.animating(t));
+        frame.fast |= gliding;
         if self.ctl.take_zoomed_past_widest() && frame.look.projection.is_rectilinear() {
             self.notices.info(
                 "widest rectilinear view: V for a wide projection, L for a little planet",
@@ -273,7 +282,14 @@ impl App {
             .buffer_mut()
             .map_err(|e| anyhow!("cannot get the drawing buffer: {e}"))?;
         let scene = match (scene_rect, &self.scene_key) {
-            (Some(r), Some(k)) if k.size == (r.w, r.h) => Some((self.scene.as_slice(), r)),
+            (Some(r), Some(k)) if k.size == (r.w, r.h) => Some((
+                match self.tour.as_mut() {
+                    // A tour: the crossfade and the hotspot markers over the scene.
+                    Some(nav) => nav.compose(&self.scene, r.w, r.h, &frame.look, t),
+                    None => self.scene.as_slice(),
+                },
+                r,
+            )),
             _ => None,
         };
         self.compositor.compose(
@@ -293,6 +309,9 @@ impl App {
         let now = Instant::now();
         self.count_fps(now);
         self.print_readouts();
+        if let Some(r) = scene_rect {
+            self.print_tour(&frame.look, (r.w, r.h));
+        }
         self.save_prefs(false);
 
         // When is the next frame due?
@@ -327,6 +346,10 @@ impl App {
             }
         }
         if self.notices.expire(t) {
+            want(now);
+        }
+        if tour_moving {
+            // The glide and the crossfade: a frame every refresh.
             want(now);
         }
         if self.lit.refining() || self.baked.pending() {

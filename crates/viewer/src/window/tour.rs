@@ -1,0 +1,585 @@
+//! Tours in the window: a Pannellum or Marzipano tour opened (command line, Open dialog,
+//! recent list, drop), its hotspots drawn over the scene in every output projection, the
+//! hotspot's text on hover, a click on a scene link gliding toward it and crossfading
+//! into the target scene at the view the link names, back and forward through the
+//! scenes visited (Alt+←/→, the mouse's back/forward buttons, the ◀ ▶ buttons), and the
+//! scene list.
+//!
+//! [`TourNav`] is the state (pure: no window, no thread; times are the window's clock in
+//! seconds), unit-tested below; the event loop (`app`) calls it at a few hooks: opening,
+//! a scene shown (`arrived`), the frame's look (`glide_look`), the composed scene
+//! (`compose`), and the small tour bar ([`tour_bar`]).
+//!
+//! A scene's horizon (`horizonPitch`/`horizonRoll`) is levelled on the loading thread,
+//! the map re-levelled once at load as `viewer render` does (`crate::tour::render::level`);
+//! cube and tile scenes are shown as they are.
+
+use super::input::Look;
+use super::loader::Source;
+use crate::tour::{self, markers, Angles, HotspotKind, Tour};
+use std::path::{Path, PathBuf};
+
+/// How long the glide toward a clicked scene link lasts, seconds.
+pub const GLIDE_S: f64 = 0.45;
+/// The glide ends at this fraction of the hfov it started at (a step into the link).
+pub const GLIDE_ZOOM: f64 = 0.7;
+/// The crossfade when the tour gives none: Pannellum's default `sceneFadeDuration`.
+pub const DEFAULT_FADE_MS: f64 = 1000.0;
+/// Longest crossfade taken from a tour (a typo of 10^6 ms does not freeze the window).
+pub const MAX_FADE_MS: f64 = 5000.0;
+/// A marker under the pointer: within this many pixels of its centre.
+pub const PICK_RADIUS: f64 = markers::MARKER_RADIUS + 2.0;
+/// The hovered marker's outline.
+const HOVER_COLOR: u32 = 0x00FF_FFFF;
+
+/// A scene visited: its index and the view it was left at.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Visit {
+    /// The scene's index in the tour.
+    pub scene: usize,
+    /// The view.
+    pub view: Angles,
+}
+
+/// A scene asked for and loading: where it arrives.
+#[derive(Debug, Clone, PartialEq)]
+struct Pending {
+    scene: usize,
+    source: Source,
+    view: Angles,
+}
+
+/// The glide toward a clicked link.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Glide {
+    from: Look,
+    to: (f64, f64, f64),
+    t0: f64,
+}
+
+/// What a click, a button or a key asks of the window.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TourAction {
+    /// Load this source (the scene to go to); the arrival comes through
+    /// [`TourNav::arrived`].
+    Load(Source),
+    /// Show this text (an info hotspot, or why a link goes nowhere).
+    Info(String),
+    /// A problem to show as an error.
+    Error(String),
+}
+
+/// The tour open in the window and where the user is in it.
+pub struct TourNav {
+    /// The tour.
+    pub tour: Tour,
+    /// Its file.
+    pub path: PathBuf,
+    /// The scene shown.
+    current: usize,
+    back: Vec<Visit>,
+    forward: Vec<Visit>,
+    pending: Option<Pending>,
+    glide: Option<Glide>,
+    /// The crossfade: the old scene's last frame, its size, and when it started.
+    fade: Option<(Vec<u32>, (u32, u32), f64)>,
+    /// The scene composed with the fade and the markers.
+    buf: Vec<u32>,
+    /// The hotspot under the pointer.
+    hover: Option<usize>,
+}
+
+/// The source of scene `i` of `tour`: an equirectangular file, six cube faces, or a
+/// Pannellum multires / Marzipano tile scene when it is a tiled pyramid this viewer
+/// reads (a folder with `config.json`).
+///
+/// # Errors
+/// A path that leaves the tour's folder, a missing cube face, tiles in a layout this
+/// viewer does not read: one line naming the scene.
+pub fn scene_source(tour: &Tour, i: usize) -> Result<Source, String> {
+    let s = &tour.scenes[i];
+    let file = |rel: &str| {
+        tour.resolve(rel)
+            .map_err(|why| format!("scene \"{}\": {why}", s.id))
+    };
+    match &s.source {
+        tour::Source::Equirect(p) => Ok(Source::File(file(p)?)),
+        tour::Source::Cube(faces) => {
+            let mut paths = Vec::new();
+            for f in faces {
+                let Some(f) = f else {
+                    return Err(format!(
+                        "scene \"{}\": a cube face is missing (null): the window needs all six",
+                        s.id
+                    ));
+                };
+                paths.push(file(f)?);
+            }
+            Ok(Source::Cube {
+                paths,
+                layout: None,
+            })
+        }
+        tour::Source::Multires(v) => {
+            // A multires scene whose basePath is a pyramid folder this viewer reads
+            // (`viewer tile` writes config.json there).
+            let base = v.get("basePath").and_then(|b| b.as_str()).unwrap_or("");
+            let dir = if base.is_empty() {
+                tour.dir.clone()
+            } else {
+                file(base)?
+            };
+            if crate::panorama::is_tiled(&dir) {
+                Ok(Source::File(dir))
+            } else {
+                Err(format!(
+                    "scene \"{}\": a multires scene opens when its basePath is a tiled pyramid \
+                     folder with config.json ({} is not)",
+                    s.id,
+                    dir.display()
+                ))
+            }
+        }
+        tour::Source::MarzipanoTiles { dir, .. } => {
+            let d = file(dir)?;
+            if crate::panorama::is_tiled(&d) {
+                Ok(Source::File(d))
+            } else {
+                Err(format!(
+                    "scene \"{}\": Marzipano tiles ({}) do not open in the window yet: \
+                     `viewer tour convert` and `viewer tile` make a pyramid it opens",
+                    s.id,
+                    d.display()
+                ))
+            }
+        }
+    }
+}
+
+/// Yaw difference `to - from` wrapped to (-180, 180].
+fn wrap(d: f64) -> f64 {
+    let w = (d + 180.0).rem_euclid(360.0) - 180.0;
+    if w == -180.0 {
+        180.0
+    } else {
+        w
+    }
+}
+
+/// Smoothstep easing of `p` in [0, 1].
+fn ease(p: f64) -> f64 {
+    let p = p.clamp(0.0, 1.0);
+    p * p * (3.0 - 2.0 * p)
+}
+
+impl TourNav {
+    /// A tour read from `path`, starting in its first scene that opens. Returns the
+    /// state and the first scene's source; its start view comes through
+    /// [`TourNav::arrived`].
+    ///
+    /// # Errors
+    /// No scene of the tour opens (each scene's reason, joined).
+    pub fn start(tour: Tour, path: PathBuf) -> Result<(TourNav, Source), String> {
+        let first = tour.first().and_then(|f| tour.index(&f.id)).unwrap_or(0);
+        let order = std::iter::once(first).chain((0..tour.scenes.len()).filter(|&i| i != first));
+        let mut why = Vec::new();
+        for i in order {
+            match scene_source(&tour, i) {
+                Ok(source) => {
+                    let view = tour.scenes[i].start;
+                    let nav = TourNav {
+                        tour,
+                        path,
+                        current: i,
+                        back: Vec::new(),
+                        forward: Vec::new(),
+                        pending: Some(Pending {
+                            scene: i,
+                            source: source.clone(),
+                            view,
+                        }),
+                        glide: None,
+                        fade: None,
+                        buf: Vec::new(),
+                        hover: None,
+                    };
+                    return Ok((nav, source));
+                }
+                Err(e) => why.push(e),
+            }
+        }
+        if why.is_empty() {
+            why.push("it has no scenes".into());
+        }
+        Err(format!(
+            "{}: no scene of the tour opens: {}",
+            path.display(),
+            why.join("; ")
+        ))
+    }
+
+    /// The scene shown (or, before the first one arrives, the one loading).
+    pub fn current(&self) -> usize {
+        self.current
+    }
+
+    /// The scene shown.
+    pub fn scene(&self) -> &tour::TourScene {
+        &self.tour.scenes[self.current]
+    }
+
+    /// Whether back and forward have somewhere to go.
+    pub fn can_go(&self) -> (bool, bool) {
+        (!self.back.is_empty(), !self.forward.is_empty())
+    }
+
+    /// The view `look` as tour angles.
+    fn angles(look: Look) -> Angles {
+        Angles {
+            yaw: look.yaw,
+            pitch: look.pitch,
+            hfov: look.hfov,
+        }
+    }
+
+    /// Ask for scene `i` arriving at `view`.
+    fn go(&mut self, i: usize, view: Angles) -> TourAction {
+        match scene_source(&self.tour, i) {
+            Ok(source) => {
+                self.pending = Some(Pending {
+                    scene: i,
+                    source: source.clone(),
+                    view,
+                });
+                TourAction::Load(source)
+            }
+            Err(e) => {
+                self.glide = None;
+                TourAction::Error(e)
+            }
+        }
+    }
+
+    /// A click on hotspot `index` of the scene shown, seen at `look`, at time `t`: a
+    /// scene link glides toward the hotspot and loads its target (the view it arrives at
+    /// by Pannellum's rules); an info hotspot gives its text and link.
+    pub fn click(&mut self, index: usize, look: Look, t: f64) -> Option<TourAction> {
+        let scene = self.tour.scenes.get(self.current)?;
+        let hs = scene.hotspots.get(index)?;
+        match &hs.kind {
+            HotspotKind::Info { url } => {
+                let mut text = hs.text.clone();
+                if let Some(u) = url {
+                    text = if text.is_empty() {
+                        u.clone()
+                    } else {
+                        format!("{text} ({u})")
+                    };
+                }
+                Some(TourAction::Info(if text.is_empty() {
+                    "(no text)".into()
+                } else {
+                    text
+                }))
+            }
+            HotspotKind::Scene { scene_id, .. } => {
+                let Some((i, view)) = self.tour.arrival(scene, Self::angles(look), hs) else {
+                    return Some(TourAction::Error(format!(
+                        "the link goes to scene \"{scene_id}\", which is not in the tour"
+                    )));
+                };
+                self.back.push(Visit {
+                    scene: self.current,
+                    view: Self::angles(look),
+                });
+                self.forward.clear();
+                self.glide = Some(Glide {
+                    from: look,
+                    to: (hs.yaw, hs.pitch, look.hfov * GLIDE_ZOOM),
+                    t0: t,
+                });
+                Some(self.go(i, view))
+            }
+        }
+    }
+
+    /// The scene list's choice: scene `i` at its start view.
+    pub fn choose(&mut self, i: usize, look: Look) -> Option<TourAction> {
+        if i >= self.tour.scenes.len() || (i == self.current && self.pending.is_none()) {
+            return None;
+        }
+        self.back.push(Visit {
+            scene: self.current,
+            view: Self::angles(look),
+        });
+        self.forward.clear();
+        let view = self.tour.scenes[i].start;
+        Some(self.go(i, view))
+    }
+
+    /// Back (`forward` false) or forward through the scenes visited, each at the view
+    /// it was left at.
+    pub fn step(&mut self, forward: bool, look: Look) -> Option<TourAction> {
+        let here = Visit {
+            scene: self.current,
+            view: Self::angles(look),
+        };
+        let to = if forward {
+            let v = self.forward.pop()?;
+            self.back.push(here);
+            v
+        } else {
+            let v = self.back.pop()?;
+            self.forward.push(here);
+            v
+        };
+        self.glide = None;
+        Some(self.go(to.scene, to.view))
+    }
+
+    /// A panorama was shown from `source`: when it is the scene asked for, it is now the
+    /// current scene, and its arrival view is returned (the caller goes there and starts
+    /// the crossfade from `old_frame`, the last frame of the scene left, `size` pixels,
+    /// at `t`). `None`: not a scene of this tour (the tour is left).
+    pub fn arrived(
+        &mut self,
+        source: &Source,
+        old_frame: Option<(&[u32], (u32, u32))>,
+        t: f64,
+    ) -> Option<Angles> {
+        let p = self.pending.take_if(|p| p.source == *source)?;
+        self.current = p.scene;
+        self.glide = None;
+        self.hover = None;
+        self.fade = old_frame.map(|(px, size)| (px.to_vec(), size, t));
+        Some(p.view)
+    }
+
+    /// The crossfade's duration, seconds.
+    fn fade_s(&self) -> f64 {
+        self.tour
+            .fade_ms
+            .filter(|f| f.is_finite() && *f >= 0.0)
+            .unwrap_or(DEFAULT_FADE_MS)
+            .min(MAX_FADE_MS)
+            / 1000.0
+    }
+
+    /// The glide's look at time `t` (`None`: no glide). The glide ends at the hotspot,
+    /// zoomed in; it stops when the target scene arrives.
+    pub fn glide_look(&mut self, t: f64) -> Option<Look> {
+        let g = self.glide?;
+        let p = ((t - g.t0) / GLIDE_S).clamp(0.0, 1.0);
+        let e = ease(p);
+        let (yaw, pitch, hfov) = g.to;
+        let look = g.from.moved(
+            g.from.yaw + wrap(yaw - g.from.yaw) * e,
+            g.from.pitch + (pitch - g.from.pitch) * e,
+            g.from.hfov * (hfov / g.from.hfov).powf(e),
+        );
+        if p >= 1.0 {
+            self.glide = None;
+        }
+        Some(look)
+    }
+
+    /// True while the glide or the crossfade runs (a frame is due every refresh).
+    pub fn animating(&self, t: f64) -> bool {
+        self.glide.is_some() || self.fade.as_ref().is_some_and(|f| t - f.2 < self.fade_s())
+    }
+
+    /// The hotspot of the scene shown under (`x`, `y`) of a `w × h` frame of `look`.
+    pub fn hotspot_at(&self, look: &Look, w: u32, h: u32, x: f64, y: f64) -> Option<usize> {
+        if self.pending.is_some() && self.glide.is_some() {
+            return None;
+        }
+        markers::placed(self.scene(), look.view(), w, h)
+            .into_iter()
+            .map(|p| (p.index, (p.x - x).hypot(p.y - y)))
+            .filter(|(_, d)| *d <= PICK_RADIUS)
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(i, _)| i)
+    }
+
+    /// The hotspot under the pointer (its marker is highlighted).
+    pub fn set_hover(&mut self, hover: Option<usize>) {
+        self.hover = hover;
+    }
+
+    /// The scene as shown: `scene` (`w × h`, the frame of `look`) faded from the old
+    /// scene while the crossfade runs, with the hotspot markers over it (not while
+    /// fading or gliding into another scene).
+    pub fn compose(&mut self, scene: &[u32], w: u32, h: u32, look: &Look, t: f64) -> &[u32] {
+        self.buf.clear();
+        self.buf.extend_from_slice(scene);
+        let fade_s = self.fade_s();
+        let mut fading = false;
+        if let Some((old, size, t0)) = &self.fade {
+            let a = if fade_s > 0.0 {
+                ((t - t0) / fade_s).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            if a < 1.0 && *size == (w, h) && old.len() == self.buf.len() {
+                blend(&mut self.buf, old, a);
+                fading = true;
+            }
+            if a >= 1.0 || *size != (w, h) {
+                self.fade = None;
+            }
+        }
+        if !fading && self.glide.is_none() {
+            let view = look.view();
+            let placed = markers::draw(&self.tour.scenes[self.current], view, &mut self.buf, w, h);
+            if let Some(p) = placed.iter().find(|p| Some(p.index) == self.hover) {
+                ring(&mut self.buf, w, h, p.x, p.y);
+            }
+        }
+        &self.buf
+    }
+
+    /// One line for `--print-view` naming the scene shown and where each of its
+    /// hotspots is in a `w × h` frame of `look`: `tour scene ID i/n hotspots 0@x,y ...`.
+    pub fn describe(&self, look: &Look, w: u32, h: u32) -> String {
+        let s = self.scene();
+        let list: Vec<String> = markers::placed(s, look.view(), w, h)
+            .iter()
+            .map(|p| format!("{}@{:.1},{:.1}", p.index, p.x, p.y))
+            .collect();
+        format!(
+            "tour scene {} {}/{} hotspots {}",
+            s.id,
+            self.current + 1,
+            self.tour.scenes.len(),
+            if list.is_empty() {
+                "-".into()
+            } else {
+                list.join(" ")
+            }
+        )
+    }
+
+    /// The window title's name for the scene shown: the tour file, the scene's title.
+    pub fn title(&self) -> String {
+        let file = self.path.file_name().map_or_else(
+            || self.path.display().to_string(),
+            |n| n.to_string_lossy().into(),
+        );
+        let s = self.scene();
+        format!("{file}: {}", s.title.as_deref().unwrap_or(&s.id))
+    }
+
+    /// The horizon to level a load of `source` by (pitch, roll), when it is a scene of
+    /// the tour with one.
+    pub fn horizon_for(&self, source: &Source) -> Option<(f64, f64)> {
+        let i = match &self.pending {
+            Some(p) if p.source == *source => p.scene,
+            _ => self.current,
+        };
+        let h = self.tour.scenes.get(i)?.horizon;
+        (!h.is_level() && scene_source(&self.tour, i).ok().as_ref() == Some(source))
+            .then_some((h.pitch, h.roll))
+    }
+}
+
+/// `dst = old·(1 − a) + dst·a` per 8-bit channel.
+fn blend(dst: &mut [u32], old: &[u32], a: f64) {
+    let k = (a * 256.0).round() as u32;
+    for (d, &o) in dst.iter_mut().zip(old) {
+        let mut out = 0;
+        for shift in [0, 8, 16] {
+            let n = (*d >> shift) & 0xFF;
+            let o = (o >> shift) & 0xFF;
+            out |= ((o * (256 - k) + n * k) >> 8) << shift;
+        }
+        *d = out;
+    }
+}
+
+/// A one-pixel ring around a marker (the hovered one).
+fn ring(out: &mut [u32], w: u32, h: u32, cx: f64, cy: f64) {
+    let r = markers::MARKER_RADIUS + 1.5;
+    let (x0, x1) = (
+        (cx - r - 1.0).floor().max(0.0) as i64,
+        (cx + r + 1.0).ceil() as i64,
+    );
+    let (y0, y1) = (
+        (cy - r - 1.0).floor().max(0.0) as i64,
+        (cy + r + 1.0).ceil() as i64,
+    );
+    for y in y0..=y1.min(h as i64 - 1) {
+        for x in x0..=x1.min(w as i64 - 1) {
+            let d = (x as f64 + 0.5 - cx).hypot(y as f64 + 0.5 - cy);
+            if (d - r).abs() <= 0.75 {
+                out[y as usize * w as usize + x as usize] = HOVER_COLOR;
+            }
+        }
+    }
+}
+
+/// Whether `path` is a tour file (a Pannellum config or a Marzipano `data.js`).
+pub fn is_tour(path: &Path) -> bool {
+    path.is_file() && tour::sniff(path).is_some()
+}
+
+/// What the user did in the tour bar.
+#[derive(Debug, Default, Clone, PartialEq)]
+pub struct TourBarOutput {
+    /// ◀ pressed.
+    pub back: bool,
+    /// ▶ pressed.
+    pub forward: bool,
+    /// A scene chosen in the list.
+    pub chosen: Option<usize>,
+}
+
+/// The tour bar below the toolbar: back, forward, and the scene list.
+pub fn tour_bar(ctx: &egui::Context, scene: egui::Rect, nav: &TourNav) -> TourBarOutput {
+    let mut out = TourBarOutput::default();
+    let (can_back, can_forward) = nav.can_go();
+    egui::Area::new(egui::Id::new("tour-bar"))
+        .fixed_pos(scene.min + egui::vec2(8.0, 48.0))
+        .order(egui::Order::Foreground)
+        .show(ctx, |ui| {
+            egui::Frame::popup(ui.style())
+                .fill(ui.visuals().window_fill.gamma_multiply(0.85))
+                .inner_margin(egui::Margin::symmetric(6, 4))
+                .show(ui, |ui| {
+                    ui.horizontal(|ui| {
+                        out.back = ui
+                            .add_enabled(can_back, egui::Button::new("◀"))
+                            .on_hover_text("Back to the scene before (Alt+←, mouse back)")
+                            .clicked();
+                        out.forward = ui
+                            .add_enabled(can_forward, egui::Button::new("▶"))
+                            .on_hover_text("Forward again (Alt+→, mouse forward)")
+                            .clicked();
+                        let name =
+                            |s: &tour::TourScene| s.title.clone().unwrap_or_else(|| s.id.clone());
+                        egui::ComboBox::from_id_salt("tour-scenes")
+                            .selected_text(name(nav.scene()))
+                            .show_ui(ui, |ui| {
+                                for (i, s) in nav.tour.scenes.iter().enumerate() {
+                                    if ui.selectable_label(i == nav.current(), name(s)).clicked() {
+                                        out.chosen = Some(i);
+                                    }
+                                }
+                            });
+                    });
+                });
+        });
+    out
+}
+
+/// The hotspot's text by the pointer.
+pub fn hover_text(ctx: &egui::Context, at: egui::Pos2, text: &str) {
+    egui::Area::new(egui::Id::new("tour-hover"))
+        .fixed_pos(at + egui::vec2(14.0, 10.0))
+        .order(egui::Order::Tooltip)
+        .interactable(false)
+        .show(ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| {
+                ui.label(text);
+            });
+        });
+}
