@@ -24,6 +24,8 @@
 //! moving; 2: the level no pixel is magnified by more than √2 on,
 //! `Renderer::set_still_level`, the window's still bilinear frames; the pyramid is
 //! built before timing).
+//! `rlod` 0|1 (0): 1 = bilinear chooses its pyramid level per region of the frame
+//! (`Renderer::set_region_lod`; the pyramid is built by the untimed first view).
 //! `crop` WxH+LEFT+TOP: render a partial map holding only that rectangle of the map's
 //! pixels (the cropped kernels).
 //! `file` PATH: render that panorama instead of the generated map (e.g. `viewer
@@ -176,6 +178,7 @@ fn run() -> Result<(), String> {
     let mut cube_renderer = None;
     let mut cache = None;
     let mut level = 0;
+    let mut rlod = false;
     let mut file = None;
     let mut crop: Option<(u32, u32, u32, u32)> = None;
     for a in std::env::args().skip(1) {
@@ -223,6 +226,7 @@ fn run() -> Result<(), String> {
             },
             "cache" => cache = Some(std::path::PathBuf::from(v)),
             "level" => level = num(v)? as u32,
+            "rlod" => rlod = num(v)? != 0.0,
             "file" => file = Some(std::path::PathBuf::from(v)),
             _ => return Err(format!("unknown argument '{k}'")),
         }
@@ -277,6 +281,7 @@ fn run() -> Result<(), String> {
     let mut out = vec![0u32; w as usize * h as usize];
     pano.set_bilinear_level(level == 1);
     pano.set_still_level(level == 2);
+    pano.set_region_lod(rlod);
     // The gather's positions (the map's geometry).
     let mut r = Renderer::new(&map);
     if level != 0 {

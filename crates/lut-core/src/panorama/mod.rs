@@ -283,6 +283,14 @@ impl Panorama {
         }
     }
 
+    /// Bilinear frames of a map choose their pyramid level per region
+    /// ([`Renderer::set_region_lod`]); no effect on a cube or a tiled panorama.
+    pub fn set_region_lod(&mut self, on: bool) {
+        if let Repr::Map { renderer, .. } = &mut self.repr {
+            renderer.set_region_lod(on);
+        }
+    }
+
     /// Render `view` into `frame` with `opts`: a map with its renderer (LUT, grid or
     /// exact, as `opts.renderer` says), a cube map with `opts.cube` (rectilinear views;
     /// other output projections per pixel).

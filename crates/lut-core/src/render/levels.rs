@@ -131,6 +131,39 @@ pub(crate) fn frame_min_footprint(
         .unwrap_or(0.0)
 }
 
+/// The largest footprint in a frame of `view` on `width × height` pixels of a map of
+/// `geometry`, in map pixels per screen pixel, sampled as [`frame_min_footprint`] on
+/// 17 × 9 points spanning the frame (corners and edges included) and its centre
+/// (`Renderer::set_region_lod`: a frame whose largest sampled footprint is at most √2 is
+/// drawn without the pyramid; one that is larger between the points is drawn with it
+/// only if some point is above √2, which costs sharpness nowhere, only the speed there).
+/// Points the map does not cover are skipped; a pole in view gives a footprint near it
+/// that grows without bound, caught by the points around it. With none covered, 0.
+pub(crate) fn frame_max_footprint(
+    view: View,
+    width: u32,
+    height: u32,
+    geometry: MapGeometry,
+) -> f64 {
+    let fp = ExactFootprint::new(view, width, height, geometry);
+    let at = |x: f64, y: f64| -> Option<f64> {
+        let uv = exact_uv_at(&fp.cam, fp.proj, fp.mw, fp.mh, x, y)?;
+        let f = fp.footprint(x, y, uv);
+        // (At a pole itself the footprint is unbounded: as large as it gets.)
+        Some(if f.is_finite() { f } else { f64::MAX })
+    };
+    let (w, h) = (width as f64, height as f64);
+    const NX: u32 = 17;
+    const NY: u32 = 9;
+    let x_at = |i: u32| 0.5 + (w - 1.0) * i as f64 / (NX - 1) as f64;
+    let y_at = |j: u32| 0.5 + (h - 1.0) * j as f64 / (NY - 1) as f64;
+    (0..NY)
+        .flat_map(|j| (0..NX).map(move |i| (i, j)))
+        .filter_map(|(i, j)| at(x_at(i), y_at(j)))
+        .chain(at(w * 0.5, h * 0.5))
+        .fold(0.0, f64::max)
+}
+
 #[cfg(test)]
 mod tests {
     use super::{centre_footprint, frame_level, frame_min_footprint};

@@ -214,13 +214,35 @@ pub(crate) struct TriSink<'a> {
     pub(crate) exact: (&'a ExactFootprint, usize),
     /// Spans waiting for the batch kernel, with their levels of detail.
     pub(crate) batch: Batch,
+    /// Bilinear with a level per region (`Renderer::set_region_lod`): every level of
+    /// detail is rounded to the nearest whole level ([`nearest_level`]), so each span is
+    /// bilinear on one level, level 0 (the map) where the footprint is at most √2.
+    pub(crate) nearest: bool,
 }
 
 impl TriSink<'_> {
-    /// Set the level of detail (Q.8).
+    /// Set the level of detail (Q.8; rounded to a whole level in `nearest` mode).
     #[inline(always)]
     pub(crate) fn set_lod(&mut self, lod: i32) {
-        self.lod = lod;
+        self.lod = if self.nearest {
+            (nearest_level(lod) as i32) << 8
+        } else {
+            lod
+        };
+    }
+}
+
+/// The pyramid level nearest to the footprint whose trilinear level of detail is `lod`
+/// (Q.8, [`lod_q8`]: log2(footprint) − ½, 0 up to a footprint of √2): k = ⌊log2(f) + ½⌋
+/// = ⌊lod/256⌋ + 1 for lod > 0, else 0. Footprints in (2^(k−½), 2^(k+½)] read level k,
+/// which then reads between 0.71 and 1.41 of its texels per pixel. (Clamped to the last
+/// level by the readers, as `EnvMap::trilinear` does.)
+#[inline(always)]
+pub(crate) fn nearest_level(lod: i32) -> u32 {
+    if lod <= 0 {
+        0
+    } else {
+        (lod >> 8) as u32 + 1
     }
 }
 
@@ -352,6 +374,7 @@ impl RowSinks for TriRows<'_> {
             lod: 0,
             exact: (self.exact, y),
             batch: Batch::new(),
+            nearest: false,
         }
     }
 }
