@@ -23,7 +23,7 @@ use crate::render::cube::cube_frame;
 use crate::render::frame::Frame;
 use crate::render::heat::ErrorMap;
 use crate::render::{BandHook, RenderOptions, RenderReport, Renderer};
-use crate::tiles::{frame_level, trilinear_levels, TiledPanorama};
+use crate::tiles::{frame_level, TiledPanorama};
 use std::sync::{Arc, Mutex};
 
 /// What kind of panorama a [`Panorama`] is (readouts, messages). New kinds will be added
@@ -341,10 +341,9 @@ impl Panorama {
                 let mut p = t.pano.lock().unwrap_or_else(|e| e.into_inner());
                 p.pump();
                 let level = frame_level(p.store(), view, w, h, t.still);
-                let f = if opts.sampler == crate::map::sample::Sampler::Trilinear {
-                    let (fine, tw) = trilinear_levels(p.store(), view, w, h, t.still);
-                    p.render_trilinear(view, fine, tw, frame.pixels_mut(), w, h, t.wait)
-                } else if t.wait {
+                // Trilinear is drawn bilinear on the level: `TiledPanorama::render_trilinear`
+                // is not dispatched to until its test passes (docs/huge.md).
+                let f = if t.wait {
                     p.render_wait(view, opts.sampler, level, frame.pixels_mut(), w, h)
                 } else {
                     p.render(view, opts.sampler, level, frame.pixels_mut(), w, h, true)
