@@ -160,6 +160,8 @@ pub fn run(a: BenchTilesArgs) -> Result<()> {
                 .arg("-q")
                 .arg("-o")
                 .arg(&dir)
+                // Its summary line would spoil the JSON on standard output.
+                .stdout(std::process::Stdio::null())
                 .status()
                 .context("cannot run viewer tile")?;
             if !st.success() {
