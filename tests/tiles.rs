@@ -298,3 +298,196 @@ fn bad_pyramids_are_refused_at_open_with_one_line() {
         assert!(e.contains("not a regular file"), "{e}");
     }
 }
+
+/// The pyramid Pannellum's own `generate.py` made of `courtyard-512.jpg`
+/// (tests/data/multires/README.md: 160-px faces, 64-px tiles, JPEG q75, nona's and
+/// Pillow's Lanczos resampling) read by our reader and drawn from its top level, against
+/// the source JPEG drawn directly by the map renderer (bilinear): the same views across
+/// tile and face edges and both poles. Required ≥ 28 dB (the tiles are q75 JPEG of a
+/// resampled, re-encoded image; both sides bilinear); a face turned or swapped, or tiles
+/// placed at the wrong spot, score far lower, as the control view turned 90° shows.
+#[test]
+fn generate_py_pyramid_renders_like_its_source() {
+    let data = test_support::repo_root().join("tests/data/multires");
+    let src = lut_core::load_map(
+        &data.join("courtyard-512.jpg"),
+        &LoadOptions {
+            projection: Some(Projection::Equirect),
+            ..LoadOptions::default()
+        },
+        &mut |_| {},
+    )
+    .expect("courtyard-512");
+    let mut map = Panorama::map(src);
+    let mut pano = TiledPanorama::open(&data.join("generate-py"), 64 << 20, 2).unwrap();
+    let top = pano.config().max_level;
+    assert_eq!((pano.config().cube, top), (160, 3));
+    let (w, h) = (160, 120);
+    let opts = RenderOptions {
+        sampler: Sampler::Bilinear,
+        ..RenderOptions::default()
+    };
+    let direct = |map: &mut Panorama, view: View| {
+        let mut px = vec![0u32; (w * h) as usize];
+        let mut frame = Frame::new(&mut px, w, h).unwrap();
+        map.render(view, &opts, &mut frame).unwrap();
+        px
+    };
+    let (mut worst, mut best_wrong) = (f64::INFINITY, 0.0f64);
+    for view in views() {
+        let mut px = vec![0u32; (w * h) as usize];
+        let f = pano.render_wait(view, Sampler::Bilinear, top, &mut px, w, h);
+        assert!(!f.coarser(), "{view:?}: drawn coarser");
+        let p = psnr(&px, &direct(&mut map, view));
+        worst = worst.min(p);
+        assert!(p >= 28.0, "{view:?}: {p:.1} dB against the source");
+        // Control: the source turned by 90° is far from the tiles.
+        let turned = View::new(view.yaw_deg() + 90.0, view.pitch_deg(), view.hfov_deg()).unwrap();
+        best_wrong = best_wrong.max(psnr(&px, &direct(&mut map, turned)));
+    }
+    assert!(pano.take_notices().is_empty());
+    assert!(
+        best_wrong < worst - 6.0,
+        "control {best_wrong:.1} dB, worst {worst:.1} dB"
+    );
+    eprintln!(
+        "generate.py pyramid against its source: worst {worst:.1} dB, control {best_wrong:.1} dB"
+    );
+}
+
+/// A pyramid whose folder changes while it is open (tiles replaced by other pictures,
+/// removed, replaced by garbage, a tile of the wrong size, a FIFO; at last the whole
+/// folder removed): tiles held in the cache stay as decoded; a tile decoded again (after
+/// eviction) is the file as it is now, or, when it no longer decodes, drawn from its
+/// ancestor with one notice. Never a panic, a hang or a hole: every pixel is the old
+/// colour or the new one.
+#[test]
+fn a_folder_changing_while_open_gives_new_tiles_or_the_ancestor_with_a_notice() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("pyr");
+    let (old, new) = (0x00_20_60_a0u32, 0x00_c0_40_10u32);
+    write_pyramid(&dir, 648, 128, "png", &|_, _, _, w, h| {
+        vec![old; (w * h) as usize]
+    })
+    .unwrap();
+    let mut pano = TiledPanorama::open(&dir, 64 << 20, 2).unwrap();
+    let top = pano.config().max_level;
+    let view = View::new(0.0, 0.0, 60.0).unwrap();
+    let (w, h) = (96, 64);
+    let mut px = vec![0u32; (w * h) as usize];
+    let f = pano.render_wait(view, Sampler::Nearest, top, &mut px, w, h);
+    assert!(!f.coarser() && px.iter().all(|&p| p == old));
+    let front: Vec<TileId> = f.touched.iter().map(|t| t.0).collect();
+    assert!(front.len() >= 4, "{front:?}");
+    let path = |id: TileId| dir.join(format!("{}/f{}_{}.png", id.level, id.y, id.x));
+    // Every front tile of the top level and the level below replaced by the new colour…
+    for level in [top - 1, top] {
+        for entry in std::fs::read_dir(dir.join(level.to_string())).unwrap() {
+            let p = entry.unwrap().path();
+            let (tw, th) = image::image_dimensions(&p).unwrap();
+            let c = image::Rgb([(new >> 16) as u8, (new >> 8) as u8, new as u8]);
+            image::RgbImage::from_pixel(tw, th, c).save(&p).unwrap();
+        }
+    }
+    // …then four of the frame's top-level tiles broken in different ways.
+    std::fs::remove_file(path(front[0])).unwrap();
+    std::fs::write(path(front[1]), b"\x89PNG\r\n\x1a\n garbage").unwrap();
+    image::RgbImage::new(20, 20).save(path(front[2])).unwrap();
+    std::fs::remove_file(path(front[3])).unwrap();
+    let made = std::process::Command::new("mkfifo")
+        .arg(path(front[3]))
+        .status()
+        .unwrap();
+    assert!(made.success());
+    // Still cached: the same frame, the old tiles.
+    pano.render_wait(view, Sampler::Nearest, top, &mut px, w, h);
+    assert!(px.iter().all(|&p| p == old));
+    assert!(pano.take_notices().is_empty());
+    // Evicted (level 1 is kept), then read again: the new colour where a tile decodes,
+    // the ancestor (the new level below) where not, one notice a broken tile.
+    pano.store_mut().set_budget(0);
+    pano.store_mut().set_budget(64 << 20);
+    let f = pano.render_wait(view, Sampler::Nearest, top, &mut px, w, h);
+    assert!(f.coarser());
+    assert!(
+        px.iter().all(|&p| p == new),
+        "not every pixel the new colour"
+    );
+    let notices = pano.take_notices();
+    assert_eq!(notices.len(), 4, "{notices:#?}");
+    assert!(notices
+        .iter()
+        .all(|n| !n.contains('\n') && n.contains("drawn from a coarser level")));
+    // The whole folder gone: frames drawn from level 1 (kept since the open: the old
+    // colour), the tiles not found noticed once each.
+    std::fs::remove_dir_all(&dir).unwrap();
+    pano.store_mut().set_budget(0);
+    pano.store_mut().set_budget(64 << 20);
+    for _ in 0..2 {
+        let f = pano.render_wait(view, Sampler::Nearest, top, &mut px, w, h);
+        assert!(f.coarser());
+        assert!(px.iter().all(|&p| p == old));
+    }
+    let notices = pano.take_notices();
+    assert!(!notices.is_empty());
+    assert!(
+        notices.iter().all(|n| n.contains("cannot read")),
+        "{notices:#?}"
+    );
+}
+
+/// Trilinear between two levels against the analytic footprint: each level a flat colour
+/// of its own, so a trilinear frame is flat, the colours of level `l` and `l − 1` mixed by
+/// `t = log2(m_l)`, where `m_l = size_l · tan(hfov / 2) / width` is the level's texels per
+/// pixel at the centre of a view straight at a face (its face coordinate is `tan` of the
+/// angle, scaled by the half face). Tolerance: one level per channel (the weight is
+/// rounded to 1/256).
+#[test]
+#[ignore = "fails at level 4, m 1.9 (blue 228, 222.2 wanted: the weight of m = 1.93, not 1.9); Panorama does not dispatch trilinear to render_trilinear until it passes"]
+fn trilinear_mixes_two_levels_by_the_analytic_footprint() {
+    let dir = tempfile::tempdir().unwrap();
+    let colours = [
+        0x00_10_20_30u32,
+        0x00_f0_d0_b0,
+        0x00_30_a0_f0,
+        0x00_80_ff_00,
+    ];
+    // Faces of 648: levels of 81, 162, 324 and 648 texels.
+    write_pyramid(dir.path(), 648, 128, "png", &|id, _, _, w, h| {
+        vec![colours[id.level as usize - 1]; (w * h) as usize]
+    })
+    .unwrap();
+    let sizes = [81.0, 162.0, 324.0, 648.0];
+    let mut pano = TiledPanorama::open(dir.path(), 64 << 20, 2).unwrap();
+    let (w, h) = (64u32, 48u32);
+    let ch = |c: u32, k: u32| f64::from((c >> k) & 0xff);
+    // (level, its texels per pixel) → hfov, and the expected pair and weight.
+    for (level, m) in [
+        (2usize, 1.1892),
+        (3, 1.5),
+        (4, 1.9),
+        (3, 1.0),
+        (4, 0.5),
+        (1, 1.6),
+    ] {
+        let hfov = 2.0 * (m * f64::from(w) / sizes[level - 1]).atan().to_degrees();
+        for yaw in [0.0, 90.0, 180.0] {
+            let view = View::new(yaw, 0.0, hfov).unwrap();
+            let mut px = vec![0u32; (w * h) as usize];
+            let (fine, tw) = lut_core::tile_trilinear_levels(pano.store(), view, w, h, false);
+            pano.render_trilinear(view, fine, tw, &mut px, w, h, true);
+            // Level 1 has no coarser level; a magnified top level no finer one.
+            let t: f64 = if level == 1 || m < 1.0 { 0.0 } else { m.log2() };
+            let (a, b) = (colours[level - 1], colours[level.saturating_sub(2)]);
+            for &p in &px {
+                for k in [0, 8, 16] {
+                    let want = ch(a, k) * (1.0 - t) + ch(b, k) * t;
+                    assert!(
+                        (ch(p, k) - want).abs() <= 1.0,
+                        "level {level}, m {m}, yaw {yaw}: {p:06x}, channel {k} wants {want:.1}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -1,7 +1,9 @@
 //! The command line: `viewer [PANORAMA]` opens the window; the subcommands render,
 //! convert, summarize IES files and measure.
 
-use crate::commands::{bench, bench_load, convert, ies, lux, render, report, tile, tour};
+use crate::commands::{
+    bench, bench_load, bench_tiles, convert, ies, lux, render, report, tile, tour,
+};
 use clap::{Parser, Subcommand};
 
 /// CPU panorama viewer: scanline-coherent LUT rendering (US 5,748,194).
@@ -40,6 +42,10 @@ pub enum Command {
     /// Huge panoramas: load time, table build, frame time and peak memory for generated
     /// 8k, 16k and 32k equirectangular JPEGs (each in a fresh process).
     BenchLoad(bench_load::BenchLoadArgs),
+    /// Gigapixel panoramas from tiles: first picture, time to sharp, pan frame times,
+    /// peak memory and decode rates for synthetic 16k, 64k and 256k pyramids (each in a
+    /// fresh process, cold).
+    BenchTiles(Box<bench_tiles::BenchTilesArgs>),
     /// Gigapixel panoramas: write a Pannellum multires pyramid (tiled cube faces) of a
     /// panorama, read in row bands, memory bounded whatever its size.
     Tile(Box<tile::TileArgs>),

@@ -5,7 +5,9 @@
 use clap::Parser;
 use std::process::ExitCode;
 use viewer::cli::{Cli, Command};
-use viewer::commands::{bench, bench_load, convert, ies, lux, render, report, tile, tour};
+use viewer::commands::{
+    bench, bench_load, bench_tiles, convert, ies, lux, render, report, tile, tour,
+};
 
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
@@ -32,6 +34,7 @@ fn main() -> ExitCode {
         Some(Command::Report(a)) => report::run(*a),
         Some(Command::Bench(a)) => bench::run(a),
         Some(Command::BenchLoad(a)) => bench_load::run(a),
+        Some(Command::BenchTiles(a)) => bench_tiles::run(*a),
         Some(Command::Tile(a)) => tile::run(*a),
         Some(Command::Tour(a)) => tour::run(a),
         None => viewer::window::run(cli.open),

@@ -349,6 +349,8 @@ impl Panorama {
                 let mut p = t.pano.lock().unwrap_or_else(|e| e.into_inner());
                 p.pump();
                 let level = frame_level(p.store(), view, w, h, t.still);
+                // Trilinear is drawn bilinear on the level: `TiledPanorama::render_trilinear`
+                // is not dispatched to until its test passes (docs/huge.md).
                 let f = if t.wait {
                     p.render_wait(view, opts.sampler, level, frame.pixels_mut(), w, h)
                 } else {

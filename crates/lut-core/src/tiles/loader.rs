@@ -7,10 +7,11 @@ use super::config::{MultiresConfig, TileId};
 use super::decode::decode_tile;
 use super::store::TileStore;
 use std::collections::HashSet;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 type Done = (TileId, Result<Vec<u32>, String>);
 
@@ -25,6 +26,22 @@ struct Queue {
 struct Shared {
     q: Mutex<Queue>,
     cv: Condvar,
+    /// Tiles decoded (successfully), their texels and the threads' time decoding them
+    /// (reading the file included), for [`TileLoader::decode_stats`].
+    tiles: AtomicU64,
+    texels: AtomicU64,
+    busy_ns: AtomicU64,
+}
+
+/// What the pool's threads decoded since it started (the bench's rates per thread).
+#[derive(Debug, Default, Clone, Copy, PartialEq)]
+pub struct DecodeStats {
+    /// Tiles decoded (failures not counted).
+    pub tiles: u64,
+    /// Their texels.
+    pub texels: u64,
+    /// Seconds the threads spent reading and decoding tiles, summed over the threads.
+    pub busy_s: f64,
 }
 
 /// A pool of threads decoding tiles of one pyramid.
@@ -51,6 +68,9 @@ impl TileLoader {
         let shared = Arc::new(Shared {
             q: Mutex::new(Queue::default()),
             cv: Condvar::new(),
+            tiles: AtomicU64::new(0),
+            texels: AtomicU64::new(0),
+            busy_ns: AtomicU64::new(0),
         });
         let (tx, rx) = channel();
         let threads = (0..threads.max(1))
@@ -86,6 +106,15 @@ impl TileLoader {
         self.outstanding = q.wanted.iter().chain(q.busy.iter()).copied().collect();
         drop(q);
         self.shared.cv.notify_all();
+    }
+
+    /// Tiles decoded, their texels and the threads' busy time since the pool started.
+    pub fn decode_stats(&self) -> DecodeStats {
+        DecodeStats {
+            tiles: self.shared.tiles.load(Ordering::Relaxed),
+            texels: self.shared.texels.load(Ordering::Relaxed),
+            busy_s: self.shared.busy_ns.load(Ordering::Relaxed) as f64 * 1e-9,
+        }
     }
 
     /// Tiles requested and not yet in the store.
@@ -166,7 +195,14 @@ fn worker(s: &Shared, cfg: &MultiresConfig, tx: &Sender<Done>) {
                 q = s.cv.wait(q).unwrap_or_else(|e| e.into_inner());
             }
         };
+        let t = Instant::now();
         let r = decode_tile(cfg, id);
+        let ns = u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        s.busy_ns.fetch_add(ns, Ordering::Relaxed);
+        if let Ok(px) = &r {
+            s.tiles.fetch_add(1, Ordering::Relaxed);
+            s.texels.fetch_add(px.len() as u64, Ordering::Relaxed);
+        }
         s.q.lock()
             .unwrap_or_else(|e| e.into_inner())
             .busy

@@ -13,8 +13,8 @@ pub(crate) mod write;
 
 pub use config::{MultiresConfig, TileId, TilesError};
 pub use decode::decode_bytes;
-pub use loader::TileLoader;
-pub use render::{frame_level, render_tiles, TileFrame};
+pub use loader::{DecodeStats, TileLoader};
+pub use render::{frame_level, render_tiles, trilinear_levels, TileFrame};
 pub use store::{CacheStats, TileStore};
 pub use write::{generator_levels, write_pyramid};
 
@@ -75,6 +75,11 @@ impl TiledPanorama {
     /// The decoded tiles, to change the budget.
     pub fn store_mut(&mut self) -> &mut TileStore {
         &mut self.store
+    }
+
+    /// What the decoding threads did since the open ([`DecodeStats`]).
+    pub fn decode_stats(&self) -> DecodeStats {
+        self.loader.decode_stats()
     }
 
     /// Tiles requested and not yet decoded.
@@ -155,6 +160,42 @@ impl TiledPanorama {
             }
         }
         out
+    }
+
+    /// A trilinear frame: bilinear on `fine` blended with bilinear on `fine − 1`, weight
+    /// `t` ([`trilinear_levels`]); `wait` as [`TiledPanorama::render_wait`], else as
+    /// [`TiledPanorama::render`]. The report is the finer level's (its misses and whether
+    /// it was drawn coarser).
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_trilinear(
+        &mut self,
+        view: View,
+        fine: u32,
+        t: f64,
+        pixels: &mut [u32],
+        width: u32,
+        height: u32,
+        wait: bool,
+    ) -> TileFrame {
+        let draw = |p: &mut Self, level: u32, px: &mut [u32]| {
+            if wait {
+                p.render_wait(view, Sampler::Bilinear, level, px, width, height)
+            } else {
+                p.render(view, Sampler::Bilinear, level, px, width, height, true)
+            }
+        };
+        let w8 = (t.clamp(0.0, 1.0) * 256.0).round() as u32;
+        if w8 == 0 || fine <= 1 {
+            return draw(self, fine, pixels);
+        }
+        let mut coarse = vec![0u32; pixels.len()];
+        // The coarser level first: the finer level's requests are the ones kept.
+        draw(self, fine - 1, &mut coarse);
+        let f = draw(self, fine, pixels);
+        for (p, c) in pixels.iter_mut().zip(&coarse) {
+            *p = crate::map::sample::lerp_px(*p, *c, w8);
+        }
+        f
     }
 
     /// A frame drawn only when every tile it reads at `level` is decoded (or cannot be):

@@ -55,11 +55,11 @@ impl TileFrame {
     }
 }
 
-/// The level a frame of `view` at `width × height` is drawn from. Still (`still`): the
-/// coarsest level on which no pixel is magnified by more than √2 (the frame's smallest
-/// footprint, at 17 × 9 points, as `set_still_level` for maps); moving: the level whose
-/// texels are nearest one per pixel at the centre (⌊log2(footprint) + ½⌋ levels down).
-pub fn frame_level(store: &TileStore, view: View, width: u32, height: u32, still: bool) -> u32 {
+/// The texels of the top level (the full face) per output pixel the frame's level is
+/// chosen by: still (`still`), the frame's smallest footprint at 17 × 9 points (as
+/// `set_still_level` for maps); moving, the footprint at the centre. Infinite when no
+/// point has one.
+pub fn frame_footprint(store: &TileStore, view: View, width: u32, height: u32, still: bool) -> f64 {
     let cfg = store.config();
     let cam = Camera::new(view, width.max(1), height.max(1));
     let half = cfg.cube as f64 / 2.0;
@@ -79,7 +79,7 @@ pub fn frame_level(store: &TileStore, view: View, width: u32, height: u32, still
         fp.is_finite().then_some(fp)
     };
     let (w, h) = (width as f64, height as f64);
-    let m = if still {
+    if still {
         let mut m = f64::INFINITY;
         for j in 0..9 {
             for i in 0..17 {
@@ -93,7 +93,16 @@ pub fn frame_level(store: &TileStore, view: View, width: u32, height: u32, still
         m
     } else {
         foot(w / 2.0, h / 2.0).unwrap_or(f64::INFINITY)
-    };
+    }
+}
+
+/// The level a frame of `view` at `width × height` is drawn from. Still (`still`): the
+/// coarsest level on which no pixel is magnified by more than √2 (the frame's smallest
+/// footprint, at 17 × 9 points, as `set_still_level` for maps); moving: the level whose
+/// texels are nearest one per pixel at the centre (⌊log2(footprint) + ½⌋ levels down).
+pub fn frame_level(store: &TileStore, view: View, width: u32, height: u32, still: bool) -> u32 {
+    let cfg = store.config();
+    let m = frame_footprint(store, view, width, height, still);
     if !m.is_finite() || m <= 0.0 {
         return cfg.max_level;
     }
@@ -105,6 +114,38 @@ pub fn frame_level(store: &TileStore, view: View, width: u32, height: u32, still
         }
     }
     cfg.max_level
+}
+
+/// Trilinear between two levels: `(fine, t)`, the frame drawn as `(1 − t)·fine + t·(fine −
+/// 1)`. `fine` is the coarsest level whose texels are at least one per pixel (footprint
+/// `m_l` ≥ 1, [`frame_footprint`] scaled to the level), `t = log2(m_l)` in [0, 1): 0 when
+/// a texel is a pixel, toward 1 as `fine` gets minified by 2 (where its parent's texels
+/// are one per pixel). `t` is 0 when the top level is magnified (no finer level) and on
+/// level 1 (no coarser one).
+pub fn trilinear_levels(
+    store: &TileStore,
+    view: View,
+    width: u32,
+    height: u32,
+    still: bool,
+) -> (u32, f64) {
+    let cfg = store.config();
+    let m = frame_footprint(store, view, width, height, still);
+    if !m.is_finite() || m <= 0.0 {
+        return (cfg.max_level, 0.0);
+    }
+    for l in 1..=cfg.max_level {
+        let ml = m * cfg.level_size(l) as f64 / cfg.cube as f64;
+        if ml >= 1.0 {
+            let t = if l == 1 {
+                0.0
+            } else {
+                ml.log2().clamp(0.0, 1.0)
+            };
+            return (l, t);
+        }
+    }
+    (cfg.max_level, 0.0)
 }
 
 /// Per-frame constants (as the cube renderer's `Rays`).

@@ -297,7 +297,7 @@ fn generate_jpeg(path: &Path, w: u32, h: u32, quality: u8) -> Result<()> {
 }
 
 /// A field of `/proc/self/status` in bytes (Linux; `None` elsewhere).
-fn proc_status_bytes(field: &str) -> Option<u64> {
+pub(crate) fn proc_status_bytes(field: &str) -> Option<u64> {
     let s = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = s.lines().find(|l| l.starts_with(field))?;
     let kb: u64 = line[field.len()..]

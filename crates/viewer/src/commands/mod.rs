@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod bench_load;
+pub mod bench_tiles;
 pub mod convert;
 pub mod ies;
 pub mod lux;

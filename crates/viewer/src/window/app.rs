@@ -166,7 +166,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
     };
     let prefs_dir = super::prefs::config_dir();
     let mut notices = Notices::default();
-    let prefs = match &prefs_dir {
+    let mut prefs = match &prefs_dir {
         Some(d) => {
             let (p, msg) = Prefs::load(d);
             if let Some(m) = msg {
@@ -177,6 +177,12 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         }
         None => Prefs::default(),
     };
+    // `--cache-mib`: this run's budget, and the next runs' (saved with the settings: the
+    // file as read differs, so the next save writes it).
+    let prefs_saved = prefs.clone();
+    if let Some(mib) = args.cache_mib {
+        prefs.tile_cache_mib = mib;
+    }
     let mut app = App {
         print_view: args.print_view,
         initial_size: args.size,
@@ -195,7 +201,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         shortcuts: Shortcuts::default(),
         notices,
         dialogs: Dialogs::new(),
-        prefs_saved: prefs.clone(),
+        prefs_saved,
         prefs,
         prefs_dir,
         prefs_saved_at: 0.0,

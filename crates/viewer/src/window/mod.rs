@@ -82,6 +82,10 @@ pub struct OpenArgs {
     /// The pixel limit for panoramas opened or dropped.
     #[command(flatten)]
     pub limit: MaxPixelsArg,
+    /// Decoded tiles of tiled pyramids kept in memory (MiB); kept in the settings for the
+    /// next runs (default: the settings', else 1024).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(16..=1 << 20))]
+    pub cache_mib: Option<u64>,
     /// Luminaires lighting the scene (also added, moved and removed in the panel).
     #[command(flatten)]
     pub lights: LightArgs,

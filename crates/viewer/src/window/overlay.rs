@@ -166,6 +166,38 @@ pub fn compass(ctx: &egui::Context, scene: egui::Rect, look: &Look, pose_heading
         });
 }
 
+/// The tiles-loading indicator's text: `None` when no tile is pending.
+pub fn tiles_loading_text(pending: usize) -> Option<String> {
+    match pending {
+        0 => None,
+        1 => Some("loading 1 tile".into()),
+        n => Some(format!("loading {n} tiles")),
+    }
+}
+
+/// A small indicator at the bottom left of the scene while tiles of a tiled pyramid are
+/// decoding (the frame meanwhile drawn from a coarser level): the count pending.
+pub fn tiles_loading(ctx: &egui::Context, scene: egui::Rect, pending: usize) {
+    let Some(text) = tiles_loading_text(pending) else {
+        return;
+    };
+    egui::Area::new(egui::Id::new("tiles-loading"))
+        .fixed_pos(egui::pos2(scene.min.x + 10.0, scene.max.y - 28.0))
+        .order(egui::Order::Foreground)
+        .interactable(false)
+        .show(ctx, |ui| {
+            let (fg, bg) = (ui.visuals().text_color(), ui.visuals().window_fill);
+            let galley = ui
+                .painter()
+                .layout_no_wrap(text, egui::FontId::proportional(12.0), fg);
+            let (rect, _) =
+                ui.allocate_exact_size(galley.size() + egui::vec2(8.0, 4.0), egui::Sense::hover());
+            let p = ui.painter();
+            p.rect_filled(rect, 3.0, bg.gamma_multiply(0.85));
+            p.galley(rect.min + egui::vec2(4.0, 2.0), galley, fg);
+        });
+}
+
 /// What the notices area reports.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct NoticesOutput {

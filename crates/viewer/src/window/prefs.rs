@@ -1,5 +1,6 @@
 //! Settings kept between runs: panel shown, anti-aliasing mode, sampler, drag style,
-//! inertia, zoom limit, auto-rotation, export scale, recent files and the save folder,
+//! inertia, zoom limit, auto-rotation, export scale, the tiled pyramids' cache budget,
+//! recent files and the save folder,
 //! as JSON in the user's config folder (`$XDG_CONFIG_HOME/lutpano/settings.json`, else
 //! `~/.config/lutpano/`, or the platform's equivalent through the `directories` crate;
 //! [`CONFIG_DIR_ENV`] overrides it, which the tests use so they never touch the real
@@ -19,8 +20,11 @@ use lut_core::Sampler;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// The tiled pyramids' cache budget (MiB; `viewer render --cache-mib` for the CLI).
+/// The tiled pyramids' default cache budget (MiB; `viewer --cache-mib` sets the window's,
+/// kept in the settings; `viewer render --cache-mib` the CLI's).
 pub const TILE_CACHE_MIB: u64 = 1024;
+/// The cache budgets accepted (MiB), as `viewer render --cache-mib`.
+pub const TILE_CACHE_MIB_RANGE: std::ops::RangeInclusive<u64> = 16..=1 << 20;
 
 /// Environment variable naming the config folder (tests, portable setups).
 pub const CONFIG_DIR_ENV: &str = "LUTPANO_CONFIG_DIR";
@@ -60,6 +64,8 @@ pub struct Prefs {
     pub auto_rotate_idle_s: f64,
     /// "Save view…": the scene's size times this.
     pub export_scale: u32,
+    /// Decoded tiles of a tiled pyramid kept in memory, MiB (`--cache-mib`).
+    pub tile_cache_mib: u64,
     /// Recently opened files and folders, newest first.
     pub recent: Vec<PathBuf>,
     /// The folder "Save view…" last wrote to.
@@ -90,6 +96,7 @@ impl Default for Prefs {
             auto_rotate_speed: a.speed_deg_s,
             auto_rotate_idle_s: a.idle_s,
             export_scale: s.export_scale,
+            tile_cache_mib: TILE_CACHE_MIB,
             recent: Vec::new(),
             save_dir: None,
             extra: serde_json::Map::new(),
@@ -277,6 +284,9 @@ impl Prefs {
         if !super::input::EXPORT_SCALES.contains(&self.export_scale) {
             self.export_scale = d.export_scale;
         }
+        if !TILE_CACHE_MIB_RANGE.contains(&self.tile_cache_mib) {
+            self.tile_cache_mib = d.tile_cache_mib;
+        }
         self.recent.truncate(MAX_RECENT);
         self
     }
@@ -372,6 +382,26 @@ mod tests {
         // `null` switches the zoom limit off.
         std::fs::write(&path, r#"{"zoom_limit": null}"#).unwrap();
         assert_eq!(Prefs::load(tmp.path()).0.zoom_limit, None);
+    }
+
+    #[test]
+    fn the_tile_cache_budget_is_kept_and_checked() {
+        let tmp = tempfile::tempdir().unwrap();
+        let p = Prefs {
+            tile_cache_mib: 256,
+            ..Prefs::default()
+        };
+        p.save(tmp.path()).unwrap();
+        let (q, msg) = Prefs::load(tmp.path());
+        assert_eq!((q.tile_cache_mib, msg), (256, None));
+        for bad in ["0", "15", "2000000", "-1", "\"big\""] {
+            let text = format!("{{\"tile_cache_mib\": {bad}, \"panel\": true}}");
+            std::fs::write(tmp.path().join(FILE_NAME), text).unwrap();
+            let (q, msg) = Prefs::load(tmp.path());
+            assert_eq!(q.tile_cache_mib, TILE_CACHE_MIB, "{bad}");
+            assert!(q.panel);
+            assert!(msg.unwrap().contains("tile_cache_mib"), "{bad}");
+        }
     }
 
     #[test]

@@ -186,6 +186,13 @@ impl App {
         req.open_recent = bar.open_recent;
         let pose = self.doc.readouts.pose_heading;
         overlay::compass(ctx, scene, &self.ctl.look(), pose);
+        // While the last frame was drawn coarser than wanted (a redraw is then due, so
+        // the indicator goes with the frame that is sharp).
+        if let Some((_, pending, RenderPath::Tiles { coarser: true, .. })) =
+            &self.doc.readouts.tiles
+        {
+            overlay::tiles_loading(ctx, scene, (*pending).max(1));
+        }
         if self.show_help && overlay::help(ctx, scene) {
             req.keys.push(KeyAction::Help);
         }
@@ -515,7 +522,15 @@ impl App {
             .rendered(degraded || bilinear_level || tiles_loading);
         self.renders.push_back(Instant::now());
         let tiles = match self.doc.current().and_then(|c| c.scene.tiles_status()) {
-            Some((stats, pending, notices)) => {
+            Some((mut stats, pending, notices)) => {
+                // The budget of the settings (`--cache-mib`), applied to the open pyramid.
+                let budget = (self.prefs.tile_cache_mib as usize).saturating_mul(1 << 20);
+                if stats.budget != budget {
+                    if let Some(c) = self.doc.current_mut() {
+                        c.scene.set_tile_cache_bytes(budget);
+                    }
+                    stats.budget = budget;
+                }
                 // One notice per tile that could not be decoded (drawn from its ancestor).
                 for n in notices {
                     let t = self.now();
