@@ -223,3 +223,49 @@ fn non_2to1_maps_render_with_an_explicit_projection() {
         );
     }
 }
+
+/// Issue 33 (10): `viewer render` starts at a file's GPano start view, as the window
+/// does: the tagged file renders exactly as the untagged one at those angles given on
+/// the command line, and each angle given overrides the file's.
+#[test]
+fn renders_a_files_gpano_start_view() {
+    let d = tmpdir("gpano-start");
+    let plain = test_support::repo_root().join("assets/courtyard.jpg");
+    let src = std::fs::read(&plain).unwrap();
+    let xmp = lut_core::xmp_packet(&[
+        ("ProjectionType", "equirectangular"),
+        ("InitialViewHeadingDegrees", "120"),
+        ("InitialViewPitchDegrees", "10"),
+        ("InitialHorizontalFOVDegrees", "60"),
+    ]);
+    let tagged = d.join("tagged.jpg");
+    std::fs::write(&tagged, lut_core::insert_xmp(&src, &xmp).unwrap()).unwrap();
+    let render = |name: &str, input: &Path, extra: &[&str]| {
+        let out = d.join(name);
+        let mut args = vec!["render", s(input), "-o", s(&out), "--size", "320x200"];
+        args.extend_from_slice(extra);
+        let o = viewer(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        image::open(&out).unwrap().to_rgb8()
+    };
+    let own = render("own.png", &tagged, &[]);
+    let given = render(
+        "given.png",
+        &plain,
+        &["--yaw", "120", "--pitch", "10", "--hfov", "60"],
+    );
+    let default = render("default.png", &plain, &[]);
+    assert!(
+        own == given,
+        "the file's start view is not the one rendered"
+    );
+    assert!(own != default, "the start view changes the picture");
+    // The command line's yaw wins; the file's pitch and hfov stay.
+    let over = render("over.png", &tagged, &["--yaw", "0"]);
+    let want = render(
+        "over-want.png",
+        &plain,
+        &["--yaw", "0", "--pitch", "10", "--hfov", "60"],
+    );
+    assert!(over == want, "--yaw overrides the file's heading only");
+}

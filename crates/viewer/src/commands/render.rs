@@ -141,6 +141,20 @@ impl RenderArgs {
         )
     }
 
+    /// The view at a file's start view `start` for the angles not given on the command
+    /// line, in `projection`; `None` when the file's angles make no valid view (the
+    /// command line's or the default view is kept).
+    pub fn file_view(
+        &self,
+        start: lut_core::StartView,
+        projection: ViewProjection,
+    ) -> Option<View> {
+        let yaw = self.yaw.unwrap_or(start.yaw_deg);
+        let pitch = self.pitch.unwrap_or(start.pitch_deg);
+        let hfov = self.hfov.or(start.hfov_deg).unwrap_or(90.0);
+        View::with_projection(yaw, pitch, hfov, projection).ok()
+    }
+
     /// The output projection these arguments select (Pannini with its d).
     ///
     /// # Errors
@@ -311,6 +325,13 @@ fn frame_with(a: &RenderArgs, tour_scene: Option<&crate::tour::TourScene>) -> Re
     }
     let mut scene = a.load(scene_pano)?;
     scene.set_still_level(a.still_level);
+    // The file's own start view (GPano), as the window opens it, for the angles neither
+    // the command line nor a scene file gives.
+    if let (None, Some(start)) = (scene_view, scene.as_map().and_then(|m| m.start_view())) {
+        if let Some(v) = a.file_view(start, view.projection()) {
+            view = v;
+        }
+    }
     if let (true, Some(map)) = (a.view_limit, scene.as_map()) {
         view = lut_core::limit_view(view, w, h, &map.coverage());
     }
