@@ -411,8 +411,7 @@ impl Renderer {
         let region_lod = self.region_lod
             && opts.sampler == Sampler::Bilinear
             && map.crop().is_none()
-            && frame_max_footprint(view, width, height, geometry)
-                > std::f64::consts::SQRT_2;
+            && frame_max_footprint(view, width, height, geometry) > std::f64::consts::SQRT_2;
         let (setup, report) = if region_lod {
             // (The setup measures the scanlines' vertical footprints for trilinear.)
             let tri = RenderOptions {
