@@ -362,7 +362,16 @@ for n in a1 a2 a10; do
 done
 
 ########## Run 2: the settings of run 1, panel hidden, default zoom limit ##########
-sed -i -e 's/"panel": true/"panel": false/' -e '/"zoom_limit"/d' "$CFG/settings.json"
+# Edited as JSON (the file is written with its keys sorted, so a line-wise delete of the
+# last key would leave a trailing comma and an unreadable file).
+python3 - "$CFG/settings.json" <<'PY'
+import json, sys
+p = sys.argv[1]
+s = json.load(open(p))
+s["panel"] = False
+s.pop("zoom_limit", None)
+json.dump(s, open(p, "w"), indent=2)
+PY
 log "run 2: the viewer on the bundled sample"
 start_viewer
 wait_for '^loaded ' 0 60
