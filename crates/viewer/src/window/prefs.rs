@@ -438,6 +438,19 @@ mod tests {
         assert_eq!(q, p);
     }
 
+    #[test]
+    fn an_unknown_long_number_reads_back_unchanged() {
+        // Found by the settings fuzz target: 84 digits parsed without correct rounding
+        // came back one unit in the last place off after a save.
+        let text = format!("{{\"pan^l\": {}}}", "6".repeat(84));
+        let (p, problems) = Prefs::parse(text.as_bytes(), Path::new("settings.json"));
+        assert!(problems.is_empty(), "{problems:?}");
+        assert_eq!(p.extra["pan^l"].as_f64(), Some(6.666666666666666e83));
+        let (q, problems) = Prefs::parse(p.to_json().unwrap().as_bytes(), Path::new("s"));
+        assert!(problems.is_empty(), "{problems:?}");
+        assert_eq!(q, p);
+    }
+
     #[cfg(unix)]
     #[test]
     fn an_unreadable_settings_file_never_blocks_and_is_never_replaced() {
