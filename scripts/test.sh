@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # The whole test suite: formatting, lints, unit/integration/golden/property tests, the
 # real window under Xvfb (a smoke test and a one-minute soak), and every fuzz target
-# briefly on its committed seeds (FUZZ_SECONDS each, default 20). Works on a fresh
+# briefly on its committed seeds (FUZZ_SECONDS each, default 12). Works on a fresh
 # machine with the Rust toolchain: it installs the Debian packages the window tests need
 # when they are missing (as root, via apt-get), and the nightly toolchain and cargo-fuzz
 # for the fuzz targets.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Each stage line carries the minutes:seconds since the start, so a slow CI run shows where
+# its time went.
+stage() { printf '== [%d:%02d] %s\n' $((SECONDS / 60)) $((SECONDS % 60)) "$*"; }
 
 need_pkgs=()
 command -v Xvfb >/dev/null || need_pkgs+=(xvfb)
@@ -41,12 +44,12 @@ if [ ${#need_pkgs[@]} -gt 0 ]; then
   fi
 fi
 
-echo "== cargo fmt --check"
+stage "cargo fmt --check"
 cargo fmt --all -- --check
 cargo fmt --manifest-path fuzz/Cargo.toml -- --check
-echo "== cargo clippy"
+stage "cargo clippy"
 cargo clippy --workspace --all-targets --profile ci -- -D warnings
-echo "== cargo clippy for aarch64 (the portable kernels compile warning-free off x86-64; lib and binaries: the benches' and tests' C dependencies need a cross compiler)"
+stage "cargo clippy for aarch64 (the portable kernels compile warning-free off x86-64; lib and binaries: the benches' and tests' C dependencies need a cross compiler)"
 if rustup target list --installed 2>/dev/null | grep -q aarch64-unknown-linux-gnu \
     || rustup target add aarch64-unknown-linux-gnu >/dev/null 2>&1; then
   cargo clippy -p lut-core --lib --target aarch64-unknown-linux-gnu -- -D warnings
@@ -54,24 +57,24 @@ if rustup target list --installed 2>/dev/null | grep -q aarch64-unknown-linux-gn
 else
   echo "warning: could not install the aarch64 standard library (rustup target add); aarch64 check skipped" >&2
 fi
-echo "== cargo test (profile ci: optimized, overflow checks on)"
+stage "cargo test (profile ci: optimized, overflow checks on)"
 cargo test --workspace --profile ci
-echo "== cargo test again with the scalar span kernel forced (LUTPANO_KERNEL=scalar)"
+stage "cargo test again with the scalar span kernel forced (LUTPANO_KERNEL=scalar)"
 # Same binaries (the kernel is chosen at run time): SIMD and scalar must render the same.
 LUTPANO_KERNEL=scalar cargo test --workspace --profile ci
 if [ -f scripts/window-smoke.sh ]; then
-  echo "== window smoke test under Xvfb"
+  stage "window smoke test under Xvfb"
   # the binary the test run just built (optimized, overflow checks on): no second build
   VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-smoke.sh
 fi
-echo "== tour window test under Xvfb (a hotspot clicked, back and forward)"
+stage "tour window test under Xvfb (a hotspot clicked, back and forward)"
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-tour.sh
-echo "== window soak under Xvfb (one minute of random input, drops and the memory curve)"
+stage "window soak under Xvfb (one minute of random input, drops and the memory curve)"
 t0=$SECONDS
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-soak.sh --duration 60
-echo "== window soak took $((SECONDS - t0)) s"
-echo "== fuzz targets, ${FUZZ_SECONDS:-20} s each on the committed seeds (installs nightly and cargo-fuzz if missing)"
+stage "window soak took $((SECONDS - t0)) s"
+stage "fuzz targets, ${FUZZ_SECONDS:-12} s each on the committed seeds (installs nightly and cargo-fuzz if missing)"
 t0=$SECONDS
-bash scripts/fuzz.sh --ci --time "${FUZZ_SECONDS:-20}"
-echo "== fuzzing (install, build, runs) took $((SECONDS - t0)) s"
-echo "== all tests passed"
+bash scripts/fuzz.sh --ci --time "${FUZZ_SECONDS:-12}"
+stage "fuzzing (install, build, runs) took $((SECONDS - t0)) s"
+stage "all tests passed"
