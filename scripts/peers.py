@@ -4,6 +4,7 @@
     python3 scripts/peers.py [--size 1920x1080] [--threads 2] [--out /tmp/peers]
                              [--viewer target/release/viewer] [--no-install] [--no-ffmpeg]
                              [--no-py360] [--no-nona] [--rounds N]
+                             [--view YAW,PITCH,HFOV ...]
 
 1. Installs the peers with the ordinary tools if missing: `pip install
    opencv-python-headless numpy py360convert`, `apt-get install -y ffmpeg hugin-tools`.
@@ -25,6 +26,10 @@
    timings, so a machine whose speed drifts weighs on both alike.
 5. Prints a table: median ms per frame, our time as a ratio to theirs, and their PSNR
    against our exact render (same sampler). Writes OUT/peers.json.
+6. With `--view YAW,PITCH,HFOV` (repeatable): `viewer bench --view` times exactly those
+   views (ours, every round) and OpenCV remaps exactly those; a per-view table follows
+   (our LUT bilinear against OpenCV's fixed-point and float bilinear remap of the same
+   view), also in peers.json as "per_view" (each with its "view": [yaw, pitch, hfov]).
 
 The source map is padded by one wrapped column on each side so OpenCV's
 BORDER_REPLICATE clamps vertically and wraps horizontally, as our convention does.
@@ -32,6 +37,7 @@ BORDER_REPLICATE clamps vertically and wraps horizontally, as our convention doe
 
 import argparse
 import json
+import math
 import os
 import shutil
 import statistics
@@ -119,11 +125,23 @@ def main():
     ap.add_argument("--no-py360", action="store_true", help="skip py360convert")
     ap.add_argument("--no-nona", action="store_true", help="skip Hugin's nona")
     ap.add_argument("--bench-args", default="", help="extra arguments for viewer bench")
+    ap.add_argument("--view", action="append", default=[], metavar="YAW,PITCH,HFOV",
+                    help="time exactly this view (repeatable; passed to viewer bench --view)")
     ap.add_argument("--rounds", type=int, default=1,
                     help="rounds of the OpenCV remap timings, each after a `viewer bench "
                          "--only-default` of ours (the first after the full bench): ours and "
                          "theirs timed in turns, medians over the rounds")
     a = ap.parse_args()
+    given = []
+    for s in a.view:
+        try:
+            vals = [float(x) for x in s.split(",")]
+        except ValueError:
+            vals = []
+        if len(vals) != 3 or not all(math.isfinite(x) for x in vals):
+            sys.exit(f"peers: --view '{s}' must be YAW,PITCH,HFOV in degrees (three numbers)")
+        given.append(vals)
+    view_args = [x for s in a.view for x in ("--view", s)]
     install(a.no_install)
     import cv2
     import numpy as np
@@ -133,7 +151,7 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     ours_path = os.path.join(a.out, "ours.json")
     cmd = [a.viewer, "bench", "--size", a.size, "--threads", str(a.threads),
-           "--export-maps", a.out, "--json"] + a.bench_args.split()
+           "--export-maps", a.out, "--json"] + view_args + a.bench_args.split()
     print("peers: running", " ".join(cmd), file=sys.stderr)
     with open(ours_path, "w") as fo:
         subprocess.run(cmd, check=True, stdout=fo)
@@ -151,6 +169,8 @@ def main():
     imgs = {k: [] for k in ["cv_float_bil", "cv_fixed_bil", "cv_float_nn", "cv_fixed_nn",
                             "np_build_remap", "ff_v360", "py360", "nona"]}
     np_map_err = 0.0
+    # Per view (index in views.json): the remap timings, for the per-view table.
+    per_view = {k: {} for k in ["cv_float_bil", "cv_fixed_bil", "cv_float_nn", "cv_fixed_nn"]}
     for i, v in enumerate(meta["views"]):
         rd = lambda name, dt: np.fromfile(os.path.join(a.out, v[name]), dtype=dt)  # noqa: E731
         mx = rd("mapx", np.float32).reshape(h, w) + 1.0  # +1: the padding column
@@ -166,6 +186,8 @@ def main():
                 dt = time.perf_counter() - t
                 if _ > 0:
                     res[key].append(dt)
+                    if key in per_view:
+                        per_view[key].setdefault(i, []).append(dt)
             return out
 
         bil, nn, rep = cv2.INTER_LINEAR, cv2.INTER_NEAREST, cv2.BORDER_REPLICATE
@@ -293,10 +315,10 @@ def main():
     later = []
     for rnd in range(2, a.rounds + 1):
         cmd = [a.viewer, "bench", "--size", a.size, "--threads", str(a.threads), "--json",
-               "--only-default"] + round_args
+               "--only-default"] + view_args + round_args
         later.append(json.loads(subprocess.run(cmd, check=True, stdout=subprocess.PIPE,
                                                stderr=subprocess.DEVNULL).stdout))
-        for v in meta["views"]:
+        for vi, v in enumerate(meta["views"]):
             rd = lambda name, dt: np.fromfile(os.path.join(a.out, v[name]), dtype=dt)  # noqa: E731
             mx = rd("mapx", np.float32).reshape(h, w) + 1.0
             my = rd("mapy", np.float32).reshape(h, w)
@@ -313,10 +335,25 @@ def main():
                     t = time.perf_counter()
                     fn()
                     if rep_i > 0:
-                        res[key].append(time.perf_counter() - t)
+                        dt = time.perf_counter() - t
+                        res[key].append(dt)
+                        per_view[key].setdefault(vi, []).append(dt)
         print(f"peers: round {rnd}/{a.rounds} (ours, then OpenCV remap)", file=sys.stderr)
 
+    def our_view(sampler, view):
+        """Median over the rounds of our LUT (adaptive step) row timing `view`."""
+        vals = [r["ms_median"] for rows in [ours] + later for r in rows
+                if r["renderer"] == "lut" and r["sampler"] == sampler
+                and r.get("surface", "cylinder") == "cylinder"
+                and r["index_step"] == "adaptive" and r.get("view") == view]
+        return statistics.median(vals) if vals else None
+
     def our(sampler, step, rows=None):
+        if given:
+            # The given views: the median over them of our per-view medians.
+            vals = [our_view(sampler, [v["yaw"], v["pitch"], v["hfov"]]) for v in meta["views"]]
+            vals = [x for x in vals if x is not None]
+            return statistics.median(vals) if vals else None
         if rows is None:
             vals = [our(sampler, step, r) for r in [ours] + later]
             vals = [x for x in vals if x is not None]
@@ -373,7 +410,17 @@ def main():
                "ours_lut_nearest_step4_ms": lut_nn,
                "numpy_map_max_diff_px": np_map_err,
                "ffmpeg_baseline_ms": median_ms(res["ff_base"]) if res.get("ff_base") else None,
-               "rows": rows}
+               "rows": rows, "per_view": []}
+    for i, v in enumerate(meta["views"]):
+        view = [v["yaw"], v["pitch"], v["hfov"]]
+        row = {"view": view, "ours_lut_bilinear_adaptive_ms": our_view("bilinear", view)}
+        for key in ["cv_fixed_bil", "cv_float_bil"]:
+            t = per_view[key].get(i)
+            ms = median_ms(t) if t else None
+            row[key + "_ms"] = ms
+            o = row["ours_lut_bilinear_adaptive_ms"]
+            row["ratio_ours_over_" + key] = o / ms if o and ms else None
+        summary["per_view"].append(row)
     json.dump(summary, open(os.path.join(a.out, "peers.json"), "w"), indent=2)
     print(f"peers: {w}x{h} from {mw}x{mh}, {n} threads, {len(meta['views'])} views x {a.reps} reps")
     print(f"| peer | their ms (median) | ours | our ms | ours/theirs | their PSNR vs our exact |")
@@ -385,6 +432,15 @@ def main():
         ps = "-" if p is None else ("identical" if p == float("inf") else f"{p:.1f} dB")
         print(f"| {r['peer']} | {r['ms_median']:.2f} | {r['ours']} | {om} | {ratio} | {ps} |")
     print(f"numpy-built maps vs our exported exact maps: max |diff| {np_map_err:.2e} px")
+    if given:
+        print("| view [yaw, pitch, hfov] | ours (LUT bilinear) ms | OpenCV fixed ms | ours/fixed "
+              "| OpenCV float ms | ours/float |")
+        print("|---|---:|---:|---:|---:|---:|")
+        f = lambda x, d=2: "-" if x is None else f"{x:.{d}f}"  # noqa: E731
+        for r in summary["per_view"]:
+            print(f"| {r['view']} | {f(r['ours_lut_bilinear_adaptive_ms'])} "
+                  f"| {f(r['cv_fixed_bil_ms'])} | {f(r['ratio_ours_over_cv_fixed_bil'], 3)} "
+                  f"| {f(r['cv_float_bil_ms'])} | {f(r['ratio_ours_over_cv_float_bil'], 3)} |")
 
 
 if __name__ == "__main__":

@@ -19,11 +19,12 @@ use crate::error::ViewError;
 use crate::geom::camera::{check_size, View};
 use crate::lut::{Surface, TableKind};
 use crate::map::envmap::EnvMap;
+use crate::map::sample::Sampler;
 use crate::render::cube::cube_frame;
 use crate::render::frame::Frame;
 use crate::render::heat::ErrorMap;
 use crate::render::{BandHook, RenderOptions, RenderReport, Renderer};
-use crate::tiles::{frame_level, TiledPanorama};
+use crate::tiles::{frame_level, trilinear_levels, TiledPanorama};
 use std::sync::{Arc, Mutex};
 
 /// What kind of panorama a [`Panorama`] is (readouts, messages). New kinds will be added
@@ -41,12 +42,20 @@ pub enum PanoramaKind {
 }
 
 impl PanoramaKind {
-    /// Short name: "map", "cube".
+    /// Short name: "map", "cube", "tiled".
     pub fn name(self) -> &'static str {
         match self {
             PanoramaKind::Map => "map",
             PanoramaKind::Cube => "cube",
             PanoramaKind::Tiled => "tiled",
+        }
+    }
+
+    /// What a reader calls it: "map", "cube", "tiled pyramid".
+    pub fn noun(self) -> &'static str {
+        match self {
+            PanoramaKind::Tiled => "tiled pyramid",
+            other => other.name(),
         }
     }
 }
@@ -348,13 +357,18 @@ impl Panorama {
                 let (w, h) = (frame.width(), frame.height());
                 let mut p = t.pano.lock().unwrap_or_else(|e| e.into_inner());
                 p.pump();
-                let level = frame_level(p.store(), view, w, h, t.still);
-                // Trilinear is drawn bilinear on the level: `TiledPanorama::render_trilinear`
-                // is not dispatched to until its test passes (docs/huge.md).
-                let f = if t.wait {
-                    p.render_wait(view, opts.sampler, level, frame.pixels_mut(), w, h)
+                // Trilinear: the two levels around the footprint, mixed by its log2;
+                // nearest and bilinear: the one level the footprint picks.
+                let f = if opts.sampler == Sampler::Trilinear {
+                    let (fine, tw) = trilinear_levels(p.store(), view, w, h, t.still);
+                    p.render_trilinear(view, fine, tw, frame.pixels_mut(), w, h, t.wait)
                 } else {
-                    p.render(view, opts.sampler, level, frame.pixels_mut(), w, h, true)
+                    let level = frame_level(p.store(), view, w, h, t.still);
+                    if t.wait {
+                        p.render_wait(view, opts.sampler, level, frame.pixels_mut(), w, h)
+                    } else {
+                        p.render(view, opts.sampler, level, frame.pixels_mut(), w, h, true)
+                    }
                 };
                 drop(p);
                 if let Some(hook) = hook {

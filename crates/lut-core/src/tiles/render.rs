@@ -284,6 +284,53 @@ impl Ctx<'_> {
         }
     }
 
+    /// A bilinear piece reading within a texel of its tile's edge reads the border: where
+    /// that border still holds an ancestor's texels, the tiles it stands for are wanted
+    /// (not hit), so a waiting frame loads them (refilling the border) and a moving one
+    /// counts as coarser until they arrive.
+    #[allow(clippy::too_many_arguments)]
+    fn note_stale_border(
+        &self,
+        band: &mut Band,
+        id: TileId,
+        tile: &super::store::Tile,
+        run: &FaceRun,
+        n: usize,
+        x: usize,
+        y: usize,
+    ) {
+        let t = self.store.config().tile as f64;
+        let at = |i: usize| {
+            let dx = run.dx + i as f64;
+            let (a, b, m) = (
+                run.p[0] + dx * run.d[0],
+                run.p[1] + dx * run.d[1],
+                run.p[2] + dx * run.d[2],
+            );
+            let q = run.half / m;
+            (run.half + a * q, run.half - b * q)
+        };
+        // A run on a face is a straight segment of the face: its ends bound it.
+        let ((u0, v0), (u1, v1)) = (at(0), at(n.saturating_sub(1)));
+        let (x0, y0) = (id.x as f64 * t, id.y as f64 * t);
+        let (x1, y1) = (x0 + tile.w as f64, y0 + tile.h as f64);
+        let near = u0.min(u1) < x0 + 1.0
+            || u0.max(u1) > x1 - 1.0
+            || v0.min(v1) < y0 + 1.0
+            || v0.max(v1) > y1 - 1.0;
+        if !near {
+            return;
+        }
+        let xm = x as f64 + n as f64 / 2.0;
+        let d = (xm - self.cx).powi(2) + (y as f64 + 0.5 - self.cy).powi(2);
+        for &s in tile.stale_border() {
+            if self.store.get(s).is_none() && !self.store.config().is_missing(s) {
+                let e = band.touched.entry(s).or_insert((d, false));
+                e.0 = e.0.min(d);
+            }
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn piece(
         &self,
@@ -306,6 +353,9 @@ impl Ctx<'_> {
             self.note(band, id, xm, y as f64 + 0.5, tile.is_some());
         }
         if let Some(tile) = tile {
+            if self.bilinear && l == self.level && !tile.stale_border().is_empty() {
+                self.note_stale_border(band, id, tile, run, out.len(), x, y);
+            }
             let t = cfg.tile as f64;
             let (kx, ky) = (id.x as f64 * t / run.half, id.y as f64 * t / run.half);
             let shifted = FaceRun {

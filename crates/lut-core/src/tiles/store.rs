@@ -47,6 +47,19 @@ pub struct Tile {
     used: AtomicU64,
     /// Level 1: never evicted.
     pinned: bool,
+    /// The tiles of its own level some of its border was wanted from and which were not
+    /// decoded when it was filled (the border holds their ancestors' texels there). A
+    /// bilinear frame reading near this tile's edge asks for them
+    /// ([`Tile::stale_border`]), so their arrival refills the border.
+    stale: Vec<TileId>,
+}
+
+impl Tile {
+    /// The tiles of its level whose texels its border holds only approximately (from an
+    /// ancestor), until they are decoded.
+    pub fn stale_border(&self) -> &[TileId] {
+        &self.stale
+    }
 }
 
 /// Counters the panel and the bench read.
@@ -231,6 +244,7 @@ impl TileStore {
             px: buf,
             used: AtomicU64::new(self.frame),
             pinned: id.level == 1,
+            stale: Vec::new(),
         };
         if let Some(old) = self.tiles.insert(id, tile) {
             self.bytes -= old.px.len() * 4;
@@ -318,8 +332,15 @@ impl TileStore {
         );
         let s = self.stride();
         let mut ring = Vec::with_capacity(2 * (w + h + 4) as usize);
+        let mut stale = Vec::new();
         let mut at = |bx: i64, by: i64| {
-            let v = self.texel(id.level as u32, id.face, x0 + bx - 1, y0 + by - 1);
+            let v = self.texel(
+                id.level as u32,
+                id.face,
+                x0 + bx - 1,
+                y0 + by - 1,
+                &mut stale,
+            );
             ring.push((by as usize * s + bx as usize, v));
         };
         for bx in 0..=w + 1 {
@@ -330,10 +351,14 @@ impl TileStore {
             at(0, by);
             at(w + 1, by);
         }
+        stale.sort_unstable();
+        stale.dedup();
+        stale.retain(|&n| n != id);
         let t = self.tiles.get_mut(&id).expect("present");
         for (i, v) in ring {
             t.px[i] = v;
         }
+        t.stale = stale;
         // The texels right of and below a short tile's border repeat it (positions inside
         // the tile never read them; a position rounded a hair past the edge reads the
         // border's value).
@@ -352,8 +377,9 @@ impl TileStore {
 
     /// Texel `(ix, iy)` of `face` at `level`, where the indices may lie one texel outside
     /// the face (then: the neighbouring face's bilinear sample in that direction), from
-    /// the tile holding it or its nearest decoded ancestor.
-    fn texel(&self, level: u32, face: Face, ix: i64, iy: i64) -> u32 {
+    /// the tile holding it or its nearest decoded ancestor. A tile of `level` wanted and
+    /// not decoded is pushed on `stale`.
+    fn texel(&self, level: u32, face: Face, ix: i64, iy: i64, stale: &mut Vec<TileId>) -> u32 {
         let size = self.cfg.level_size(level) as i64;
         if (0..size).contains(&ix) && (0..size).contains(&iy) {
             let t = self.cfg.tile as i64;
@@ -367,6 +393,7 @@ impl TileStore {
                 let s = self.stride();
                 return tile.px[((iy % t) + 1) as usize * s + (ix % t) as usize + 1];
             }
+            stale.push(id);
             if level > 1 {
                 let sc = self.cfg.level_size(level - 1) as f64 / size as f64;
                 return self.bilinear(
@@ -385,6 +412,20 @@ impl TileStore {
         let d = face_dir(face, s, tt);
         let f2 = face_of(d);
         let (u, v) = face_uv(f2, d, half);
+        // The neighbour face's sample reads the tile holding (u, v) and, within half a
+        // texel of its edge, that tile's border: the tile is the one wanted.
+        let n = self.cfg.tiles_across(level);
+        let t = self.cfg.tile as f64;
+        let cell = |c: f64| ((c.max(0.0) / t) as u32).min(n - 1);
+        let want = TileId {
+            level: level as u8,
+            face: f2,
+            x: cell(u),
+            y: cell(v),
+        };
+        if !self.tiles.contains_key(&want) {
+            stale.push(want);
+        }
         self.bilinear(level, f2, u, v, false)
     }
 

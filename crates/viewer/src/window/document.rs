@@ -284,13 +284,10 @@ impl Document {
             map: loaded.label(),
             ..Readouts::default()
         };
-        let size = match loaded.map() {
-            Some(_) => format!("{mw}×{mh}"),
-            None => format!("cube, {mw}px faces"),
-        };
         fx.push(Effect::Title(format!(
-            "viewer: {} ({size})",
-            loaded.source.short_name()
+            "viewer: {} ({})",
+            loaded.source.short_name(),
+            loaded.size_label()
         )));
         if opening {
             fx.push(Effect::StartView(self.start_view_of(&loaded)));

@@ -127,17 +127,26 @@ impl Loaded {
         (w, h, kind)
     }
 
+    /// The size as the title shows it: "W×H" for a map, "cube, Npx faces", "tiled
+    /// pyramid, Npx faces".
+    pub fn size_label(&self) -> String {
+        let (w, h, _) = self.describe();
+        match self.scene.kind() {
+            PanoramaKind::Map => format!("{w}×{h}"),
+            kind => format!("{}, {w}px faces", kind.noun()),
+        }
+    }
+
     /// The map readout: name, size, projection and memory.
     pub fn label(&self) -> String {
         let (w, h, proj) = self.describe();
         let name = self.source.short_name();
         match self.scene.kind() {
-            PanoramaKind::Cube => format!("{name} (cube, {w}px faces)"),
-            PanoramaKind::Tiled => format!("{name} (tiled pyramid, {w}px faces)"),
-            _ => format!(
+            PanoramaKind::Map => format!(
                 "{name} ({w}×{h}, {proj}, {} in memory)",
                 format_bytes(self.scene.bytes())
             ),
+            _ => format!("{name} ({})", self.size_label()),
         }
     }
 

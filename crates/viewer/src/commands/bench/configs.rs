@@ -43,6 +43,57 @@ pub struct ViewSet {
     pub hfov: f64,
     /// The frames.
     pub views: Vec<View>,
+    /// A set of one view given with `--view`: its rows carry `view` [yaw, pitch, hfov].
+    pub given: Option<[f64; 3]>,
+}
+
+/// One `--view YAW,PITCH,HFOV` (degrees), checked as a [`View`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewArg(pub [f64; 3]);
+
+/// Parse one `--view YAW,PITCH,HFOV`: three finite numbers of degrees, a valid view
+/// (pitch within ±90, hfov within the rectilinear range).
+pub fn parse_view(s: &str) -> Result<ViewArg, String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "view '{s}' must be YAW,PITCH,HFOV in degrees (three numbers, e.g. 30,90,90)"
+        ));
+    }
+    let mut v = [0.0; 3];
+    for (x, p) in v.iter_mut().zip(&parts) {
+        *x = crate::args::parse_angle(p).map_err(|e| format!("view '{s}': {e}"))?;
+    }
+    if !(-90.0..=90.0).contains(&v[1]) {
+        return Err(format!(
+            "view '{s}': pitch {} is outside -90..90 degrees",
+            v[1]
+        ));
+    }
+    View::new(v[0], v[1], v[2]).map_err(|e| format!("view '{s}': {e}"))?;
+    Ok(ViewArg(v))
+}
+
+/// The sets of `--view`: one set of one frame per view, in the order given, on the table
+/// the renderer would choose for its hfov (wide above [`lut_core::LUT_SWITCH_HFOV`],
+/// else high).
+pub fn given_view_sets(given: &[ViewArg]) -> Result<Vec<ViewSet>> {
+    given
+        .iter()
+        .map(|&ViewArg([y, p, hfov])| {
+            let table = if hfov > lut_core::LUT_SWITCH_HFOV {
+                TableKind::Wide
+            } else {
+                TableKind::High
+            };
+            Ok(ViewSet {
+                table,
+                hfov,
+                views: views(&[(y, p)], hfov)?,
+                given: Some([y, p, hfov]),
+            })
+        })
+        .collect()
 }
 
 /// The fixed (yaw, pitch) views of every set: center, the ±180° seam, two oblique, near
@@ -87,6 +138,7 @@ pub fn view_sets(which: ViewsArg) -> Result<Vec<ViewSet>> {
                 table,
                 hfov,
                 views: views(&at, hfov)?,
+                given: None,
             })
         })
         .collect()
@@ -317,6 +369,36 @@ mod tests {
         assert!((pan[1].yaw_deg() - (3.7 + 45.0)).abs() < 1e-9);
         // full starts with quick's fixed views.
         assert_eq!(full[0].views[..5], quick[0].views[..5]);
+    }
+
+    #[test]
+    fn given_views_parse_and_make_one_set_each() {
+        assert_eq!(parse_view("30,90,90"), Ok(ViewArg([30.0, 90.0, 90.0])));
+        assert_eq!(
+            parse_view(" -10.5, -45 ,150"),
+            Ok(ViewArg([-10.5, -45.0, 150.0]))
+        );
+        for bad in [
+            "30,90",
+            "30,90,90,1",
+            "a,0,90",
+            "0,nan,90",
+            "0,91,90",
+            "0,0,0",
+            "",
+        ] {
+            let e = parse_view(bad).unwrap_err();
+            assert!(e.contains(&format!("'{bad}'")), "{e}");
+            assert!(!e.contains('\n'), "{e}");
+        }
+        let sets =
+            given_view_sets(&[ViewArg([30.0, 90.0, 90.0]), ViewArg([0.0, 0.0, 50.0])]).unwrap();
+        assert_eq!(sets.len(), 2);
+        assert_eq!((sets[0].table, sets[0].hfov), (TableKind::Wide, 90.0));
+        assert_eq!(sets[0].given, Some([30.0, 90.0, 90.0]));
+        assert_eq!(sets[0].views.len(), 1);
+        assert_eq!(sets[0].views[0].pitch_deg(), 90.0);
+        assert_eq!(sets[1].table, TableKind::High);
     }
 
     #[test]

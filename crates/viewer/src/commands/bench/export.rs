@@ -34,6 +34,16 @@ impl Export {
         })
     }
 
+    /// Views written so far.
+    pub fn len(&self) -> usize {
+        self.manifest.len()
+    }
+
+    /// Whether no view was written yet.
+    pub fn is_empty(&self) -> bool {
+        self.manifest.is_empty()
+    }
+
     /// Write view `vi`: its exact positions (`exact`: per pixel the map position, if any,
     /// and the latitude) and its exact nearest and bilinear images.
     ///

@@ -16,7 +16,6 @@ use lut_core::{
     Camera, EnvMap, Frame, Named, Panorama, Projection, Renderer, RendererKind, Sampler, View,
 };
 use rayon::prelude::*;
-use std::path::Path;
 use std::time::Instant;
 
 /// Run `f` on a rayon pool of `threads` workers (default: all cores), which every
@@ -153,13 +152,13 @@ fn render_config(
 }
 
 /// Per view: the exact positions and images once, then every configuration's positions
-/// (LUT) and image compared with them. With `export`, the hfov-90 set's exact data is
-/// written for `scripts/peers.py`.
+/// (LUT) and image compared with them. With `export`, the set's exact data is written
+/// for `scripts/peers.py`, its views numbered from `export.len()`.
 pub fn measure_errors(
     ctx: &Ctx,
     renderer: &mut Renderer,
     cfgs: &[Config],
-    export: Option<&Path>,
+    mut export: Option<&mut Export>,
 ) -> Result<Errors> {
     let (w, h) = (ctx.w, ctx.h);
     let n = w as usize * h as usize;
@@ -167,7 +166,7 @@ pub fn measure_errors(
     let (mw, mh, proj) = (map.width(), map.height(), map.projection());
     let mut acc = vec![ErrAcc::default(); cfgs.len()];
     let mut gather_idx = Vec::with_capacity(ctx.set.views.len());
-    let mut export = export.map(|dir| Export::start(dir, ctx.src)).transpose()?;
+    let first = export.as_ref().map_or(0, |ex| ex.len());
     let mut img = vec![0u32; n];
     let mut exact_img = [vec![0u32; n], vec![0u32; n]];
     for (vi, &view) in ctx.set.views.iter().enumerate() {
@@ -204,8 +203,8 @@ pub fn measure_errors(
                 None => u32::MAX,
             })
             .collect();
-        if let Some(ex) = &mut export {
-            ex.view(vi, view, &exact, &exact_img)?;
+        if let Some(ex) = export.as_deref_mut() {
+            ex.view(first + vi, view, &exact, &exact_img)?;
         }
         for (ci, cfg) in cfgs.iter().enumerate() {
             let e = &mut acc[ci];
@@ -260,9 +259,6 @@ pub fn measure_errors(
             view.yaw_deg(),
             view.pitch_deg()
         ));
-    }
-    if let Some(ex) = export {
-        ex.finish((mw, mh), (w, h))?;
     }
     Ok(Errors {
         per_config: acc,
@@ -525,6 +521,7 @@ mod tests {
                 View::new(20.0, 10.0, 90.0).unwrap(),
                 View::new(180.0, 80.0, 90.0).unwrap(),
             ],
+            given: None,
         };
         let ctx = Ctx {
             map: &map,

@@ -34,7 +34,8 @@ pub mod report;
 use crate::args::{named, parse_map_size, parse_size, MaxPixelsArg, ProjectionOpt};
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
-use configs::{configs, view_sets, ViewsArg};
+use configs::{configs, given_view_sets, view_sets, ViewArg, ViewsArg};
+use export::Export;
 use lut_core::CubeMap;
 use lut_core::{IndexStep, TableKind};
 use lut_core::{Kernel, Projection, Renderer, Sampler, Surface};
@@ -65,6 +66,12 @@ pub struct BenchArgs {
     /// The view sets: quick or full.
     #[arg(long, default_value = "quick", value_parser = named::<ViewsArg>())]
     pub views: ViewsArg,
+    /// Time exactly this view instead of the view sets: YAW,PITCH,HFOV in degrees
+    /// (repeatable; each view is its own set of one frame, on the table the renderer picks
+    /// for its hfov, and every row carries `view` [yaw, pitch, hfov]; no minification set).
+    #[arg(long = "view", value_name = "YAW,PITCH,HFOV", value_parser = configs::parse_view,
+          conflicts_with = "views")]
+    pub view: Vec<ViewArg>,
     /// Timed passes over each set, each after a warm-up pass (the configurations take
     /// turns, pass by pass).
     #[arg(long, default_value_t = 3)]
@@ -232,8 +239,12 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         projection: map.projection().name().into(),
         kernel: kernel.active.name().into(),
     };
-    let mut sets = view_sets(a.views)?;
-    if a.only_default {
+    let mut sets = if a.view.is_empty() {
+        view_sets(a.views)?
+    } else {
+        given_view_sets(&a.view)?
+    };
+    if a.only_default && a.view.is_empty() {
         sets.retain(|s| s.table == TableKind::Wide && s.hfov == 90.0);
     }
     let mut renderer = Renderer::new(&map);
@@ -281,9 +292,14 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
     };
 
     let mut rows = Vec::new();
+    // The export: the hfov-90 set's views, or every `--view`.
+    let mut export = match &a.export_maps {
+        Some(d) => Some(Export::start(d, &src)?),
+        None => None,
+    };
     for set in &sets {
-        let export = match (&a.export_maps, set.table) {
-            (Some(d), TableKind::Wide) => Some(d.as_path()),
+        let export = match &mut export {
+            Some(ex) if set.given.is_some() || set.table == TableKind::Wide => Some(ex),
             _ => None,
         };
         let mut cfgs = configs(cube_map.is_some());
@@ -316,6 +332,7 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
                 )
             };
             e.fill(&mut row);
+            row.view = set.given;
             row.surface = cfg.surface().map(Into::into);
             match cfg {
                 configs::Config::Lut(..) => {
@@ -345,8 +362,12 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
         }
     }
 
+    if let Some(ex) = export {
+        ex.finish((map.width(), map.height()), (w, h))?;
+    }
+
     let mut minify_note = None;
-    if !a.no_minify && !a.only_default {
+    if !a.no_minify && !a.only_default && a.view.is_empty() {
         let (mut mrows, note) = measure::minify_set(&run, a.size, a.passes, &map, &mut renderer)?;
         rows.append(&mut mrows);
         minify_note = Some(note);
@@ -431,6 +452,25 @@ mod tests {
             let e = bench_args(&[flag, bad]).unwrap_err().to_string();
             assert!(e.contains(bad), "{e}");
         }
+    }
+
+    #[test]
+    fn views_given_on_the_command_line() {
+        let a = bench_args(&["--view", "30,90,90", "--view", "0,0,150"]).unwrap();
+        assert_eq!(
+            a.view,
+            [
+                super::ViewArg([30.0, 90.0, 90.0]),
+                super::ViewArg([0.0, 0.0, 150.0])
+            ]
+        );
+        assert!(bench_args(&[]).unwrap().view.is_empty());
+        for bad in ["30,90", "x,0,90", "0,100,90", "0,0,200"] {
+            let e = bench_args(&["--view", bad]).unwrap_err().to_string();
+            assert!(e.contains(bad), "{e}");
+        }
+        let e = bench_args(&["--view", "0,0,90", "--views", "full"]).unwrap_err();
+        assert_eq!(e.kind(), clap::error::ErrorKind::ArgumentConflict);
     }
 
     #[test]

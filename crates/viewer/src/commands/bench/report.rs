@@ -85,6 +85,10 @@ pub struct Row {
     /// reads JSON files written before and labels those rows.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub position_bound_texels: Option<f64>,
+    /// With `--view`: the one view this row timed, [yaw, pitch, hfov] in degrees (absent
+    /// for the fixed view sets).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub view: Option<[f64; 3]>,
 }
 
 impl Row {
@@ -121,6 +125,7 @@ impl Row {
             table_build_ms: None,
             surface: None,
             position_bound_texels: None,
+            view: None,
         }
     }
 }
