@@ -63,10 +63,14 @@ impl App {
                 self.lit.set_indirect(s.key.clone(), s.radiosity.clone());
             }
         }
-        self.lights.work_plane = crate::lighting::describe_work_plane(
+        let line = crate::lighting::describe_work_plane(
             self.solver.latest().filter(|s| s.key == key),
             self.solver.pending(),
         );
+        if line != self.lights.work_plane && self.print_view && !self.lights.lights.is_empty() {
+            let _ = crate::outln!("work-plane {line}");
+        }
+        self.lights.work_plane = line;
         self.poll_report();
     }
 
