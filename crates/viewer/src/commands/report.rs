@@ -664,7 +664,8 @@ mod tests {
     /// The window's "Report…" writes what `viewer report` computes for the same lights:
     /// the JSON of the panel's state (here the state `viewer report` read from its
     /// arguments) is byte for byte the command's JSON; an unknown extension is refused
-    /// and writes nothing.
+    /// and writes nothing; the panel's live figures from the solving thread are the
+    /// report's work plane.
     #[test]
     fn the_window_report_is_the_commands_report() {
         let mut argv = vec!["report".to_string(), "--room".into(), "6x5x2.8".into()];
@@ -688,5 +689,32 @@ mod tests {
         assert!(e.to_string().contains(".html, .json or .png"), "{e}");
         assert!(!bad.exists());
         let _ = std::fs::remove_dir_all(&dir);
+        // The panel's live figures, from the solving thread, are the report's work plane.
+        let mut solver = crate::lighting::Solver::start(Arc::new(|| {}));
+        assert!(solver.request(&st));
+        let key = st.geometry_key();
+        let t0 = std::time::Instant::now();
+        while !solver.poll(&key) {
+            assert!(
+                t0.elapsed().as_secs() < 120,
+                "no result from the solving thread"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        let (live, points) = solver.latest().unwrap().work_plane.clone().unwrap();
+        let wp = &report.areas[0];
+        assert_eq!(points, wp.grid.points.len());
+        for (got, want) in [
+            (live.em, wp.stats.em),
+            (live.emin, wp.stats.emin),
+            (live.emax, wp.stats.emax),
+            (live.u0, wp.stats.u0),
+        ] {
+            assert!(
+                (got - want).abs() <= 1e-9 * want.abs(),
+                "{live:?} vs {:?}",
+                wp.stats
+            );
+        }
     }
 }
