@@ -20,7 +20,8 @@
 #   along the ceiling without turning the view; dragging a room edge resizes the room, and
 #   so does dragging a room corner (its two walls), Shift-dragging a ceiling or floor
 #   edge changes the room's height or camera height; then, the lighting settled, a zoom
-#   draws the lit panorama (lit=baked).
+#   draws the lit panorama (lit=baked); the work plane's Em and U0 (solved on the
+#   solving thread) are printed after the load and again, different, after the changes.
 #
 # Screenshots and logs: target/window-smoke/ (kept as CI artifacts). The settings live
 # in a temporary config folder (LUTPANO_CONFIG_DIR), never the real home.
@@ -417,6 +418,11 @@ SCENE=$(field size); SW=${SCENE%x*}; SH=${SCENE#*x}
 CX=$((X + SW / 2)); CY=$((Y + SH / 2))
 [ "$(field yaw)" = -40.0000 ] || fail "the scene's view yaw -40 should be kept, got $(field yaw)"
 [ "$(field lights)" = 5 ] || fail "the scene's five lights should be loaded, got $(field lights)"
+# The work plane's figures arrive from the solving thread (inter-reflections included).
+wait_for '^work-plane Em ' 0 60
+WP1=$(grep '^work-plane Em ' "$VIEWLOG" | tail -n 1)
+WPN=$(lines)
+log "$WP1"
 # A marker well inside the scene (clear of the toolbar): "N=X,Y".
 MARK=$(grep '^markers ' "$VIEWLOG" | tail -n 1 | tr ' ' '\n' | grep '=' |
   awk -F'[=,]' -v w="$SW" -v h="$SH" '$2 > 60 && $2 < w - 60 && $3 > 80 && $3 < h - 60 { print; exit }')
@@ -513,6 +519,11 @@ xdotool mousemove "$CX" "$CY"; sleep 0.2; xdotool click 4
 wait_for '^view .* lit=baked' "$N" 10
 settle
 log "after the lighting settled: lit=$(field lit)"
+# The figures followed the dragged light and room: fresh ones, not the first.
+wait_for '^work-plane Em ' "$WPN" 30
+WP2=$(grep '^work-plane Em ' "$VIEWLOG" | tail -n 1)
+log "$WP2"
+[ "$WP2" != "$WP1" ] || fail "the work plane's figures did not follow the changes: $WP1"
 sleep 0.3
 $IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/lights.png"
 quit_viewer

@@ -34,6 +34,7 @@ use lut_core::{
     shade_frame, IesFile, IlluminanceMap, Interpolation, LightScene, LightTable, Luminaire,
     MapOptions, Room, ShadeOptions, TableOptions,
 };
+use lut_core::{AreaStats, CalcGrid, FormFactors, Radiosity, Reflectances, RoomFace};
 use lut_core::{Camera, View};
 use std::hint::black_box;
 use std::sync::Arc;
@@ -295,6 +296,29 @@ fn relight(c: &mut Criterion) {
         g.bench_function(BenchmarkId::new("preview", 8), |b| {
             pool.install(|| b.iter(|| black_box(IlluminanceMap::build(&s, &MapOptions::preview()))))
         });
+        // With inter-reflections, the form factors of the room kept (computed once, on the
+        // first iteration).
+        let refl = Reflectances::default();
+        g.bench_function(BenchmarkId::new("indirect", 8), |b| {
+            pool.install(|| {
+                b.iter(|| {
+                    let r = Arc::new(Radiosity::solve(&s, refl).expect("solve"));
+                    let lit = s.clone().with_radiosity(r);
+                    let lmap = IlluminanceMap::build(&lit, &MapOptions::default()).expect("map");
+                    black_box(lmap.bake_map(&pano, &shade).expect("bake"))
+                })
+            })
+        });
+        g.bench_function(BenchmarkId::new("solve", 8), |b| {
+            pool.install(|| {
+                b.iter(|| {
+                    let r = Arc::new(Radiosity::solve(&s, refl).expect("solve"));
+                    let lit = s.clone().with_radiosity(r);
+                    let grid = CalcGrid::work_plane(lit.room(), 0.75).expect("grid");
+                    black_box(AreaStats::of(&read_grid(&lit, &grid)))
+                })
+            })
+        });
         drop(pano);
         let big = grid_map(8192, 4096, Projection::Equirect).expect("map");
         big.pyramid();
@@ -305,5 +329,46 @@ fn relight(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, pan, shade_pass, relight);
+/// The illuminance (direct + exact indirect) at each point of `grid`, as `viewer report`
+/// reads its grids.
+fn read_grid(scene: &LightScene, grid: &CalcGrid) -> Vec<f64> {
+    use rayon::prelude::*;
+    grid.points
+        .par_iter()
+        .map(|&p| scene.direct(p, grid.normal) + scene.indirect(p, grid.normal))
+        .collect()
+}
+
+/// `viewer report`'s figures for the 6 × 5 × 2.8 m room with 8 lights, from scratch.
+fn report(c: &mut Criterion) {
+    let pool = pool();
+    let table = Arc::new(synthetic_table(Interpolation::Linear));
+    let s = scene(8, &table);
+    let refl = Reflectances::default();
+    let mut g = c.benchmark_group("lights_report");
+    short(&mut g);
+    g.bench_function(BenchmarkId::new("figures", 8), |b| {
+        pool.install(|| {
+            b.iter(|| {
+                // A fresh process has no form factors: compute them (the solve below then
+                // finds the room's in the cache, so they are counted once).
+                black_box(FormFactors::new(s.room(), lut_core::DEFAULT_PATCHES).expect("ff"));
+                let r = Arc::new(Radiosity::solve(&s, refl).expect("solve"));
+                let lit = s.clone().with_radiosity(r);
+                let mut grids = vec![CalcGrid::work_plane(lit.room(), 0.75).expect("grid")];
+                for face in RoomFace::ALL {
+                    grids.push(CalcGrid::face(lit.room(), face).expect("grid"));
+                }
+                let stats: Vec<AreaStats> = grids
+                    .iter()
+                    .map(|g| AreaStats::of(&read_grid(&lit, g)))
+                    .collect();
+                black_box(stats)
+            })
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, pan, shade_pass, relight, report);
 criterion_main!(benches);

@@ -192,7 +192,8 @@ pub use tiles::{
 // Lights.
 pub use light::{
     border_band, en12464_spacing, ugr, AreaStats, CalcGrid, DirectLight, FormFactors, GlareTerm,
-    LuminousArea, Patch, Radiosity, Reflectances, Ugr, MAX_GRID_POINTS, MAX_PATCHES,
+    LuminousArea, Patch, Radiosity, Reflectances, Ugr, DEFAULT_PATCHES, MAX_GRID_POINTS,
+    MAX_PATCHES,
 };
 pub use light::{
     detect_format, false_color, false_color_position, lit_cube_bytes, lit_map_bytes,

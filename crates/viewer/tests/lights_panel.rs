@@ -1,7 +1,7 @@
 //! The panel's "Lights" section drawn offscreen (no display): with luminaires it opens
 //! and shows the scene buttons, the room's fitting fields, each light's switch and fields
 //! (only the selected light's when one is selected), the exposure's "automatic" switch and
-//! the interpolation choice.
+//! the interpolation choice; the work plane's Em and U0 and the "Report…" button.
 
 use viewer::lighting::LightsState;
 use viewer::window::input::{AutoRotate, Look};
@@ -79,6 +79,8 @@ fn the_lights_section_shows_the_room_and_each_light() {
         "automatic",
         "Interpolation",
         "linear",
+        "Work plane",
+        "Report…",
     ] {
         assert!(t.iter().any(|s| s == want), "no '{want}' in {t:?}");
     }
@@ -95,6 +97,10 @@ fn the_lights_section_shows_the_room_and_each_light() {
             .any(|s| s == "lit panorama: 43 MiB, baked in 41 ms"),
         "{t:?}"
     );
+    // The work plane's figures, as the window sets them from the solving thread.
+    lights.work_plane = "Em 512 lx  U0 0.64".into();
+    let t = panel_texts(&mut lights);
+    assert!(t.iter().any(|s| s == "Em 512 lx  U0 0.64"), "{t:?}");
 }
 
 #[test]
@@ -102,4 +108,5 @@ fn without_lights_the_section_stays_closed() {
     let t = panel_texts(&mut LightsState::default());
     assert!(t.iter().any(|s| s == "Lights (0)"), "{t:?}");
     assert!(!t.iter().any(|s| s == "Room turn"), "{t:?}");
+    assert!(!t.iter().any(|s| s == "Report…"), "{t:?}");
 }

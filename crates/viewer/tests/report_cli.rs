@@ -226,6 +226,117 @@ fn bad_input_writes_nothing() {
     }
 }
 
+/// The one line on stderr (besides clap's "For more information" hint), checked free of
+/// panics.
+fn one_line(o: &std::process::Output) -> String {
+    let err = String::from_utf8_lossy(&o.stderr);
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| !l.is_empty() && !l.starts_with("For more information"))
+        .collect();
+    assert_eq!(lines.len(), 1, "one line: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    lines[0].to_string()
+}
+
+/// The budgets `viewer report` is held to (`lut_core::limits`): more luminaires than
+/// `MAX_LIGHTS` (200) on the command line or in a scene file, a room side past
+/// `MAX_ROOM_SIDE` (100 m): one line naming the value and the limit, exit 2 (exit 1 when
+/// the numbers come from a scene file), none of the three outputs written. One luminaire fewer, at the limit, is reported.
+#[test]
+fn past_the_limits_one_line_naming_the_limit_and_nothing_written() {
+    let dir = tmpdir("report", "limits");
+    let (json, png, html) = (dir.join("r.json"), dir.join("r.png"), dir.join("r.html"));
+    let outputs: Vec<String> = vec![
+        "--json".into(),
+        s(&json).into(),
+        "--png".into(),
+        s(&png).into(),
+        "--html".into(),
+        s(&html).into(),
+    ];
+    let light = |i: usize| {
+        // Spread over the ceiling of a 6 × 5 m room (the positions need not differ).
+        let (x, z) = ((i % 20) as f64 * 0.25 - 2.4, (i / 20) as f64 * 0.4 - 2.0);
+        format!("{}@{x},2.75,{z}", louvre())
+    };
+    let cli = |n: usize, room: &str| {
+        let mut a = vec!["report".to_string(), "--room".into(), room.into()];
+        for i in 0..n {
+            a.push("--light".into());
+            a.push(light(i));
+        }
+        a
+    };
+    let scene = |n: usize, room: [f64; 3]| {
+        let lights: Vec<serde_json::Value> = (0..n)
+            .map(|i| {
+                let (x, z) = ((i % 20) as f64 * 0.25 - 2.4, (i / 20) as f64 * 0.4 - 2.0);
+                serde_json::json!({"file": louvre(), "position": [x, 2.75, z]})
+            })
+            .collect();
+        let v = serde_json::json!({
+            "format": "lutpano-scene", "version": 1,
+            "room": {"width": room[0], "depth": room[1], "height": room[2],
+                     "camera_height": 1.5},
+            "lights": lights,
+            "exposure_lux": 300.0, "ambient": 0.15
+        });
+        let p = dir.join(format!("scene-{n}-{}.json", room[0]));
+        std::fs::write(&p, serde_json::to_string(&v).unwrap()).unwrap();
+        vec!["report".to_string(), "--scene".into(), s(&p).into()]
+    };
+    // Exit 2 for the command line, 1 for a file's content (the project's one rule,
+    // docs/reliability.md).
+    for (what, mut a, want, code) in [
+        (
+            "201 --light",
+            cli(201, "6x5x2.8"),
+            "luminaires 201 exceeds the limit of 200",
+            2,
+        ),
+        (
+            "a scene of 201 lights",
+            scene(201, [6.0, 5.0, 2.8]),
+            "luminaires 201 exceeds the limit of 200",
+            1,
+        ),
+        (
+            "a 101 m room",
+            cli(1, "101x5x2.8"),
+            "101 m exceeds the limit of 100 m",
+            2,
+        ),
+        (
+            "a scene's 101 m room",
+            scene(1, [101.0, 5.0, 2.8]),
+            "101 m exceeds the limit of 100 m",
+            1,
+        ),
+    ] {
+        a.extend(outputs.iter().cloned());
+        let o = run(&a);
+        let line = one_line(&o);
+        assert_eq!(o.status.code(), Some(code), "{what}: {line}");
+        assert!(line.contains(want), "{what}: {line}");
+        for f in [&json, &png, &html] {
+            assert!(!f.exists(), "{what} wrote {}", f.display());
+        }
+    }
+    // At the limit: reported (the JSON alone, the direct light: the limit is checked,
+    // not the cost of 200 lights' inter-reflections).
+    let mut a = cli(200, "6x5x2.8");
+    a.extend([
+        "--direct-only".to_string(),
+        "--json".into(),
+        s(&json).into(),
+    ]);
+    let o = run(&a);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(v["luminaires"].as_array().unwrap().len(), 200);
+}
+
 /// Chromium's executable, if installed.
 fn chromium() -> Option<&'static str> {
     ["chromium", "chromium-browser", "google-chrome"]

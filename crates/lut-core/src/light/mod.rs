@@ -51,7 +51,9 @@ pub use illum::{IlluminanceMap, MapOptions};
 pub use ldt::{LampSet, LdtError, LdtFile, LdtSymmetry, LdtType};
 pub use map_shade::{FrameShader, BLOCK as MAP_SHADE_BLOCK};
 pub use photometry::{detect_format, LightFileFormat, Photometry, PhotometrySource};
-pub use radiosity::{DirectLight, FormFactors, Patch, Radiosity, Reflectances, MAX_PATCHES};
+pub use radiosity::{
+    DirectLight, FormFactors, Patch, Radiosity, Reflectances, DEFAULT_PATCHES, MAX_PATCHES,
+};
 pub use room::{Room, RoomFace};
 pub use shade::{
     false_color, false_color_position, lux_at, shade_frame, LightScene, Luminaire, ShadeOptions,

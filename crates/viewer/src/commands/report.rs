@@ -17,7 +17,6 @@ use anyhow::{Context, Result};
 use clap::Args;
 use glam::DVec3;
 use lut_core::{AreaStats, CalcGrid, LightScene, LuminousArea, Photometry, Reflectances, RoomFace};
-use rayon::prelude::*;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -284,14 +283,6 @@ fn view_of(a: &ReportArgs) -> Result<[f64; 3]> {
     ])
 }
 
-/// The illuminance (direct + exact indirect) at each point of `grid`.
-fn read_grid(scene: &LightScene, grid: &CalcGrid) -> Vec<f64> {
-    grid.points
-        .par_iter()
-        .map(|&p| scene.direct(p, grid.normal) + scene.indirect(p, grid.normal))
-        .collect()
-}
-
 /// Compute the report (no output written).
 ///
 /// # Errors
@@ -310,8 +301,27 @@ pub fn compute(a: &ReportArgs) -> Result<(Report, LightScene, crate::lighting::L
         }
     }
     let Setup { st, scene, view } = setup(a)?;
+    let (report, scene) = compute_state(&st, scene, a.height, task, view)?;
+    Ok((report, scene, st))
+}
+
+/// Compute the report of the light state `st` (whose direct scene is `scene`) with the
+/// work plane at `height`, against `task`, the observer looking along `view` (yaw,
+/// pitch, hfov): what `viewer report` computes once its arguments are read, and what the
+/// window's "Report…" button computes from the panel.
+///
+/// # Errors
+/// A height outside the room or grids past the budget (usage errors), reflectances out
+/// of range, an unreadable luminaire file.
+pub fn compute_state(
+    st: &crate::lighting::LightsState,
+    scene: LightScene,
+    height: f64,
+    task: &'static Task,
+    view: [f64; 3],
+) -> Result<(Report, LightScene)> {
     let room = *scene.room();
-    let mut grids = vec![CalcGrid::work_plane(&room, a.height).map_err(|e| match e {
+    let mut grids = vec![CalcGrid::work_plane(&room, height).map_err(|e| match e {
         lut_core::LightError::TooMany { .. } => usage!("--room: {e}"),
         e => usage!("--height: {e}"),
     })?];
@@ -342,7 +352,7 @@ pub fn compute(a: &ReportArgs) -> Result<(Report, LightScene, crate::lighting::L
     };
     let mut areas = Vec::new();
     for grid in grids {
-        let values = read_grid(&scene, &grid);
+        let values = crate::lighting::read_grid(&scene, &grid);
         let stats = AreaStats::of(&values);
         let required = match grid.face {
             None => Some((task.em, task.u0)),
@@ -410,7 +420,7 @@ pub fn compute(a: &ReportArgs) -> Result<(Report, LightScene, crate::lighting::L
         room: [room.width(), room.depth(), room.height()],
         reflectances: st.reflectances,
         indirect: st.indirect,
-        height: a.height,
+        height,
         band: lut_core::border_band(room.width(), room.depth()),
         areas,
         task,
@@ -421,7 +431,7 @@ pub fn compute(a: &ReportArgs) -> Result<(Report, LightScene, crate::lighting::L
         observer: (eye, sight),
         view,
     };
-    Ok((report, scene, st))
+    Ok((report, scene))
 }
 
 /// Lux with three significant digits at most, as the tables print it.
@@ -553,4 +563,158 @@ pub fn run(a: ReportArgs) -> Result<()> {
     }
     crate::outln!("{}", text(&report).trim_end_matches('\n'))?;
     Ok(())
+}
+
+/// The kinds of file the window's "Report…" writes, by the name's extension.
+pub const WINDOW_REPORT_EXTENSIONS: &[&str] = &["html", "json", "png"];
+
+/// Write the report of the window's light state `st` to `path` (the kind by its
+/// extension: `.html` the page with the image and tables, `.json`, `.png`), with
+/// `viewer report`'s defaults (work plane 0.75 m, task office-writing) and the observer
+/// along `view` (yaw, pitch, hfov in degrees); `pano`, the panorama shown, gives the lit
+/// view beside the plan (rendered as `viewer render` does, exposed so the work plane's
+/// Em looks like the photograph; grey without one). Everything is made before anything
+/// is written; the file is written atomically. Returns the line the window shows.
+///
+/// # Errors
+/// No luminaire, an unknown extension, the computation's errors, a failed write.
+pub fn write_from_state(
+    st: &crate::lighting::LightsState,
+    pano: Option<&mut lut_core::Panorama>,
+    view: [f64; 3],
+    path: &std::path::Path,
+) -> Result<String> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    if !WINDOW_REPORT_EXTENSIONS.contains(&ext.as_str()) {
+        anyhow::bail!(
+            "{}: a report is written as .html, .json or .png",
+            path.display()
+        );
+    }
+    let scene = st
+        .direct_scene()
+        .map_err(anyhow::Error::msg)?
+        .context("no luminaire to report on")?;
+    let task = task("office-writing")?;
+    let (report, scene) = compute_state(st, scene, crate::lighting::WORK_PLANE_HEIGHT, task, view)?;
+    let bytes: Vec<u8> = if ext == "json" {
+        json::json(&report).into_bytes()
+    } else {
+        let (w, h) = png::VIEW_SIZE;
+        let mut frame = vec![0x808080u32; (w * h) as usize];
+        if let Some(pano) = pano {
+            let mut lit = st.clone();
+            lit.exposure_lux = report.areas[0].stats.em.max(1.0);
+            lit.auto_exposure = false;
+            lit.false_color = false;
+            lit.show_room = false;
+            let v = lut_core::View::new(view[0], view[1], view[2])
+                .map_err(|e| anyhow::anyhow!("the lit view: {e}"))?;
+            lit.render_lit(
+                &mut crate::lighting::LitCache::default(),
+                false,
+                pano,
+                v,
+                &lut_core::RenderOptions::default(),
+                &mut frame,
+                (w, h),
+            )
+            .map_err(|e| anyhow::anyhow!("the lit view: {e}"))?;
+        }
+        let image = png::encode(&png::render_with(&report, &scene, &frame)?)?;
+        if ext == "png" {
+            image
+        } else {
+            html::html(&report, &image).into_bytes()
+        }
+    };
+    crate::output::write_image_atomic(path, |w| Ok(w.write_all(&bytes)?))?;
+    let wp = &report.areas[0].stats;
+    Ok(format!(
+        "report {}: work plane Em {} lx, U0 {:.2}: {}",
+        path.display(),
+        lux(wp.em),
+        wp.u0,
+        if report.pass { "pass" } else { "FAIL" }
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        report: ReportArgs,
+    }
+
+    fn louvre_at(x: f64, z: f64) -> String {
+        format!(
+            "{}@{x},2.75,{z}",
+            test_support::test_data("ldt/office_louvre_2x28w.ldt").display()
+        )
+    }
+
+    /// The window's "Report…" writes what `viewer report` computes for the same lights:
+    /// the JSON of the panel's state (here the state `viewer report` read from its
+    /// arguments) is byte for byte the command's JSON; an unknown extension is refused
+    /// and writes nothing; the panel's live figures from the solving thread are the
+    /// report's work plane.
+    #[test]
+    fn the_window_report_is_the_commands_report() {
+        let mut argv = vec!["report".to_string(), "--room".into(), "6x5x2.8".into()];
+        for (x, z) in [(-1.5, -1.2), (1.5, -1.2), (-1.5, 1.2), (1.5, 1.2)] {
+            argv.push("--light".into());
+            argv.push(louvre_at(x, z));
+        }
+        let a = Cli::parse_from(&argv).report;
+        let (report, _, st) = compute(&a).unwrap();
+        let want = json::json(&report);
+        let dir = std::env::temp_dir().join(format!("viewer-window-report-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("r.json");
+        let line = write_from_state(&st, None, view_of(&a).unwrap(), &path).unwrap();
+        let got = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(got, want);
+        assert!(line.contains("work plane Em"), "{line}");
+        assert!(report.areas[0].stats.em > 0.0);
+        let bad = dir.join("r.txt");
+        let e = write_from_state(&st, None, [0.0, 0.0, 90.0], &bad).unwrap_err();
+        assert!(e.to_string().contains(".html, .json or .png"), "{e}");
+        assert!(!bad.exists());
+        let _ = std::fs::remove_dir_all(&dir);
+        // The panel's live figures, from the solving thread, are the report's work plane.
+        let mut solver = crate::lighting::Solver::start(Arc::new(|| {}));
+        assert!(solver.request(&st));
+        let key = st.geometry_key();
+        let t0 = std::time::Instant::now();
+        while !solver.poll(&key) {
+            assert!(
+                t0.elapsed().as_secs() < 120,
+                "no result from the solving thread"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        let (live, points) = solver.latest().unwrap().work_plane.clone().unwrap();
+        let wp = &report.areas[0];
+        assert_eq!(points, wp.grid.points.len());
+        for (got, want) in [
+            (live.em, wp.stats.em),
+            (live.emin, wp.stats.emin),
+            (live.emax, wp.stats.emax),
+            (live.u0, wp.stats.u0),
+        ] {
+            assert!(
+                (got - want).abs() <= 1e-9 * want.abs(),
+                "{live:?} vs {:?}",
+                wp.stats
+            );
+        }
+    }
 }

@@ -4,11 +4,17 @@
 //! [`lut_core::FrameShader`] as soon as it is drawn), and the automatic exposure is set
 //! from it.
 //! In the window a change first builds a coarse map ([`lut_core::MapOptions::preview`],
-//! immediate feedback while a value is dragged), refined on the next frame.
+//! immediate feedback while a value is dragged), refined on the next frame; there the
+//! inter-reflections are never solved on the UI thread: the map takes the last solve
+//! handed in from the solving thread ([`LitCache::set_indirect`], see [`super::Solver`])
+//! when it is for these luminaires, or one of the same room and reflectances while the
+//! fresh one is on its way, else the direct light; a solve that arrives rebuilds the map.
 
 use super::state::{LightsKey, LightsState};
 use crate::scene::render_scene_lit;
-use lut_core::{Camera, IlluminanceMap, MapOptions, RenderOptions, RenderReport, View};
+use lut_core::{
+    Camera, IlluminanceMap, LightScene, MapOptions, Radiosity, RenderOptions, RenderReport, View,
+};
 use std::sync::Arc;
 
 /// The illuminance map of a [`LightsState`]'s luminaires, kept until they change.
@@ -21,6 +27,12 @@ pub struct LitCache {
     coarse: bool,
     /// Counts the maps built (a lit frame depends on it).
     generation: u64,
+    /// The scene the map was built from (the lux at the cursor reads it).
+    scene: Option<LightScene>,
+    /// The last inter-reflections solved off the UI thread, and what for.
+    indirect: Option<(LightsKey, Arc<Radiosity>)>,
+    /// The solve the map was built with (its address; 0 for none).
+    built_with: usize,
 }
 
 impl LitCache {
@@ -31,22 +43,49 @@ impl LitCache {
     ///
     /// # Errors
     /// A room or luminaire the map cannot be built for (a light outside the room).
+    ///
+    /// With `progressive` (the window) the inter-reflections are not solved here: the
+    /// map takes the solve handed in ([`LitCache::set_indirect`]) for these luminaires,
+    /// else one of the same room and reflectances, else none (direct light), and is
+    /// rebuilt when a different solve is handed in. Without (`viewer render`) the scene
+    /// is solved here ([`LightsState::scene`]).
     pub fn update(
         &mut self,
         st: &mut LightsState,
         progressive: bool,
     ) -> Result<Option<Arc<IlluminanceMap>>, String> {
         let key = st.geometry_key();
-        let changed = self.key.as_ref() != Some(&key);
+        let solved = if progressive && st.indirect {
+            self.indirect
+                .as_ref()
+                .filter(|(k, _)| *k == key || k.same_room(&key))
+                .map(|(_, r)| r.clone())
+        } else {
+            None
+        };
+        let with = solved.as_ref().map_or(0, |r| Arc::as_ptr(r) as usize);
+        let moved = self.key.as_ref() != Some(&key);
+        let changed = moved || (progressive && with != self.built_with);
         if !changed && !self.coarse {
             return Ok(self.map.clone());
         }
-        let coarse = changed && progressive;
+        let coarse = moved && progressive;
         self.key = Some(key);
         self.map = None;
+        self.scene = None;
         self.coarse = false;
+        self.built_with = with;
         self.generation += 1;
-        let Some(scene) = st.scene()? else {
+        let scene = if progressive {
+            match (st.direct_scene()?, solved) {
+                (None, _) => None,
+                (Some(s), Some(r)) => Some(s.with_radiosity(r)),
+                (Some(s), None) => Some(s),
+            }
+        } else {
+            st.scene()?
+        };
+        let Some(scene) = scene else {
             return Ok(None);
         };
         let opts = if coarse {
@@ -57,8 +96,32 @@ impl LitCache {
         let map = Arc::new(IlluminanceMap::build(&scene, &opts).map_err(|e| e.to_string())?);
         st.apply_auto_exposure(&map);
         self.map = Some(map.clone());
+        self.scene = Some(scene);
         self.coarse = coarse;
         Ok(Some(map))
+    }
+
+    /// Hand in the inter-reflections solved for `key` (`None`: nothing to add, every
+    /// reflectance 0 or inter-reflections off); the next [`LitCache::update`] rebuilds
+    /// the map with them when they are for its luminaires or room.
+    pub fn set_indirect(&mut self, key: LightsKey, radiosity: Option<Arc<Radiosity>>) {
+        self.indirect = radiosity.map(|r| (key, r));
+    }
+
+    /// The scene the current map was built from (with the inter-reflections it was
+    /// built with), `None` without a map.
+    pub fn scene(&self) -> Option<&LightScene> {
+        self.scene.as_ref()
+    }
+
+    /// The map was built with the solve handed in for exactly these luminaires (or
+    /// needs none): false while a fresh solve is awaited.
+    pub fn indirect_current(&self, st: &LightsState) -> bool {
+        !st.indirect
+            || st.reflectances.is_zero()
+            || self.indirect.as_ref().is_some_and(|(k, r)| {
+                *k == st.geometry_key() && Arc::as_ptr(r) as usize == self.built_with
+            })
     }
 
     /// A coarse map waits to be refined (the window asks for another frame).
@@ -205,6 +268,60 @@ mod tests {
         st.lights.clear();
         assert!(c.update(&mut st, true).unwrap().is_none());
         assert_eq!(c.bytes(), 0);
+    }
+
+    /// The window's path (progressive) never solves the inter-reflections itself: with
+    /// no solve handed in the map is the direct light; the solve handed in (as the
+    /// solving thread does) rebuilds it with the same light as `viewer render`'s scene;
+    /// a moved luminaire keeps the old solve of the same room as a stand-in until its
+    /// own arrives; a changed room does not.
+    #[test]
+    fn the_window_path_takes_the_solve_handed_in_and_never_solves() {
+        use glam::DVec3;
+        let mut st = LightsState {
+            room: (6.0, 5.0, 2.8),
+            ..LightsState::default()
+        };
+        st.load_and_add(&lamp()).unwrap();
+        assert!(st.indirect);
+        let (p, n) = (DVec3::new(0.3, 0.0, 0.2), DVec3::Y);
+        let mut c = LitCache::default();
+        c.update(&mut st, true).unwrap();
+        c.update(&mut st, true).unwrap();
+        let direct = st.direct_scene().unwrap().unwrap().direct(p, n);
+        assert!(direct > 0.0);
+        let s = c.scene().unwrap();
+        assert!(s.radiosity().is_none(), "solved on the UI thread");
+        assert_eq!(s.illuminance(p, n), direct);
+        assert!(!c.indirect_current(&st));
+        // The solve arrives.
+        let g = c.generation();
+        let solved = Arc::new(
+            lut_core::Radiosity::solve(&st.direct_scene().unwrap().unwrap(), st.reflectances)
+                .unwrap(),
+        );
+        c.set_indirect(st.geometry_key(), Some(solved));
+        c.update(&mut st, true).unwrap();
+        assert!(c.generation() > g, "rebuilt with the solve");
+        assert!(c.indirect_current(&st));
+        let with = c.scene().unwrap().illuminance(p, n);
+        let want = st.scene().unwrap().unwrap().illuminance(p, n);
+        // The floor under a ceiling light gets a little reflected light (about 1 % here).
+        assert!(with > direct * 1.005, "{with} vs direct {direct}");
+        assert!((with - want).abs() <= 1e-9 * want, "{with} vs {want}");
+        // Unchanged: not rebuilt.
+        let g = c.generation();
+        c.update(&mut st, true).unwrap();
+        assert_eq!(c.generation(), g);
+        // A light moved: the same room's solve stands in until the fresh one.
+        st.lights[0].position[0] += 0.3;
+        c.update(&mut st, true).unwrap();
+        assert!(c.scene().unwrap().radiosity().is_some());
+        assert!(!c.indirect_current(&st));
+        // The room changed: no stand-in.
+        st.room.0 += 0.5;
+        c.update(&mut st, true).unwrap();
+        assert!(c.scene().unwrap().radiosity().is_none());
     }
 
     #[test]

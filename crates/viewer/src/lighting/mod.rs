@@ -9,6 +9,7 @@ pub mod legend;
 mod lit;
 pub mod overlay;
 mod scene_file;
+mod solver;
 mod state;
 
 pub use baked::{BakeKey, BakeState, LitPanorama};
@@ -19,6 +20,7 @@ pub use scene_file::{
     is_scene, is_scene_file, SceneFile, SceneLight, ScenePanorama, SceneRoom, SceneView,
     FORMAT as SCENE_FORMAT, VERSION as SCENE_VERSION,
 };
+pub use solver::{describe_work_plane, read_grid, work_plane, Solved, Solver, WORK_PLANE_HEIGHT};
 pub use state::{
     format_lux, load_table, LightEntry, LightsKey, LightsState, AUTO_EXPOSURE_QUANTILE,
     DEFAULT_CAMERA_HEIGHT, DEFAULT_EXPOSURE_LUX, DEFAULT_ROOM,

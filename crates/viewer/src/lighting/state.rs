@@ -91,6 +91,10 @@ pub struct LightsState {
     /// Where the window's lit panorama stands (`super::BakeState::describe`; empty
     /// without luminaires).
     pub lit_panorama: String,
+    /// The work plane's figures as the window last had them from the solving thread
+    /// ([`super::Solver`]): "Em … U0 …", "computing…", or why there are none; empty
+    /// without luminaires.
+    pub work_plane: String,
     /// Draw the room box and the luminaires over the view (the window's "Show room").
     pub show_room: bool,
     /// The luminaire selected in the view or the panel.
@@ -120,6 +124,7 @@ impl Default for LightsState {
             scene_error: None,
             lux_at_cursor: None,
             lit_panorama: String::new(),
+            work_plane: String::new(),
             show_room: false,
             selected: None,
         }
@@ -137,6 +142,19 @@ pub struct LightsKey {
     multiplier: f64,
     reflectances: Option<[f64; 3]>,
     shade: Option<ShadeOptions>,
+}
+
+impl LightsKey {
+    /// The same room (size, camera height, turn, centre) and reflectances: a solve of
+    /// the inter-reflections for one key is a close stand-in for the other while only
+    /// the luminaires differ.
+    pub fn same_room(&self, other: &LightsKey) -> bool {
+        self.room == other.room
+            && self.camera_height == other.camera_height
+            && self.room_yaw == other.room_yaw
+            && self.room_center == other.room_center
+            && self.reflectances == other.reflectances
+    }
 }
 
 impl LightsState {

@@ -137,6 +137,11 @@ struct App {
     lit: LitCache,
     /// The panorama lit once the lighting has settled, panned as an unlit one.
     baked: LitPanorama,
+    /// The inter-reflections and the work plane's figures, solved off the UI thread.
+    solver: crate::lighting::Solver,
+    /// A lighting report being written on a thread of its own: the line to show when
+    /// it is done.
+    report_job: Option<std::sync::mpsc::Receiver<Result<String, String>>>,
     /// What a drag in the view moves instead of the view (a luminaire, a room corner,
     /// an edge, or with Shift an edge's floor or ceiling).
     scene_drag: Option<SceneDrag>,
@@ -222,6 +227,8 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         fatal: None,
         lights,
         lit: LitCache::default(),
+        solver: crate::lighting::Solver::start(wake_on_bake.clone()),
+        report_job: None,
         baked: LitPanorama::new(rayon::current_num_threads(), wake_on_bake),
         scene_drag: None,
         scene_file: args.lights.room.scene.clone(),

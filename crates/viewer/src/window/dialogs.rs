@@ -14,6 +14,7 @@ enum Purpose {
     Open,
     Save,
     SaveScene,
+    SaveReport,
 }
 
 /// What the user chose.
@@ -25,6 +26,8 @@ pub enum Chosen {
     Save(PathBuf),
     /// Save the scene (room, luminaires, exposure, panorama, view) to this file.
     SaveScene(PathBuf),
+    /// Write the lighting report (`viewer report`'s, of the panel's lights) to this file.
+    SaveReport(PathBuf),
 }
 
 /// The window's file dialogs (one at a time).
@@ -50,6 +53,7 @@ impl Dialogs {
             .add_save_extension("PNG", "png")
             .add_save_extension("JPEG", "jpg")
             .add_save_extension("Scene", "json")
+            .add_save_extension("Report (HTML)", "html")
             .default_save_extension("PNG")
             .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO);
         Dialogs {
@@ -124,6 +128,19 @@ impl Dialogs {
         self.purpose = Some(Purpose::SaveScene);
     }
 
+    /// Show the Save dialog for a lighting report in `dir` named `name` (`.html`, and
+    /// `.json` or `.png` by the name typed).
+    pub fn save_report(&mut self, ctx: &egui::Context, dir: &Path, name: &str) {
+        self.prepare(ctx);
+        let c = self.dialog.config_mut();
+        c.initial_directory = dir.to_path_buf();
+        c.default_file_name = name.to_string();
+        c.title = Some("Write the lighting report (.html, .json or .png)".into());
+        c.default_save_extension = Some("Report (HTML)".into());
+        self.dialog.save_file();
+        self.purpose = Some(Purpose::SaveReport);
+    }
+
     /// Draw the open dialog (if any) and return what was chosen. `scale` is the Save
     /// dialog's size choice (the scene's size times it), `size_of` the image size for a
     /// scale.
@@ -154,6 +171,7 @@ impl Dialogs {
                     Purpose::Open => Chosen::Open(p),
                     Purpose::Save => Chosen::Save(p),
                     Purpose::SaveScene => Chosen::SaveScene(p),
+                    Purpose::SaveReport => Chosen::SaveReport(p),
                 })
             }
             _ => {

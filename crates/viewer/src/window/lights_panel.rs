@@ -2,7 +2,7 @@
 //! camera height, turn, centre; "Show room" draws it over the view), the luminaires
 //! (selected in the list or by a click on their marker; position, aim, multiplier, on/off,
 //! remove), the exposure (automatic or set), the surfaces' reflectances (inter-reflections),
-//! interpolation and false colours.
+//! interpolation and false colours; the work plane's Em and U0, live, and "Report…".
 
 use super::ui::{named_combo, PanelModel, PanelOutput};
 use crate::lighting::format_lux;
@@ -22,6 +22,24 @@ pub fn lights_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, out: &mut Panel
                 ui.label("lux at cursor");
                 ui.monospace(format_lux(l.lux_at_cursor));
             });
+            if !l.lights.is_empty() {
+                ui.horizontal(|ui| {
+                    ui.label("Work plane");
+                    ui.monospace(&l.work_plane).on_hover_text(
+                        "Maintained illuminance Em and uniformity U0 = Emin/Em on the work \
+                         plane (0.75 m) on EN 12464-1's grid, with the inter-reflections, as \
+                         `viewer report` computes them; solved on a thread of its own after \
+                         each change",
+                    );
+                });
+                out.report = ui
+                    .button("Report…")
+                    .on_hover_text(
+                        "Write the lighting report (work plane, floor, ceiling, walls against \
+                         EN 12464-1 office writing; luminaires; UGR) as HTML, JSON or PNG",
+                    )
+                    .clicked();
+            }
             ui.horizontal(|ui| {
                 out.open_scene = ui
                     .button("Open scene…")

@@ -252,6 +252,8 @@ pub struct PanelOutput {
     pub open_scene: bool,
     /// "Save scene…" was pressed.
     pub save_scene: bool,
+    /// "Report…" was pressed (the lights' report against EN 12464-1).
+    pub report: bool,
     /// An output projection was chosen (or Pannini's d changed).
     pub view_projection: Option<lut_core::ViewProjection>,
     /// "Little planet" was pressed.

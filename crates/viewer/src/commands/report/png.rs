@@ -105,6 +105,26 @@ fn plan_values(r: &Report, scene: &LightScene, pw: u32, ph: u32) -> Vec<f64> {
 /// # Errors
 /// The panorama cannot be loaded or rendered, or text cannot be drawn.
 pub fn render(a: &ReportArgs, r: &Report, scene: &LightScene) -> Result<Image> {
+    let view = lit_view(a, r)?;
+    render_with(r, scene, &view)
+}
+
+/// The lit view's size in pixels.
+pub const VIEW_SIZE: (u32, u32) = VIEW;
+
+/// [`render`] with the lit view given ([`VIEW_SIZE`] pixels, 0RGB): the window renders
+/// it from the panorama it shows.
+///
+/// # Errors
+/// Text cannot be drawn, or `view` is not [`VIEW_SIZE`].
+pub fn render_with(r: &Report, scene: &LightScene, view: &[u32]) -> Result<Image> {
+    anyhow::ensure!(
+        view.len() == (VIEW.0 * VIEW.1) as usize,
+        "the lit view has {} pixels, not {}x{}",
+        view.len(),
+        VIEW.0,
+        VIEW.1
+    );
     let (w_m, d_m) = (r.room[0], r.room[1]);
     let scale = (PLAN_MAX / w_m.max(d_m)).min(200.0);
     let pw = ((w_m * scale).round() as u32).max(40);
@@ -192,7 +212,6 @@ pub fn render(a: &ReportArgs, r: &Report, scene: &LightScene) -> Result<Image> {
     }
     crate::lighting::legend::draw_legend(&mut panel, lw, lh, top).map_err(|e| anyhow!(e))?;
     // The lit view.
-    let view = lit_view(a, r)?;
     let w = MARGIN * 3 + lw + VIEW.0;
     let h = TITLE + MARGIN + lh.max(VIEW.1) + MARGIN + 24;
     let mut px = vec![0xffffffu32; (w * h) as usize];
@@ -206,7 +225,7 @@ pub fn render(a: &ReportArgs, r: &Report, scene: &LightScene) -> Result<Image> {
     blit(&mut px, &panel, lw, lh, MARGIN, TITLE + MARGIN);
     blit(
         &mut px,
-        &view,
+        view,
         VIEW.0,
         VIEW.1,
         MARGIN * 2 + lw,

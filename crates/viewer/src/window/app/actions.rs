@@ -127,6 +127,9 @@ impl App {
         if req.panel.open_scene {
             self.start_open_dialog(true);
         }
+        if req.panel.report {
+            self.start_report_dialog();
+        }
         if let Some(p) = req.open_recent {
             if p.exists() {
                 self.open_path(p);
@@ -145,6 +148,7 @@ impl App {
             }
             Some(Chosen::Save(p)) => self.save_view_to(&p, t),
             Some(Chosen::SaveScene(p)) => self.save_scene_to(&p, t),
+            Some(Chosen::SaveReport(p)) => self.write_report(p, t),
             None => {}
         }
         if !req.keys.is_empty() {

@@ -629,12 +629,15 @@ impl App {
         rect: Option<SceneRect>,
         look: Look,
     ) -> bool {
-        let lux = match (cursor, rect, self.lights.scene()) {
-            (Some((x, y)), Some(r), Ok(Some(scene))) if r.w > 0 && r.h > 0 => Some(
-                lut_core::lux_at(&scene, &lut_core::Camera::new(look.view(), r.w, r.h), x, y),
-            ),
-            _ => None,
-        };
+        // The scene the illuminance map was built from: its inter-reflections come from
+        // the solving thread (never solved here, on the UI thread).
+        let lux =
+            match (cursor, rect, self.lit.scene()) {
+                (Some((x, y)), Some(r), Some(scene)) if r.w > 0 && r.h > 0 => Some(
+                    lut_core::lux_at(scene, &lut_core::Camera::new(look.view(), r.w, r.h), x, y),
+                ),
+                _ => None,
+            };
         let changed = lux.map(f64::to_bits) != self.lights.lux_at_cursor.map(f64::to_bits);
         self.lights.lux_at_cursor = lux;
         changed

@@ -38,6 +38,7 @@ impl App {
     /// changed); a scene that cannot be lit (a light outside the room) is reported in the
     /// panel.
     pub(super) fn update_lit(&mut self) -> Option<Arc<IlluminanceMap>> {
+        self.update_solve();
         match self.lit.update(&mut self.lights, true) {
             Ok(map) => {
                 self.lights.scene_error = None;
@@ -47,6 +48,103 @@ impl App {
                 self.lights.scene_error = Some(e);
                 None
             }
+        }
+    }
+
+    /// The inter-reflections and the work plane's figures: ask the solving thread after
+    /// each change of the luminaires, room or reflectances; take what it sent back for
+    /// the lights as they are now (stale results are dropped) and hand its solve to the
+    /// illuminance map; show the figures in the panel.
+    fn update_solve(&mut self) {
+        self.solver.request(&self.lights);
+        let key = self.lights.geometry_key();
+        if self.solver.poll(&key) {
+            if let Some(s) = self.solver.latest() {
+                self.lit.set_indirect(s.key.clone(), s.radiosity.clone());
+            }
+        }
+        let line = crate::lighting::describe_work_plane(
+            self.solver.latest().filter(|s| s.key == key),
+            self.solver.pending(),
+        );
+        if line != self.lights.work_plane && self.print_view && !self.lights.lights.is_empty() {
+            let _ = crate::outln!("work-plane {line}");
+        }
+        self.lights.work_plane = line;
+        self.poll_report();
+    }
+
+    /// The Save dialog for a lighting report, beside the scene or panorama.
+    pub(super) fn start_report_dialog(&mut self) {
+        let near = self
+            .scene_file
+            .clone()
+            .or(self.doc.last_file().map(Path::to_path_buf));
+        let dir = near
+            .as_deref()
+            .and_then(Path::parent)
+            .filter(|d| d.is_dir())
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+        self.dialogs
+            .save_report(&self.egui_ctx, &dir, "report.html");
+        if self.print_view {
+            let _ = crate::outln!("dialog save-report {}", dir.display());
+        }
+    }
+
+    /// Write the report of the panel's lights to `path` on a thread of its own (the
+    /// radiosity solve and the grids take a while): `viewer report`'s computation
+    /// ([`crate::commands::report::write_from_state`]), the lit view from the panorama
+    /// shown. The outcome is a notice when it is done.
+    pub(super) fn write_report(&mut self, path: PathBuf, t: f64) {
+        let st = self.lights.clone();
+        let mut pano = self.doc.current().map(|c| c.scene.share());
+        let look = self.ctl.look();
+        let view = [look.yaw, look.pitch, look.hfov];
+        let (tx, rx) = std::sync::mpsc::channel();
+        let proxy = self.proxy.clone();
+        let spawned = std::thread::Builder::new()
+            .name("viewer-report".into())
+            .spawn(move || {
+                let r = crate::commands::report::write_from_state(&st, pano.as_mut(), view, &path)
+                    .map_err(|e| format!("report failed: {e:#}"));
+                let _ = tx.send(r);
+                let _ = proxy.send_event(super::AppEvent::Baked);
+            });
+        match spawned {
+            Ok(_) => {
+                self.report_job = Some(rx);
+                self.notices.info("writing the report…", t);
+            }
+            Err(e) => {
+                self.notices
+                    .error(format!("report failed: cannot start its thread: {e}"), t);
+            }
+        }
+    }
+
+    /// A report written: its line as a notice (and on stdout with `--print-view`).
+    fn poll_report(&mut self) {
+        let Some(rx) = &self.report_job else {
+            return;
+        };
+        let Ok(r) = rx.try_recv() else {
+            return;
+        };
+        self.report_job = None;
+        let t = self.now();
+        let line = match r {
+            Ok(l) => {
+                self.notices.info(&l, t);
+                l
+            }
+            Err(e) => {
+                self.notices.error(&e, t);
+                e
+            }
+        };
+        if self.print_view {
+            let _ = crate::outln!("{line}");
         }
     }
 
