@@ -11,8 +11,9 @@
 //! (`compose`), and the small tour bar ([`tour_bar`]).
 //!
 //! A scene's horizon (`horizonPitch`/`horizonRoll`) is levelled on the loading thread,
-//! the map re-levelled once at load as `viewer render` does (`crate::tour::render::level`);
-//! cube and tile scenes are shown as they are.
+//! the map (or a cube's faces) re-levelled once at load as `viewer render` does
+//! (`lut_core::level_horizon`, `lut_core::level_cube_horizon`); tile scenes are shown as
+//! they are.
 
 mod edit;
 
