@@ -17,7 +17,7 @@
 
 mod edit;
 
-pub use edit::{edit_panel, EditRequest, Editor};
+pub use edit::{edit_panel, typing, EditRequest, Editor};
 
 use super::input::Look;
 use super::loader::Source;

@@ -189,7 +189,7 @@ impl App {
         } else {
             Vec::new()
         };
-        if nav.editor.on && !ui.ctx().egui_wants_keyboard_input() {
+        if nav.editor.on && !tour::typing(ui.ctx()) {
             edits.extend(ui.input(|i| {
                 let key = |k: egui::Key, shift: bool| {
                     i.events.iter().any(|e| {

@@ -335,6 +335,15 @@ impl TourNav {
     }
 }
 
+/// The ids of the panel's text fields.
+const TEXT_IDS: [&str; 2] = ["tour-edit-text", "tour-edit-scene-file"];
+
+/// Whether one of the edit panel's text fields has the keyboard (Ctrl+Z is then the
+/// field's, not the tour's).
+pub fn typing(ctx: &egui::Context) -> bool {
+    ctx.memory(|m| TEXT_IDS.iter().any(|id| m.has_focus(egui::Id::new(id))))
+}
+
 /// The edit panel under the tour bar; returns what was asked.
 pub fn edit_panel(ctx: &egui::Context, scene: egui::Rect, nav: &mut TourNav) -> Vec<EditRequest> {
     let mut out = Vec::new();
@@ -398,7 +407,11 @@ pub fn edit_panel(ctx: &egui::Context, scene: egui::Rect, nav: &mut TourNav) -> 
                     });
                     ui.horizontal(|ui| {
                         ui.label("Text");
-                        ui.add(egui::TextEdit::singleline(&mut ed.text).desired_width(160.0));
+                        ui.add(
+                            egui::TextEdit::singleline(&mut ed.text)
+                                .id(egui::Id::new(TEXT_IDS[0]))
+                                .desired_width(160.0),
+                        );
                     });
                     ui.horizontal(|ui| {
                         egui::ComboBox::from_id_salt("tour-edit-target")
@@ -478,6 +491,7 @@ pub fn edit_panel(ctx: &egui::Context, scene: egui::Rect, nav: &mut TourNav) -> 
                     ui.horizontal(|ui| {
                         ui.add(
                             egui::TextEdit::singleline(&mut ed.scene_file)
+                                .id(egui::Id::new(TEXT_IDS[1]))
                                 .hint_text("panorama in the tour's folder")
                                 .desired_width(160.0),
                         );
