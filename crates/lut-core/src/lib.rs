@@ -177,6 +177,7 @@ pub use io::partial::{decode_partial, load_partial, CoverageSource};
 
 // Cube maps.
 pub use cube::layout::{layout_dimensions, Layout, Naming, Transform};
+pub use cube::level::level_cube_horizon;
 pub use cube::{
     check_face_size, face_axes, face_dir, face_of, face_uv, CubeError, CubeMap, Face, FacesProblem,
     LayoutProblem, UsageProblem, MAX_FACE_SIZE,

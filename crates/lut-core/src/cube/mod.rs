@@ -40,6 +40,7 @@
 //! Loading from files is `io/cube.rs`; layouts and namings are `cube/layout.rs`.
 
 pub(crate) mod layout;
+pub(crate) mod level;
 pub(crate) mod pyramid;
 
 use crate::error::ViewError;

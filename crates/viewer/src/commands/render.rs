@@ -112,7 +112,7 @@ pub struct RenderArgs {
     pub lights: LightArgs,
     /// A level horizon: the pitch of the panorama's horizon in degrees (Pannellum's
     /// horizonPitch, GPano's PosePitchDegrees), rotated away before projection
-    /// (equirectangular maps; the map is re-levelled once at load, docs/tours.md).
+    /// (equirectangular and cube maps, re-levelled once at load, docs/tours.md).
     #[arg(long, value_parser = parse_angle, allow_hyphen_values = true)]
     pub horizon_pitch: Option<f64>,
     /// A level horizon: the roll of the panorama's horizon in degrees (Pannellum's
@@ -241,14 +241,16 @@ impl RenderArgs {
                     "--coverage applies to equirectangular panoramas, not cube maps"
                 ));
             }
-            if self.horizon_pitch.is_some_and(|p| p != 0.0)
-                || self.horizon_roll.is_some_and(|r| r != 0.0)
-            {
-                return Err(usage!(
-                    "--horizon-pitch and --horizon-roll apply to equirectangular panoramas, not cube maps"
-                ));
+            let cube = load_cube(panorama, input.cube)?;
+            // A level horizon: the faces re-levelled once, as a map is.
+            let (p, r) = (
+                self.horizon_pitch.unwrap_or(0.0),
+                self.horizon_roll.unwrap_or(0.0),
+            );
+            if p != 0.0 || r != 0.0 {
+                return Ok(Panorama::cube(lut_core::level_cube_horizon(&cube, p, r)?));
             }
-            return Ok(Panorama::cube(load_cube(panorama, input.cube)?));
+            return Ok(Panorama::cube(cube));
         }
         if panorama.len() > 1 {
             return Err(usage!(

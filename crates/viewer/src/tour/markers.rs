@@ -42,6 +42,17 @@ pub fn place(view: View, w: u32, h: u32, yaw: f64, pitch: f64) -> Option<(f64, f
     (back.dot(d) > 1.0 - 1e-9).then_some((x, y))
 }
 
+/// The direction (yaw, pitch, degrees) seen at pixel position (`x`, `y`) of a `w × h`
+/// frame of `view` (the inverse of [`place`]); `None` where the projection has none.
+pub fn direction_at(view: View, w: u32, h: u32, x: f64, y: f64) -> Option<(f64, f64)> {
+    let d = Camera::new(view, w, h).ray(x, y)?.normalize();
+    if !d.is_finite() {
+        return None;
+    }
+    let (lambda, phi) = lut_core::dir_to_lat_long(d);
+    Some((lambda.to_degrees(), phi.to_degrees()))
+}
+
 /// Every hotspot of `scene` the view shows, in hotspot order.
 pub fn placed(scene: &TourScene, view: View, w: u32, h: u32) -> Vec<Placed> {
     scene

@@ -8,6 +8,7 @@
 //! * [`pannellum`]: read a tour or single-scene config, write one Pannellum opens.
 //! * [`marzipano`]: read a Marzipano tool export (`data.js` and its `tiles/`).
 //! * [`check`]: every link, file and scene id (`viewer tour check`).
+//! * [`edit`]: the edit operations and their undo stack (the window's editor).
 //! * [`markers`]: hotspot markers drawn on a rendered view.
 //!
 //! Reading never stops at the first problem: each bad scene or hotspot is left out with a
@@ -15,6 +16,7 @@
 //! opens.
 
 pub mod check;
+pub mod edit;
 pub mod literal;
 pub mod markers;
 pub mod marzipano;

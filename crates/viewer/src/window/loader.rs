@@ -179,8 +179,9 @@ pub struct LoadRequest {
     pub naming: Option<Naming>,
     /// `--coverage`, when it applies to this source.
     pub coverage: Option<Coverage>,
-    /// A tour scene's horizon to level (pitch, roll, degrees): full equirectangular
-    /// maps are re-levelled once here; other panoramas are shown as they are.
+    /// A tour scene's horizon to level (pitch, roll, degrees): cube maps and full
+    /// equirectangular maps are re-levelled once here; other panoramas are shown as they
+    /// are.
     pub horizon: Option<(f64, f64)>,
 }
 
@@ -226,7 +227,11 @@ pub fn load(
                 layout: *layout,
                 naming,
             };
-            let cube = crate::panorama::load_cube(paths, cube).map_err(|e| format!("{e:#}"))?;
+            let mut cube = crate::panorama::load_cube(paths, cube).map_err(|e| format!("{e:#}"))?;
+            // A tour scene's horizon: the faces re-levelled once, as a map is.
+            if let Some((p, r)) = horizon {
+                cube = lut_core::level_cube_horizon(&cube, p, r).map_err(|e| format!("{e:#}"))?;
+            }
             // The face pyramid (the window's default sampler is trilinear) now, so the
             // first frames do not wait for it.
             let mut scene = Panorama::cube(cube);

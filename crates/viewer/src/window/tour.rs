@@ -2,8 +2,8 @@
 //! recent list, drop), its hotspots drawn over the scene in every output projection, the
 //! hotspot's text on hover, a click on a scene link gliding toward it and crossfading
 //! into the target scene at the view the link names, back and forward through the
-//! scenes visited (Alt+←/→, the mouse's back/forward buttons, the ◀ ▶ buttons), and the
-//! scene list.
+//! scenes visited (Alt+←/→, the mouse's back/forward buttons, the ◀ ▶ buttons), the
+//! scene list, and the Edit toggle (the editor is [`edit`]).
 //!
 //! [`TourNav`] is the state (pure: no window, no thread; times are the window's clock in
 //! seconds), unit-tested below; the event loop (`app`) calls it at a few hooks: opening,
@@ -11,8 +11,13 @@
 //! (`compose`), and the small tour bar ([`tour_bar`]).
 //!
 //! A scene's horizon (`horizonPitch`/`horizonRoll`) is levelled on the loading thread,
-//! the map re-levelled once at load as `viewer render` does (`crate::tour::render::level`);
-//! cube and tile scenes are shown as they are.
+//! the map (or a cube's faces) re-levelled once at load as `viewer render` does
+//! (`lut_core::level_horizon`, `lut_core::level_cube_horizon`); tile scenes are shown as
+//! they are.
+
+mod edit;
+
+pub use edit::{edit_panel, typing, EditRequest, Editor};
 
 use super::input::Look;
 use super::loader::Source;
@@ -47,6 +52,8 @@ struct Pending {
     scene: usize,
     source: Source,
     view: Angles,
+    /// Crossfade from the scene left (not for a reload of the same scene).
+    fade: bool,
 }
 
 /// The glide toward a clicked link.
@@ -87,6 +94,8 @@ pub struct TourNav {
     buf: Vec<u32>,
     /// The hotspot under the pointer.
     hover: Option<usize>,
+    /// The editor (edit mode, undo, the spot and hotspot picked).
+    pub editor: Editor,
 }
 
 /// The source of scene `i` of `tour`: an equirectangular file, six cube faces, or a
@@ -197,11 +206,13 @@ impl TourNav {
                             scene: i,
                             source: source.clone(),
                             view,
+                            fade: true,
                         }),
                         glide: None,
                         fade: None,
                         buf: Vec::new(),
                         hover: None,
+                        editor: Editor::default(),
                     };
                     return Ok((nav, source));
                 }
@@ -250,6 +261,7 @@ impl TourNav {
                     scene: i,
                     source: source.clone(),
                     view,
+                    fade: true,
                 });
                 TourAction::Load(source)
             }
@@ -351,7 +363,9 @@ impl TourNav {
         self.current = p.scene;
         self.glide = None;
         self.hover = None;
-        self.fade = old_frame.map(|(px, size)| (px.to_vec(), size, t));
+        self.fade = old_frame
+            .filter(|_| p.fade)
+            .map(|(px, size)| (px.to_vec(), size, t));
         Some(p.view)
     }
 
@@ -433,6 +447,19 @@ impl TourNav {
             let placed = markers::draw(&self.tour.scenes[self.current], view, &mut self.buf, w, h);
             if let Some(p) = placed.iter().find(|p| Some(p.index) == self.hover) {
                 ring(&mut self.buf, w, h, p.x, p.y);
+            }
+            if self.editor.on {
+                let sel = self.editor.selected;
+                if let Some(p) = placed.iter().find(|p| Some(p.index) == sel) {
+                    ring(&mut self.buf, w, h, p.x, p.y);
+                }
+                if let Some((x, y)) = self
+                    .editor
+                    .spot
+                    .and_then(|(yaw, pitch)| markers::place(view, w, h, yaw, pitch))
+                {
+                    cross(&mut self.buf, w, h, x, y);
+                }
             }
         }
         &self.buf
@@ -517,6 +544,18 @@ fn ring(out: &mut [u32], w: u32, h: u32, cx: f64, cy: f64) {
     }
 }
 
+/// A small cross at (cx, cy): the spot picked in edit mode.
+fn cross(out: &mut [u32], w: u32, h: u32, cx: f64, cy: f64) {
+    let (x, y) = (cx.floor() as i64, cy.floor() as i64);
+    for d in -6..=6i64 {
+        for (px, py) in [(x + d, y), (x, y + d)] {
+            if (0..w as i64).contains(&px) && (0..h as i64).contains(&py) {
+                out[py as usize * w as usize + px as usize] = HOVER_COLOR;
+            }
+        }
+    }
+}
+
 /// Whether `path` is a tour file (a Pannellum config or a Marzipano `data.js`).
 pub fn is_tour(path: &Path) -> bool {
     path.is_file() && tour::sniff(path).is_some()
@@ -531,6 +570,8 @@ pub struct TourBarOutput {
     pub forward: bool,
     /// A scene chosen in the list.
     pub chosen: Option<usize>,
+    /// The Edit toggle pressed.
+    pub edit: bool,
 }
 
 /// The tour bar below the toolbar: back, forward, and the scene list.
@@ -565,6 +606,13 @@ pub fn tour_bar(ctx: &egui::Context, scene: egui::Rect, nav: &TourNav) -> TourBa
                                     }
                                 }
                             });
+                        out.edit = ui
+                            .selectable_label(nav.editor.on, "Edit")
+                            .on_hover_text(
+                                "Edit the tour: hotspots, start view, north, horizon, scenes; \
+                                 undo, save",
+                            )
+                            .clicked();
                     });
                 });
         });
@@ -582,4 +630,138 @@ pub fn hover_text(ctx: &egui::Context, at: egui::Pos2, text: &str) {
                 ui.label(text);
             });
         });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The Pannellum test tour, started (its first scene loading).
+    pub fn sample() -> TourNav {
+        let path = test_support::test_data("tours/pannellum/tour.json");
+        let loaded = tour::load(&path).unwrap();
+        assert!(loaded.problems.is_empty(), "{:?}", loaded.problems);
+        let (nav, source) = TourNav::start(loaded.tour, path).unwrap();
+        assert!(matches!(&source, Source::File(p) if p.ends_with("courtyard.jpg")));
+        nav
+    }
+
+    fn arrive(nav: &mut TourNav, a: &TourAction, t: f64) -> Angles {
+        let TourAction::Load(src) = a else {
+            panic!("not a load: {a:?}");
+        };
+        let frame = vec![0u32; 4];
+        nav.arrived(src, Some((&frame, (2, 2))), t).unwrap()
+    }
+
+    #[test]
+    fn a_link_glides_to_its_hotspot_and_arrives_at_its_target_view() {
+        let mut nav = sample();
+        let src = scene_source(&nav.tour, 0).unwrap();
+        // The first scene arrives at its start view.
+        let start = nav.arrived(&src, None, 0.0).unwrap();
+        assert_eq!((start.yaw, start.pitch, start.hfov), (20.0, -5.0, 90.0));
+        let look = Look::new(start.yaw, start.pitch, start.hfov);
+        // Hotspot 0: to "interior", targetYaw sameAzimuth, targetPitch 0.
+        let a = nav.click(0, look, 10.0).unwrap();
+        assert!(nav.animating(10.0));
+        let mid = nav.glide_look(10.0 + GLIDE_S / 2.0).unwrap();
+        assert!(mid.yaw > 20.0 && mid.yaw < 60.0, "{mid:?}");
+        // Just past its duration: the glide's last look, at the hotspot (zoomed in).
+        let end = nav.glide_look(10.0 + GLIDE_S + 1e-3).unwrap();
+        assert!((end.yaw - 60.0).abs() < 1e-9 && (end.pitch + 2.0).abs() < 1e-9);
+        assert!((end.hfov - 90.0 * GLIDE_ZOOM).abs() < 1e-9);
+        assert!(nav.glide_look(11.0).is_none(), "the glide ended");
+        let v = arrive(&mut nav, &a, 11.0);
+        assert_eq!(nav.scene().id, "interior");
+        // sameAzimuth: 20 + 30 (courtyard north) - 120 (interior north) = -70.
+        assert!((v.yaw + 70.0).abs() < 1e-9, "{v:?}");
+        assert_eq!((v.pitch, v.hfov), (0.0, 100.0));
+        // The crossfade runs for the tour's 1000 ms.
+        assert!(nav.animating(11.5) && !nav.animating(12.01));
+        // Back returns to the courtyard at the view it was left at; forward again.
+        let back = nav.step(false, Look::new(v.yaw, v.pitch, v.hfov)).unwrap();
+        let v0 = arrive(&mut nav, &back, 13.0);
+        assert_eq!(nav.scene().id, "courtyard");
+        assert_eq!((v0.yaw, v0.pitch, v0.hfov), (20.0, -5.0, 90.0));
+        assert_eq!(nav.can_go(), (false, true));
+        let fwd = nav.step(true, Look::new(1.0, 2.0, 80.0)).unwrap();
+        let v1 = arrive(&mut nav, &fwd, 14.0);
+        assert_eq!(nav.scene().id, "interior");
+        assert!((v1.yaw + 70.0).abs() < 1e-9);
+        assert_eq!(nav.can_go(), (true, false));
+        // A panorama that is not the scene asked for is not an arrival.
+        assert!(nav
+            .arrived(&Source::File("elsewhere.jpg".into()), None, 15.0)
+            .is_none());
+    }
+
+    #[test]
+    fn info_hotspots_give_their_text_and_the_scene_list_goes_to_start_views() {
+        let mut nav = sample();
+        let look = Look::new(0.0, 0.0, 90.0);
+        assert_eq!(
+            nav.click(1, look, 0.0),
+            Some(TourAction::Info(
+                "The courtyard (CC0, Greg Zaal). (https://hdrihaven.com)".into()
+            ))
+        );
+        assert!(!nav.animating(0.0), "an info hotspot does not glide");
+        let a = nav.choose(2, look).unwrap();
+        let TourAction::Load(Source::Cube { paths, .. }) = &a else {
+            panic!("the cube scene loads six faces: {a:?}");
+        };
+        assert_eq!(paths.len(), 6);
+        let v = arrive(&mut nav, &a, 1.0);
+        assert_eq!((v.yaw, v.pitch, v.hfov), (0.0, 0.0, 100.0));
+        assert_eq!(nav.title(), "tour.json: Courtyard (cube)");
+    }
+
+    #[test]
+    fn the_marker_under_the_pointer_is_the_hotspot_and_it_is_drawn_there() {
+        let mut nav = sample();
+        let src = scene_source(&nav.tour, 0).unwrap();
+        nav.arrived(&src, None, 0.0);
+        let look = Look::new(60.0, -2.0, 90.0);
+        let (w, h) = (400, 300);
+        // Hotspot 0 is at yaw 60, pitch -2: the centre of this view.
+        let (cx, cy) = (200.0, 150.0);
+        assert_eq!(nav.hotspot_at(&look, w, h, cx + 3.0, cy - 2.0), Some(0));
+        assert_eq!(nav.hotspot_at(&look, w, h, cx + 40.0, cy), None);
+        let scene = vec![0x0020_2020; (w * h) as usize];
+        let out = nav.compose(&scene, w, h, &look, 0.0).to_vec();
+        assert_eq!(out[150 * 400 + 200], markers::SCENE_COLOR);
+        assert_eq!(out[150 * 400 + 240], 0x0020_2020);
+        assert!(nav
+            .describe(&look, w, h)
+            .starts_with("tour scene courtyard 1/3 hotspots 0@200.0,150.0"));
+    }
+
+    #[test]
+    fn a_crossfade_blends_the_old_frame_into_the_new() {
+        let mut d = vec![0x00FF_FFFF; 2];
+        blend(&mut d, &[0, 0], 0.5);
+        assert_eq!(d[0], 0x007F_7F7F, "{:06x}", d[0]);
+        let mut d = vec![0x0012_3456];
+        blend(&mut d, &[0x00AB_CDEF], 0.0);
+        assert_eq!(d[0], 0x00AB_CDEF);
+        let mut d = vec![0x0012_3456];
+        blend(&mut d, &[0x00AB_CDEF], 1.0);
+        assert_eq!(d[0], 0x0012_3456);
+    }
+
+    #[test]
+    fn a_tour_with_no_scene_that_opens_is_one_clear_error() {
+        let mut t = Tour::new(PathBuf::from("/nowhere"));
+        let s = sample().tour.scenes[0].clone();
+        t.scenes.push(tour::TourScene {
+            source: tour::Source::Equirect("../outside.jpg".into()),
+            ..s
+        });
+        let e = TourNav::start(t, PathBuf::from("t.json")).err().unwrap();
+        assert!(
+            e.contains("no scene of the tour opens") && e.contains("leaves"),
+            "{e}"
+        );
+    }
 }

@@ -36,9 +36,16 @@ type Parts = (Value, Vec<(String, Value)>, Vec<String>);
 fn parts(tour: &Tour) -> Parts {
     let mut left_out = Vec::new();
     let mut default = Map::new();
+    // The first scene as saved: the tour's, unless it is left out (Marzipano tiles), then
+    // the first scene that is saved (a config must not start in a scene it lacks).
+    let saved = |s: &&crate::tour::TourScene| !matches!(s.source, Source::MarzipanoTiles { .. });
+    let first = tour
+        .first()
+        .filter(saved)
+        .or_else(|| tour.scenes.iter().find(saved));
     default.insert(
         "firstScene".into(),
-        json!(tour.first().map_or("", |s| s.id.as_str())),
+        json!(first.map_or("", |s| s.id.as_str())),
     );
     if let Some(f) = tour.fade_ms {
         default.insert("sceneFadeDuration".into(), json!(f));

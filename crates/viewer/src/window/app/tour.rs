@@ -181,6 +181,44 @@ impl App {
                 i.pointer.button_pressed(egui::PointerButton::Extra2),
             )
         });
+        if bar.edit {
+            nav.editor.on = !nav.editor.on;
+        }
+        let mut edits = if nav.editor.on && !self.dialogs.is_open() {
+            tour::edit_panel(ui.ctx(), scene, nav)
+        } else {
+            Vec::new()
+        };
+        if nav.editor.on && !tour::typing(ui.ctx()) {
+            edits.extend(ui.input(|i| {
+                let key = |k: egui::Key, shift: bool| {
+                    i.events.iter().any(|e| {
+                        matches!(e, egui::Event::Key { key, pressed: true, modifiers, .. }
+                            if *key == k && modifiers.command && modifiers.shift == shift)
+                    })
+                };
+                if key(egui::Key::Z, false) {
+                    Some(tour::EditRequest::Undo)
+                } else if key(egui::Key::Z, true) || key(egui::Key::Y, false) {
+                    Some(tour::EditRequest::Redo)
+                } else {
+                    None
+                }
+            }));
+        }
+        let mut did = Vec::new();
+        for r in edits {
+            if self.print_view {
+                let _ = crate::outln!("tour edit {r:?}");
+            }
+            did.extend(nav.edit_request(r, look));
+        }
+        for a in did {
+            self.tour_do(a, t);
+        }
+        let Some(nav) = self.tour.as_mut() else {
+            return;
+        };
         let action = if bar.back || alt_back || m_back {
             nav.step(false, look)
         } else if bar.forward || alt_fwd || m_fwd {
@@ -200,6 +238,10 @@ impl App {
             return false;
         };
         let look = self.ctl.look();
+        // Editing: the click picks a spot or selects a hotspot.
+        if nav.edit_click(&look, size.0, size.1, at.0, at.1) {
+            return true;
+        }
         let Some(i) = nav.hotspot_at(&look, size.0, size.1, at.0, at.1) else {
             return false;
         };
