@@ -109,6 +109,8 @@ struct App {
     prefs_saved_at: f64,
     /// The help overlay is shown.
     show_help: bool,
+    /// The first-run hint was drawn (and reported with `--print-view`).
+    hint_drawn: bool,
     /// The scene at its size; a degraded frame's lower-resolution render.
     scene: Vec<u32>,
     small: Vec<u32>,
@@ -206,6 +208,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         prefs_dir,
         prefs_saved_at: 0.0,
         show_help: false,
+        hint_drawn: false,
         scene: Vec::new(),
         small: Vec::new(),
         scene_key: None,
