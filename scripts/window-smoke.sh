@@ -13,7 +13,9 @@
 #   exits 0 and the recent files are in the settings file.
 # Run 2 (the settings written by run 1, panel hidden, default zoom limit): the panel
 #   stays hidden, the view opens at 90° and the wheel reaches 50° (the zoom reach) on the
-#   1024x512 sample, where a notice says why it stops; Ctrl+S
+#   1024x512 sample, where a notice says why it stops; the help fits the window at
+#   800x500, 640x400 and 1024x640 (resized with xdotool); a fullscreen round trip (F, the
+#   window at the screen's size, Esc, back: no window manager under Xvfb) keeps hfov; Ctrl+S
 #   saves the view where the settings say; the README's screenshot is taken here
 #   (into $OUT; copied to docs/screenshot.png only with SMOKE_UPDATE_SCREENSHOT=1).
 # Run 3 (panel hidden): a scene file with --show-room opens its panorama at its view with
@@ -406,6 +408,54 @@ log "$(grep '^notice zoom stops' "$VIEWLOG" | tail -n 1)"
 sleep 0.3
 $IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/screenshot.png"
 if [ "${SMOKE_UPDATE_SCREENSHOT:-0}" = 1 ]; then cp "$OUT/screenshot.png" "$ROOT/docs/screenshot.png"; fi
+
+# The help fits the window at 800x500, 640x400 (the smallest supported) and 1024x640 (the
+# default): the viewer prints where egui laid it out against the scene.
+help_fits() {
+  local line
+  line=$(grep '^help rect ' "$VIEWLOG" | tail -n 1)
+  log "$1: $line"
+  echo "$line" | awk -F'[ ,]' '{ exit !($3 >= $8 && $4 >= $9 && $5 <= $10 && $6 <= $11 && $5 - $3 > ($10 - $8) / 2) }' ||
+    fail "the help does not fit the ${1} window: $line"
+}
+resize_to() {
+  local n
+  n=$(lines)
+  xdotool windowsize "$WID" "$1" "$2"
+  wait_for "^view .*size=${1}x${2} " "$n" 10
+  settle
+}
+N=$(lines)
+focus
+xdotool key question
+wait_for '^help rect ' "$N" 5
+help_fits 800x500
+for size in "640 400" "1024 640"; do
+  N=$(lines)
+  # shellcheck disable=SC2086 # width and height
+  resize_to $size
+  wait_for "^help rect .* scene 0,0,${size% *},${size#* }" "$N" 5
+  help_fits "${size/ /x}"
+done
+$IMPORT -window root -crop "1024x640+${X}+${Y}" +repage "$OUT/help-1024x640.png"
+N=$(lines)
+xdotool key question
+wait_for '^help hidden' "$N" 5
+# A fullscreen round trip keeps the view's hfov. Under Xvfb there is no window manager to
+# honour F, so the window's size change that fullscreen makes is done by hand (the whole
+# screen and back); F and Esc are pressed too, as a user would.
+resize_to 800 500
+HFOVF=$(field hfov)
+focus
+press f
+sleep 0.3
+resize_to 1280 800
+log "fullscreen-sized: hfov=$(field hfov)"
+press Escape
+sleep 0.3
+resize_to 800 500
+log "fullscreen round trip: hfov $HFOVF -> $(field hfov)"
+[ "$(field hfov)" = "$HFOVF" ] || fail "the fullscreen round trip changed hfov: $HFOVF -> $(field hfov)"
 
 # Ctrl+S: the Save dialog opens in the folder of the settings, Enter saves view-1.png.
 N=$(lines)

@@ -111,6 +111,8 @@ struct App {
     show_help: bool,
     /// The first-run hint was drawn (and reported with `--print-view`).
     hint_drawn: bool,
+    /// The help overlay's rectangle and the scene's last printed with `--print-view`.
+    help_printed: Option<(egui::Rect, egui::Rect)>,
     /// The scene at its size; a degraded frame's lower-resolution render.
     scene: Vec<u32>,
     small: Vec<u32>,
@@ -209,6 +211,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         prefs_saved_at: 0.0,
         show_help: false,
         hint_drawn: false,
+        help_printed: None,
         scene: Vec::new(),
         small: Vec::new(),
         scene_key: None,

@@ -210,6 +210,25 @@ impl App {
         if self.show_help && overlay::help(ctx, scene) {
             req.keys.push(KeyAction::Help);
         }
+        if self.show_help && self.print_view {
+            // Where the help was laid out, against the scene (the window tests check it
+            // fits): printed when either changes.
+            let help = ctx.memory(|m| m.area_rect(egui::Id::new("help")));
+            if let Some(r) = help.filter(|&r| self.help_printed != Some((r, scene))) {
+                self.help_printed = Some((r, scene));
+                let _ = crate::outln!(
+                    "help rect {:.0},{:.0},{:.0},{:.0} scene {:.0},{:.0},{:.0},{:.0}",
+                    r.min.x,
+                    r.min.y,
+                    r.max.x,
+                    r.max.y,
+                    scene.min.x,
+                    scene.min.y,
+                    scene.max.x,
+                    scene.max.y
+                );
+            }
+        }
     }
 
     /// The hfov range for the current panorama in a `scene_width`-pixel scene: zooming
