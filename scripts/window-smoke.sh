@@ -15,7 +15,8 @@
 #   stays hidden, the view opens at 90° and the wheel reaches 50° (the zoom reach) on the
 #   1024x512 sample, where a notice says why it stops; the help fits the window at
 #   800x500, 640x400 and 1024x640 (resized with xdotool); a fullscreen round trip (F, the
-#   window at the screen's size, Esc, back: no window manager under Xvfb) keeps hfov; Ctrl+S
+#   window at the screen's size, Esc, back: no window manager under Xvfb) keeps hfov; the
+#   recent-files menu closes on Esc; one Esc closes the Save dialog; Ctrl+S
 #   saves the view where the settings say; the README's screenshot is taken here
 #   (into $OUT; copied to docs/screenshot.png only with SMOKE_UPDATE_SCREENSHOT=1).
 # Run 3 (panel hidden): a scene file with --show-room opens its panorama at its view with
@@ -456,6 +457,24 @@ sleep 0.3
 resize_to 800 500
 log "fullscreen round trip: hfov $HFOVF -> $(field hfov)"
 [ "$(field hfov)" = "$HFOVF" ] || fail "the fullscreen round trip changed hfov: $HFOVF -> $(field hfov)"
+
+# The recent-files menu (the toolbar's ⏷, after Open) closes on Esc.
+N=$(lines)
+xdotool mousemove "$((X + 88))" "$((Y + 22))"; sleep 0.2; xdotool click 1
+wait_for '^menu open' "$N" 5
+$IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/recent.png"
+xdotool windowfocus "$WID" 2>/dev/null || true
+press Escape
+wait_for '^menu closed' "$N" 5
+# One Esc closes the Save dialog, whose file name field has the keyboard.
+N=$(lines)
+focus
+chord ctrl s
+wait_for "^dialog save $SAVES" "$N" 5
+sleep 0.5
+press Escape
+wait_for '^dialog closed' "$N" 5
+sleep 0.3
 
 # Ctrl+S: the Save dialog opens in the folder of the settings, Enter saves view-1.png.
 N=$(lines)

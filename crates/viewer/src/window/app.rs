@@ -113,6 +113,8 @@ struct App {
     hint_drawn: bool,
     /// The help overlay's rectangle and the scene's last printed with `--print-view`.
     help_printed: Option<(egui::Rect, egui::Rect)>,
+    /// A menu was open at the last frame (printed with `--print-view` when it changes).
+    menu_open: bool,
     /// The scene at its size; a degraded frame's lower-resolution render.
     scene: Vec<u32>,
     small: Vec<u32>,
@@ -212,6 +214,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         show_help: false,
         hint_drawn: false,
         help_printed: None,
+        menu_open: false,
         scene: Vec::new(),
         small: Vec::new(),
         scene_key: None,

@@ -68,11 +68,22 @@ impl App {
             }
         }
         let export = self.doc.readouts.scene;
+        let dialog_was_open = self.dialogs.is_open();
         req.chosen = self
             .dialogs
             .update(ui.ctx(), &mut self.ctl.settings.export_scale, &|k| {
                 crate::window::export::export_size(export, k)
             });
+        if self.print_view {
+            if dialog_was_open && !self.dialogs.is_open() && req.chosen.is_none() {
+                let _ = crate::outln!("dialog closed");
+            }
+            // A menu (the recent files) opened or closed.
+            let menu = egui::Popup::is_any_open(ui.ctx());
+            if menu != std::mem::replace(&mut self.menu_open, menu) {
+                let _ = crate::outln!("menu {}", if menu { "open" } else { "closed" });
+            }
+        }
         req.scene_rect = SceneRect::from_points(rect, ppp, win.0, win.1);
         let Some(sr) = req.scene_rect else {
             return req;
