@@ -12,7 +12,11 @@
 #   a path typed into it loads; PageDown opens the next file in natural order; Ctrl+Q
 #   exits 0 and the recent files are in the settings file.
 # Run 2 (the settings written by run 1, panel hidden, default zoom limit): the panel
-#   stays hidden, the zoom stops where a map pixel covers two screen pixels, Ctrl+S
+#   stays hidden, the view opens at 90° and the wheel reaches 50° (the zoom reach) on the
+#   1024x512 sample, where a notice says why it stops; the help fits the window at
+#   800x500, 640x400 and 1024x640 (resized with xdotool); a fullscreen round trip (F, the
+#   window at the screen's size, Esc, back: no window manager under Xvfb) keeps hfov; the
+#   recent-files menu closes on Esc; one Esc closes the Save dialog; Ctrl+S
 #   saves the view where the settings say; the README's screenshot is taken here
 #   (into $OUT; copied to docs/screenshot.png only with SMOKE_UPDATE_SCREENSHOT=1).
 # Run 3 (panel hidden): a scene file with --show-room opens its panorama at its view with
@@ -21,7 +25,10 @@
 #   so does dragging a room corner (its two walls), Shift-dragging a ceiling or floor
 #   edge changes the room's height or camera height; then, the lighting settled, a zoom
 #   draws the lit panorama (lit=baked); the work plane's Em and U0 (solved on the
-#   solving thread) are printed after the load and again, different, after the changes.
+#   solving thread) are printed after the load and again, different, after the changes;
+#   a luminaire dropped on it switches the scene's fixed exposure to automatic with a
+#   notice; PageUp then opens the other panorama of the folder on its own, without the
+#   scene's room and lights.
 #
 # Screenshots and logs: target/window-smoke/ (kept as CI artifacts). The settings live
 # in a temporary config folder (LUTPANO_CONFIG_DIR), never the real home.
@@ -229,6 +236,9 @@ done
 sleep 0.3 # hold still before release: no inertia throw
 xdotool mouseup 1
 settle
+# The first-run hint was shown after the load, and the first drag took it away.
+grep -q '^hint shown' "$VIEWLOG" || fail "no first-run hint on a fresh settings file"
+grep -q '^hint gone' "$VIEWLOG" || fail "the first drag did not take the first-run hint away"
 YAW1=$(field yaw); PITCH1=$(field pitch)
 log "after drag: yaw=$YAW1 pitch=$PITCH1"
 $IMPORT -window root "$OUT/2-dragged.png"
@@ -361,6 +371,7 @@ quit_viewer
 for n in a1 a2 a10; do
   grep -q "\"$PANOS/$n.jpg\"" "$CFG/settings.json" || fail "$n.jpg is not among the recent files"
 done
+grep -q '"first_run_hint": false' "$CFG/settings.json" || fail "the first-run hint is not remembered as shown"
 
 ########## Run 2: the settings of run 1, panel hidden, default zoom limit ##########
 # Edited as JSON (the file is written with its keys sorted, so a line-wise delete of the
@@ -383,18 +394,89 @@ SCENE=$(field size); SW=${SCENE%x*}; SH=${SCENE#*x}
 CX=$((X + SW / 2)); CY=$((Y + SH / 2))
 [ "$SW" = "$WIDTH" ] || fail "the panel should stay hidden: scene ${SW} of ${WIDTH} px"
 ! grep -q '^readouts ' "$VIEWLOG" || fail "readouts printed with the panel hidden"
-# One map pixel over two screen pixels at the limit: 1024 px over 360°, f = 2·1024/(2π).
-LIMIT=$(awk -v w="$SW" 'BEGIN { printf "%.4f", 2 * atan2(w / 2, 2 * 1024 / (2 * 3.14159265358979)) * 180 / 3.14159265358979 }')
-log "start: hfov=$(field hfov), the limit for a ${SW}-px scene: $LIMIT"
+! grep -q '^hint shown' "$VIEWLOG" || fail "the first-run hint came back on the second run"
+# The bundled 1024x512 sample: the default zoom limit (one map pixel over two screen
+# pixels) would stop at ~102° in an 800-px scene, but zooming in always reaches the zoom
+# reach (50°), where it stops with a notice saying why and where to change it.
+log "start: hfov=$(field hfov)"
+[ "$(field hfov)" = 90.0000 ] || fail "the view should open at the default 90°, not $(field hfov)"
+N=$(lines)
 xdotool mousemove "$CX" "$CY"
-for _ in 1 2 3 4 5; do xdotool click 4; sleep 0.1; done
+for _ in $(seq 1 10); do xdotool click 4; sleep 0.1; done
 settle
 log "after scroll: hfov=$(field hfov)"
-awk -v a="$(field hfov)" -v l="$LIMIT" 'BEGIN { exit !(a > l - 0.01 && a < l + 0.01) }' ||
-  fail "the zoom should stop at the resolution limit $LIMIT, got $(field hfov)"
+[ "$(field hfov)" = 50.0000 ] || fail "the wheel should reach 50° on a 1024x512 map, got $(field hfov)"
+wait_for '^notice zoom stops at 50°: .*Zoom limit' "$N" 5
+log "$(grep '^notice zoom stops' "$VIEWLOG" | tail -n 1)"
 sleep 0.3
 $IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/screenshot.png"
 if [ "${SMOKE_UPDATE_SCREENSHOT:-0}" = 1 ]; then cp "$OUT/screenshot.png" "$ROOT/docs/screenshot.png"; fi
+
+# The help fits the window at 800x500, 640x400 (the smallest supported) and 1024x640 (the
+# default): the viewer prints where egui laid it out against the scene.
+help_fits() {
+  local line
+  line=$(grep '^help rect ' "$VIEWLOG" | tail -n 1)
+  log "$1: $line"
+  echo "$line" | awk -F'[ ,]' '{ exit !($3 >= $8 && $4 >= $9 && $5 <= $10 && $6 <= $11 && $5 - $3 > ($10 - $8) / 2) }' ||
+    fail "the help does not fit the ${1} window: $line"
+}
+resize_to() {
+  local n
+  n=$(lines)
+  xdotool windowsize "$WID" "$1" "$2"
+  wait_for "^view .*size=${1}x${2} " "$n" 10
+  settle
+}
+N=$(lines)
+focus
+xdotool key question
+wait_for '^help rect ' "$N" 5
+help_fits 800x500
+for size in "640 400" "1024 640"; do
+  N=$(lines)
+  # shellcheck disable=SC2086 # width and height
+  resize_to $size
+  wait_for "^help rect .* scene 0,0,${size% *},${size#* }" "$N" 5
+  help_fits "${size/ /x}"
+done
+$IMPORT -window root -crop "1024x640+${X}+${Y}" +repage "$OUT/help-1024x640.png"
+N=$(lines)
+xdotool key question
+wait_for '^help hidden' "$N" 5
+# A fullscreen round trip keeps the view's hfov. Under Xvfb there is no window manager to
+# honour F, so the window's size change that fullscreen makes is done by hand (the whole
+# screen and back); F and Esc are pressed too, as a user would.
+resize_to 800 500
+HFOVF=$(field hfov)
+focus
+press f
+sleep 0.3
+resize_to 1280 800
+log "fullscreen-sized: hfov=$(field hfov)"
+press Escape
+sleep 0.3
+resize_to 800 500
+log "fullscreen round trip: hfov $HFOVF -> $(field hfov)"
+[ "$(field hfov)" = "$HFOVF" ] || fail "the fullscreen round trip changed hfov: $HFOVF -> $(field hfov)"
+
+# The recent-files menu (the toolbar's ⏷, after Open) closes on Esc.
+N=$(lines)
+xdotool mousemove "$((X + 88))" "$((Y + 22))"; sleep 0.2; xdotool click 1
+wait_for '^menu open' "$N" 5
+$IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/recent.png"
+xdotool windowfocus "$WID" 2>/dev/null || true
+press Escape
+wait_for '^menu closed' "$N" 5
+# One Esc closes the Save dialog, whose file name field has the keyboard.
+N=$(lines)
+focus
+chord ctrl s
+wait_for "^dialog save $SAVES" "$N" 5
+sleep 0.5
+press Escape
+wait_for '^dialog closed' "$N" 5
+sleep 0.3
 
 # Ctrl+S: the Save dialog opens in the folder of the settings, Enter saves view-1.png.
 N=$(lines)
@@ -526,5 +608,27 @@ log "$WP2"
 [ "$WP2" != "$WP1" ] || fail "the work plane's figures did not follow the changes: $WP1"
 sleep 0.3
 $IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/lights.png"
+# A luminaire dropped on the lit scene, whose exposure the scene file fixes: the exposure
+# follows the lights from then on (a notice says so and how to fix it again), so the
+# picture is not blown out: the 5 % of the room's surface above the exposure at most.
+N=$(lines)
+timeout 20 /usr/bin/python3 scripts/xdnd-drop.py "$WID" "$ROOT/tests/data/ldt/office_louvre_2x28w.ldt" ||
+  fail "the window did not take the dropped luminaire"
+wait_for '^notice exposure now follows the lights' "$N" 10
+wait_for '^view .* lights=6 ' "$N" 10
+settle
+log "after the drop: lights=$(field lights); $(grep '^notice exposure' "$VIEWLOG" | tail -n 1)"
+$IMPORT -window root -crop "${WIDTH}x${HEIGHT}+${X}+${Y}" +repage "$OUT/dropped.png"
+MEAN=$($IDENTIFY -format '%[fx:mean]' "$OUT/dropped.png")
+log "mean brightness after the drop: $MEAN"
+awk -v m="$MEAN" 'BEGIN { exit !(m > 0.05 && m < 0.8) }' || fail "the picture after the drop is not readable (mean $MEAN)"
+# PageUp opens the folder's other panorama on its own: the scene's room and lights go.
+N=$(lines)
+focus
+press Prior
+wait_for "^loaded .*courtyard.jpg" "$N" 30
+settle
+log "after PageUp: $(grep '^loaded ' "$VIEWLOG" | tail -n 1), lights=$(field lights)"
+[ "$(field lights)" = 0 ] || fail "a panorama opened on its own kept the scene's $(field lights) lights"
 quit_viewer
 log "PASS (screenshots in $OUT$([ "${SMOKE_UPDATE_SCREENSHOT:-0}" = 1 ] && echo ", docs/screenshot.png updated"))"

@@ -301,3 +301,91 @@ fn the_heat_map_legend_is_in_the_panel() {
     assert_eq!(row("error max"), Some("0.0123 px"));
     assert_eq!(row("error mean"), Some("0.00140 px"));
 }
+
+/// Issue 33 (6): at the default window size (1024×640) every text the panel draws, with
+/// the longest readouts (over the budget, nearest quality, a long map name), lies within
+/// the panel's frame: it wraps or elides instead of running past the window's edge.
+#[test]
+fn the_panels_text_stays_within_its_frame() {
+    let (w, h) = (1024.0_f32, 640.0_f32);
+    let ctx = egui::Context::default();
+    ctx.set_visuals(egui::Visuals::dark());
+    let mut settings = Settings::default();
+    let mut projection = None;
+    let mut lights = LightsState::default();
+    let mut zoom_limit = Some(2.0);
+    let mut auto_rotate = AutoRotate::default();
+    let readouts = Readouts {
+        map: "a_rather_long_panorama_file_name_2024.jpg (16384×8192, equirect)".into(),
+        render_ms: 16.88,
+        full_ms: Some(16.88),
+        ui_ms: 1.25,
+        fps: 59.0,
+        scene: (794, 640),
+        level: Some(viewer::window::quality::Level::Nearest),
+        sampler: Some(lut_core::Sampler::Nearest),
+        pixels: 794 * 640,
+        exact_pixels: 1234,
+        table_bytes: 12_345_678,
+        pose_heading: Some(123.4),
+        heat: Some((0.0123, 0.0014)),
+        ..Readouts::default()
+    };
+    let mut shapes = Vec::new();
+    let mut panel_left = 0.0;
+    for _ in 0..3 {
+        let raw = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(
+                egui::Pos2::ZERO,
+                egui::vec2(w, h),
+            )),
+            ..Default::default()
+        };
+        let out = ctx.run_ui(raw, |ui| {
+            ui::side_panel(
+                ui,
+                PanelModel {
+                    settings: &mut settings,
+                    projection: &mut projection,
+                    look: Look::new(12.5, -3.0, 75.0),
+                    readouts: &readouts,
+                    loading: None,
+                    zoom_limit: &mut zoom_limit,
+                    auto_rotate: &mut auto_rotate,
+                    lights: &mut lights,
+                },
+            );
+            panel_left = ui.available_rect_before_wrap().max.x;
+        });
+        shapes = out.shapes;
+    }
+    assert!(
+        (panel_left - (w - PANEL_WIDTH)).abs() < 20.0,
+        "the panel starts at {panel_left}"
+    );
+    let mut texts = 0;
+    let mut check = |s: &egui::Shape| {
+        if let egui::Shape::Text(t) = s {
+            if t.galley.text().trim().is_empty() {
+                return;
+            }
+            texts += 1;
+            let r = t.visual_bounding_rect();
+            assert!(
+                r.min.x >= panel_left - 1.0 && r.max.x <= w + 0.5,
+                "text {:?} at {r:?} leaves the panel ({panel_left}..{w})",
+                t.galley.text()
+            );
+        }
+    };
+    fn walk(s: &egui::Shape, f: &mut dyn FnMut(&egui::Shape)) {
+        match s {
+            egui::Shape::Vec(v) => v.iter().for_each(|s| walk(s, f)),
+            s => f(s),
+        }
+    }
+    for c in &shapes {
+        walk(&c.shape, &mut check);
+    }
+    assert!(texts > 30, "only {texts} texts drawn");
+}

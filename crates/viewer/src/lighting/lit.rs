@@ -342,4 +342,45 @@ mod tests {
             st.exposure_lux
         );
     }
+
+    /// Issue 33 (5): a luminaire added to a scene whose exposure is fixed (a scene file's,
+    /// here 1 lx) would leave most of the room above the exposure (white); after
+    /// `lights_added` the exposure follows the lights and at most 5 % of the room's
+    /// surface is above it.
+    #[test]
+    fn a_light_added_at_a_fixed_exposure_keeps_the_picture_readable() {
+        let mut st = LightsState {
+            auto_exposure: false,
+            exposure_lux: 1.0,
+            ..LightsState::default()
+        };
+        assert_eq!(st.lights_added(), None, "no light: nothing to do");
+        st.load_and_add(&lamp()).unwrap();
+        st.lights[0].multiplier = 50.0;
+        let mut fixed = st.clone();
+        let map = LitCache::default()
+            .update(&mut fixed, false)
+            .unwrap()
+            .unwrap();
+        assert_eq!(fixed.exposure_lux, 1.0, "fixed: not followed");
+        assert!(
+            map.quantile(0.5) > fixed.exposure_lux,
+            "the test's light must blow out half the room at the fixed exposure: {} lx",
+            map.quantile(0.5)
+        );
+        let notice = st.lights_added().expect("a notice");
+        assert!(
+            notice.contains("automatic") && notice.contains("1 lx"),
+            "{notice}"
+        );
+        assert!(st.auto_exposure);
+        let map = LitCache::default().update(&mut st, false).unwrap().unwrap();
+        let above = map.quantile(crate::lighting::state::AUTO_EXPOSURE_QUANTILE);
+        assert!(
+            st.exposure_lux >= above * (1.0 - 1e-9),
+            "exposure {} lx below the 95 % quantile {above} lx",
+            st.exposure_lux
+        );
+        assert_eq!(st.lights_added(), None, "said once");
+    }
 }

@@ -370,6 +370,22 @@ impl LightsState {
         }
     }
 
+    /// Luminaires were added (dropped, opened, typed in the panel): with a fixed exposure
+    /// the picture would turn white under a new light, so the exposure follows the
+    /// lights from now on. Returns the notice saying so and how to fix it again (`None`:
+    /// it already did).
+    pub fn lights_added(&mut self) -> Option<String> {
+        if self.auto_exposure || self.lights.is_empty() {
+            return None;
+        }
+        self.auto_exposure = true;
+        Some(format!(
+            "exposure now follows the lights (it was fixed at {:.0} lx, which a new light \
+             can blow out); to fix it again, untick Lights > Exposure > automatic",
+            self.exposure_lux
+        ))
+    }
+
     /// How the lit frame is shaded.
     pub fn shade_options(&self) -> ShadeOptions {
         ShadeOptions {

@@ -109,6 +109,12 @@ struct App {
     prefs_saved_at: f64,
     /// The help overlay is shown.
     show_help: bool,
+    /// The first-run hint was drawn (and reported with `--print-view`).
+    hint_drawn: bool,
+    /// The help overlay's rectangle and the scene's last printed with `--print-view`.
+    help_printed: Option<(egui::Rect, egui::Rect)>,
+    /// A menu was open at the last frame (printed with `--print-view` when it changes).
+    menu_open: bool,
     /// The scene at its size; a degraded frame's lower-resolution render.
     scene: Vec<u32>,
     small: Vec<u32>,
@@ -211,6 +217,9 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         prefs_dir,
         prefs_saved_at: 0.0,
         show_help: false,
+        hint_drawn: false,
+        help_printed: None,
+        menu_open: false,
         scene: Vec::new(),
         small: Vec::new(),
         scene_key: None,

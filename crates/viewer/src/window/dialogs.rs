@@ -151,6 +151,17 @@ impl Dialogs {
         size_of: &dyn Fn(u32) -> (u32, u32),
     ) -> Option<Chosen> {
         let purpose = self.purpose?;
+        // One Esc closes the dialog, even while its file name field has the keyboard
+        // (egui_file_dialog would only take the focus from the field on the first).
+        if ctx.input(|i| i.key_pressed(egui::Key::Escape)) {
+            self.purpose = None;
+            ctx.memory_mut(|m| {
+                if let Some(id) = m.focused() {
+                    m.surrender_focus(id);
+                }
+            });
+            return None;
+        }
         if purpose == Purpose::Save {
             self.dialog.update_with_right_panel_ui(ctx, &mut |ui, _| {
                 ui.heading("Size");
@@ -178,6 +189,67 @@ impl Dialogs {
                 self.purpose = None;
                 None
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One UI pass of a 1024×640 window with `events`, the dialogs drawn.
+    fn pass(ctx: &egui::Context, d: &mut Dialogs, events: Vec<egui::Event>) -> Option<Chosen> {
+        let raw = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(
+                egui::Pos2::ZERO,
+                egui::vec2(1024.0, 640.0),
+            )),
+            events,
+            ..Default::default()
+        };
+        let mut chosen = None;
+        let _ = ctx.run_ui(raw, |ui| {
+            chosen = d.update(ui.ctx(), &mut 1, &|k| (800 * k, 500 * k));
+        });
+        chosen
+    }
+
+    fn key(key: egui::Key) -> egui::Event {
+        egui::Event::Key {
+            key,
+            physical_key: None,
+            pressed: true,
+            repeat: false,
+            modifiers: egui::Modifiers::NONE,
+        }
+    }
+
+    /// Issue 33 (9): the Save dialog opens with its file name field focused; one Esc
+    /// closes it all the same (and the Open dialog).
+    #[test]
+    fn one_escape_closes_a_dialog() {
+        let dir = tempfile::tempdir().unwrap();
+        for save in [true, false] {
+            let ctx = egui::Context::default();
+            let mut d = Dialogs::new();
+            if save {
+                d.save_view(&ctx, dir.path(), "view-1.png");
+            } else {
+                d.open_panorama(&ctx, dir.path());
+            }
+            for _ in 0..3 {
+                assert_eq!(pass(&ctx, &mut d, Vec::new()), None);
+            }
+            assert!(d.is_open());
+            if save {
+                assert!(
+                    ctx.memory(|m| m.focused().is_some()),
+                    "the name field has the keyboard"
+                );
+            }
+            assert_eq!(pass(&ctx, &mut d, vec![key(egui::Key::Escape)]), None);
+            assert!(!d.is_open(), "save={save}: still open after one Esc");
+            assert!(ctx.memory(|m| m.focused().is_none()));
         }
     }
 }

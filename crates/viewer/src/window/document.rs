@@ -69,6 +69,10 @@ pub enum Effect {
     ShowPanel,
     /// A panorama was opened: go to its start view.
     StartView(StartView),
+    /// A panorama was opened on its own (the Open dialog, the recent list, PageUp/Down,
+    /// a drop without luminaires or a scene): the previous scene's room, lights and
+    /// scene file go.
+    NewScene,
     /// This file or folder was opened (for the recent list).
     Opened(PathBuf),
 }
@@ -93,6 +97,9 @@ struct Loading {
     opening: bool,
     /// A reload for another exposure.
     exposure: bool,
+    /// A panorama opened on its own (not with a scene, its lights or the command
+    /// line's): the previous scene's room and lights go when it is shown.
+    new_scene: bool,
 }
 
 /// The document state (see the module docs for its rules).
@@ -186,7 +193,9 @@ impl Document {
             FileKind::Other => {}
         }
         let source = Source::of_paths(vec![path], false, None)?;
-        Some(self.start_load(source, None, exposure_ev, true))
+        let fx = self.start_load(source, None, exposure_ev, true);
+        self.mark_new_scene();
+        Some(fx)
     }
 
     /// Start loading `source`; the current panorama stays until it is done. `opening`:
@@ -214,6 +223,7 @@ impl Document {
             status: LoadStatus::new(source.name()),
             opening,
             exposure: false,
+            new_scene: false,
         });
         self.keep_error = false;
         let coverage = self
@@ -259,7 +269,14 @@ impl Document {
                     return Vec::new();
                 };
                 let mut fx = match result {
-                    Ok(loaded) => self.show(loaded, l.opening),
+                    Ok(loaded) => {
+                        let mut fx = Vec::new();
+                        if l.opening && l.new_scene {
+                            fx.push(Effect::NewScene);
+                        }
+                        fx.extend(self.show(loaded, l.opening));
+                        fx
+                    }
                     Err(e) => self.failed(e, Some(l.source), exposure_ev),
                 };
                 if let Some(ev) = self.pending_exposure.take() {
@@ -385,8 +402,19 @@ impl Document {
         }
         if let Some(source) = Source::of_paths(rest, false, None) {
             fx.push(self.start_load(source, None, exposure_ev, true));
+            // Dropped with luminaires or a scene: part of that scene.
+            if fx.len() == 1 {
+                self.mark_new_scene();
+            }
         }
         fx
+    }
+
+    /// The load just started opens a panorama on its own (see [`Effect::NewScene`]).
+    fn mark_new_scene(&mut self) {
+        if let Some(l) = &mut self.loading {
+            l.new_scene = true;
+        }
     }
 
     /// The panel's "Dismiss": the error goes, the projection choice is the current one's.

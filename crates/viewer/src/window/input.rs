@@ -295,6 +295,12 @@ pub struct Controller {
     zoom_range: (f64, f64),
     /// A zoom out was stopped at the widest view (the hook for wide projections).
     zoomed_past_widest: bool,
+    /// A zoom in was stopped at the narrowest view (the window says why).
+    zoomed_past_narrowest: bool,
+    /// The hfov a change of the zoom range narrowed or widened the view from (a
+    /// fullscreen's wider limit): the view returns to it once the range allows again;
+    /// any zoom by the user forgets it.
+    wanted_hfov: Option<f64>,
     zoom_anim: Option<ZoomAnim>,
     /// Frame interval while animating (the display's refresh).
     frame_s: f64,
@@ -325,6 +331,8 @@ impl Controller {
             limit: None,
             zoom_range: (HFOV_MIN, HFOV_MAX),
             zoomed_past_widest: false,
+            zoomed_past_narrowest: false,
+            wanted_hfov: None,
             zoom_anim: None,
             frame_s: DEFAULT_FRAME_S,
             last_input: f64::NEG_INFINITY,
@@ -343,6 +351,7 @@ impl Controller {
         self.prev_frame = None;
         // The projection the user picked stays (a little planet's return view goes).
         self.planet = None;
+        self.wanted_hfov = None;
         self.look = self
             .look
             .moved(home.yaw, home.pitch, self.clamp_hfov(home.hfov));
@@ -362,13 +371,16 @@ impl Controller {
     }
 
     /// Keep hfov within `min`..=`max` from now on (the map's resolution limit and the
-    /// widest view; the projection's [`widest_hfov`] holds too), and pull the current
-    /// view in at once.
+    /// widest view; the projection's [`widest_hfov`] holds too; the start view's hfov is
+    /// always within reach), and pull the current view in at once. A view pulled in
+    /// returns to its hfov when a later range allows it again (leaving fullscreen).
     pub fn set_zoom_range(&mut self, min: f64, max: f64) {
         let max = max.clamp(HFOV_MIN, WIDE_HFOV_MAX);
         let min = min.clamp(HFOV_MIN, max);
         self.zoom_range = (min, max);
-        let h = self.clamp_hfov(self.look.hfov);
+        let want = self.wanted_hfov.unwrap_or(self.look.hfov);
+        let h = self.clamp_hfov(want);
+        self.wanted_hfov = (h != want).then_some(want);
         if h != self.look.hfov {
             self.look = self.look.moved(self.look.yaw, self.look.pitch, h);
         }
@@ -376,7 +388,12 @@ impl Controller {
 
     /// The hfov range in force.
     pub fn zoom_range(&self) -> (f64, f64) {
-        (self.zoom_range.0.min(self.widest()), self.widest())
+        (self.narrowest(), self.widest())
+    }
+
+    /// True (once) when a zoom in was stopped at the narrowest view since the last call.
+    pub fn take_zoomed_past_narrowest(&mut self) -> bool {
+        std::mem::take(&mut self.zoomed_past_narrowest)
     }
 
     /// True (once) when a zoom out was stopped at the widest view since the last call:
@@ -386,8 +403,16 @@ impl Controller {
     }
 
     fn clamp_hfov(&self, hfov: f64) -> f64 {
-        let widest = self.widest();
-        hfov.clamp(self.zoom_range.0.min(widest), widest)
+        hfov.clamp(self.narrowest(), self.widest())
+    }
+
+    /// The narrowest hfov now: the zoom range's, or the start view's when narrower (a
+    /// file's start view is shown whatever the map's resolution), at most the widest.
+    fn narrowest(&self) -> f64 {
+        self.zoom_range
+            .0
+            .min(self.home.hfov.max(HFOV_MIN))
+            .min(self.widest())
     }
 
     /// The widest hfov now: the zoom range's, at most the projection's [`widest_hfov`].
@@ -436,6 +461,14 @@ impl Controller {
     /// True while a drag is in progress.
     pub fn dragging(&self) -> bool {
         self.drag.is_some()
+    }
+
+    /// Auto-rotation switched on by the user at time `t` (Space, the panel): it turns at
+    /// once, without the idle delay.
+    pub fn start_rotation(&mut self, t: f64) {
+        self.auto_rotate.enabled = true;
+        self.touch_tick(t);
+        self.rotating = true;
     }
 
     /// The user did something at time `t` (a press, a key, the wheel): auto-rotation
@@ -529,7 +562,11 @@ impl Controller {
     pub fn double_click(&mut self, pos: (f64, f64), size: (u32, u32), t: f64) {
         self.interacted(t);
         self.velocity = (0.0, 0.0);
+        self.wanted_hfov = None;
         let to = self.clamp_hfov(self.look.hfov / DOUBLE_CLICK_ZOOM);
+        if to >= self.look.hfov {
+            self.zoomed_past_narrowest = true;
+        }
         if to < self.look.hfov {
             self.zoom_anim = Some(ZoomAnim {
                 dir: dir_at(&self.look, pos, size),
@@ -549,6 +586,10 @@ impl Controller {
         if hfov > self.widest() && self.look.hfov >= self.widest() {
             self.zoomed_past_widest = true;
         }
+        if hfov < self.narrowest() && self.look.hfov <= self.narrowest() {
+            self.zoomed_past_narrowest = true;
+        }
+        self.wanted_hfov = None;
         let hfov = self.clamp_hfov(hfov);
         if hfov == self.look.hfov {
             return;
@@ -578,6 +619,7 @@ impl Controller {
                 // The start view in the projection in use.
                 let h = self.home;
                 self.planet = None;
+                self.wanted_hfov = None;
                 self.look = self.look.moved(h.yaw, h.pitch, self.clamp_hfov(h.hfov));
                 self.velocity = (0.0, 0.0);
                 self.zoom_anim = None;
@@ -697,6 +739,12 @@ impl Controller {
         let hfov = self.look.hfov * (zoom * dt * std::f64::consts::LN_2 / ZOOM_HALVING_S).exp();
         if hfov > self.widest() && h.zoom_out {
             self.zoomed_past_widest = true;
+        }
+        if hfov < self.narrowest() && h.zoom_in {
+            self.zoomed_past_narrowest = true;
+        }
+        if h.zoom_in || h.zoom_out {
+            self.wanted_hfov = None;
         }
         let pitch = self.look.pitch + pitch_rate * dt;
         if pitch.abs() >= 90.0 {
@@ -1315,19 +1363,17 @@ mod tests {
 
     #[test]
     fn zoom_range_holds_against_wheel_keys_buttons_and_reset() {
-        let mut c = Controller::new(Look::new(0.0, 0.0, 60.0));
+        let mut c = Controller::new(Look::new(0.0, 0.0, 100.0));
         c.set_zoom_range(80.0, 120.0);
-        assert_eq!(c.look().hfov, 80.0, "pulled out to the limit at once");
+        assert_eq!(c.look().hfov, 100.0, "inside the range: untouched");
         for _ in 0..50 {
             c.wheel(1.0, Some((100.0, 100.0)), SIZE);
         }
         assert_eq!(c.look().hfov, 80.0);
+        assert!(c.take_zoomed_past_narrowest(), "the window says why");
+        assert!(!c.take_zoomed_past_narrowest(), "reported once");
         c.key(KeyAction::Reset);
-        assert_eq!(
-            c.look().hfov,
-            80.0,
-            "the 60° start view is narrower than allowed"
-        );
+        assert_eq!(c.look().hfov, 100.0, "the start view");
         assert!(!c.take_zoomed_past_widest());
         for _ in 0..50 {
             c.key(KeyAction::ZoomOut);
@@ -1346,6 +1392,49 @@ mod tests {
         c.set_zoom_range(HFOV_MIN, HFOV_MAX);
         c.wheel(30.0, None, SIZE);
         assert!(c.look().hfov < 10.0);
+    }
+
+    #[test]
+    fn the_start_view_is_shown_whatever_the_zoom_range() {
+        // A file's 60° start view on a map whose resolution stops the zoom at 80°: the
+        // view opens at 60° and zooming in goes no further than it.
+        let mut c = Controller::new(Look::new(0.0, 0.0, 60.0));
+        c.set_zoom_range(80.0, 120.0);
+        assert_eq!(c.look().hfov, 60.0, "the start view is not pulled out");
+        c.wheel(1.0, None, SIZE);
+        assert_eq!(c.look().hfov, 60.0);
+        assert!(c.take_zoomed_past_narrowest());
+        c.wheel(-3.0, None, SIZE);
+        assert!(c.look().hfov > 80.0);
+        for _ in 0..20 {
+            c.key(KeyAction::ZoomIn);
+        }
+        assert_eq!(c.look().hfov, 60.0, "the start view stays within reach");
+        c.set_home(Look::new(0.0, 0.0, 30.0));
+        assert_eq!(c.look().hfov, 30.0, "a new file's start view too");
+    }
+
+    #[test]
+    fn a_view_pulled_in_by_the_range_returns_when_the_range_allows() {
+        // Fullscreen: a wider scene raises the resolution limit (50° -> 70°), which pulls
+        // the view out; leaving it lowers the limit again and the view comes back.
+        let mut c = Controller::default();
+        c.set_zoom_range(50.0, HFOV_MAX);
+        c.wheel(10.0, None, SIZE);
+        assert_eq!(c.look().hfov, 50.0);
+        c.set_zoom_range(70.0, HFOV_MAX);
+        assert_eq!(c.look().hfov, 70.0, "pulled out in the wider scene");
+        c.set_zoom_range(60.0, HFOV_MAX);
+        assert_eq!(c.look().hfov, 60.0, "as close as the range allows");
+        c.set_zoom_range(50.0, HFOV_MAX);
+        assert_eq!(c.look().hfov, 50.0, "back as it was");
+        // A zoom by the user in between is the new view to keep.
+        c.set_zoom_range(70.0, HFOV_MAX);
+        c.wheel(-1.0, None, SIZE);
+        let h = c.look().hfov;
+        assert!(h > 70.0);
+        c.set_zoom_range(50.0, HFOV_MAX);
+        assert_eq!(c.look().hfov, h, "the user's zoom stays");
     }
 
     #[test]
@@ -1411,6 +1500,26 @@ mod tests {
         assert_eq!(c.wake_at(), Some(t + 2.0));
         c.auto_rotate.enabled = false;
         assert_eq!(c.wake_at(), None);
+    }
+
+    #[test]
+    fn auto_rotation_switched_on_turns_at_once() {
+        let mut c = Controller::default();
+        c.frame(0.0);
+        c.interacted(10.0); // the Space key itself
+        c.start_rotation(10.0);
+        assert!(c.animating());
+        // Half a second of display frames (a tick's step is capped, as after a stall).
+        for i in 0..=30 {
+            c.frame(10.0 + f64::from(i) / 60.0);
+        }
+        let speed = c.auto_rotate.speed_deg_s;
+        close(
+            c.look().yaw,
+            speed * 0.5,
+            1e-6,
+            "half a second of rotation, no delay",
+        );
     }
 
     #[test]

@@ -177,7 +177,7 @@ pub const BINDINGS: &[Binding] = &[
     Binding {
         chords: &[plain(Key::Space)],
         action: KeyAction::AutoRotate,
-        help: "auto-rotate on/off (starts after the idle delay)",
+        help: "auto-rotate on/off (starts at once)",
     },
     Binding {
         chords: &[plain(Key::V)],

@@ -77,11 +77,42 @@ pub fn toolbar(ctx: &egui::Context, m: ToolbarModel<'_>) -> ToolbarOutput {
                         .clicked();
                     ui.add_enabled_ui(!m.recent.is_empty(), |ui| {
                         ui.menu_button(recent, |ui| {
+                            ui.set_max_width(RECENT_MENU_WIDTH);
                             for p in m.recent {
-                                if ui.button(p.display().to_string()).clicked() {
+                                let (name, folder) = recent_label(p, RECENT_FOLDER_CHARS);
+                                let mut job = egui::text::LayoutJob::default();
+                                let style = ui.style();
+                                egui::RichText::new(name).strong().append_to(
+                                    &mut job,
+                                    style,
+                                    egui::FontSelection::Default,
+                                    egui::Align::Center,
+                                );
+                                egui::RichText::new(format!("  {folder}"))
+                                    .weak()
+                                    .small()
+                                    .append_to(
+                                        &mut job,
+                                        style,
+                                        egui::FontSelection::Default,
+                                        egui::Align::Center,
+                                    );
+                                let b = ui
+                                    .add(egui::Button::new(job).truncate())
+                                    .on_hover_text(p.display().to_string());
+                                if b.clicked() {
                                     out.open_recent = Some(p.clone());
                                     ui.close();
                                 }
+                            }
+                            // Moving the pointer away from the menu closes it.
+                            let near = ui.min_rect().expand(RECENT_MENU_MARGIN);
+                            let away = ui
+                                .ctx()
+                                .pointer_latest_pos()
+                                .is_some_and(|pos| !near.contains(pos));
+                            if away {
+                                ui.close();
                             }
                         })
                         .response
@@ -97,12 +128,13 @@ pub fn toolbar(ctx: &egui::Context, m: ToolbarModel<'_>) -> ToolbarOutput {
                     out.reset = ui.button(reset).on_hover_text("Start view (R)").clicked();
                     out.fullscreen = ui.button(full).on_hover_text("Fullscreen (F)").clicked();
                     ui.separator();
+                    // Framed buttons (a selectable label looks disabled), lit when on.
                     out.panel = ui
-                        .selectable_label(m.panel, panel)
+                        .add(egui::Button::new(panel).selected(m.panel))
                         .on_hover_text("Engineering panel (H)")
                         .clicked();
                     out.help = ui
-                        .selectable_label(m.help, help)
+                        .add(egui::Button::new(help).selected(m.help))
                         .on_hover_text("Keys and mouse (? or F1)")
                         .clicked();
                     ui.separator();
@@ -112,6 +144,52 @@ pub fn toolbar(ctx: &egui::Context, m: ToolbarModel<'_>) -> ToolbarOutput {
             });
         });
     out
+}
+
+/// The first-run hint's text.
+pub const FIRST_RUN_HINT: &str = "Drag to look around · scroll to zoom · ? for every key";
+
+/// The first-run hint, centred low over the scene (it takes no input: the drag that
+/// dismisses it goes to the view).
+pub fn first_run_hint(ctx: &egui::Context, scene: egui::Rect) {
+    egui::Area::new(egui::Id::new("first_run_hint"))
+        .pivot(egui::Align2::CENTER_BOTTOM)
+        .fixed_pos(egui::pos2(scene.center().x, scene.max.y - 56.0))
+        .order(egui::Order::Foreground)
+        .interactable(false)
+        .show(ctx, |ui| {
+            bar_frame(ui).show(ui, |ui| {
+                ui.label(egui::RichText::new(FIRST_RUN_HINT).size(16.0).strong());
+            });
+        });
+}
+
+/// Width of the recent-files menu, points.
+pub const RECENT_MENU_WIDTH: f32 = 380.0;
+/// The recent-files menu closes when the pointer is this far (points) from it.
+pub const RECENT_MENU_MARGIN: f32 = 48.0;
+/// The folder beside a recent file's name is elided to this many characters.
+pub const RECENT_FOLDER_CHARS: usize = 40;
+
+/// A recent file's label: its name, and its folder elided at the start to at most `max`
+/// characters ("…/photos/2024" keeps the end, the part that tells folders apart).
+pub fn recent_label(p: &std::path::Path, max: usize) -> (String, String) {
+    let name = p.file_name().map_or_else(
+        || p.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let folder = p
+        .parent()
+        .map(|d| d.display().to_string())
+        .unwrap_or_default();
+    let n = folder.chars().count();
+    let folder = if n > max && max > 1 {
+        let tail: String = folder.chars().skip(n - (max - 1)).collect();
+        format!("…{tail}")
+    } else {
+        folder
+    };
+    (name, folder)
 }
 
 /// Radius of the compass, points.
@@ -263,6 +341,11 @@ pub fn help_rows() -> Vec<(String, &'static str)> {
         .collect()
 }
 
+/// The help's columns are at least this wide (points), else they go one under the other.
+pub const HELP_COLUMN_MIN: f32 = 380.0;
+/// Room for a key's name in the help (points); its description wraps in the rest.
+pub const HELP_KEY_WIDTH: f32 = 130.0;
+
 /// The help overlay in the middle of the scene; true when its close button was pressed.
 /// Keys on the left, the mouse on the right (one column under the other in a narrow
 /// window).
@@ -270,12 +353,29 @@ pub fn help(ctx: &egui::Context, scene: egui::Rect) -> bool {
     let mut close = false;
     let rows = help_rows();
     let (keys, mouse) = rows.split_at(BINDINGS.len());
-    let grid = |ui: &mut egui::Ui, id: &str, rows: &[(String, &str)]| {
-        egui::Grid::new(id).striped(true).show(ui, |ui| {
+    // The width inside the frame: the scene's less a margin, and two columns only when
+    // each gets a readable width; every description wraps within its column.
+    let width = (scene.width() - 40.0).clamp(160.0, 900.0);
+    let two = width >= 2.0 * HELP_COLUMN_MIN + 20.0;
+    let column = if two { (width - 20.0) / 2.0 } else { width };
+    // Each row: the key in a fixed-width cell, its description wrapping in the rest of
+    // the column (no grid: a grid sizes its columns from their widest cell, wider than
+    // the window at 1024 px).
+    let key_width = HELP_KEY_WIDTH.min(column * 0.4);
+    let grid = |ui: &mut egui::Ui, rows: &[(String, &str)]| {
+        ui.vertical(|ui| {
+            ui.set_width(column);
             for (k, h) in rows {
-                ui.monospace(k);
-                ui.label(*h);
-                ui.end_row();
+                ui.horizontal_top(|ui| {
+                    ui.vertical(|ui| {
+                        ui.set_width(key_width);
+                        ui.add(egui::Label::new(egui::RichText::new(k).monospace()).wrap());
+                    });
+                    ui.vertical(|ui| {
+                        ui.set_width((column - key_width - ui.spacing().item_spacing.x).max(40.0));
+                        ui.add(egui::Label::new(*h).wrap());
+                    });
+                });
             }
         });
     };
@@ -284,9 +384,10 @@ pub fn help(ctx: &egui::Context, scene: egui::Rect) -> bool {
         .pivot(egui::Align2::CENTER_CENTER)
         .order(egui::Order::Foreground)
         .fade_in(false)
+        .constrain_to(scene)
         .show(ctx, |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| {
-                ui.set_max_width((scene.width() - 32.0).clamp(200.0, 900.0));
+                ui.set_max_width(width);
                 ui.horizontal(|ui| {
                     ui.heading("Keys and mouse");
                     close = ui
@@ -295,19 +396,19 @@ pub fn help(ctx: &egui::Context, scene: egui::Rect) -> bool {
                         .clicked();
                 });
                 egui::ScrollArea::vertical()
-                    .max_height((scene.height() - 60.0).max(100.0))
+                    .max_height((scene.height() - 70.0).max(60.0))
                     .show(ui, |ui| {
-                        if scene.width() > 860.0 {
+                        if two {
                             ui.horizontal_top(|ui| {
-                                grid(ui, "help_keys", keys);
+                                grid(ui, keys);
                                 ui.separator();
-                                grid(ui, "help_mouse", mouse);
+                                grid(ui, mouse);
                             });
                         } else {
                             // (No separator: it would take the whole width.)
-                            grid(ui, "help_keys", keys);
+                            grid(ui, keys);
                             ui.add_space(10.0);
-                            grid(ui, "help_mouse", mouse);
+                            grid(ui, mouse);
                         }
                     });
             });
@@ -333,5 +434,126 @@ mod tests {
         }
         assert!(rows.iter().any(|(k, _)| k == "Ctrl+O"));
         assert!(rows.iter().any(|(k, _)| k == "double-click"));
+    }
+
+    #[test]
+    fn a_recent_label_is_the_name_and_its_folder_elided_at_the_start() {
+        let (n, f) = recent_label(std::path::Path::new("/a/b/c.jpg"), 40);
+        assert_eq!((n.as_str(), f.as_str()), ("c.jpg", "/a/b"));
+        let long = std::path::Path::new("/home/someone/Pictures/panoramas/2024/summer/x.jpg");
+        let (n, f) = recent_label(long, 16);
+        assert_eq!(n, "x.jpg");
+        assert_eq!(f.chars().count(), 16);
+        assert_eq!(f, "…mas/2024/summer", "the end of the folder kept");
+    }
+
+    /// One UI pass of the toolbar in a 1024×640 window with `events`; whether a popup
+    /// (the recent-files menu) is open after it.
+    fn toolbar_pass(ctx: &egui::Context, recent: &[PathBuf], events: Vec<egui::Event>) -> bool {
+        let screen = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1024.0, 640.0));
+        let raw = egui::RawInput {
+            screen_rect: Some(screen),
+            events,
+            ..Default::default()
+        };
+        let _ = ctx.run_ui(raw, |ui| {
+            toolbar(
+                ui.ctx(),
+                ToolbarModel {
+                    scene: screen,
+                    title: "a.jpg",
+                    recent,
+                    panel: false,
+                    help: false,
+                },
+            );
+        });
+        egui::Popup::is_any_open(ctx)
+    }
+
+    /// Issue 33 (7): the recent-files menu closes on Esc and when the pointer moves away.
+    #[test]
+    fn the_recent_menu_closes_on_escape_and_moving_away() {
+        let recent = vec![PathBuf::from("/p/one.jpg"), PathBuf::from("/p/two.jpg")];
+        let move_to = |x: f32, y: f32| egui::Event::PointerMoved(egui::pos2(x, y));
+        let click = |x: f32, y: f32, pressed: bool| egui::Event::PointerButton {
+            pos: egui::pos2(x, y),
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        };
+        for close in ["escape", "away"] {
+            let ctx = egui::Context::default();
+            assert!(!toolbar_pass(&ctx, &recent, Vec::new()));
+            // The ⏷ button: find it by trying the toolbar's start (it follows "Open").
+            let mut opened = false;
+            for x in (60..140).step_by(4) {
+                let x = x as f32;
+                toolbar_pass(&ctx, &recent, vec![move_to(x, 20.0)]);
+                toolbar_pass(&ctx, &recent, vec![click(x, 20.0, true)]);
+                if toolbar_pass(&ctx, &recent, vec![click(x, 20.0, false)]) {
+                    opened = true;
+                    // Staying near it keeps it open.
+                    assert!(toolbar_pass(&ctx, &recent, vec![move_to(x, 30.0)]));
+                    assert!(toolbar_pass(&ctx, &recent, Vec::new()));
+                    break;
+                }
+            }
+            assert!(opened, "the recent menu did not open");
+            let ev = match close {
+                "escape" => egui::Event::Key {
+                    key: egui::Key::Escape,
+                    physical_key: None,
+                    pressed: true,
+                    repeat: false,
+                    modifiers: egui::Modifiers::NONE,
+                },
+                _ => move_to(900.0, 500.0),
+            };
+            toolbar_pass(&ctx, &recent, vec![ev]);
+            assert!(
+                !toolbar_pass(&ctx, &recent, Vec::new()),
+                "{close}: still open"
+            );
+        }
+    }
+
+    /// Issue 33 (2): the help fits the scene of any window from 640×400 (its frame
+    /// inside the scene, scrolled when taller), at 1024×640 too.
+    #[test]
+    fn the_help_fits_the_window() {
+        for (w, h) in [
+            (640.0, 400.0),
+            (1024.0, 640.0),
+            (800.0, 500.0),
+            (1920.0, 1080.0),
+            // The scene beside the panel in a 640×400 window.
+            (640.0 - crate::window::ui::PANEL_WIDTH, 400.0),
+        ] {
+            let ctx = egui::Context::default();
+            let scene = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(w, h));
+            for _ in 0..3 {
+                let raw = egui::RawInput {
+                    screen_rect: Some(scene),
+                    ..Default::default()
+                };
+                let _ = ctx.run_ui(raw, |ui| {
+                    help(ui.ctx(), scene);
+                });
+            }
+            let r = ctx
+                .memory(|m| m.area_rect(egui::Id::new("help")))
+                .expect("the help was drawn");
+            assert!(
+                scene.contains_rect(r),
+                "{w}x{h}: the help {r:?} is not inside the window"
+            );
+            // Not squeezed: half the window at least, or its full width (900 points and
+            // its frame) in a large one.
+            assert!(
+                r.width() > (w * 0.5).min(900.0),
+                "{w}x{h}: the help is {r:?}"
+            );
+        }
     }
 }

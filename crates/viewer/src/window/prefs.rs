@@ -35,6 +35,9 @@ pub const MAX_RECENT: usize = 10;
 /// The default zoom limit: the narrowest view shows one map pixel over this many screen
 /// pixels.
 pub const DEFAULT_ZOOM_LIMIT: f64 = 2.0;
+/// The default zoom reach: zooming in always reaches this hfov (degrees), whatever the
+/// map's resolution (Pannellum's default narrowest view).
+pub const DEFAULT_ZOOM_REACH: f64 = 50.0;
 
 /// The settings kept between runs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -56,6 +59,12 @@ pub struct Prefs {
     /// Zoom limit: screen pixels per map pixel at the narrowest view; `None`: off (any
     /// hfov down to 1°, for inspection).
     pub zoom_limit: Option<f64>,
+    /// Zoom reach, degrees: zooming in always reaches this hfov; the zoom limit applies
+    /// only to narrower views.
+    pub zoom_reach: f64,
+    /// The first-run hint ("drag to look around") is still to be shown: it goes at the
+    /// first drag, for good.
+    pub first_run_hint: bool,
     /// Auto-rotation on.
     pub auto_rotate: bool,
     /// Auto-rotation speed, degrees per second.
@@ -92,6 +101,8 @@ impl Default for Prefs {
             drag: s.drag,
             inertia: s.inertia,
             zoom_limit: Some(DEFAULT_ZOOM_LIMIT),
+            zoom_reach: DEFAULT_ZOOM_REACH,
+            first_run_hint: true,
             auto_rotate: a.enabled,
             auto_rotate_speed: a.speed_deg_s,
             auto_rotate_idle_s: a.idle_s,
@@ -275,6 +286,10 @@ impl Prefs {
         if !self.zoom_limit.is_none_or(|z| z.is_finite() && z > 0.0) {
             self.zoom_limit = d.zoom_limit;
         }
+        let hfov = super::input::HFOV_MIN..=super::input::HFOV_MAX;
+        if !(self.zoom_reach.is_finite() && hfov.contains(&self.zoom_reach)) {
+            self.zoom_reach = d.zoom_reach;
+        }
         if !(self.auto_rotate_speed.is_finite() && self.auto_rotate_speed.abs() <= 360.0) {
             self.auto_rotate_speed = d.auto_rotate_speed;
         }
@@ -321,6 +336,7 @@ mod tests {
             drag: DragStyle::Qtvr,
             inertia: false,
             zoom_limit: None,
+            zoom_reach: 30.0,
             auto_rotate: true,
             auto_rotate_speed: -7.5,
             auto_rotate_idle_s: 10.0,
@@ -368,7 +384,7 @@ mod tests {
         // Missing fields take their defaults; values out of range are reset.
         std::fs::write(
             &path,
-            r#"{"panel": true, "zoom_limit": -1, "export_scale": 3, "auto_rotate_speed": 1e9}"#,
+            r#"{"panel": true, "zoom_limit": -1, "export_scale": 3, "auto_rotate_speed": 1e9, "zoom_reach": 0}"#,
         )
         .unwrap();
         let (p, msg) = Prefs::load(tmp.path());
@@ -376,8 +392,18 @@ mod tests {
         assert!(p.panel);
         let d = Prefs::default();
         assert_eq!(
-            (p.zoom_limit, p.export_scale, p.auto_rotate_speed),
-            (d.zoom_limit, d.export_scale, d.auto_rotate_speed)
+            (
+                p.zoom_limit,
+                p.export_scale,
+                p.auto_rotate_speed,
+                p.zoom_reach
+            ),
+            (
+                d.zoom_limit,
+                d.export_scale,
+                d.auto_rotate_speed,
+                d.zoom_reach
+            )
         );
         // `null` switches the zoom limit off.
         std::fs::write(&path, r#"{"zoom_limit": null}"#).unwrap();

@@ -366,6 +366,40 @@ pub fn readout_rows(look: &Look, r: &Readouts) -> Vec<(&'static str, String)> {
     rows
 }
 
+/// What a readout of [`readout_rows`] measures (its hover text).
+pub fn readout_help(key: &str) -> &'static str {
+    match key {
+        "yaw" | "pitch" => "The view's direction, degrees",
+        "hfov" => "The view's horizontal field of view, degrees",
+        "heading" => "The compass heading of the view (from the file's GPano pose)",
+        "projection" => "The output projection of the view",
+        "error max" | "error mean" => {
+            "The LUT's sampling error against the exact projection, in source pixels \
+             (the heat map's max and mean over the frame)"
+        }
+        "in use" => "The renderer and table that drew the frame shown",
+        "quality" => "The sampler and quality level of the frame shown",
+        "tile level" => "The pyramid level the frame's tiles come from",
+        "tile cache" => "Tiles in memory, their size against the budget, and the hit rate",
+        "tiles" => "Tiles still loading (the frame shows coarser ones meanwhile)",
+        "table" => "Memory of the look-up tables",
+        "exact px" => "Share of the frame's pixels computed exactly (no LUT)",
+        "scene" => "The scene's size in pixels",
+        "render" => {
+            "render: the time to compute the last frame's scene pixels (the panorama \
+             through the LUT, at whatever quality that frame had), ms"
+        }
+        "full frame" => {
+            "full frame: the recent full-quality renders' time at this size, against the \
+             16 ms budget of a 60 Hz display (fits / over budget); moving frames degrade \
+             when it is over"
+        }
+        "UI" => "The time to build and paint the panel and the overlays, ms",
+        "fps" => "Frames drawn in the last second (0 when idle)",
+        _ => "",
+    }
+}
+
 /// A combo box of every value of `T`, by name, each with its help as the tooltip.
 pub(super) fn named_combo<T: Named + PartialEq>(
     ui: &mut egui::Ui,
@@ -472,8 +506,11 @@ fn readouts_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, _out: &mut PanelO
     section(ui, "Readouts", true, |ui| {
         egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
             for (k, v) in readout_rows(&m.look, m.readouts) {
-                ui.label(k);
-                ui.monospace(v);
+                // Every readout says what it measures; long values wrap in the panel.
+                let tip = readout_help(k);
+                ui.label(k).on_hover_text(tip);
+                ui.add(egui::Label::new(egui::RichText::new(v).monospace()).wrap())
+                    .on_hover_text(tip);
                 ui.end_row();
             }
         });
@@ -627,6 +664,27 @@ fn save_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, out: &mut PanelOutput
 #[cfg(test)]
 mod tests {
     use super::{LoadStatus, LoadStep};
+
+    /// Issue 33 (6): every readout the panel can show says what it measures, and
+    /// "render" and "full frame" say which time each is.
+    #[test]
+    fn every_readout_has_a_hover_text() {
+        use super::{readout_help, readout_rows, Readouts};
+        use crate::window::input::Look;
+        let r = Readouts {
+            full_ms: Some(20.0),
+            heat: Some((0.01, 0.001)),
+            pose_heading: Some(10.0),
+            pixels: 100,
+            exact_pixels: 5,
+            ..Readouts::default()
+        };
+        for (k, _) in readout_rows(&Look::new(0.0, 0.0, 90.0), &r) {
+            assert!(!readout_help(k).is_empty(), "no hover text for {k}");
+        }
+        assert!(readout_help("render").starts_with("render: "));
+        assert!(readout_help("full frame").starts_with("full frame: "));
+    }
 
     #[test]
     fn advance_ignores_late_and_backward_reports() {

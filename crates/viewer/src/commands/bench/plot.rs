@@ -47,6 +47,60 @@ const PALETTE: [RGBColor; 12] = [
     RGBColor(0, 0, 0),
 ];
 
+/// The marker shapes of the series: the colours repeat after [`PALETTE`]'s twelve, each
+/// round with the next shape, so every series has its own colour-and-shape pair.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Marker {
+    Circle,
+    Square,
+    Triangle,
+    Diamond,
+}
+
+const MARKERS: [Marker; 4] = [
+    Marker::Circle,
+    Marker::Square,
+    Marker::Triangle,
+    Marker::Diamond,
+];
+
+/// Series `si`'s colour and marker (distinct pairs for the first 48 series).
+fn series_style(si: usize) -> (RGBColor, Marker) {
+    (
+        PALETTE[si % PALETTE.len()],
+        MARKERS[(si / PALETTE.len()) % MARKERS.len()],
+    )
+}
+
+/// Draw `m` of radius `r` filled with `c` at pixel `(x, y)` of `area`.
+fn draw_marker<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    (x, y): (i32, i32),
+    r: i32,
+    m: Marker,
+    c: RGBColor,
+) -> Result<()> {
+    let style = c.filled();
+    let res = match m {
+        Marker::Circle => area.draw(&Circle::new((x, y), r, style)),
+        Marker::Square => area.draw(&Rectangle::new([(x - r, y - r), (x + r, y + r)], style)),
+        Marker::Triangle => area.draw(&Polygon::new(
+            vec![(x, y - r - 1), (x - r - 1, y + r), (x + r + 1, y + r)],
+            style,
+        )),
+        Marker::Diamond => area.draw(&Polygon::new(
+            vec![
+                (x, y - r - 1),
+                (x + r + 1, y),
+                (x, y + r + 1),
+                (x - r - 1, y),
+            ],
+            style,
+        )),
+    };
+    res.map_err(|e| anyhow!("drawing the chart: {e}"))
+}
+
 /// Colours of the peers' dashed lines: a dark family, apart from the series'.
 const PEER_PALETTE: [RGBColor; 6] = [
     RGBColor(0, 0, 0),
@@ -357,8 +411,8 @@ fn err<E: std::fmt::Display>(e: E) -> anyhow::Error {
 enum Entry {
     /// A group's heading.
     Head(String),
-    /// A series: its point's colour.
-    Point(RGBColor, String),
+    /// A series: its point's colour and marker.
+    Point(RGBColor, Marker, String),
     /// A solid line (references, budget, front).
     Line(RGBColor, String),
     /// A dashed line (peers).
@@ -511,7 +565,7 @@ pub fn plot(path: &Path, rows: &[Row], peers: &[Peer]) -> Result<()> {
             .draw_series(LineSeries::new(steps, BLACK.mix(0.45).stroke_width(2)))
             .map_err(err)?;
         for (si, s) in all.iter().enumerate() {
-            let c = PALETTE[si % PALETTE.len()];
+            let (c, marker) = series_style(si);
             for r in &s.rows {
                 let (x, lo, hi) = (r.ms_median, mean_of(r), max_of(r));
                 chart
@@ -524,13 +578,10 @@ pub fn plot(path: &Path, rows: &[Row], peers: &[Peer]) -> Result<()> {
                 ))
                 .map_err(err)?;
             }
-            chart
-                .draw_series(
-                    s.rows
-                        .iter()
-                        .map(|r| Circle::new((r.ms_median, mean_of(r)), 5, c.filled())),
-                )
-                .map_err(err)?;
+            for r in &s.rows {
+                let p = chart.backend_coord(&(r.ms_median, mean_of(r)));
+                draw_marker(&root, p, 5, marker, c)?;
+            }
         }
         // Step labels where they fit.
         let mut at = Vec::new();
@@ -578,7 +629,8 @@ pub fn plot(path: &Path, rows: &[Row], peers: &[Peer]) -> Result<()> {
             all.len()
         };
         for (si, s) in all.iter().enumerate().take(listed) {
-            entries.push(Entry::Point(PALETTE[si % PALETTE.len()], s.label.clone()));
+            let (c, m) = series_style(si);
+            entries.push(Entry::Point(c, m, s.label.clone()));
         }
         if listed < all.len() {
             entries.push(Entry::Note(format!(
@@ -641,11 +693,9 @@ pub fn plot(path: &Path, rows: &[Row], peers: &[Peer]) -> Result<()> {
                         .draw(&Text::new(t.clone(), (12, y - mid), font.clone()))
                         .map_err(err)?;
                 }
-                Entry::Point(c, t) | Entry::Line(c, t) | Entry::Dashed(c, t) => {
+                Entry::Point(c, _, t) | Entry::Line(c, t) | Entry::Dashed(c, t) => {
                     match e {
-                        Entry::Point(..) => right
-                            .draw(&Circle::new((24, y), 4, c.filled()))
-                            .map_err(err)?,
+                        Entry::Point(_, m, _) => draw_marker(&right, (24, y), 4, *m, *c)?,
                         Entry::Line(..) => right
                             .draw(&PathElement::new([(12, y), (36, y)], c.stroke_width(2)))
                             .map_err(err)?,
@@ -709,6 +759,20 @@ mod tests {
             mean_err_px: Some(err / 4.0),
             ..Row::timed(&run(), "lut", Sampler::Bilinear, 90.0, 1, &[ms])
         }
+    }
+
+    #[test]
+    fn every_series_has_its_own_colour_and_marker() {
+        // Issue 33 (11): "lut wide nearest" (series 0) and "lut plane high bilinear"
+        // (series 12) shared a colour; now their markers differ.
+        let styles: Vec<_> = (0..48).map(series_style).collect();
+        for (i, a) in styles.iter().enumerate() {
+            for (j, b) in styles.iter().enumerate().skip(i + 1) {
+                assert_ne!(a, b, "series {i} and {j}");
+            }
+        }
+        assert_eq!(styles[0].0, styles[12].0);
+        assert_ne!(styles[0].1, styles[12].1);
     }
 
     #[test]

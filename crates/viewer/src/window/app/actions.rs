@@ -21,12 +21,18 @@ impl App {
             match e {
                 Effect::Load(req) => self.spawn_load(req),
                 Effect::AddLights(paths) => {
+                    let t = self.now();
                     for p in &paths {
                         // The error is also kept in the Lights section.
                         if let Err(e) = self.lights.load_and_add(p) {
-                            let t = self.now();
                             self.notices.error(e, t);
                         }
+                    }
+                    if let Some(msg) = self.lights.lights_added() {
+                        if self.print_view {
+                            let _ = crate::outln!("notice {msg}");
+                        }
+                        self.notices.info(msg, t);
                     }
                 }
                 Effect::OpenScene(p) => self.open_scene(p),
@@ -51,6 +57,7 @@ impl App {
                     let home = self.tour_start_view(v);
                     self.ctl.set_home(home);
                 }
+                Effect::NewScene => self.new_scene(),
                 Effect::Opened(p) => {
                     let p = std::path::absolute(&p).unwrap_or(p);
                     self.prefs.add_recent(p);
@@ -194,10 +201,17 @@ impl App {
                 }
             }
             KeyAction::AutoRotate => {
-                let a = &mut self.ctl.auto_rotate;
-                a.enabled = !a.enabled;
-                let msg = if a.enabled {
-                    format!("auto-rotate on: starts after {:.0} s idle", a.idle_s)
+                let on = !self.ctl.auto_rotate.enabled;
+                self.ctl.auto_rotate.enabled = on;
+                if on {
+                    self.ctl.start_rotation(t);
+                }
+                let a = &self.ctl.auto_rotate;
+                let msg = if on {
+                    format!(
+                        "auto-rotate on (Space: off); after input it resumes after {:.0} s idle",
+                        a.idle_s
+                    )
                 } else {
                     "auto-rotate off".to_string()
                 };

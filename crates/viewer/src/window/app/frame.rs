@@ -68,11 +68,22 @@ impl App {
             }
         }
         let export = self.doc.readouts.scene;
+        let dialog_was_open = self.dialogs.is_open();
         req.chosen = self
             .dialogs
             .update(ui.ctx(), &mut self.ctl.settings.export_scale, &|k| {
                 crate::window::export::export_size(export, k)
             });
+        if self.print_view {
+            if dialog_was_open && !self.dialogs.is_open() && req.chosen.is_none() {
+                let _ = crate::outln!("dialog closed");
+            }
+            // A menu (the recent files) opened or closed.
+            let menu = egui::Popup::is_any_open(ui.ctx());
+            if menu != std::mem::replace(&mut self.menu_open, menu) {
+                let _ = crate::outln!("menu {}", if menu { "open" } else { "closed" });
+            }
+        }
         req.scene_rect = SceneRect::from_points(rect, ppp, win.0, win.1);
         let Some(sr) = req.scene_rect else {
             return req;
@@ -92,6 +103,14 @@ impl App {
             let origin = ui
                 .input(|i| i.pointer.press_origin())
                 .or(resp.interact_pointer_pos());
+            if self.prefs.first_run_hint {
+                // The first drag: the hint has done its job, for good.
+                self.prefs.first_run_hint = false;
+                self.save_prefs(true);
+                if self.print_view {
+                    let _ = crate::outln!("hint gone");
+                }
+            }
             if let Some(o) = origin {
                 // On a luminaire's marker the drag moves the luminaire.
                 let shift = ui.input(|i| i.modifiers.shift);
@@ -193,23 +212,55 @@ impl App {
         {
             overlay::tiles_loading(ctx, scene, (*pending).max(1));
         }
+        if self.prefs.first_run_hint && self.doc.current().is_some() {
+            overlay::first_run_hint(ctx, scene);
+            if !std::mem::replace(&mut self.hint_drawn, true) && self.print_view {
+                let _ = crate::outln!("hint shown");
+            }
+        }
         if self.show_help && overlay::help(ctx, scene) {
             req.keys.push(KeyAction::Help);
         }
+        if self.show_help && self.print_view {
+            // Where the help was laid out, against the scene (the window tests check it
+            // fits): printed when either changes.
+            let help = ctx.memory(|m| m.area_rect(egui::Id::new("help")));
+            if let Some(r) = help.filter(|&r| self.help_printed != Some((r, scene))) {
+                self.help_printed = Some((r, scene));
+                let _ = crate::outln!(
+                    "help rect {:.0},{:.0},{:.0},{:.0} scene {:.0},{:.0},{:.0},{:.0}",
+                    r.min.x,
+                    r.min.y,
+                    r.max.x,
+                    r.max.y,
+                    scene.min.x,
+                    scene.min.y,
+                    scene.max.x,
+                    scene.max.y
+                );
+            }
+        }
     }
 
-    /// The hfov range for the current panorama in a `scene_width`-pixel scene: the zoom
-    /// limit from the map's resolution (off: the global minimum) to the widest view.
+    /// The hfov range for the current panorama in a `scene_width`-pixel scene: zooming
+    /// in always reaches the zoom reach (50° by default), and further where the map's
+    /// resolution allows (the zoom limit; off: the global minimum), up to the widest view.
     pub(super) fn update_zoom_range(&mut self) {
+        let min = self
+            .zoom_limit_hfov()
+            .map_or(0.0, |l| l.min(self.prefs.zoom_reach));
+        self.ctl.set_zoom_range(min, WIDE_HFOV_MAX);
+    }
+
+    /// The zoom limit's hfov for the current panorama and scene (`None`: off, or nothing
+    /// shown).
+    fn zoom_limit_hfov(&self) -> Option<f64> {
         let map_px_deg = self.doc.current().map(|c| match c.map() {
             Some(m) => 360.0 / f64::from(m.width()),
             None => 90.0 / f64::from(c.describe().0.max(1)),
-        });
-        let min = match (self.prefs.zoom_limit, map_px_deg) {
-            (Some(ratio), Some(deg)) => resolution_hfov(deg, self.scene_width, ratio),
-            _ => 0.0,
-        };
-        self.ctl.set_zoom_range(min, WIDE_HFOV_MAX);
+        })?;
+        let ratio = self.prefs.zoom_limit?;
+        Some(resolution_hfov(map_px_deg, self.scene_width, ratio))
     }
 
     pub(super) fn redraw(&mut self, el: &ActiveEventLoop) -> Result<()> {
@@ -237,6 +288,11 @@ impl App {
             Route::Shortcuts
         };
         let keys = self.shortcuts.route(&mut raw.events, route);
+        if !keys.is_empty() {
+            // A shortcut (Esc, PageDown, …) taken from egui closes an open menu (the
+            // recent files): egui never sees the key that would close it.
+            egui::Popup::close_all(&ctx);
+        }
         let look_before = self.ctl.look();
         let mut req = FrameRequests::default();
         let full = ctx.run_ui(raw, |ui| req = self.build_ui(ui, t, (w, h)));
@@ -265,6 +321,14 @@ impl App {
                 "widest rectilinear view: V for a wide projection, L for a little planet",
                 t,
             );
+        }
+        if self.ctl.take_zoomed_past_narrowest() {
+            let (min, _) = self.ctl.zoom_range();
+            let msg = zoom_stop_notice(min, self.prefs.zoom_limit);
+            if self.print_view {
+                let _ = crate::outln!("notice {msg}");
+            }
+            self.notices.info(msg, t);
         }
         let mut ui_ms = ui_t0.elapsed().as_secs_f64() * 1e3;
         if let Some(r) = scene_rect {
@@ -658,6 +722,18 @@ fn same_rows(a: &[(&'static str, String)], b: &[(&'static str, String)]) -> bool
     a.iter().filter(keep).eq(b.iter().filter(keep))
 }
 
+/// The notice when a zoom in stops at `min_hfov`: why it stops there, and where to change
+/// it (`limit`: the zoom limit in screen pixels per map pixel, `None`: off).
+pub fn zoom_stop_notice(min_hfov: f64, limit: Option<f64>) -> String {
+    match limit {
+        Some(r) => format!(
+            "zoom stops at {min_hfov:.0}°: narrower, one map pixel would cover more than {r} \
+             screen pixels (change it: P, Navigation, Zoom limit)"
+        ),
+        None => format!("narrowest view: {min_hfov:.0}°"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::fit;
@@ -677,5 +753,13 @@ mod tests {
         let at = buf.as_ptr();
         fit(&mut buf, 800 * 500);
         assert_eq!(buf.as_ptr(), at, "the same size reallocated");
+    }
+
+    #[test]
+    fn the_zoom_stop_notice_says_why_and_where() {
+        let m = super::zoom_stop_notice(50.0, Some(2.0));
+        assert!(m.contains("50°") && m.contains("2 screen pixels"), "{m}");
+        assert!(m.contains("Zoom limit"), "names the setting: {m}");
+        assert_eq!(super::zoom_stop_notice(1.0, None), "narrowest view: 1°");
     }
 }

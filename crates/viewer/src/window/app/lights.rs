@@ -373,6 +373,27 @@ impl App {
         }
     }
 
+    /// A panorama opened on its own: the previous scene's room, luminaires and scene
+    /// file go (the text typed in the "IES file" field stays).
+    pub(super) fn new_scene(&mut self) {
+        let had = !self.lights.lights.is_empty() || self.scene_file.is_some();
+        let path_input = std::mem::take(&mut self.lights.path_input);
+        // The window's default: the exposure follows the lights (`window::run`).
+        self.lights = crate::lighting::LightsState {
+            path_input,
+            auto_exposure: true,
+            ..crate::lighting::LightsState::default()
+        };
+        self.scene_file = None;
+        if had {
+            let t = self.now();
+            self.notices.info(
+                "a new panorama: the previous scene's room and lights are cleared",
+                t,
+            );
+        }
+    }
+
     /// Open a scene file: its room, luminaires and exposure replace the panel's; its
     /// panorama (if it names one) opens at its view. Errors are notices.
     pub(super) fn open_scene(&mut self, path: PathBuf) {

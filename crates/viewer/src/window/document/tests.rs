@@ -493,3 +493,49 @@ fn a_load_that_cannot_start_is_an_error() {
     assert_eq!(d.error(), Some("cannot start loading: no threads"));
     assert!(d.panel_parts().loading.is_none());
 }
+
+/// Issue 33 (4): a panorama opened on its own (dialog, recent list, PageUp/Down, a drop
+/// of panoramas only) starts a new scene; one opened with a scene, with luminaires in
+/// the same drop or from the command line keeps the scene's room and lights; reloads
+/// never clear them.
+#[test]
+fn a_panorama_opened_on_its_own_starts_a_new_scene() {
+    let new_scene = |fx: &[Effect]| fx.contains(&Effect::NewScene);
+    let mut d = doc();
+    // The command line (and a scene file, which opens its panorama the same way).
+    // (An HDR file: only those reload for another exposure.)
+    let r = request(d.open(file("a.hdr"), None, StartArgs::default(), 0.0));
+    let fx = d.on_event(done(r.id, Ok(loaded(file("a.hdr"), 64, true, 0.0))), 0.0);
+    assert!(!new_scene(&fx), "{fx:?}");
+    // Another exposure: a reload.
+    let r = request(d.reload_exposure(1.0).unwrap());
+    let fx = d.on_event(done(r.id, Ok(loaded(file("a.hdr"), 64, true, 1.0))), 0.0);
+    assert!(!new_scene(&fx), "a reload keeps the scene: {fx:?}");
+    // The Open dialog, the recent list, PageDown.
+    let r = request(d.open_path(PathBuf::from("b.jpg"), 0.0).unwrap());
+    let fx = d.on_event(done(r.id, Ok(loaded(file("b.jpg"), 64, false, 0.0))), 0.0);
+    assert!(new_scene(&fx), "{fx:?}");
+    assert_eq!(fx[0], Effect::NewScene, "before the new start view");
+    // A failed open clears nothing.
+    let r = request(d.open_path(PathBuf::from("c.jpg"), 0.0).unwrap());
+    let fx = d.on_event(done(r.id, Err("c.jpg: truncated".into())), 0.0);
+    assert!(!new_scene(&fx), "{fx:?}");
+    // A drop of a panorama alone; then one with a luminaire file.
+    let dir = tempfile::tempdir().unwrap();
+    let ies = dir.path().join("lamp.ies");
+    std::fs::write(&ies, "IESNA:LM-63-2002\n").unwrap();
+    d.drop_path(PathBuf::from("d.jpg"));
+    let r = loads(&d.open_drops(0.0))[0].clone();
+    let fx = d.on_event(done(r.id, Ok(loaded(file("d.jpg"), 64, false, 0.0))), 0.0);
+    assert!(new_scene(&fx), "{fx:?}");
+    d.drop_path(PathBuf::from("e.jpg"));
+    d.drop_path(ies);
+    let fx = d.open_drops(0.0);
+    assert!(
+        fx.iter().any(|e| matches!(e, Effect::AddLights(_))),
+        "{fx:?}"
+    );
+    let r = loads(&fx)[0].clone();
+    let fx = d.on_event(done(r.id, Ok(loaded(file("e.jpg"), 64, false, 0.0))), 0.0);
+    assert!(!new_scene(&fx), "dropped with its lights: {fx:?}");
+}
