@@ -99,13 +99,21 @@ impl Look {
         Look::in_projection(yaw, pitch, hfov, ViewProjection::Rectilinear)
     }
 
-    /// A look in `projection`, hfov clamped to its [`widest_hfov`].
+    /// A look in `projection`, hfov clamped to its [`widest_hfov`] (the wrapping and
+    /// clamping of [`View::clamped_in`], NaN included).
     pub fn in_projection(yaw: f64, pitch: f64, hfov: f64, projection: ViewProjection) -> Look {
+        let hfov = if hfov.is_nan() { HFOV_HOME } else { hfov };
+        let hfov = hfov.clamp(HFOV_MIN, widest_hfov(projection));
+        Look::from_view(View::clamped_in(yaw, pitch, hfov, projection))
+    }
+
+    /// The look of a lut-core view.
+    pub fn from_view(v: View) -> Look {
         Look {
-            yaw: wrap_deg(yaw),
-            pitch: pitch.clamp(-90.0, 90.0),
-            hfov: hfov.clamp(HFOV_MIN, widest_hfov(projection)),
-            projection,
+            yaw: v.yaw_deg(),
+            pitch: v.pitch_deg(),
+            hfov: v.hfov_deg(),
+            projection: v.projection(),
         }
     }
 
@@ -114,10 +122,10 @@ impl Look {
         Look::in_projection(yaw, pitch, hfov, self.projection)
     }
 
-    /// The lut-core view. A `Look` always holds finite, in-range angles, so this cannot
-    /// fail; the fallback keeps it total anyway.
+    /// The lut-core view (infallible: [`View::clamped_in`]; a `Look` made by its
+    /// constructors already holds in-range angles, which pass unchanged).
     pub fn view(&self) -> View {
-        View::with_projection(self.yaw, self.pitch, self.hfov, self.projection).unwrap_or_default()
+        View::clamped_in(self.yaw, self.pitch, self.hfov, self.projection)
     }
 }
 
@@ -1285,6 +1293,10 @@ mod tests {
         );
         let big = Look::new(725.0, -200.0, 500.0);
         assert_eq!(big, Look::new(5.0, -90.0, HFOV_MAX));
+        // NaN does not pass through (View::clamped_in): the home angles.
+        let nan = f64::NAN;
+        assert_eq!(Look::new(nan, nan, nan), Look::default());
+        assert_eq!(Look::new(nan, 10.0, 60.0).view(), View::new(0.0, 10.0, 60.0).unwrap());
     }
 
     #[test]
