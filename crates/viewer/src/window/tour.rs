@@ -448,7 +448,7 @@ impl TourNav {
             .collect();
         format!(
             "tour scene {} {}/{} hotspots {}",
-            s.id,
+            lut_core::shown(&s.id),
             self.current + 1,
             self.tour.scenes.len(),
             if list.is_empty() {
@@ -466,7 +466,9 @@ impl TourNav {
             |n| n.to_string_lossy().into(),
         );
         let s = self.scene();
-        format!("{file}: {}", s.title.as_deref().unwrap_or(&s.id))
+        // Escaped and shortened as every echoed text (docs/reliability.md, class 5): the
+        // window system's title gets no control character and no megabyte of text.
+        lut_core::shown(&format!("{file}: {}", s.title.as_deref().unwrap_or(&s.id)))
     }
 
     /// The horizon to level a load of `source` by (pitch, roll), when it is a scene of
@@ -554,8 +556,10 @@ pub fn tour_bar(ctx: &egui::Context, scene: egui::Rect, nav: &TourNav) -> TourBa
                             .add_enabled(can_forward, egui::Button::new("▶"))
                             .on_hover_text("Forward again (Alt+→, mouse forward)")
                             .clicked();
-                        let name =
-                            |s: &tour::TourScene| s.title.clone().unwrap_or_else(|| s.id.clone());
+                        // Escaped and shortened as every echoed text.
+                        let name = |s: &tour::TourScene| {
+                            lut_core::shown(s.title.as_deref().unwrap_or(&s.id))
+                        };
                         egui::ComboBox::from_id_salt("tour-scenes")
                             .selected_text(name(nav.scene()))
                             .show_ui(ui, |ui| {
