@@ -181,7 +181,11 @@ impl TourNav {
     /// No scene of the tour opens (each scene's reason, joined).
     pub fn start(tour: Tour, path: PathBuf) -> Result<(TourNav, Source), String> {
         let first = tour.first().and_then(|f| tour.index(&f.id)).unwrap_or(0);
-        let order = std::iter::once(first).chain((0..tour.scenes.len()).filter(|&i| i != first));
+        // A tour whose every scene was left out has none to try (no index 0 either).
+        let order = (!tour.scenes.is_empty())
+            .then_some(first)
+            .into_iter()
+            .chain((0..tour.scenes.len()).filter(|&i| i != first));
         let mut why = Vec::new();
         for i in order {
             match scene_source(&tour, i) {
@@ -586,4 +590,29 @@ pub fn hover_text(ctx: &egui::Context, at: egui::Pos2, text: &str) {
                 ui.label(text);
             });
         });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tour_with_no_scene_left_is_an_error_not_a_panic() {
+        // Every scene left out (a path leaving the folder, say): nothing to start in.
+        let path = PathBuf::from("t.json");
+        let loaded = crate::tour::parse(
+            br#"{"default": {"firstScene": "a"}, "scenes": {"a": {"panorama": "../x.jpg"}}}"#,
+            &path,
+        )
+        .unwrap();
+        assert!(loaded.tour.scenes.is_empty());
+        let Err(e) = TourNav::start(loaded.tour, path) else {
+            panic!("a tour without scenes started")
+        };
+        assert!(e.contains("no scene of the tour opens"), "{e}");
+        let Err(e) = TourNav::start(Tour::new(PathBuf::new()), PathBuf::from("u.json")) else {
+            panic!("an empty tour started")
+        };
+        assert!(e.contains("it has no scenes"), "{e}");
+    }
 }
