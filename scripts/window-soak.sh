@@ -3,7 +3,8 @@
 # (seeded) user actions — drags, flicks, wheel, keys, resize storms, minimizing (unmapped,
 # and shrunk to 1x1) and back, fullscreen, dropping good and bad files (a truncated JPEG,
 # header-only files claiming huge sizes, a text file, a FIFO, a symbolic-link loop, a
-# damaged EXR, a cube folder, a cube layout image, an IES light), the next/previous file
+# damaged EXR, a cube folder, a cube layout image, an IES light, a tour and a tiled
+# pyramid, and damaged ones of each), the next/previous file
 # in the folder (bad ones among them), the Open and Save dialogs (a view saved with
 # Enter), the help overlay, and clicks all over the panel (every menu, checkbox, slider
 # and button it has) — while sampling the process's resident memory (VmRSS from /proc)
@@ -56,7 +57,7 @@ while [ $# -gt 0 ]; do
     --install) INSTALL=1 ;;
     --no-build) BUILD=0 ;;
     --heap) HEAP=1 ;;
-    -h|--help) sed -n '2,41p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,42p' "$0"; exit 0 ;;
     *) echo "window-soak: unknown argument '$1'" >&2; exit 2 ;;
   esac
   shift
@@ -120,8 +121,30 @@ sof = b"\xff\xc0\x00\x11\x08" + struct.pack(">HH", 16384, 32768) + b"\x03\x01\x2
 com = b"\xff\xfe" + struct.pack(">H", 2280) + b"x" * 2278
 open(f"{d}/claims-32k.jpg", "wb").write(b"\xff\xd8" + sof + com + b"\xff\xd9")
 EOF
-GOOD=("$F/pano.jpg" "$F/interior.exr" "$F/skyfantasy" "$F/view.png" "$F/cross.png" "$F/lamp.ies")
-BAD=("$F/truncated.jpg" "$F/cut.exr" "$F/text.jpg" "$F/pipe.jpg" "$F/loop-a.jpg" "$F/huge-header.png" "$F/claims-32k.jpg")
+# A tour (its scenes open on the tour's links) and a tiled pyramid (a folder holding
+# config.json); a damaged pyramid (a tile cut short, a tile that is a FIFO, a tile of
+# text) and a damaged tour (a scene whose panorama is missing, control characters and a
+# 100 000-character title).
+cp -r tests/data/tours/pannellum "$F/tour"
+cp -r tests/data/multires/generate-py "$F/pyramid"
+cp -r tests/data/multires/generate-py "$F/bad-pyramid"
+tiles=("$F"/bad-pyramid/1/*.jpg)
+head -c "$(($(stat -c %s "${tiles[0]}") / 2))" "${tiles[0]}" >"$F/cut-tile" && mv "$F/cut-tile" "${tiles[0]}"
+rm "${tiles[1]}" && mkfifo "${tiles[1]}"
+echo "not a tile" >"${tiles[2]}"
+"$PY" - "$F" <<'EOF'
+import json, sys
+d = sys.argv[1]
+tour = {"default": {"firstScene": "a"}, "scenes": {
+    "a": {"title": "\x1b]0;owned\x07" + "t" * 100000, "panorama": "pano.jpg",
+          "hotSpots": [{"pitch": 0, "yaw": 10, "type": "scene", "sceneId": "b"}]},
+    "b": {"panorama": "missing.jpg"}}}
+open(f"{d}/bad-tour.json", "w").write(json.dumps(tour))
+EOF
+GOOD=("$F/pano.jpg" "$F/interior.exr" "$F/skyfantasy" "$F/view.png" "$F/cross.png" "$F/lamp.ies"
+  "$F/tour/tour.json" "$F/pyramid")
+BAD=("$F/truncated.jpg" "$F/cut.exr" "$F/text.jpg" "$F/pipe.jpg" "$F/loop-a.jpg" "$F/huge-header.png" "$F/claims-32k.jpg"
+  "$F/bad-pyramid" "$F/bad-tour.json")
 
 # --- X and the viewer -------------------------------------------------------------------
 XVFB_PID=""

@@ -53,3 +53,60 @@ fn check_map(m: &EnvMap) {
     assert!(m.width() >= 1 && m.height() >= 1);
     assert!(u64::from(m.width()) * u64::from(m.height()) <= MAX_PIXELS);
 }
+
+/// What the tour targets demand of a tour read from `path` (either format): within the
+/// limits, every angle finite, every problem one safe line, and the Pannellum config it
+/// is saved as reads back as a tour that saves to the same text. A Marzipano tour's
+/// first save leaves its tile scenes out (Pannellum has no form for them), so for it
+/// (`resave`) the test starts from the second save.
+pub fn check_tour(r: anyhow::Result<viewer::tour::Loaded>, path: &std::path::Path, resave: bool) {
+    use viewer::tour::{self, pannellum, HotspotKind, TargetAngle};
+    let loaded = match r {
+        Ok(l) => l,
+        Err(e) => {
+            let line = lut_core::one_line(&format!("{e:#}"));
+            assert_safe(&line);
+            assert!(line.chars().count() <= lut_core::MESSAGE_MAX_CHARS + 40);
+            return;
+        }
+    };
+    let t = &loaded.tour;
+    assert!(t.scenes.len() <= lut_core::limits::MAX_TOUR_SCENES);
+    for s in &t.scenes {
+        assert!(s.hotspots.len() <= lut_core::limits::MAX_TOUR_HOTSPOTS);
+        let a = s.start;
+        assert!(
+            a.yaw.is_finite() && a.pitch.is_finite() && a.hfov.is_finite(),
+            "{a:?}"
+        );
+        assert!(s.north_offset.is_finite());
+        assert!(s.horizon.pitch.is_finite() && s.horizon.roll.is_finite());
+        for h in &s.hotspots {
+            assert!(h.yaw.is_finite() && h.pitch.is_finite(), "{h:?}");
+            if let HotspotKind::Scene { target, .. } = &h.kind {
+                for v in [target.yaw, target.pitch, target.hfov] {
+                    if let TargetAngle::Value(v) = v {
+                        assert!(v.is_finite());
+                    }
+                }
+            }
+        }
+    }
+    for p in &loaded.problems {
+        let line = p.to_string();
+        assert_safe(&line);
+        assert!(line.chars().count() <= lut_core::MESSAGE_MAX_CHARS + 40);
+    }
+    // Saved as Pannellum, read back, saved again: the same text.
+    let saved = std::path::Path::new("tour/saved.json");
+    let (mut text, _) = pannellum::to_text(t);
+    if resave {
+        let back = tour::parse(text.as_bytes(), saved)
+            .unwrap_or_else(|e| panic!("its own Pannellum config does not read: {e:#}\n{text}"));
+        text = pannellum::to_text(&back.tour).0;
+    }
+    let back = tour::parse(text.as_bytes(), saved)
+        .unwrap_or_else(|e| panic!("its own Pannellum config does not read: {e:#}\n{text}"));
+    let (again, _) = pannellum::to_text(&back.tour);
+    assert_eq!(again, text, "saving is not stable (read from {path:?})");
+}

@@ -120,7 +120,8 @@ pub fn contain<T, E: From<DecoderPanic>>(
 pub const FAULT_ENV: &str = "LUTPANO_FAULT";
 
 /// Panic here when [`FAULT_ENV`] names `point` (see there): `decoder` inside every
-/// image decoder's containment, `loader` on the window's loading thread outside it.
+/// image decoder's containment, `tile` inside a tiled pyramid's tile decoder only (the
+/// pyramid opens; each tile fails), `loader` on the window's loading thread outside it.
 pub fn fault_point(point: &str) {
     if let Some(v) = std::env::var_os(FAULT_ENV) {
         if v.to_str().is_some_and(|s| s.split(',').any(|p| p == point)) {

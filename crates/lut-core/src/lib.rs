@@ -86,6 +86,7 @@ mod file;
 mod geom;
 mod guard;
 mod io;
+mod jpeg;
 mod light;
 mod lut;
 mod map;
@@ -116,6 +117,11 @@ pub mod limits {
     pub use crate::geom::limits::*;
     pub use crate::io::load::DEFAULT_MAX_PIXELS;
     pub use crate::light::MAX_FILE_BYTES as MAX_LIGHT_FILE_BYTES;
+    pub use crate::tiles::config::{
+        MAX_BASE_TILES, MAX_CONFIG_BYTES as MAX_TILE_CONFIG_BYTES, MAX_CUBE_RESOLUTION,
+        MAX_LEVELS as MAX_TILE_LEVELS, MAX_MISSING_TILES, MAX_TILE_RESOLUTION, MIN_TILE_RESOLUTION,
+    };
+    pub use crate::tiles::decode::MAX_TILE_FILE_BYTES;
 }
 
 // The guards every input path shares (docs/reliability.md): decoder containment, echoed
@@ -168,12 +174,12 @@ pub use io::cube::{
     cube_face_files, decode_layout_image, load_cube, load_face_files, load_layout_image,
 };
 pub use io::gpano::{insert_xmp, jpeg_xmp, read_gpano, xmp_packet, GPano, GPANO_NS, XMP_SIGNATURE};
-pub use io::jpeg::jpeg_max_pixels;
 pub use io::load::{
     check_pixel_limit, decode_map, load_map, map_from_image, resolve_projection, LoadOptions,
     LoadPhase, LoadProgress, DEFAULT_MAX_PIXELS,
 };
 pub use io::partial::{decode_partial, load_partial, CoverageSource};
+pub use jpeg::jpeg_max_pixels;
 
 // Cube maps.
 pub use cube::layout::{layout_dimensions, Layout, Naming, Transform};
@@ -230,6 +236,7 @@ mod layout {
         ),
         ("file", &[]),
         ("guard", &[]),
+        ("jpeg", &["error", "guard"]),
         (
             "light",
             &[
@@ -238,12 +245,15 @@ mod layout {
         ),
         (
             "tiles",
-            &["geom", "map", "cube", "render", "error", "named", "file"],
+            &[
+                "geom", "map", "cube", "render", "error", "named", "file", "guard", "jpeg",
+            ],
         ),
         (
             "io",
             &[
                 "geom", "map", "lut", "cube", "render", "panorama", "error", "file", "guard",
+                "jpeg",
             ],
         ),
     ];

@@ -62,6 +62,10 @@ const NOT_NUMERIC: &[&str] = &[
     "--index-step",
     "--lut-surface",
     "--tour",
+    "--task",
+    "--json",
+    "--png",
+    "--html",
 ];
 
 /// One command and its cheap base arguments (`{iso}`, `{png}`, `{out}` replaced).
@@ -168,13 +172,70 @@ fn commands() -> Vec<Cmd> {
             base: &["ies", "--json", "{iso}"],
             options: &[("--sample", &["{},0", "0,{}"])],
         },
+        Cmd {
+            name: "report",
+            base: &[
+                "report",
+                "--room",
+                "5x5x3",
+                "--light",
+                "{iso}@0,2,0",
+                "--json",
+                "{json}",
+            ],
+            options: LIGHT_OPTS,
+        },
+        Cmd {
+            name: "report",
+            base: &[
+                "report",
+                "--room",
+                "5x5x3",
+                "--light",
+                "{iso}@0,2,0",
+                "--json",
+                "{json}",
+            ],
+            options: &[
+                ("--height", &["{}"]),
+                ("--yaw", &["{}"]),
+                ("--pitch", &["{}"]),
+                ("--hfov", &["{}"]),
+            ],
+        },
+        Cmd {
+            name: "tile",
+            base: &["tile", "--synthetic", "64x32", "-o", "{tiles}", "--quiet"],
+            options: &[
+                ("--synthetic", &["{}x32", "64x{}"]),
+                ("--tile-size", &["{}"]),
+                ("--quality", &["{}"]),
+                ("--fallback-size", &["{}"]),
+                ("--cube-size", &["{}"]),
+                ("--hfov", &["{}"]),
+                ("--max-pixels", &["{}"]),
+            ],
+        },
     ]
 }
 
+/// The commands whose every value option must be classified (`tour` has subcommands).
+const CLASSIFIED: &[&[&str]] = &[
+    &["render"],
+    &["lux"],
+    &["convert"],
+    &["ies"],
+    &["report"],
+    &["tile"],
+    &["tour", "check"],
+    &["tour", "convert"],
+];
+
 /// The value options `viewer CMD --help` lists (`--name <VALUE>`).
-fn value_options(cmd: &str) -> Vec<String> {
+fn value_options(cmd: &[&str]) -> Vec<String> {
     let out = Command::new(env!("CARGO_BIN_EXE_viewer"))
-        .args([cmd, "--help"])
+        .args(cmd)
+        .arg("--help")
         .output()
         .unwrap();
     let help = String::from_utf8_lossy(&out.stdout).to_string();
@@ -229,16 +290,21 @@ fn every_numeric_option_takes_the_extremes_calmly() {
         .unwrap();
     let iso = test_support::test_data("ies/isotropic_10000lm.ies");
     let out = dir.join("faces");
+    let tiles = dir.join("tiles");
+    let json = dir.join("report.json");
     let fill = |t: &str, v: &str| {
         t.replace("{iso}", s(&iso))
             .replace("{png}", s(&png))
             .replace("{out}", s(&out))
+            .replace("{tiles}", s(&tiles))
+            .replace("{json}", s(&json))
             .replace("{}", v)
     };
     let cmds = commands();
     // Every value option of these commands is classified.
-    for name in ["render", "lux", "convert", "ies"] {
-        for opt in value_options(name) {
+    for cmd in CLASSIFIED {
+        let name = cmd.join(" ");
+        for opt in value_options(cmd) {
             let numeric = cmds
                 .iter()
                 .filter(|c| c.name == name)
@@ -270,6 +336,7 @@ fn every_numeric_option_takes_the_extremes_calmly() {
                     }
                     // `--opt=VALUE`: a negative value is a value, not an option.
                     args.push(format!("{opt}={}", fill(templates[ti], &ext[ei])));
+                    let _ = std::fs::remove_file(&json);
                     let (code, stdout, stderr) = run(&args);
                     prop_assert!(
                         matches!(code, Some(0..=2)),
@@ -277,11 +344,19 @@ fn every_numeric_option_takes_the_extremes_calmly() {
                     );
                     prop_assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
                     prop_assert!(stderr.len() < 3000, "{args:?}: {} bytes", stderr.len());
-                    if code == Some(0) && cmd.base.contains(&"--json") {
+                    // JSON on standard output (`report --json` names a file instead).
+                    let json_out = cmd.base.contains(&"--json") && !cmd.base.contains(&"{json}");
+                    if code == Some(0) && json_out {
                         prop_assert!(!stdout.contains("null"), "{args:?}: {stdout}");
                         let v: serde_json::Value = serde_json::from_str(&stdout)
                             .map_err(|e| TestCaseError::fail(format!("{args:?}: {e}")))?;
                         prop_assert!(v.is_object());
+                    }
+                    // A JSON file written (`report --json`): the same rule.
+                    if code == Some(0) && cmd.base.contains(&"{json}") {
+                        let text = std::fs::read_to_string(&json)
+                            .map_err(|e| TestCaseError::fail(format!("{args:?}: {e}")))?;
+                        prop_assert!(!text.contains("null"), "{args:?}: {text}");
                     }
                     Ok(())
                 })

@@ -24,27 +24,24 @@ fn run_env(args: &[&str], env: &[(&str, &str)], secs: u64) -> Output {
         cmd.env(k, v);
     }
     let mut child = cmd.spawn().expect("run viewer");
+    // Both pipes drained while it runs: a command printing more than a pipe holds must
+    // not block on it (that would look like a hang).
+    let drain = |mut r: Box<dyn Read + Send>| {
+        std::thread::spawn(move || {
+            let mut v = Vec::new();
+            let _ = r.read_to_end(&mut v);
+            v
+        })
+    };
+    let out = drain(Box::new(child.stdout.take().unwrap()));
+    let err = drain(Box::new(child.stderr.take().unwrap()));
     let t0 = Instant::now();
     loop {
         if let Some(status) = child.try_wait().unwrap() {
-            let mut stdout = Vec::new();
-            let mut stderr = Vec::new();
-            child
-                .stdout
-                .take()
-                .unwrap()
-                .read_to_end(&mut stdout)
-                .unwrap();
-            child
-                .stderr
-                .take()
-                .unwrap()
-                .read_to_end(&mut stderr)
-                .unwrap();
             return Output {
                 status,
-                stdout,
-                stderr,
+                stdout: out.join().unwrap(),
+                stderr: err.join().unwrap(),
             };
         }
         if t0.elapsed() > Duration::from_secs(secs) {
@@ -214,6 +211,80 @@ fn scene_files_are_checked_against_the_same_limits_before_any_work() {
     );
 }
 
+/// A tiled pyramid's `config.json` in `dir` with these `multiRes` numbers.
+fn tile_config(dir: &Path, tile: &str, cube: &str, levels: &str) -> std::path::PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(
+        dir.join("config.json"),
+        format!(
+            "{{\"type\":\"multires\",\"multiRes\":{{\"path\":\"/%l/%s%y_%x\",\
+             \"extension\":\"jpg\",\"tileResolution\":{tile},\"maxLevel\":{levels},\
+             \"cubeResolution\":{cube}}}}}"
+        ),
+    )
+    .unwrap();
+    dir.to_path_buf()
+}
+
+#[test]
+fn tile_configs_and_tours_are_checked_against_the_same_limits() {
+    let dir = tmpdir("classes", "tile-limits");
+    // Each number of a tiled pyramid's configuration, past its limit: refused at open,
+    // the limit in the one line (lut_core::limits).
+    for (tile, cube, levels, limit) in [
+        (
+            "512",
+            "1e300",
+            "3",
+            lut_core::limits::MAX_CUBE_RESOLUTION.to_string(),
+        ),
+        (
+            "100000",
+            "1000",
+            "3",
+            lut_core::limits::MAX_TILE_RESOLUTION.to_string(),
+        ),
+        (
+            "512",
+            "1000",
+            "60",
+            lut_core::limits::MAX_TILE_LEVELS.to_string(),
+        ),
+    ] {
+        let pyr = tile_config(&dir.join(format!("p{tile}-{levels}")), tile, cube, levels);
+        let (code, line) = one_line(&run(&["render", s(&pyr), "-o", "/dev/null"]));
+        assert_eq!(code, 1, "{line}");
+        assert!(
+            line.contains("config.json") && line.contains(&format!("..={limit}")),
+            "{limit}: {line}"
+        );
+    }
+    // A tour of more scenes than the limit: the rest are left out with one line naming it.
+    let n = lut_core::limits::MAX_TOUR_SCENES + 1;
+    let scenes: Vec<String> = (0..n)
+        .map(|i| format!("\"s{i}\":{{\"panorama\":\"a.png\"}}"))
+        .collect();
+    let tour = dir.join("big.json");
+    std::fs::write(
+        &tour,
+        format!(
+            "{{\"default\":{{\"firstScene\":\"s0\"}},\"scenes\":{{{}}}}}",
+            scenes.join(",")
+        ),
+    )
+    .unwrap();
+    let out = run(&["tour", "check", s(&tour)]);
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let limit = format!("more than {} scenes", lut_core::limits::MAX_TOUR_SCENES);
+    assert_eq!(
+        text.lines().filter(|l| l.contains(&limit)).count(),
+        1,
+        "{}",
+        &text[..text.len().min(500)]
+    );
+}
+
 // ---- 2. Decoders behind one containment ---------------------------------------------
 
 /// PNG chunk.
@@ -355,6 +426,39 @@ fn a_panic_in_any_decoder_is_the_files_error() {
     }
 }
 
+#[test]
+fn a_panic_in_the_tour_tile_config_and_band_readers_is_the_files_error() {
+    // The same fault point, inside the same containment, on the new input paths.
+    let dir = tmpdir("classes", "contain-new");
+    let tour = test_support::test_data("tours/pannellum/tour.json");
+    let js = test_support::test_data("tours/marzipano/data.js");
+    let pyr = test_support::test_data("multires/generate-py");
+    let pano = png(&dir, "a.png");
+    let tiles = dir.join("tiles");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["tour", "check", s(&tour)], "tour.json"),
+        (vec!["tour", "check", s(&js)], "data.js"),
+        (
+            vec!["render", s(&pyr), "-o", "/dev/null", "--size", "64x32"],
+            "config.json",
+        ),
+        (
+            vec!["tile", pano.as_str(), "-o", s(&tiles), "--quiet"],
+            "a.png",
+        ),
+    ];
+    for (args, name) in cases {
+        assert!(
+            run(&args).status.success(),
+            "{args:?} works without the fault"
+        );
+        let out = run_env(&args, &[(lut_core::FAULT_ENV, "decoder")], 20);
+        let (code, line) = one_line(&out);
+        assert_eq!(code, 1, "{args:?}: {line}");
+        assert!(line.contains(name) && line.contains("damaged"), "{line}");
+    }
+}
+
 // ---- 3. Image data shorter than its header ------------------------------------------
 
 fn jpeg_claiming(w: u16, h: u16, pad: usize) -> Vec<u8> {
@@ -455,6 +559,188 @@ fn fifos_as_scene_files_are_refused_without_blocking() {
     assert!(line.contains("folder"), "{line}");
 }
 
+#[cfg(unix)]
+#[test]
+fn fifos_as_tours_tile_configs_and_tiles_are_refused_without_blocking() {
+    let dir = tmpdir("classes", "fifo-new");
+    let mkfifo = |p: &Path| {
+        assert!(Command::new("mkfifo").arg(p).status().unwrap().success());
+    };
+    // A FIFO as a tour file (either format) and as a tile configuration (named, or as
+    // the config.json of a folder).
+    let (tour, js, cfg) = (dir.join("t.json"), dir.join("data.js"), dir.join("c.json"));
+    let pyr = dir.join("pyr");
+    std::fs::create_dir_all(&pyr).unwrap();
+    for p in [&tour, &js, &cfg, &pyr.join("config.json")] {
+        mkfifo(p);
+    }
+    for a in [
+        vec!["tour", "check", s(&tour)],
+        vec!["tour", "check", s(&js)],
+        vec!["tour", "convert", s(&tour), "-o", s(&dir.join("out.json"))],
+        vec!["render", s(&cfg), "-o", "/dev/null"],
+        vec!["render", s(&pyr), "-o", "/dev/null"],
+    ] {
+        let (code, line) = one_line(&run(&a));
+        assert_eq!(code, 1, "{a:?}: {line}");
+        assert!(line.contains("FIFO"), "{line}");
+    }
+    // A FIFO as one tile of a pyramid: the tile is refused (its error named), never
+    // waited on; the frame is made without it.
+    let good = test_support::test_data("multires/generate-py");
+    let copy = dir.join("copy");
+    copy_tree(&good, &copy);
+    let tile = std::fs::read_dir(copy.join("1"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "jpg"))
+        .expect("a level-1 tile");
+    std::fs::remove_file(&tile).unwrap();
+    mkfifo(&tile);
+    let out = run(&["render", s(&copy), "-o", "/dev/null", "--size", "64x32"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    // The frame is made, with a warning naming the tile and why.
+    let name = tile.file_name().unwrap().to_str().unwrap();
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("warning:") && l.contains(name) && l.contains("FIFO")),
+        "{err}"
+    );
+}
+
+/// Copy the files of `from` (one level of folders deep) into `to`.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        let dst = to.join(e.file_name());
+        if e.file_type().unwrap().is_dir() {
+            copy_tree(&e.path(), &dst);
+        } else {
+            std::fs::copy(e.path(), dst).unwrap();
+        }
+    }
+}
+
+/// Every level-1 JPEG tile of a copy of the test pyramid in `dir`, and the copy.
+fn pyramid_copy(dir: &Path) -> (std::path::PathBuf, Vec<std::path::PathBuf>) {
+    let copy = dir.join("pyr");
+    copy_tree(&test_support::test_data("multires/generate-py"), &copy);
+    let mut tiles: Vec<_> = std::fs::read_dir(copy.join("1"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "jpg"))
+        .collect();
+    tiles.sort();
+    (copy, tiles)
+}
+
+#[test]
+fn a_panic_in_a_tile_decode_is_that_tiles_error() {
+    // The fault point inside the tile decoder's containment (`tile`), on every tile:
+    // each is its own error, named in a warning; the frame is still made (from the
+    // background), and nothing waits for a tile whose decoding thread died.
+    let dir = tmpdir("classes", "contain-tile");
+    let (pyr, tiles) = pyramid_copy(&dir);
+    let args = ["render", s(&pyr), "-o", "/dev/null", "--size", "64x32"];
+    let out = run_env(&args, &[(lut_core::FAULT_ENV, "tile")], 20);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for t in &tiles {
+        let name = t.file_name().unwrap().to_str().unwrap();
+        assert!(
+            err.lines().any(|l| l.starts_with("warning:")
+                && l.contains(name)
+                && l.contains("the decoder failed")),
+            "{name}: {err}"
+        );
+    }
+    // Without the fault: no warning.
+    let out = run(&args);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn a_jpeg_tile_shorter_than_its_header_is_a_named_warning_never_filled_in() {
+    // A tile cut short: `image`'s lenient JPEG decoder fills the missing rows with grey
+    // and reports success; through the map loader's strict decoder it is the tile's
+    // error, named, and the frame is drawn from the coarser level instead.
+    let dir = tmpdir("classes", "short-tile");
+    let (pyr, tiles) = pyramid_copy(&dir);
+    let tile = &tiles[0];
+    let bytes = std::fs::read(tile).unwrap();
+    let cut = &bytes[..bytes.len() * 2 / 3];
+    assert!(
+        image::load_from_memory(cut).is_ok(),
+        "the lenient decoder takes the cut tile (else this test proves nothing)"
+    );
+    std::fs::write(tile, cut).unwrap();
+    let out = run(&["render", s(&pyr), "-o", "/dev/null", "--size", "64x32"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let name = tile.file_name().unwrap().to_str().unwrap();
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("warning:") && l.contains(name) && l.contains("truncated")),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+}
+
+#[cfg(unix)]
+#[test]
+fn tour_and_pyramid_outputs_are_whole_ordinary_files() {
+    use std::os::unix::fs::PermissionsExt;
+    // `tour convert` and `viewer tile` write their JSON through the one output writer:
+    // renamed into place whole, with an ordinary file's permissions (a temporary file's
+    // 0600 would keep a web server from serving the tour or the pyramid), no temporary
+    // file left beside it.
+    let dir = tmpdir("classes", "outputs");
+    let src = test_support::test_data("tours/pannellum");
+    copy_tree(&src, &dir.join("tour"));
+    let out_json = dir.join("tour").join("converted.json");
+    let out = run(&[
+        "tour",
+        "convert",
+        s(&dir.join("tour/tour.json")),
+        "-o",
+        s(&out_json),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let pano = png(&dir, "a.png");
+    let tiles = dir.join("tiles");
+    let out = run(&["tile", &pano, "-o", s(&tiles), "--quiet"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for (f, folder) in [
+        (out_json.clone(), dir.join("tour")),
+        (tiles.join("config.json"), tiles.clone()),
+    ] {
+        let mode = std::fs::metadata(&f).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode & 0o044, 0o044, "{}: mode {mode:o}", f.display());
+        serde_json::from_str::<serde_json::Value>(&std::fs::read_to_string(&f).unwrap()).unwrap();
+        for e in std::fs::read_dir(folder).unwrap() {
+            let n = e.unwrap().file_name().to_string_lossy().into_owned();
+            assert!(!n.ends_with(".tmp"), "a temporary file left: {n}");
+        }
+    }
+}
+
 // ---- 5. Text from input echoed: escaped and shortened ------------------------------
 
 #[test]
@@ -500,6 +786,46 @@ fn echoed_names_and_numbers_are_escaped_and_shortened() {
         assert!(err.contains("characters)"), "{err}");
         assert!(matches!(out.status.code(), Some(1 | 2)), "{err}");
     }
+}
+
+#[test]
+fn text_from_tours_is_escaped_and_shortened_on_every_line() {
+    let dir = tmpdir("classes", "echo-tour");
+    // Scene ids, titles and paths holding an escape sequence (it would retitle the
+    // terminal), a line break, a bidi override, and a 100 000-character path: every
+    // line `tour check` prints (standard output and error) is one safe, short line.
+    let long = "x".repeat(100_000);
+    let tour = dir.join("t.json");
+    std::fs::write(
+        &tour,
+        format!(
+            "{{\"default\":{{\"firstScene\":\"a\\u001b]0;owned\\u0007\"}},\"scenes\":{{\
+             \"a\\u001b]0;owned\\u0007\":{{\"title\":\"t\\n\\u202e\",\"panorama\":\"p\\u001b[2J.jpg\",\
+             \"hotSpots\":[{{\"pitch\":0,\"yaw\":0,\"type\":\"scene\",\"sceneId\":\"{long}\"}}]}},\
+             \"b\":{{\"panorama\":\"{long}.jpg\"}},\"c\":{{\"panorama\":\"q\\u001b[2J.jpg\"}}}}}}"
+        ),
+    )
+    .unwrap();
+    let out = run(&["tour", "check", s(&tour)]);
+    assert_eq!(out.status.code(), Some(1));
+    for (what, bytes) in [("stdout", &out.stdout), ("stderr", &out.stderr)] {
+        assert!(
+            !bytes.iter().any(|&b| b < 0x20 && b != b'\n' || b == 0x7f),
+            "a control character on {what}: {:?}",
+            String::from_utf8_lossy(bytes)
+        );
+        let text = String::from_utf8_lossy(bytes);
+        assert!(!text.contains('\u{202e}'), "{what}: {text}");
+        for l in text.lines() {
+            assert!(
+                l.chars().count() <= lut_core::MESSAGE_MAX_CHARS,
+                "{what}: {l}"
+            );
+        }
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("\\u{1b}[2J"), "{text}");
+    assert!(text.contains("characters)"), "{text}");
 }
 
 // ---- 6. Output that is not a number: refused, one status per option -----------------
@@ -563,6 +889,81 @@ fn json_never_holds_null_and_options_exit_alike_in_every_command() {
     );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(v["points"][0]["lux"].as_f64().unwrap().is_finite());
+}
+
+#[test]
+fn report_json_goes_through_the_one_json_writer() {
+    // `viewer report --json` holds only finite numbers (never null), at the largest
+    // multiplier accepted too.
+    let dir = tmpdir("classes", "report-json");
+    let light = format!("{}@0,2.5,0", iso());
+    for m in ["1", "1e6"] {
+        let out_json = dir.join(format!("r{m}.json"));
+        let out = run(&[
+            "report",
+            "--room",
+            "5x5x3",
+            "--light",
+            &light,
+            "--light-multiplier",
+            m,
+            "--json",
+            s(&out_json),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = std::fs::read_to_string(&out_json).unwrap();
+        assert!(!text.contains("null"), "{text}");
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert!(v["total_flux_lm"].as_f64().unwrap().is_finite());
+    }
+}
+
+#[test]
+fn report_text_and_page_escape_and_shorten_the_luminaire_file_names() {
+    // A photometric file whose name holds an escape sequence (it would retitle the
+    // terminal) and a long run: the text on standard output and the HTML page echo it
+    // escaped and shortened; the JSON keeps it exactly (escaped by JSON itself).
+    let dir = tmpdir("classes", "report-names");
+    let name = format!("a\u{1b}]0;owned\u{7}{}.ies", "x".repeat(230));
+    let lamp = dir.join(&name);
+    std::fs::copy(iso(), &lamp).unwrap();
+    let light = format!("{}@0,2.5,0", s(&lamp));
+    let (j, h) = (dir.join("r.json"), dir.join("r.html"));
+    let out = run(&[
+        "report",
+        "--room",
+        "5x5x3",
+        "--light",
+        &light,
+        "--json",
+        s(&j),
+        "--html",
+        s(&h),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let page = std::fs::read_to_string(&h).unwrap();
+    for (what, t) in [("stdout", text.as_ref()), ("page", page.as_str())] {
+        assert!(
+            !t.bytes().any(|b| b < 0x20 && b != b'\n' || b == 0x7f),
+            "a control character in the {what}"
+        );
+        assert!(!t.contains(&"x".repeat(220)), "{what}: the name in full");
+        assert!(t.contains("characters)"), "{what}: not shortened");
+    }
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&j).unwrap()).unwrap();
+    assert!(
+        v.to_string().contains(&"x".repeat(230)),
+        "the JSON keeps the name"
+    );
 }
 
 // ---- 8. The window: a missing file and a damaged one alike --------------------------

@@ -35,3 +35,15 @@ pub const MAX_LIGHT_MULTIPLIER: f64 = 1e6;
 pub const MAX_SCENE_FILE_BYTES: u64 = 4 << 20;
 /// Largest settings file read, bytes (the window writes about 1 KB).
 pub const MAX_SETTINGS_FILE_BYTES: u64 = 1 << 20;
+/// Largest tour file read (a Pannellum config or a Marzipano `data.js`), bytes: text,
+/// and 64 MiB holds [`MAX_TOUR_SCENES`] scenes of many hotspots each.
+pub const MAX_TOUR_FILE_BYTES: u64 = 64 << 20;
+/// Most scenes of one tour read; the rest are left out with a problem naming the limit.
+pub const MAX_TOUR_SCENES: usize = 10_000;
+/// Most hotspots of one tour scene read; the rest are left out with a problem naming
+/// the limit.
+pub const MAX_TOUR_HOTSPOTS: usize = 10_000;
+/// Longest string of a tour file (a scene id, a title, a hotspot's text, a path), bytes:
+/// a longer one is a syntax error naming the limit. What is shown of one is shortened
+/// further ([`crate::guard::shown`]).
+pub const MAX_TOUR_STRING_BYTES: usize = 1 << 20;

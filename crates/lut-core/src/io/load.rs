@@ -12,11 +12,11 @@
 //! allowed pixel). [`MAX_MAP_PIXELS`] stays the hard limit whatever is asked. A JPEG
 //! header must also fit its file: a file of `n` bytes cannot describe more than `512·n`
 //! pixels, so a tiny file claiming a huge size is refused before anything is allocated
-//! (see `io/jpeg.rs`).
+//! (see `jpeg.rs`).
 //!
 //! ## Decoders and damaged files
 //! JPEG goes to zune-jpeg directly, strictly: a truncated or corrupt file is an error,
-//! never a picture with a grey part (`io/jpeg.rs`). OpenEXR goes to the `exr` crate's
+//! never a picture with a grey part (`jpeg.rs`). OpenEXR goes to the `exr` crate's
 //! block reader (`io/exr.rs`): RGB or luminance-only (Y) images, the memory a damaged
 //! DWA-compressed file can claim bounded, blocks that do not cover the image refused.
 //! PNG, Radiance `.hdr` and anything else go through `image`. Only regular files are
@@ -48,7 +48,7 @@ use crate::error::{MapError, SizeProblem};
 use crate::geom::limits::{MAX_MAP_PIXELS, MAX_MAP_WIDTH};
 use crate::geom::projection::Projection;
 use crate::io::exr::Exr;
-use crate::io::jpeg::{check_jpeg_size, prepare, Jpeg};
+use crate::jpeg::{check_jpeg_size, prepare, Jpeg};
 use crate::map::envmap::{check_map_size, EnvMap};
 use crate::map::tone::{tone_map, Tone};
 use image::{ColorType, DynamicImage, ImageDecoder, Limits};
@@ -385,7 +385,7 @@ fn check_decoded(what: &str, w: u32, h: u32, opts: &LoadOptions) -> Result<Proje
 }
 
 /// JPEG: the whole file read (the decoder needs it in memory), decoded strictly (see
-/// `io/jpeg.rs`) into the map's buffer and expanded in place.
+/// `jpeg.rs`) into the map's buffer and expanded in place.
 fn decode_jpeg<R: BufRead + Seek>(
     src: R,
     len: u64,
@@ -412,7 +412,7 @@ fn decode_jpeg<R: BufRead + Seek>(
     .map_err(|e| err(e.to_string()))?;
     sink.bytes_phase.set(None);
     // The stream must be whole; its image data (not the file's metadata or padding)
-    // bounds the size the header may claim (io/jpeg.rs).
+    // bounds the size the header may claim (jpeg.rs).
     let scan = prepare(&mut bytes, what)?;
     let jpeg = Jpeg::new(&bytes, what)?;
     let (w, h) = (jpeg.width, jpeg.height);

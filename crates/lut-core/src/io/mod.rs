@@ -6,6 +6,5 @@
 pub(crate) mod cube;
 pub(crate) mod exr;
 pub(crate) mod gpano;
-pub(crate) mod jpeg;
 pub(crate) mod load;
 pub(crate) mod partial;

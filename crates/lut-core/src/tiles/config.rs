@@ -40,6 +40,9 @@ pub const MAX_LEVELS: u32 = 24;
 pub const MAX_CONFIG_BYTES: u64 = 64 << 20;
 /// Level 1 is loaded whole at open: at most 8 × 8 tiles a face.
 pub const MAX_BASE_TILES: u32 = 8;
+/// Most tiles `missingTiles` may list (a set of them is held: 4 Mi ids are about
+/// 100 MiB; a 64 MiB configuration could otherwise list 32 million, over 1 GB).
+pub const MAX_MISSING_TILES: usize = 4 << 20;
 
 /// A pyramid could not be opened: the file (or value) and the reason, on one line.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -49,6 +52,18 @@ pub struct TilesError {
     pub path: PathBuf,
     /// Why.
     pub reason: String,
+}
+
+impl From<crate::guard::DecoderPanic> for TilesError {
+    fn from(p: crate::guard::DecoderPanic) -> TilesError {
+        TilesError {
+            path: p.path.clone(),
+            reason: format!(
+                "the file is damaged or of a kind the reader cannot handle (it failed on it: {})",
+                p.message
+            ),
+        }
+    }
 }
 
 impl TilesError {
@@ -208,22 +223,9 @@ impl MultiresConfig {
         } else {
             path.to_path_buf()
         };
-        let f = crate::file::open_regular(&file)
-            .map_err(|e| TilesError::new(&file, format!("cannot read: {e}")))?;
-        let len = f
-            .metadata()
-            .map_err(|e| TilesError::new(&file, format!("cannot read: {e}")))?
-            .len();
-        if len > MAX_CONFIG_BYTES {
-            return Err(TilesError::new(
-                &file,
-                format!("{len} bytes, more than the {MAX_CONFIG_BYTES} a configuration may have"),
-            ));
-        }
-        let mut bytes = Vec::with_capacity(len as usize);
-        use std::io::Read;
-        f.take(MAX_CONFIG_BYTES + 1)
-            .read_to_end(&mut bytes)
+        // The one reader of small input files: a FIFO or device is refused without
+        // blocking, the size limited.
+        let bytes = crate::file::read_regular(&file, MAX_CONFIG_BYTES)
             .map_err(|e| TilesError::new(&file, format!("cannot read: {e}")))?;
         let dir = file
             .parent()
@@ -234,7 +236,12 @@ impl MultiresConfig {
         } else {
             dir
         };
-        Self::parse(&bytes, &file, &dir)
+        // Parsed behind the decoders' one containment (docs/reliability.md, class 2; the
+        // fuzz target calls `parse` itself, so that a panic is a finding there).
+        crate::guard::contain(&file, || {
+            crate::guard::fault_point("decoder");
+            Self::parse(&bytes, &file, &dir)
+        })
     }
 
     /// Parse a configuration's bytes; `file` names it in errors, `dir` is the folder the
@@ -402,8 +409,10 @@ impl MultiresConfig {
                     if x >= n as u64 || y >= n as u64 {
                         return Err(bad(&format!("tile {x},{y} outside level {l}'s {n}×{n}")));
                     }
-                    if out.len() > 50_000_000 {
-                        return Err(bad("more than 50 million tiles"));
+                    if out.len() >= MAX_MISSING_TILES {
+                        return Err(bad(&format!(
+                            "more than the limit of {MAX_MISSING_TILES} tiles left out"
+                        )));
                     }
                     out.insert(TileId {
                         level: l as u8,

@@ -196,7 +196,11 @@ fn worker(s: &Shared, cfg: &MultiresConfig, tx: &Sender<Done>) {
             }
         };
         let t = Instant::now();
-        let r = decode_tile(cfg, id);
+        // Behind the decoders' one containment as a whole (the file's read, the path's
+        // making): a panic is this tile's error, so the thread lives on and the tile is
+        // settled, never waited for (docs/reliability.md, class 2).
+        let r = crate::guard::catch_quiet(|| decode_tile(cfg, id))
+            .unwrap_or_else(|m| Err(format!("the decoder failed on this file ({m})")));
         let ns = u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX);
         s.busy_ns.fetch_add(ns, Ordering::Relaxed);
         if let Ok(px) = &r {

@@ -356,6 +356,13 @@ fn frame_with(a: &RenderArgs, tour_scene: Option<&crate::tour::TourScene>) -> Re
             LitRenderError::Lights(e) => anyhow::Error::msg(e),
         })?;
     let lit_ms = t0.elapsed().as_secs_f64() * 1e3;
+    // A tiled pyramid's tiles that could not be read or decoded (each drawn from a
+    // coarser level): a warning naming each, never silence (docs/reliability.md, class 3).
+    if let Some((_, _, notices)) = scene.tiles_status() {
+        for n in notices {
+            crate::errln!("warning: {}", lut_core::one_line(&n));
+        }
+    }
     let error_map = if a.verbose || a.error_map.is_some() {
         Some(
             measure_errors(&mut scene, view, &a.options(), w, h)

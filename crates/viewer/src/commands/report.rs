@@ -496,7 +496,7 @@ pub fn text(r: &Report) -> String {
         s += &format!(
             "{:<3} {} at ({:.2}, {:.2}, {:.2}) aim ({:.0}, {:.0}): {:.0} lm{}\n",
             i + 1,
-            l.file,
+            lut_core::shown(&l.file),
             l.position[0],
             l.position[1],
             l.position[2],
@@ -550,8 +550,10 @@ pub fn run(a: ReportArgs) -> Result<()> {
         None
     };
     let png_bytes = image.as_ref().map(png::encode).transpose()?;
+    // Through the one JSON writer that refuses a number that is not finite (never null):
+    // made whatever is asked, so that no output (the page, the text) shows one either.
+    let j = json::json(&report)?;
     if let Some(p) = &a.json {
-        let j = json::json(&report);
         crate::output::write_image_atomic(p, |w| Ok(w.write_all(j.as_bytes())?))?;
     }
     if let (Some(p), Some(bytes)) = (&a.png, &png_bytes) {

@@ -55,11 +55,14 @@ fn run_check(path: &std::path::Path) -> Result<()> {
     let hotspots: usize = t.scenes.iter().map(|s| s.hotspots.len()).sum();
     if problems.is_empty() {
         outln!(
-            "{}: {} scenes, {} hotspots, first scene \"{}\": no problems",
-            path.display(),
-            t.scenes.len(),
-            hotspots,
-            t.first_scene
+            "{}",
+            lut_core::one_line(&format!(
+                "{}: {} scenes, {} hotspots, first scene \"{}\": no problems",
+                path.display(),
+                t.scenes.len(),
+                hotspots,
+                t.first_scene
+            ))
         )?;
         Ok(())
     } else {
@@ -116,8 +119,11 @@ fn run_convert(path: &std::path::Path, output: &std::path::Path) -> Result<()> {
     let left_out = pannellum::save(&loaded.tour, output)?;
     for id in &left_out {
         crate::errln!(
-            "{}: scene \"{id}\" is Marzipano tiles, which Pannellum cannot open: left out",
-            path.display()
+            "{}",
+            lut_core::one_line(&format!(
+                "{}: scene \"{id}\" is Marzipano tiles, which Pannellum cannot open: left out",
+                path.display()
+            ))
         );
     }
     Ok(())

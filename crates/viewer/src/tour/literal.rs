@@ -3,12 +3,15 @@
 //! line so every problem found later can name its place in the file.
 //!
 //! Bounded: nesting deeper than [`MAX_DEPTH`] is refused (no stack overflow on hostile
-//! input); numbers are parsed by Rust's `f64` parser (non-finite results refused).
+//! input), a string longer than [`MAX_STRING_BYTES`] too; numbers are parsed by Rust's `f64` parser (non-finite results refused).
 
 use serde_json::Value;
 
 /// Nesting deeper than this is refused.
 pub const MAX_DEPTH: usize = 64;
+
+/// A string longer than this (bytes) is refused ([`lut_core::limits::MAX_TOUR_STRING_BYTES`]).
+pub const MAX_STRING_BYTES: usize = lut_core::limits::MAX_TOUR_STRING_BYTES;
 
 /// A value with the line (1-based) where it starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -331,6 +334,12 @@ impl Parser<'_> {
                 },
                 Some(c) => out.push(c),
             }
+            if out.len() > MAX_STRING_BYTES {
+                return Err(SyntaxError {
+                    line,
+                    message: format!("a string longer than the limit of {MAX_STRING_BYTES} bytes"),
+                });
+            }
         }
         String::from_utf8(out).map_err(|_| SyntaxError {
             line,
@@ -457,5 +466,25 @@ mod tests {
             parse("\"\\u00e9\\ud83d\\ude00\"").unwrap().as_str(),
             Some("é😀")
         );
+    }
+
+    #[test]
+    fn strings_are_bounded_by_the_limit() {
+        // A string of the limit reads; one byte more (also through escapes) is refused
+        // with the limit in the message, on the string's line.
+        let at = "x".repeat(MAX_STRING_BYTES);
+        assert_eq!(
+            parse(&format!("{{\"a\": \"{at}\"}}"))
+                .unwrap()
+                .get("a")
+                .unwrap()
+                .as_str(),
+            Some(at.as_str())
+        );
+        for over in [format!("{at}x"), format!("{at}\\n")] {
+            let e = parse(&format!("{{\n\"a\": '{over}'}}")).unwrap_err();
+            assert_eq!(e.line, 2, "{e}");
+            assert!(e.message.contains(&MAX_STRING_BYTES.to_string()), "{e}");
+        }
     }
 }

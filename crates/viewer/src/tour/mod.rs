@@ -27,9 +27,9 @@ use std::fmt;
 use std::path::{Component, Path, PathBuf};
 
 /// More hotspots than this in one scene are refused (the rest of the scene opens).
-pub const MAX_HOTSPOTS: usize = 10_000;
+pub const MAX_HOTSPOTS: usize = lut_core::limits::MAX_TOUR_HOTSPOTS;
 /// More scenes than this in one tour are refused.
-pub const MAX_SCENES: usize = 10_000;
+pub const MAX_SCENES: usize = lut_core::limits::MAX_TOUR_SCENES;
 
 /// A tour: its scenes and the one it starts in.
 #[derive(Debug, Clone, PartialEq)]
@@ -216,16 +216,19 @@ pub fn num_text(x: f64) -> String {
     }
 }
 
+/// One line, escaped and shortened as every echoed text ([`lut_core::one_line`]): the
+/// place and the message repeat ids and paths from the file.
 impl fmt::Display for Problem {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.file.display())?;
+        let mut s = self.file.display().to_string();
         if self.line > 0 {
-            write!(f, ":{}", self.line)?;
+            s += &format!(":{}", self.line);
         }
         if !self.place.is_empty() {
-            write!(f, ": {}", self.place)?;
+            s += &format!(": {}", self.place);
         }
-        write!(f, ": {}", self.message)
+        s += &format!(": {}", self.message);
+        f.write_str(&lut_core::one_line(&s))
     }
 }
 
@@ -276,29 +279,30 @@ pub fn sniff(path: &Path) -> Option<Format> {
         .then_some(Format::Pannellum)
 }
 
-/// Largest tour file read (a config is text; 64 MiB holds 10^5 hotspots many times).
-pub const MAX_FILE_BYTES: u64 = 64 << 20;
+/// Largest tour file read ([`lut_core::limits::MAX_TOUR_FILE_BYTES`]).
+pub const MAX_FILE_BYTES: u64 = lut_core::limits::MAX_TOUR_FILE_BYTES;
 
-/// Read a tour file of either format (by [`sniff`], else by extension).
+/// Read a tour file of either format (by [`sniff`], else by extension): read as every
+/// small input file is ([`lut_core::read_regular`]: a FIFO or device is refused without
+/// blocking, the size limited), parsed behind the decoders' one containment
+/// ([`lut_core::contain`]).
 ///
 /// # Errors
 /// The file cannot be read, is not a tour, or has a syntax error (one line, with the
 /// line number): nothing opens. Problems within scenes are in [`Loaded::problems`].
 pub fn load(path: &Path) -> anyhow::Result<Loaded> {
-    use std::io::Read;
-    let f = lut_core::open_regular(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let mut bytes = Vec::new();
-    f.take(MAX_FILE_BYTES + 1)
-        .read_to_end(&mut bytes)
+    let bytes = lut_core::read_regular(path, MAX_FILE_BYTES)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    if bytes.len() as u64 > MAX_FILE_BYTES {
-        anyhow::bail!(
-            "{}: larger than {} MiB: not a tour config",
-            path.display(),
-            MAX_FILE_BYTES >> 20
-        );
-    }
-    let text = String::from_utf8(bytes)
+    lut_core::contain(path, || parse(&bytes, path))
+}
+
+/// Read a tour from its bytes (`path` names it and gives its folder and format).
+///
+/// # Errors
+/// As [`load`] (without the containment: [`load`] adds it).
+pub fn parse(bytes: &[u8], path: &Path) -> anyhow::Result<Loaded> {
+    lut_core::fault_point("decoder");
+    let text = std::str::from_utf8(bytes)
         .map_err(|_| anyhow::anyhow!("{}: not UTF-8 text: not a tour config", path.display()))?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let is_js = path
@@ -306,9 +310,9 @@ pub fn load(path: &Path) -> anyhow::Result<Loaded> {
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("js"));
     if is_js {
-        marzipano::read(&text, path, &dir)
+        marzipano::read(text, path, &dir)
     } else {
-        pannellum::read(&text, path, &dir)
+        pannellum::read(text, path, &dir)
     }
 }
 

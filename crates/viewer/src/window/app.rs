@@ -261,9 +261,17 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         pitch: args.pitch,
         hfov: args.hfov,
     };
-    // A tour file: its first scene (a tour that does not open is the command's error).
+    // A tour file: its first scene. A tour that does not open is shown as its error over
+    // the bundled sample, as a missing or damaged panorama is (docs/reliability.md,
+    // class 8: one behaviour).
     let source = match args.panorama.as_slice() {
-        [one] if super::tour::is_tour(one) => Some(app.start_tour(one.clone())?),
+        [one] if super::tour::is_tour(one) => match app.start_tour(one.clone()) {
+            Ok(s) => Some(s),
+            Err(e) => {
+                app.tour_failed(&e);
+                None
+            }
+        },
         _ => source,
     };
     let open = app.doc.open(

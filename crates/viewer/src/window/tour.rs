@@ -190,7 +190,11 @@ impl TourNav {
     /// No scene of the tour opens (each scene's reason, joined).
     pub fn start(tour: Tour, path: PathBuf) -> Result<(TourNav, Source), String> {
         let first = tour.first().and_then(|f| tour.index(&f.id)).unwrap_or(0);
-        let order = std::iter::once(first).chain((0..tour.scenes.len()).filter(|&i| i != first));
+        // A tour whose every scene was left out has none to try (no index 0 either).
+        let order = (!tour.scenes.is_empty())
+            .then_some(first)
+            .into_iter()
+            .chain((0..tour.scenes.len()).filter(|&i| i != first));
         let mut why = Vec::new();
         for i in order {
             match scene_source(&tour, i) {
@@ -475,7 +479,7 @@ impl TourNav {
             .collect();
         format!(
             "tour scene {} {}/{} hotspots {}",
-            s.id,
+            lut_core::shown(&s.id),
             self.current + 1,
             self.tour.scenes.len(),
             if list.is_empty() {
@@ -493,7 +497,9 @@ impl TourNav {
             |n| n.to_string_lossy().into(),
         );
         let s = self.scene();
-        format!("{file}: {}", s.title.as_deref().unwrap_or(&s.id))
+        // Escaped and shortened as every echoed text (docs/reliability.md, class 5): the
+        // window system's title gets no control character and no megabyte of text.
+        lut_core::shown(&format!("{file}: {}", s.title.as_deref().unwrap_or(&s.id)))
     }
 
     /// The horizon to level a load of `source` by (pitch, roll), when it is a scene of
@@ -595,8 +601,10 @@ pub fn tour_bar(ctx: &egui::Context, scene: egui::Rect, nav: &TourNav) -> TourBa
                             .add_enabled(can_forward, egui::Button::new("▶"))
                             .on_hover_text("Forward again (Alt+→, mouse forward)")
                             .clicked();
-                        let name =
-                            |s: &tour::TourScene| s.title.clone().unwrap_or_else(|| s.id.clone());
+                        // Escaped and shortened as every echoed text.
+                        let name = |s: &tour::TourScene| {
+                            lut_core::shown(s.title.as_deref().unwrap_or(&s.id))
+                        };
                         egui::ComboBox::from_id_salt("tour-scenes")
                             .selected_text(name(nav.scene()))
                             .show_ui(ui, |ui| {
@@ -763,5 +771,25 @@ mod tests {
             e.contains("no scene of the tour opens") && e.contains("leaves"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn a_tour_with_no_scene_left_is_an_error_not_a_panic() {
+        // Every scene left out (a path leaving the folder, say): nothing to start in.
+        let path = PathBuf::from("t.json");
+        let loaded = crate::tour::parse(
+            br#"{"default": {"firstScene": "a"}, "scenes": {"a": {"panorama": "../x.jpg"}}}"#,
+            &path,
+        )
+        .unwrap();
+        assert!(loaded.tour.scenes.is_empty());
+        let Err(e) = TourNav::start(loaded.tour, path) else {
+            panic!("a tour without scenes started")
+        };
+        assert!(e.contains("no scene of the tour opens"), "{e}");
+        let Err(e) = TourNav::start(Tour::new(PathBuf::new()), PathBuf::from("u.json")) else {
+            panic!("an empty tour started")
+        };
+        assert!(e.contains("it has no scenes"), "{e}");
     }
 }

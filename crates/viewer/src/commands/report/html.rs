@@ -106,7 +106,7 @@ pub fn html(r: &Report, png: &[u8]) -> String {
     for (i, l) in r.luminaires.iter().enumerate() {
         s += &format!(
             "<tr><td>{}</td><td class=\"name\">{}</td><td>{:.2}, {:.2}, {:.2}</td><td>{:.0}, {:.0}</td><td>{:.0}</td><td>{}</td></tr>\n",
-            i + 1, escape(&l.file), l.position[0], l.position[1], l.position[2],
+            i + 1, escape(&lut_core::shown(&l.file)), l.position[0], l.position[1], l.position[2],
             l.aim[0], l.aim[1], l.flux_lm,
             l.power_w.map_or("–".into(), |w| format!("{w:.1}"))
         );

@@ -6,9 +6,12 @@
 use super::Report;
 use serde_json::{json, Map, Value};
 
-/// The report as pretty JSON.
-pub fn json(r: &Report) -> String {
-    serde_json::to_string_pretty(&value(r)).expect("report serializes") + "\n"
+/// The report as pretty JSON, through the one JSON writer ([`crate::exit::finite_json`]).
+///
+/// # Errors
+/// A number that is not finite (a usage error naming the field), never `null`.
+pub fn json(r: &Report) -> anyhow::Result<String> {
+    Ok(crate::exit::finite_json(&value(r), true)? + "\n")
 }
 
 /// The report as a JSON value.

@@ -84,14 +84,27 @@ pub fn open(
     format: BandFormat,
     max_pixels: u64,
 ) -> Result<Option<Box<dyn RowReader>>> {
-    let r: Box<dyn RowReader> = match format {
-        BandFormat::Png => match PngRows::open(path)? {
-            Some(p) => Box::new(p),
-            None => return Ok(None),
-        },
-        BandFormat::Tiff => Box::new(TiffRows::open(path)?),
-        BandFormat::Jpeg => Box::new(JpegRows::open(path)?),
+    // Opening and every read run behind the decoders' one containment: a decoder's
+    // panic is this file's error (docs/reliability.md, class 2).
+    let inner = lut_core::contain(path, || -> Result<Option<Box<dyn RowReader>>> {
+        lut_core::fault_point("decoder");
+        let r: Box<dyn RowReader> = match format {
+            BandFormat::Png => match PngRows::open(path)? {
+                Some(p) => Box::new(p),
+                None => return Ok(None),
+            },
+            BandFormat::Tiff => Box::new(TiffRows::open(path)?),
+            BandFormat::Jpeg => Box::new(JpegRows::open(path)?),
+        };
+        Ok(Some(r))
+    })?;
+    let Some(inner) = inner else {
+        return Ok(None);
     };
+    let r: Box<dyn RowReader> = Box::new(Contained {
+        path: path.to_path_buf(),
+        inner,
+    });
     lut_core::check_pixel_limit(
         &path.display().to_string(),
         u64::from(r.width()),
@@ -100,6 +113,25 @@ pub fn open(
     )
     .map_err(crate::panorama::map_error)?;
     Ok(Some(r))
+}
+
+/// A reader whose every read runs behind [`lut_core::contain`].
+struct Contained {
+    path: PathBuf,
+    inner: Box<dyn RowReader>,
+}
+
+impl RowReader for Contained {
+    fn width(&self) -> u32 {
+        self.inner.width()
+    }
+    fn height(&self) -> u32 {
+        self.inner.height()
+    }
+    fn read_rows(&mut self, out: &mut [u8]) -> Result<usize> {
+        let inner = &mut self.inner;
+        lut_core::contain(&self.path, || inner.read_rows(out))
+    }
 }
 
 #[inline]

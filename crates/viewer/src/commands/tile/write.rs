@@ -423,18 +423,12 @@ pub fn write_pyramid(
     })
 }
 
-/// Write `config.json` atomically: a temporary file in the folder, synced, renamed.
+/// Write `config.json` through the one output writer ([`crate::output::write_image_atomic`]:
+/// a temporary file in the folder, renamed, removed on an error or a signal; an ordinary
+/// file's permissions, so a web server can serve it like the tiles).
 fn write_config(dir: &Path, text: &str) -> Result<()> {
-    use std::io::Write;
     let path: PathBuf = dir.join("config.json");
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)
-        .with_context(|| format!("{}: cannot write", path.display()))?;
-    tmp.write_all(text.as_bytes())
-        .and_then(|()| tmp.as_file().sync_all())
-        .with_context(|| format!("{}: cannot write", path.display()))?;
-    tmp.persist(&path)
-        .map_err(|e| anyhow!("{}: cannot write: {}", path.display(), e.error))?;
-    Ok(())
+    crate::output::write_image_atomic(&path, |w| Ok(w.write_all(text.as_bytes())?))
 }
 
 #[cfg(test)]

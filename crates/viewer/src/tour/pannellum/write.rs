@@ -143,25 +143,15 @@ fn hotspot_json(h: &Hotspot) -> Value {
     Value::Object(o)
 }
 
-/// Write the tour to `path` as a Pannellum config, atomically (a temporary file in the
-/// same folder, renamed). Returns the ids of scenes that have no Pannellum form (left
-/// out).
+/// Write the tour to `path` as a Pannellum config through the one output writer
+/// ([`crate::output::write_image_atomic`]: a temporary file in the same folder, renamed,
+/// removed on an error or a signal; an ordinary file's permissions). Returns the ids of
+/// scenes that have no Pannellum form (left out).
 ///
 /// # Errors
 /// The file cannot be written.
 pub fn save(tour: &Tour, path: &Path) -> anyhow::Result<Vec<String>> {
-    use std::io::Write;
     let (text, left_out) = to_text(tour);
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    tmp.write_all(text.as_bytes())
-        .and_then(|()| tmp.flush())
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    tmp.persist(path)
-        .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.error))?;
+    crate::output::write_image_atomic(path, |w| Ok(w.write_all(text.as_bytes())?))?;
     Ok(left_out)
 }

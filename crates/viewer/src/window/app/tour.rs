@@ -68,12 +68,18 @@ impl App {
             }
             Err(e) => {
                 self.tour = before;
-                let m = format!("{e:#}");
-                crate::errln!("viewer: {m}");
-                let t = self.now();
-                self.notices.error(m, t);
+                self.tour_failed(&e);
             }
         }
+    }
+
+    /// A tour that does not open: its error on stderr and as a notice, one line escaped
+    /// and shortened as every echoed text (what is shown stays).
+    pub(super) fn tour_failed(&mut self, e: &anyhow::Error) {
+        let m = lut_core::one_line(&format!("{e:#}"));
+        crate::errln!("viewer: {m}");
+        let t = self.now();
+        self.notices.error(m, t);
     }
 
     /// A panorama was shown at start view `v` (the document's effect): a tour scene
@@ -164,7 +170,8 @@ impl App {
         if let (Some(i), Some((_, at))) = (hover, cursor) {
             let text = &nav.scene().hotspots[i].text;
             if !text.is_empty() {
-                tour::hover_text(ui.ctx(), at, text);
+                // Escaped and shortened as every echoed text (docs/reliability.md, class 5).
+                tour::hover_text(ui.ctx(), at, &lut_core::shown(text));
             }
         }
         let (alt_back, alt_fwd, m_back, m_fwd) = ui.input(|i| {
