@@ -663,3 +663,34 @@ fn render_tour_scene_markers_sit_on_their_directions() {
         }
     }
 }
+
+/// Members at a tour config's root other than `default` and `scenes` (Pannellum merges
+/// them over every scene) are saved at the root as they were, and a second save is the
+/// first: moved into `default`, the scene options among them were dropped on the next
+/// read (the tour_pannellum fuzz target found it with `pitch`, `northOffset` and the
+/// horizon at the root of a tour none of whose scenes opened).
+#[test]
+fn root_members_of_a_tour_stay_at_the_root_and_saving_is_stable() {
+    let path = Path::new("tour/tour.json");
+    let text = br#"{"pitch": -5, "northOffset": 45, "horizonPitch": 1.5, "custom": {"a": 1},
+        "default": {"firstScene": "a", "author": "x"},
+        "scenes": {"a": {"panorama": "a.jpg", "yaw": 10}, "b": {"type": "multires"}}}"#;
+    let loaded = tour::parse(text, path).unwrap();
+    assert_eq!(loaded.tour.scenes.len(), 1, "b has no multiRes: left out");
+    let (saved, _) = tour::pannellum::to_text(&loaded.tour);
+    let v: serde_json::Value = serde_json::from_str(&saved).unwrap();
+    assert_eq!(v["pitch"], -5.0, "{saved}");
+    assert_eq!(v["northOffset"], 45.0, "{saved}");
+    assert_eq!(v["horizonPitch"], 1.5, "{saved}");
+    assert_eq!(v["custom"]["a"], 1.0, "{saved}");
+    assert!(v["default"].get("pitch").is_none(), "{saved}");
+    assert_eq!(v["default"]["author"], "x", "{saved}");
+    let again = tour::parse(saved.as_bytes(), path).unwrap();
+    assert_eq!(tour::pannellum::to_text(&again.tour).0, saved);
+    // No scene left at all: still stable.
+    let none =
+        br#"{"pitch": -5, "default": {"firstScene": "b"}, "scenes": {"b": {"type": "multires"}}}"#;
+    let t1 = tour::pannellum::to_text(&tour::parse(none, path).unwrap().tour).0;
+    let t2 = tour::pannellum::to_text(&tour::parse(t1.as_bytes(), path).unwrap().tour).0;
+    assert_eq!(t1, t2);
+}

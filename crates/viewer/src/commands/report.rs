@@ -604,7 +604,7 @@ pub fn write_from_state(
     let task = task("office-writing")?;
     let (report, scene) = compute_state(st, scene, crate::lighting::WORK_PLANE_HEIGHT, task, view)?;
     let bytes: Vec<u8> = if ext == "json" {
-        json::json(&report).into_bytes()
+        json::json(&report)?.into_bytes()
     } else {
         let (w, h) = png::VIEW_SIZE;
         let mut frame = vec![0x808080u32; (w * h) as usize];
@@ -677,7 +677,7 @@ mod tests {
         }
         let a = Cli::parse_from(&argv).report;
         let (report, _, st) = compute(&a).unwrap();
-        let want = json::json(&report);
+        let want = json::json(&report).unwrap();
         let dir = std::env::temp_dir().join(format!("viewer-window-report-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("r.json");

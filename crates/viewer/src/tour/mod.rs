@@ -46,6 +46,11 @@ pub struct Tour {
     pub title: Option<String>,
     /// Members of `default` not interpreted here, kept for saving.
     pub default_extra: serde_json::Map<String, serde_json::Value>,
+    /// Members of a tour config's root other than `default` and `scenes` (Pannellum
+    /// merges them over every scene), kept for saving at the root as they were: moved
+    /// into `default`, the scene options among them would change meaning (and were lost
+    /// on the next save; found by the tour_pannellum fuzz target).
+    pub root_extra: serde_json::Map<String, serde_json::Value>,
     /// Whether it came from a single-scene config (saved as a tour anyway).
     pub single: bool,
 }
@@ -350,6 +355,7 @@ impl Tour {
             fade_ms: None,
             title: None,
             default_extra: serde_json::Map::new(),
+            root_extra: serde_json::Map::new(),
             single: false,
         }
     }

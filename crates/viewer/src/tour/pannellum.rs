@@ -100,10 +100,10 @@ pub fn read(text: &str, file: &Path, dir: &Path) -> anyhow::Result<Loaded> {
     match root.get("scenes") {
         Some(scenes) => {
             // Members of the root other than default and scenes: Pannellum merges them
-            // into every scene; kept with default's.
+            // over every scene; kept at the root, as they were.
             for (k, v) in members {
                 if k != "default" && k != "scenes" {
-                    tour.default_extra.insert(k.clone(), v.to_json());
+                    tour.root_extra.insert(k.clone(), v.to_json());
                 }
             }
             if let Some(LitKind::Obj(dm)) = default.map(|d| &d.kind) {

@@ -1296,7 +1296,10 @@ mod tests {
         // NaN does not pass through (View::clamped_in): the home angles.
         let nan = f64::NAN;
         assert_eq!(Look::new(nan, nan, nan), Look::default());
-        assert_eq!(Look::new(nan, 10.0, 60.0).view(), View::new(0.0, 10.0, 60.0).unwrap());
+        assert_eq!(
+            Look::new(nan, 10.0, 60.0).view(),
+            View::new(0.0, 10.0, 60.0).unwrap()
+        );
     }
 
     #[test]

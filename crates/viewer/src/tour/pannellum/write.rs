@@ -14,8 +14,15 @@ pub fn to_text(tour: &Tour) -> (String, Vec<String>) {
             .unwrap_or_default()
             .replace('\n', &format!("\n{by}"))
     };
-    let mut t = format!(
-        "{{\n  \"default\": {},\n  \"scenes\": {{",
+    let mut t = String::from("{\n");
+    for (k, v) in &tour.root_extra {
+        if k != "default" && k != "scenes" {
+            let key = serde_json::to_string(k).unwrap_or_default();
+            t += &format!("  {key}: {},\n", indent(v, "  "));
+        }
+    }
+    t += &format!(
+        "  \"default\": {},\n  \"scenes\": {{",
         indent(&default, "  ")
     );
     for (i, (id, v)) in scenes.iter().enumerate() {
