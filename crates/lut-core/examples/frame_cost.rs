@@ -30,11 +30,22 @@
 //! pixels (the cropped kernels).
 //! `file` PATH: render that panorama instead of the generated map (e.g. `viewer
 //! bench-load`'s cached JPEGs; `map` is then ignored).
+//! `lit` none|frame|baked (none): light the frames from an illuminance map of the lights
+//! benchmark's room (6 × 5 × 2.8 m, eight luminaires on a ring, built before timing):
+//! `frame` lights each frame as its rows are drawn (`Panorama::render_with` with
+//! `FrameShader::shade_band` as the band hook, the window's path while the lighting
+//! changes); `baked` pans the lit copy (`IlluminanceMap::bake_panorama`, baked before
+//! timing, the window's path once it has settled).
+//!
+//! The checksum printed is of the last frame's pixels: compare it across commits for
+//! byte identity (docs/performance.md, "Byte identity across refactors").
 
 use lut_core::grid_map;
+use lut_core::{Camera, IlluminanceMap, MapOptions, ShadeOptions};
 use lut_core::{CubeMap, CubeRenderer, Face};
 use lut_core::{Frame, IndexStep, Panorama, Projection, RenderOptions, Renderer, Sampler, View};
 use std::time::Instant;
+use test_support::light_fixtures::{bench_table, ring};
 
 fn main() {
     if let Err(e) = run() {
@@ -181,6 +192,7 @@ fn run() -> Result<(), String> {
     let mut rlod = false;
     let mut file = None;
     let mut crop: Option<(u32, u32, u32, u32)> = None;
+    let mut lit = "none";
     for a in std::env::args().skip(1) {
         let (k, v) = a
             .split_once('=')
@@ -228,6 +240,14 @@ fn run() -> Result<(), String> {
             "level" => level = num(v)? as u32,
             "rlod" => rlod = num(v)? != 0.0,
             "file" => file = Some(std::path::PathBuf::from(v)),
+            "lit" => {
+                lit = match v {
+                    "none" => "none",
+                    "frame" => "frame",
+                    "baked" => "baked",
+                    _ => return Err(format!("lit={v}: expected none, frame or baked")),
+                }
+            }
             _ => return Err(format!("unknown argument '{k}'")),
         }
     }
@@ -282,6 +302,24 @@ fn run() -> Result<(), String> {
     pano.set_bilinear_level(level == 1);
     pano.set_still_level(level == 2);
     pano.set_region_lod(rlod);
+    // The lights benchmark's room and luminaires; the map of their light is built (and a
+    // lit copy baked) before timing.
+    let shade = ShadeOptions::default();
+    let lights = match lit {
+        "none" => None,
+        _ => Some(
+            IlluminanceMap::build(&ring(&bench_table()), &MapOptions::default())
+                .map_err(|e| e.to_string())?,
+        ),
+    };
+    if let (Some(m), "baked") = (&lights, lit) {
+        let t = Instant::now();
+        pano = m
+            .bake_panorama(&pano, &shade, &std::sync::atomic::AtomicBool::new(false))
+            .map_err(|e| e.to_string())?;
+        eprintln!("lit copy baked in {:.2} s", t.elapsed().as_secs_f64());
+    }
+    let frame_lights = lights.as_ref().filter(|_| lit == "frame");
     // The gather's positions (the map's geometry).
     let mut r = Renderer::new(&map);
     if level != 0 {
@@ -322,24 +360,28 @@ fn run() -> Result<(), String> {
             })
         })?;
     } else {
+        // One frame of `view`, lit as its rows are drawn with `lit=frame`.
+        let mut draw = |out: &mut [u32], view: View| {
+            let mut f = Frame::new(out, w, h).map_err(|e| e.to_string())?;
+            match frame_lights {
+                None => pano.render(view, &opts, &mut f),
+                Some(m) => {
+                    let cam = Camera::new(view, w, h);
+                    let shader = m.frame_shader(&cam, &shade).map_err(|e| e.to_string())?;
+                    let hook = |y0: usize, rows: &mut [u32]| shader.shade_band(y0, rows);
+                    pano.render_with(view, &opts, &mut f, &hook)
+                }
+            }
+            .map_err(|e| e.to_string())
+        };
         // The first frame builds the tables and sizes the scratch: not counted.
-        let rep = pool.install(|| {
-            let mut f = Frame::new(&mut out, w, h).map_err(|e| e.to_string())?;
-            pano.render(view(0)?, &opts, &mut f)
-                .map_err(|e| e.to_string())
-        })?;
+        let rep = pool.install(|| draw(&mut out, view(0)?))?;
         eprintln!(
             "first view: index steps {}..={}, {} pixels evaluated exactly",
             rep.min_step, rep.max_step, rep.exact_pixels
         );
-        (times, cpu) = pool.install(|| {
-            timed_frames(frames, &mut |i| {
-                let mut f = Frame::new(&mut out, w, h).map_err(|e| e.to_string())?;
-                pano.render(view(i + 1)?, &opts, &mut f)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string())
-            })
-        })?;
+        (times, cpu) = pool
+            .install(|| timed_frames(frames, &mut |i| draw(&mut out, view(i + 1)?).map(|_| ())))?;
     }
     let timed = &mut times[..];
     timed.sort_by(f64::total_cmp);
@@ -349,7 +391,7 @@ fn run() -> Result<(), String> {
         .iter()
         .fold(0u64, |a, &p| a.wrapping_mul(31).wrapping_add(p as u64));
     println!(
-        "{} | {} {} {}x{} from {}x{}, hfov {hfov}, {threads} thread(s): median {med:.2} ms (min {min:.2}; CPU {cpu:.2} ms per frame, all threads) over {} frame(s) (checksum {checksum:016x})",
+        "{} | {} {}{} {}x{} from {}x{}, hfov {hfov}, {threads} thread(s): median {med:.2} ms (min {min:.2}; CPU {cpu:.2} ms per frame, all threads) over {} frame(s) (checksum {checksum:016x})",
         lut_core::kernel_info(),
         match (gather, cube_renderer) {
             (true, _) => "gather",
@@ -357,6 +399,10 @@ fn run() -> Result<(), String> {
             _ => "lut",
         },
         sampler.name(),
+        match lit {
+            "none" => String::new(),
+            l => format!(" lit={l}"),
+        },
         w,
         h,
         map_wh.0,

@@ -9,7 +9,8 @@
 //! exact mapping, the error metric) ← `map` ([`EnvMap`], crops, samplers, pyramid, tone)
 //! ← `lut` (the tables) ← `render` ([`Frame`], [`Renderer::render`], the kernels, the
 //! exact and cube renderers) ← `panorama` ([`Panorama`]: the one panorama type, a map
-//! with its renderer or a cube map, and the one dispatch to their renderers) ← `io`
+//! with its renderer, a cube map or a tiled pyramid (`tiles`), and the one dispatch to
+//! their renderers) ← `io`
 //! (loading, partial placement, GPano, cube files) at the edge; `cube` and `light` are
 //! siblings. The modules are private; every item is exported here, at the crate root.
 //!
@@ -42,8 +43,8 @@
 //! [`shade_frame`]) are siblings of the map pipeline.
 //!
 //! ## One render entry
-//! A [`Panorama`] owns what is drawn (a map with its [`Renderer`] and tables, or a cube
-//! map; room for more kinds: [`PanoramaKind`] is `#[non_exhaustive]`) and
+//! A [`Panorama`] owns what is drawn (a map with its [`Renderer`] and tables, a cube map,
+//! or a tiled pyramid; room for more kinds: [`PanoramaKind`] is `#[non_exhaustive]`) and
 //! [`Panorama::render`] is the one call that draws any of them:
 //! ```
 //! use lut_core::{grid_map, Frame, Panorama, Projection, RenderOptions, View};

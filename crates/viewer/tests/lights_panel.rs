@@ -4,7 +4,7 @@
 //! the interpolation choice; the work plane's Em and U0 and the "Report…" button.
 
 use viewer::lighting::LightsState;
-use viewer::window::input::{AutoRotate, Look};
+use viewer::window::input::{steer_rect, AutoRotate};
 use viewer::window::quality::Settings;
 use viewer::window::ui::{self, PanelModel, Readouts};
 
@@ -31,7 +31,7 @@ fn panel_texts(lights: &mut LightsState) -> Vec<String> {
                 PanelModel {
                     settings: &mut settings,
                     projection: &mut projection,
-                    look: Look::new(0.0, 0.0, 90.0),
+                    look: steer_rect(0.0, 0.0, 90.0),
                     readouts: &readouts,
                     loading: None,
                     zoom_limit: &mut zoom_limit,

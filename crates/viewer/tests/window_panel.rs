@@ -4,7 +4,7 @@
 //! them; the toolbar, notices and help draw over the scene.
 
 use viewer::lighting::LightsState;
-use viewer::window::input::{AutoRotate, Look};
+use viewer::window::input::{steer_rect, AutoRotate};
 use viewer::window::notices::Notices;
 use viewer::window::overlay::{self, ToolbarModel, TOOLBAR_LABELS};
 use viewer::window::paint::{Compositor, SceneRect, BACKGROUND};
@@ -74,7 +74,7 @@ fn paint_panel(
                 PanelModel {
                     settings: &mut settings,
                     projection: &mut projection,
-                    look: Look::new(12.5, -3.0, 75.0),
+                    look: steer_rect(12.5, -3.0, 75.0),
                     readouts: &readouts,
                     loading,
                     zoom_limit: &mut zoom_limit,
@@ -291,7 +291,7 @@ fn the_heat_map_legend_is_in_the_panel() {
     assert!(on > 1500, "legend pixels {on}");
     assert!(off < 50, "no legend without the heat map: {off}");
     let rows = ui::readout_rows(
-        &Look::new(0.0, 0.0, 90.0),
+        &steer_rect(0.0, 0.0, 90.0),
         &Readouts {
             heat: Some((0.0123, 0.0014)),
             ..Readouts::default()
@@ -347,7 +347,7 @@ fn the_panels_text_stays_within_its_frame() {
                 PanelModel {
                     settings: &mut settings,
                     projection: &mut projection,
-                    look: Look::new(12.5, -3.0, 75.0),
+                    look: steer_rect(12.5, -3.0, 75.0),
                     readouts: &readouts,
                     loading: None,
                     zoom_limit: &mut zoom_limit,

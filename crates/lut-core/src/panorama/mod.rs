@@ -1,13 +1,14 @@
 //! The one panorama type: [`Panorama`] owns what is drawn — an equirect-family map
 //! ([`EnvMap`], any [`crate::Projection`], full or partial) with its LUT [`Renderer`]
-//! (tables, scratch, pyramid-level renderer), or a cube map ([`CubeMap`]) — and is the
-//! one dispatch from "which kind of panorama" to its renderer.
+//! (tables, scratch, pyramid-level renderer), a cube map ([`CubeMap`]), or a tiled
+//! multiresolution pyramid ([`TiledPanorama`]) — and is the one dispatch from "which kind
+//! of panorama" to its renderer.
 //!
 //! Every method that depends on the kind is written here, each as one `match` on the
 //! private representation ([`Repr`]); callers outside never match on the kind (a
-//! [`PanoramaKind`], `#[non_exhaustive]`, says what it is, for readouts). A new kind
-//! (the tiled multiresolution pyramid) is one more variant of [`Repr`] and of
-//! [`PanoramaKind`] and one more arm in each method of this file.
+//! [`PanoramaKind`], `#[non_exhaustive]`, says what it is, for readouts). A new kind is
+//! one more variant of [`Repr`] and of [`PanoramaKind`] and one more arm in each method
+//! of this file, as the tiled pyramid was.
 //!
 //! The pixels are shared (`Arc`), not copied: [`Panorama::share`] gives another handle on
 //! the same pixels and tables (with its own per-frame scratch) for another thread, e.g.
@@ -27,8 +28,8 @@ use crate::render::{BandHook, RenderOptions, RenderReport, Renderer};
 use crate::tiles::{frame_level, trilinear_levels, TiledPanorama};
 use std::sync::{Arc, Mutex};
 
-/// What kind of panorama a [`Panorama`] is (readouts, messages). New kinds will be added
-/// (the tiled multiresolution pyramid), so a `match` on it needs a wildcard arm.
+/// What kind of panorama a [`Panorama`] is (readouts, messages). More kinds may be added,
+/// so a `match` on it needs a wildcard arm.
 #[non_exhaustive]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum PanoramaKind {

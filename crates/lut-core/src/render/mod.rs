@@ -688,6 +688,21 @@ mod tests {
     use crate::render::sink::nearest_level;
     use std::f64::consts::SQRT_2;
 
+    /// A `Renderer::default()` (the viewer's for cubes) has no geometry: `table` answers
+    /// `None` instead of panicking; a renderer for a map builds the table.
+    #[test]
+    fn a_default_renderer_has_no_table_and_does_not_panic() {
+        let mut r = Renderer::default();
+        for surface in [Surface::Cylinder, Surface::Plane, Surface::Diamond] {
+            for kind in [TableKind::Wide, TableKind::High] {
+                assert!(r.table(surface, kind).is_none());
+            }
+        }
+        let map = noise_map(64, 32);
+        let mut r = Renderer::new(&map);
+        assert!(r.table(Surface::Cylinder, TableKind::Wide).is_some());
+    }
+
     /// A map of hashed pixels (every texel unlike its neighbours: any change of level or
     /// position shows).
     fn noise_map(w: u32, h: u32) -> EnvMap {

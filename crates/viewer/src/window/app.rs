@@ -21,7 +21,7 @@ use lights::SceneDrag;
 
 use super::dialogs::Dialogs;
 use super::document::{Document, LoadEvent, StartArgs};
-use super::input::{AutoRotate, Controller, Look};
+use super::input::{AutoRotate, Controller};
 use super::keys::Shortcuts;
 use super::loader::Source;
 use super::notices::Notices;
@@ -31,7 +31,7 @@ use super::quality::{FrameTimes, Level};
 use super::OpenArgs;
 use crate::lighting::{LightsKey, LightsState, LitCache, LitPanorama};
 use anyhow::{anyhow, Result};
-use lut_core::{CubeRenderer, IndexStep, LutChoice, RendererKind, Sampler};
+use lut_core::{CubeRenderer, IndexStep, LutChoice, RendererKind, Sampler, View};
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::rc::Rc;
@@ -46,7 +46,7 @@ use winit::window::{Icon, Window, WindowId};
 /// What a cached scene was rendered from: when it matches, the scene is reused.
 #[derive(Debug, Clone, PartialEq)]
 struct SceneKey {
-    look: Look,
+    look: View,
     size: (u32, u32),
     level: Level,
     renderer: RendererKind,

@@ -80,59 +80,24 @@ pub const EXPOSURE_RANGE_EV: (f64, f64) = (-8.0, 8.0);
 /// Scale factors the export offers: the scene's size times this.
 pub const EXPORT_SCALES: [u32; 3] = [1, 2, 4];
 
-/// The view as the user steers it, in degrees.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Look {
-    /// Yaw in (−180, 180].
-    pub yaw: f64,
-    /// Pitch in [−90, 90].
-    pub pitch: f64,
-    /// Horizontal field of view in [`HFOV_MIN`], [`widest_hfov`] of the projection.
-    pub hfov: f64,
-    /// The output projection (issue 12): rectilinear unless the user picks another.
-    pub projection: ViewProjection,
+/// The view as the window steers it: `lut_core`'s [`View`] with the window's hfov range
+/// ([`HFOV_MIN`] to the projection's [`widest_hfov`], narrower than [`View::clamped_in`]'s;
+/// a NaN hfov is [`HFOV_HOME`]), then [`View::clamped_in`]'s wrapping and clamping of the
+/// angles (NaN included). Every view the window holds is made here or by [`moved`].
+pub fn steer(yaw: f64, pitch: f64, hfov: f64, projection: ViewProjection) -> View {
+    let hfov = if hfov.is_nan() { HFOV_HOME } else { hfov };
+    let hfov = hfov.clamp(HFOV_MIN, widest_hfov(projection));
+    View::clamped_in(yaw, pitch, hfov, projection)
 }
 
-impl Look {
-    /// A rectilinear look with its angles normalized and clamped.
-    pub fn new(yaw: f64, pitch: f64, hfov: f64) -> Look {
-        Look::in_projection(yaw, pitch, hfov, ViewProjection::Rectilinear)
-    }
-
-    /// A look in `projection`, hfov clamped to its [`widest_hfov`] (the wrapping and
-    /// clamping of [`View::clamped_in`], NaN included).
-    pub fn in_projection(yaw: f64, pitch: f64, hfov: f64, projection: ViewProjection) -> Look {
-        let hfov = if hfov.is_nan() { HFOV_HOME } else { hfov };
-        let hfov = hfov.clamp(HFOV_MIN, widest_hfov(projection));
-        Look::from_view(View::clamped_in(yaw, pitch, hfov, projection))
-    }
-
-    /// The look of a lut-core view.
-    pub fn from_view(v: View) -> Look {
-        Look {
-            yaw: v.yaw_deg(),
-            pitch: v.pitch_deg(),
-            hfov: v.hfov_deg(),
-            projection: v.projection(),
-        }
-    }
-
-    /// This look's projection at another yaw, pitch and hfov (normalized and clamped).
-    pub fn moved(&self, yaw: f64, pitch: f64, hfov: f64) -> Look {
-        Look::in_projection(yaw, pitch, hfov, self.projection)
-    }
-
-    /// The lut-core view (infallible: [`View::clamped_in`]; a `Look` made by its
-    /// constructors already holds in-range angles, which pass unchanged).
-    pub fn view(&self) -> View {
-        View::clamped_in(self.yaw, self.pitch, self.hfov, self.projection)
-    }
+/// `view`'s projection at another yaw, pitch and hfov, as [`steer`] makes it.
+pub fn moved(view: View, yaw: f64, pitch: f64, hfov: f64) -> View {
+    steer(yaw, pitch, hfov, view.projection())
 }
 
-impl Default for Look {
-    fn default() -> Self {
-        Look::new(0.0, 0.0, HFOV_HOME)
-    }
+/// The rectilinear view [`steer`] makes: the start views of files and tours.
+pub fn steer_rect(yaw: f64, pitch: f64, hfov: f64) -> View {
+    steer(yaw, pitch, hfov, ViewProjection::Rectilinear)
 }
 
 /// How a mouse drag turns the view.
@@ -271,7 +236,7 @@ struct ZoomAnim {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Frame {
     /// The view to render.
-    pub look: Look,
+    pub look: View,
     /// True while the view turns fast (the window may render it cheaper).
     pub fast: bool,
 }
@@ -279,8 +244,8 @@ pub struct Frame {
 /// The view state machine.
 #[derive(Debug, Clone)]
 pub struct Controller {
-    look: Look,
-    home: Look,
+    look: View,
+    home: View,
     /// Panel settings (drag style, inertia, AA mode, render options).
     pub settings: Settings,
     /// Auto-rotation settings.
@@ -293,7 +258,7 @@ pub struct Controller {
     samples: Vec<(f64, f64, f64)>,
     last_tick: Option<f64>,
     /// Time and look of the previous frame, for the speed measurement.
-    prev_frame: Option<(f64, Look)>,
+    prev_frame: Option<(f64, View)>,
     fast_until: f64,
     /// The last frame was rendered below full quality because the view moved.
     degraded: bool,
@@ -322,7 +287,7 @@ pub struct Controller {
 
 impl Controller {
     /// A controller starting (and resetting) at `home`.
-    pub fn new(home: Look) -> Controller {
+    pub fn new(home: View) -> Controller {
         Controller {
             look: home,
             home,
@@ -351,7 +316,7 @@ impl Controller {
 
     /// A new panorama: `home` is its start view; the view goes there and every motion
     /// stops.
-    pub fn set_home(&mut self, home: Look) {
+    pub fn set_home(&mut self, home: View) {
         self.home = home;
         self.velocity = (0.0, 0.0);
         self.zoom_anim = None;
@@ -360,14 +325,17 @@ impl Controller {
         // The projection the user picked stays (a little planet's return view goes).
         self.planet = None;
         self.wanted_hfov = None;
-        self.look = self
-            .look
-            .moved(home.yaw, home.pitch, self.clamp_hfov(home.hfov));
+        self.look = moved(
+            self.look,
+            home.yaw_deg(),
+            home.pitch_deg(),
+            self.clamp_hfov(home.hfov_deg()),
+        );
         self.apply_limit();
     }
 
     /// The start view the view resets to.
-    pub fn home(&self) -> Look {
+    pub fn home(&self) -> View {
         self.home
     }
 
@@ -386,11 +354,11 @@ impl Controller {
         let max = max.clamp(HFOV_MIN, WIDE_HFOV_MAX);
         let min = min.clamp(HFOV_MIN, max);
         self.zoom_range = (min, max);
-        let want = self.wanted_hfov.unwrap_or(self.look.hfov);
+        let want = self.wanted_hfov.unwrap_or(self.look.hfov_deg());
         let h = self.clamp_hfov(want);
         self.wanted_hfov = (h != want).then_some(want);
-        if h != self.look.hfov {
-            self.look = self.look.moved(self.look.yaw, self.look.pitch, h);
+        if h != self.look.hfov_deg() {
+            self.look = moved(self.look, self.look.yaw_deg(), self.look.pitch_deg(), h);
         }
     }
 
@@ -419,13 +387,13 @@ impl Controller {
     fn narrowest(&self) -> f64 {
         self.zoom_range
             .0
-            .min(self.home.hfov.max(HFOV_MIN))
+            .min(self.home.hfov_deg().max(HFOV_MIN))
             .min(self.widest())
     }
 
     /// The widest hfov now: the zoom range's, at most the projection's [`widest_hfov`].
     fn widest(&self) -> f64 {
-        self.zoom_range.1.min(widest_hfov(self.look.projection))
+        self.zoom_range.1.min(widest_hfov(self.look.projection()))
     }
 
     /// Keep every edge of a `size` scene inside `coverage` from now on (`None`: no
@@ -442,19 +410,19 @@ impl Controller {
             return;
         };
         // The limit is a rectilinear frame's (wide projections show the background).
-        if w == 0 || h == 0 || !self.look.projection.is_rectilinear() {
+        if w == 0 || h == 0 || !self.look.projection().is_rectilinear() {
             return;
         }
-        let v = lut_core::limit_view(self.look.view(), w, h, &cov);
-        let l = self.look.moved(v.yaw_deg(), v.pitch_deg(), v.hfov_deg());
+        let v = lut_core::limit_view(self.look, w, h, &cov);
+        let l = moved(self.look, v.yaw_deg(), v.pitch_deg(), v.hfov_deg());
         if l != self.look {
-            if l.yaw != self.look.yaw {
+            if l.yaw_deg() != self.look.yaw_deg() {
                 self.velocity.0 = 0.0;
                 if self.rotating {
                     self.auto_rotate.speed_deg_s = -self.auto_rotate.speed_deg_s;
                 }
             }
-            if l.pitch != self.look.pitch {
+            if l.pitch_deg() != self.look.pitch_deg() {
                 self.velocity.1 = 0.0;
             }
             self.look = l;
@@ -462,7 +430,7 @@ impl Controller {
     }
 
     /// The current view.
-    pub fn look(&self) -> Look {
+    pub fn look(&self) -> View {
         self.look
     }
 
@@ -495,7 +463,8 @@ impl Controller {
         self.samples.clear();
         self.drag = Some(match self.settings.drag {
             DragStyle::Grab => {
-                self.samples.push((t, self.look.yaw, self.look.pitch));
+                self.samples
+                    .push((t, self.look.yaw_deg(), self.look.pitch_deg()));
                 Drag::Grab {
                     dir: dir_at(&self.look, pos, size),
                 }
@@ -516,13 +485,14 @@ impl Controller {
         self.last_input = t;
         match &mut self.drag {
             Some(Drag::Grab { dir }) => {
-                let Some((yaw, pitch)) = solve_grab_in(*dir, pos, size, self.look, self.look.pitch)
+                let Some((yaw, pitch)) =
+                    solve_grab_in(*dir, pos, size, self.look, self.look.pitch_deg())
                 else {
                     return;
                 };
-                let prev_yaw = self.samples.last().map_or(self.look.yaw, |s| s.1);
+                let prev_yaw = self.samples.last().map_or(self.look.yaw_deg(), |s| s.1);
                 let unwrapped = prev_yaw + wrap_deg(yaw - wrap_deg(prev_yaw));
-                self.look = self.look.moved(yaw, pitch, self.look.hfov);
+                self.look = moved(self.look, yaw, pitch, self.look.hfov_deg());
                 self.samples.push((t, unwrapped, pitch));
                 // Only the last 100 ms matter for the release velocity.
                 let keep_from = self.samples.iter().position(|s| s.0 >= t - 0.1);
@@ -546,7 +516,7 @@ impl Controller {
                     // A pause before release means the user stopped: no throw.
                     if dt > 0.01 && t - last.0 < 0.05 {
                         let v = ((last.1 - first.1) / dt, (last.2 - first.2) / dt);
-                        let max = INERTIA_MAX_HFOV_PER_S * self.look.hfov;
+                        let max = INERTIA_MAX_HFOV_PER_S * self.look.hfov_deg();
                         let k = (max / v.0.hypot(v.1)).min(1.0);
                         self.velocity = (v.0 * k, v.1 * k);
                         self.last_tick = Some(t);
@@ -561,7 +531,7 @@ impl Controller {
     /// Wheel turned by `notches` (positive zooms in) with the cursor at `cursor` (`None`:
     /// zoom about the center).
     pub fn wheel(&mut self, notches: f64, cursor: Option<(f64, f64)>, size: (u32, u32)) {
-        let hfov = self.look.hfov / ZOOM_PER_NOTCH.powf(notches);
+        let hfov = self.look.hfov_deg() / ZOOM_PER_NOTCH.powf(notches);
         self.zoom_to(hfov, cursor, size);
     }
 
@@ -571,16 +541,16 @@ impl Controller {
         self.interacted(t);
         self.velocity = (0.0, 0.0);
         self.wanted_hfov = None;
-        let to = self.clamp_hfov(self.look.hfov / DOUBLE_CLICK_ZOOM);
-        if to >= self.look.hfov {
+        let to = self.clamp_hfov(self.look.hfov_deg() / DOUBLE_CLICK_ZOOM);
+        if to >= self.look.hfov_deg() {
             self.zoomed_past_narrowest = true;
         }
-        if to < self.look.hfov {
+        if to < self.look.hfov_deg() {
             self.zoom_anim = Some(ZoomAnim {
                 dir: dir_at(&self.look, pos, size),
                 pos,
                 size,
-                from: self.look.hfov,
+                from: self.look.hfov_deg(),
                 to,
                 t0: t,
             });
@@ -591,29 +561,29 @@ impl Controller {
     /// Set hfov (clamped to the zoom range), keeping the direction under `cursor` where
     /// it is.
     pub fn zoom_to(&mut self, hfov: f64, cursor: Option<(f64, f64)>, size: (u32, u32)) {
-        if hfov > self.widest() && self.look.hfov >= self.widest() {
+        if hfov > self.widest() && self.look.hfov_deg() >= self.widest() {
             self.zoomed_past_widest = true;
         }
-        if hfov < self.narrowest() && self.look.hfov <= self.narrowest() {
+        if hfov < self.narrowest() && self.look.hfov_deg() <= self.narrowest() {
             self.zoomed_past_narrowest = true;
         }
         self.wanted_hfov = None;
         let hfov = self.clamp_hfov(hfov);
-        if hfov == self.look.hfov {
+        if hfov == self.look.hfov_deg() {
             return;
         }
         match cursor {
             Some(pos) => {
                 let dir = dir_at(&self.look, pos, size);
-                let to = self.look.moved(self.look.yaw, self.look.pitch, hfov);
-                self.look = match solve_grab_in(dir, pos, size, to, self.look.pitch) {
-                    Some((yaw, pitch)) => to.moved(yaw, pitch, hfov),
+                let to = moved(self.look, self.look.yaw_deg(), self.look.pitch_deg(), hfov);
+                self.look = match solve_grab_in(dir, pos, size, to, self.look.pitch_deg()) {
+                    Some((yaw, pitch)) => moved(to, yaw, pitch, hfov),
                     // No direction under the cursor: zoom about the centre.
                     None => to,
                 };
                 // A grab in progress keeps its point under the cursor at the new zoom.
             }
-            None => self.look = self.look.moved(self.look.yaw, self.look.pitch, hfov),
+            None => self.look = moved(self.look, self.look.yaw_deg(), self.look.pitch_deg(), hfov),
         }
     }
 
@@ -621,14 +591,19 @@ impl Controller {
     pub fn key(&mut self, action: KeyAction) {
         let size = (1, 1);
         match action {
-            KeyAction::ZoomIn => self.zoom_to(self.look.hfov / ZOOM_PER_NOTCH, None, size),
-            KeyAction::ZoomOut => self.zoom_to(self.look.hfov * ZOOM_PER_NOTCH, None, size),
+            KeyAction::ZoomIn => self.zoom_to(self.look.hfov_deg() / ZOOM_PER_NOTCH, None, size),
+            KeyAction::ZoomOut => self.zoom_to(self.look.hfov_deg() * ZOOM_PER_NOTCH, None, size),
             KeyAction::Reset => {
                 // The start view in the projection in use.
                 let h = self.home;
                 self.planet = None;
                 self.wanted_hfov = None;
-                self.look = self.look.moved(h.yaw, h.pitch, self.clamp_hfov(h.hfov));
+                self.look = moved(
+                    self.look,
+                    h.yaw_deg(),
+                    h.pitch_deg(),
+                    self.clamp_hfov(h.hfov_deg()),
+                );
                 self.velocity = (0.0, 0.0);
                 self.zoom_anim = None;
             }
@@ -672,7 +647,7 @@ impl Controller {
         if dx.hypot(dy) < QTVR_DEAD_ZONE_PX {
             return None;
         }
-        let k = QTVR_GAIN * self.look.hfov / width;
+        let k = QTVR_GAIN * self.look.hfov_deg() / width;
         // Cursor right of the press point turns right; above it, looks up.
         Some((k * dx, -k * dy))
     }
@@ -710,9 +685,9 @@ impl Controller {
             let p = ((t - z.t0) / DOUBLE_CLICK_S).clamp(0.0, 1.0);
             let e = p * p * (3.0 - 2.0 * p);
             let hfov = z.from * (z.to / z.from).powf(e);
-            let to = self.look.moved(self.look.yaw, self.look.pitch, hfov);
-            self.look = solve_grab_in(z.dir, z.pos, z.size, to, self.look.pitch)
-                .map_or(to, |(yaw, pitch)| to.moved(yaw, pitch, hfov));
+            let to = moved(self.look, self.look.yaw_deg(), self.look.pitch_deg(), hfov);
+            self.look = solve_grab_in(z.dir, z.pos, z.size, to, self.look.pitch_deg())
+                .map_or(to, |(yaw, pitch)| moved(to, yaw, pitch, hfov));
             if p >= 1.0 {
                 self.zoom_anim = None;
             }
@@ -722,7 +697,7 @@ impl Controller {
         }
         let mut yaw_rate = 0.0;
         let mut pitch_rate = 0.0;
-        let turn = TURN_HFOV_PER_S * self.look.hfov;
+        let turn = TURN_HFOV_PER_S * self.look.hfov_deg();
         let h = self.held;
         yaw_rate += turn * (f64::from(u8::from(h.right)) - f64::from(u8::from(h.left)));
         pitch_rate += turn * (f64::from(u8::from(h.up)) - f64::from(u8::from(h.down)));
@@ -739,12 +714,13 @@ impl Controller {
             let decay = (-INERTIA_DECAY * dt).exp();
             self.velocity = (self.velocity.0 * decay, self.velocity.1 * decay);
             let speed = self.velocity.0.hypot(self.velocity.1);
-            if speed < INERTIA_STOP_HFOV_PER_S * self.look.hfov {
+            if speed < INERTIA_STOP_HFOV_PER_S * self.look.hfov_deg() {
                 self.velocity = (0.0, 0.0);
             }
         }
         let zoom = f64::from(u8::from(h.zoom_out)) - f64::from(u8::from(h.zoom_in));
-        let hfov = self.look.hfov * (zoom * dt * std::f64::consts::LN_2 / ZOOM_HALVING_S).exp();
+        let hfov =
+            self.look.hfov_deg() * (zoom * dt * std::f64::consts::LN_2 / ZOOM_HALVING_S).exp();
         if hfov > self.widest() && h.zoom_out {
             self.zoomed_past_widest = true;
         }
@@ -754,14 +730,17 @@ impl Controller {
         if h.zoom_in || h.zoom_out {
             self.wanted_hfov = None;
         }
-        let pitch = self.look.pitch + pitch_rate * dt;
+        let pitch = self.look.pitch_deg() + pitch_rate * dt;
         if pitch.abs() >= 90.0 {
             // At the pole, throwing further up does nothing: drop the vertical inertia.
             self.velocity.1 = 0.0;
         }
-        self.look = self
-            .look
-            .moved(self.look.yaw + yaw_rate * dt, pitch, self.clamp_hfov(hfov));
+        self.look = moved(
+            self.look,
+            self.look.yaw_deg() + yaw_rate * dt,
+            pitch,
+            self.clamp_hfov(hfov),
+        );
         self.look != before
     }
 
@@ -773,12 +752,13 @@ impl Controller {
         if let Some((t0, prev)) = self.prev_frame {
             let dt = t - t0;
             if dt > 0.0 && prev != self.look {
-                let cos_p = self.look.pitch.to_radians().cos();
-                let dyaw = wrap_deg(self.look.yaw - prev.yaw) * cos_p;
-                let dpitch = self.look.pitch - prev.pitch;
-                let dzoom = (self.look.hfov / prev.hfov).ln().abs() * self.look.hfov;
+                let cos_p = self.look.pitch_deg().to_radians().cos();
+                let dyaw = wrap_deg(self.look.yaw_deg() - prev.yaw_deg()) * cos_p;
+                let dpitch = self.look.pitch_deg() - prev.pitch_deg();
+                let dzoom =
+                    (self.look.hfov_deg() / prev.hfov_deg()).ln().abs() * self.look.hfov_deg();
                 let speed = (dyaw.hypot(dpitch) + dzoom) / dt;
-                if speed > FAST_HFOV_PER_S * self.look.hfov {
+                if speed > FAST_HFOV_PER_S * self.look.hfov_deg() {
                     self.fast_until = t + SETTLE_S;
                 }
             }
@@ -814,7 +794,7 @@ impl Controller {
 
 impl Default for Controller {
     fn default() -> Self {
-        Controller::new(Look::default())
+        Controller::new(View::default())
     }
 }
 
@@ -833,8 +813,8 @@ mod tests {
     }
 
     /// Where the world direction `dir` appears in the scene for `look`.
-    fn screen_pos(look: &Look, dir: DVec3) -> (f64, f64) {
-        Camera::new(look.view(), SIZE.0, SIZE.1)
+    fn screen_pos(look: &View, dir: DVec3) -> (f64, f64) {
+        Camera::new(*look, SIZE.0, SIZE.1)
             .project(dir)
             .expect("direction in front of the camera")
     }
@@ -869,13 +849,13 @@ mod tests {
                 ((100.0, 50.0), (700.0, 400.0)),
                 ((600.0, 450.0), (300.0, 100.0)),
             ] {
-                let mut c = Controller::new(Look::new(yaw, pitch, hfov));
+                let mut c = Controller::new(steer_rect(yaw, pitch, hfov));
                 let start = c.look();
                 let dir = dir_at(&start, from, SIZE);
                 drag(&mut c, from, to, 10, 0.0);
                 let l = c.look();
-                assert!(l.pitch.abs() <= 90.0);
-                if l.pitch.abs() < 89.999 {
+                assert!(l.pitch_deg().abs() <= 90.0);
+                if l.pitch_deg().abs() < 89.999 {
                     let p = screen_pos(&l, dir);
                     close(p.0, to.0, 1e-6, "x under cursor");
                     close(p.1, to.1, 1e-6, "y under cursor");
@@ -888,18 +868,18 @@ mod tests {
     fn grab_signs_drag_right_turns_left_drag_down_looks_up() {
         let mut c = Controller::default();
         drag(&mut c, CENTER, (CENTER.0 + 100.0, CENTER.1), 5, 0.0);
-        assert!(c.look().yaw < -5.0, "yaw {}", c.look().yaw);
+        assert!(c.look().yaw_deg() < -5.0, "yaw {}", c.look().yaw_deg());
         close(
-            c.look().pitch,
+            c.look().pitch_deg(),
             0.0,
             1e-9,
             "pitch unchanged by a horizontal drag at the horizon",
         );
         let mut c = Controller::default();
         drag(&mut c, CENTER, (CENTER.0, CENTER.1 + 100.0), 5, 0.0);
-        assert!(c.look().pitch > 5.0, "pitch {}", c.look().pitch);
+        assert!(c.look().pitch_deg() > 5.0, "pitch {}", c.look().pitch_deg());
         close(
-            c.look().yaw,
+            c.look().yaw_deg(),
             0.0,
             1e-9,
             "yaw unchanged by a vertical drag at the center",
@@ -908,7 +888,7 @@ mod tests {
         let mut c = Controller::default();
         drag(&mut c, CENTER, (CENTER.0 + 400.0, CENTER.1), 3, 0.0);
         close(
-            c.look().yaw,
+            c.look().yaw_deg(),
             -45.0,
             1e-9,
             "edge of a 90° view to the center",
@@ -917,13 +897,13 @@ mod tests {
 
     #[test]
     fn grab_pitch_stays_within_90() {
-        let mut c = Controller::new(Look::new(0.0, 80.0, 100.0));
+        let mut c = Controller::new(steer_rect(0.0, 80.0, 100.0));
         drag(&mut c, (400.0, 0.0), (400.0, 499.0), 20, 0.0);
-        assert!(c.look().pitch <= 90.0 && c.look().pitch >= -90.0);
-        close(c.look().pitch, 90.0, 1e-9, "clamped at the zenith");
-        let mut c = Controller::new(Look::new(0.0, -80.0, 100.0));
+        assert!(c.look().pitch_deg() <= 90.0 && c.look().pitch_deg() >= -90.0);
+        close(c.look().pitch_deg(), 90.0, 1e-9, "clamped at the zenith");
+        let mut c = Controller::new(steer_rect(0.0, -80.0, 100.0));
         drag(&mut c, (400.0, 499.0), (400.0, 0.0), 20, 0.0);
-        close(c.look().pitch, -90.0, 1e-9, "clamped at the nadir");
+        close(c.look().pitch_deg(), -90.0, 1e-9, "clamped at the nadir");
     }
 
     #[test]
@@ -941,22 +921,27 @@ mod tests {
         }
         // 1 s at QTVR_GAIN · hfov · dx / width degrees per second.
         let expect = QTVR_GAIN * 90.0 * 100.0 / 800.0;
-        close(c.look().yaw, expect, 1e-6, "one second of turning right");
+        close(
+            c.look().yaw_deg(),
+            expect,
+            1e-6,
+            "one second of turning right",
+        );
         // Twice the distance, twice the speed; above the press point looks up.
         c.drag_to((CENTER.0, CENTER.1 - 200.0), SIZE, t);
-        let y0 = c.look().yaw;
+        let y0 = c.look().yaw_deg();
         for _ in 0..30 {
             t += 1.0 / 60.0;
             c.frame(t);
         }
         close(
-            c.look().yaw,
+            c.look().yaw_deg(),
             y0,
             1e-9,
             "no horizontal offset, no yaw change",
         );
         close(
-            c.look().pitch,
+            c.look().pitch_deg(),
             expect,
             1e-6,
             "half a second at twice the speed",
@@ -977,27 +962,32 @@ mod tests {
         c.drag_to((CENTER.0 + 2.0, CENTER.1 + 1.0), SIZE, 0.0);
         assert!(!c.animating());
         c.frame(1.0);
-        assert_eq!(c.look(), Look::default());
+        assert_eq!(c.look(), View::default());
     }
 
     #[test]
     fn wheel_zooms_by_delta_size_within_limits() {
         let mut a = Controller::default();
         a.wheel(1.0, None, SIZE);
-        close(a.look().hfov, 90.0 / ZOOM_PER_NOTCH, 1e-12, "one notch in");
+        close(
+            a.look().hfov_deg(),
+            90.0 / ZOOM_PER_NOTCH,
+            1e-12,
+            "one notch in",
+        );
         // One notch delivered as two half events (xdotool) zooms the same.
         let mut b = Controller::default();
         b.wheel(0.5, None, SIZE);
         b.wheel(0.5, None, SIZE);
         close(
-            b.look().hfov,
-            a.look().hfov,
+            b.look().hfov_deg(),
+            a.look().hfov_deg(),
             1e-12,
             "two halves = one notch",
         );
         a.wheel(-2.0, None, SIZE);
         close(
-            a.look().hfov,
+            a.look().hfov_deg(),
             90.0 * ZOOM_PER_NOTCH,
             1e-12,
             "two notches out",
@@ -1005,27 +995,27 @@ mod tests {
         for _ in 0..200 {
             a.wheel(1.0, None, SIZE);
         }
-        assert_eq!(a.look().hfov, HFOV_MIN);
+        assert_eq!(a.look().hfov_deg(), HFOV_MIN);
         for _ in 0..200 {
             a.wheel(-1.0, None, SIZE);
         }
-        assert_eq!(a.look().hfov, HFOV_MAX);
+        assert_eq!(a.look().hfov_deg(), HFOV_MAX);
         assert_eq!(wheel_notches(egui::MouseWheelUnit::Line, 1.0), 1.0);
         assert_eq!(wheel_notches(egui::MouseWheelUnit::Point, -50.0), -1.0);
     }
 
     #[test]
     fn wheel_zooms_toward_the_cursor() {
-        let mut c = Controller::new(Look::new(20.0, 10.0, 90.0));
+        let mut c = Controller::new(steer_rect(20.0, 10.0, 90.0));
         let cursor = (650.0, 120.0);
         let dir = dir_at(&c.look(), cursor, SIZE);
         c.wheel(3.0, Some(cursor), SIZE);
-        assert!(c.look().hfov < 90.0);
+        assert!(c.look().hfov_deg() < 90.0);
         let p = screen_pos(&c.look(), dir);
         close(p.0, cursor.0, 1e-6, "x stays under the cursor");
         close(p.1, cursor.1, 1e-6, "y stays under the cursor");
         // Zooming in toward a point right of and above the center turns right and up.
-        assert!(c.look().yaw > 20.0 && c.look().pitch > 10.0);
+        assert!(c.look().yaw_deg() > 20.0 && c.look().pitch_deg() > 10.0);
     }
 
     #[test]
@@ -1038,22 +1028,22 @@ mod tests {
         let mut c = Controller::default();
         let mut paths = Vec::new();
         // Zoom in notch by notch from 90° to well below the switch.
-        while c.look().hfov > 40.0 {
+        while c.look().hfov_deg() > 40.0 {
             let opts = c.settings.render_options(Level::Full);
             let report = r
                 .render(
                     &map,
-                    c.look().view(),
+                    c.look(),
                     &opts,
                     &mut lut_core::Frame::new(&mut out, w as u32, h as u32).expect("frame"),
                 )
                 .expect("render");
-            let want = if c.look().hfov > lut_core::LUT_SWITCH_HFOV {
+            let want = if c.look().hfov_deg() > lut_core::LUT_SWITCH_HFOV {
                 lut_core::RenderPath::LutWide
             } else {
                 lut_core::RenderPath::LutHigh
             };
-            assert_eq!(report.path, want, "hfov {}", c.look().hfov);
+            assert_eq!(report.path, want, "hfov {}", c.look().hfov_deg());
             paths.push(report.path);
             c.wheel(1.0, None, (w as u32, h as u32));
         }
@@ -1181,7 +1171,7 @@ mod tests {
             c.frame(f64::from(i) / 60.0);
         }
         close(
-            c.look().yaw,
+            c.look().yaw_deg(),
             TURN_HFOV_PER_S * 90.0,
             1e-9,
             "one second right",
@@ -1197,13 +1187,13 @@ mod tests {
         for i in 61..=600 {
             c.frame(f64::from(i) / 60.0);
         }
-        assert_eq!(c.look().pitch, 90.0);
+        assert_eq!(c.look().pitch_deg(), 90.0);
         c.set_held(Held::default(), 10.0);
         assert!(!c.animating());
         c.key(KeyAction::ZoomIn);
-        close(c.look().hfov, 90.0 / ZOOM_PER_NOTCH, 1e-12, "+ key");
+        close(c.look().hfov_deg(), 90.0 / ZOOM_PER_NOTCH, 1e-12, "+ key");
         c.key(KeyAction::Reset);
-        assert_eq!(c.look(), Look::default());
+        assert_eq!(c.look(), View::default());
     }
 
     #[test]
@@ -1211,12 +1201,12 @@ mod tests {
         // 100° x 50° across the seam (yaw 130 to -130), a 200x100 scene
         let cov = lut_core::Coverage::new(100.0, 50.0, 180.0, 0.0).unwrap();
         let size = (200, 100);
-        let inside = |c: &Controller| lut_core::view_inside(c.look().view(), 200, 100, &cov);
+        let inside = |c: &Controller| lut_core::view_inside(c.look(), 200, 100, &cov);
         let mut c = Controller::default();
         c.set_limit(Some((cov, size)));
         // the home view (yaw 0, hfov 90) cannot fit: pulled in, narrowed
         assert!(inside(&c), "{:?}", c.look());
-        assert!(c.look().hfov < 90.0);
+        assert!(c.look().hfov_deg() < 90.0);
         c.frame(0.0);
         for held in [
             Held {
@@ -1252,7 +1242,7 @@ mod tests {
         c.set_limit(None);
         c.key(KeyAction::Reset);
         c.frame(7.0);
-        assert_eq!(c.look(), Look::default());
+        assert_eq!(c.look(), View::default());
     }
 
     #[test]
@@ -1269,11 +1259,11 @@ mod tests {
         for i in 1..=60 {
             c.frame(f64::from(i) / 60.0);
         }
-        close(c.look().hfov, 45.0, 1e-9, "halved in one second");
+        close(c.look().hfov_deg(), 45.0, 1e-9, "halved in one second");
         for i in 61..=1200 {
             c.frame(f64::from(i) / 60.0);
         }
-        assert_eq!(c.look().hfov, HFOV_MIN);
+        assert_eq!(c.look().hfov_deg(), HFOV_MIN);
         // A stalled frame does not jump the view by more than MAX_TICK_S of motion.
         let mut c = Controller::default();
         c.frame(0.0);
@@ -1286,18 +1276,24 @@ mod tests {
         );
         c.frame(100.0);
         close(
-            c.look().yaw,
+            c.look().yaw_deg(),
             TURN_HFOV_PER_S * 90.0 * MAX_TICK_S,
             1e-9,
             "stall",
         );
-        let big = Look::new(725.0, -200.0, 500.0);
-        assert_eq!(big, Look::new(5.0, -90.0, HFOV_MAX));
+        let big = steer_rect(725.0, -200.0, 500.0);
+        assert_eq!(
+            (big.yaw_deg(), big.pitch_deg(), big.hfov_deg()),
+            (5.0, -90.0, HFOV_MAX)
+        );
+        // The window's hfov range is narrower than View::clamped's.
+        assert!(View::clamped(0.0, 0.0, 0.5).hfov_deg() < HFOV_MIN);
+        assert_eq!(steer_rect(0.0, 0.0, 0.5).hfov_deg(), HFOV_MIN);
         // NaN does not pass through (View::clamped_in): the home angles.
         let nan = f64::NAN;
-        assert_eq!(Look::new(nan, nan, nan), Look::default());
+        assert_eq!(steer_rect(nan, nan, nan), View::default());
         assert_eq!(
-            Look::new(nan, 10.0, 60.0).view(),
+            steer_rect(nan, 10.0, 60.0),
             View::new(0.0, 10.0, 60.0).unwrap()
         );
     }
@@ -1309,10 +1305,10 @@ mod tests {
         let t = drag(&mut c, CENTER, (CENTER.0 - 200.0, CENTER.1), 10, 0.0);
         c.release(t);
         assert!(c.animating(), "thrown");
-        let y0 = c.look().yaw;
+        let y0 = c.look().yaw_deg();
         c.frame(t + 1.0 / 60.0);
         assert!(
-            c.look().yaw > y0,
+            c.look().yaw_deg() > y0,
             "keeps turning right after a leftward drag"
         );
         let mut tt = t;
@@ -1337,7 +1333,7 @@ mod tests {
             let mut c = Controller::default();
             c.frame(0.0);
             let t = drag(&mut c, CENTER, (CENTER.0 - px, CENTER.1), frames, 0.0);
-            let y0 = c.look().yaw;
+            let y0 = c.look().yaw_deg();
             c.release(t);
             assert!(c.animating(), "thrown");
             let mut tt = t;
@@ -1346,7 +1342,7 @@ mod tests {
                 c.frame(tt);
                 assert!(tt - t < 1.05, "still coasting after {:.2} s", tt - t);
             }
-            let coast = wrap_deg(c.look().yaw - y0).abs();
+            let coast = wrap_deg(c.look().yaw_deg() - y0).abs();
             assert!(coast > 1.0, "{px} px flick coasted only {coast}°");
             if px < 1000.0 {
                 assert!(coast < 90.0, "a typical flick coasted {coast}°");
@@ -1378,22 +1374,22 @@ mod tests {
 
     #[test]
     fn zoom_range_holds_against_wheel_keys_buttons_and_reset() {
-        let mut c = Controller::new(Look::new(0.0, 0.0, 100.0));
+        let mut c = Controller::new(steer_rect(0.0, 0.0, 100.0));
         c.set_zoom_range(80.0, 120.0);
-        assert_eq!(c.look().hfov, 100.0, "inside the range: untouched");
+        assert_eq!(c.look().hfov_deg(), 100.0, "inside the range: untouched");
         for _ in 0..50 {
             c.wheel(1.0, Some((100.0, 100.0)), SIZE);
         }
-        assert_eq!(c.look().hfov, 80.0);
+        assert_eq!(c.look().hfov_deg(), 80.0);
         assert!(c.take_zoomed_past_narrowest(), "the window says why");
         assert!(!c.take_zoomed_past_narrowest(), "reported once");
         c.key(KeyAction::Reset);
-        assert_eq!(c.look().hfov, 100.0, "the start view");
+        assert_eq!(c.look().hfov_deg(), 100.0, "the start view");
         assert!(!c.take_zoomed_past_widest());
         for _ in 0..50 {
             c.key(KeyAction::ZoomOut);
         }
-        assert_eq!(c.look().hfov, 120.0);
+        assert_eq!(c.look().hfov_deg(), 120.0);
         assert!(c.take_zoomed_past_widest(), "the hook for wide projections");
         assert!(!c.take_zoomed_past_widest(), "reported once");
         c.frame(0.0);
@@ -1402,31 +1398,39 @@ mod tests {
             ..Held::default()
         };
         hold(&mut c, zoom_in, 0.0, 120);
-        assert_eq!(c.look().hfov, 80.0);
+        assert_eq!(c.look().hfov_deg(), 80.0);
         // Off for inspection: the global range.
         c.set_zoom_range(HFOV_MIN, HFOV_MAX);
         c.wheel(30.0, None, SIZE);
-        assert!(c.look().hfov < 10.0);
+        assert!(c.look().hfov_deg() < 10.0);
     }
 
     #[test]
     fn the_start_view_is_shown_whatever_the_zoom_range() {
         // A file's 60° start view on a map whose resolution stops the zoom at 80°: the
         // view opens at 60° and zooming in goes no further than it.
-        let mut c = Controller::new(Look::new(0.0, 0.0, 60.0));
+        let mut c = Controller::new(steer_rect(0.0, 0.0, 60.0));
         c.set_zoom_range(80.0, 120.0);
-        assert_eq!(c.look().hfov, 60.0, "the start view is not pulled out");
+        assert_eq!(
+            c.look().hfov_deg(),
+            60.0,
+            "the start view is not pulled out"
+        );
         c.wheel(1.0, None, SIZE);
-        assert_eq!(c.look().hfov, 60.0);
+        assert_eq!(c.look().hfov_deg(), 60.0);
         assert!(c.take_zoomed_past_narrowest());
         c.wheel(-3.0, None, SIZE);
-        assert!(c.look().hfov > 80.0);
+        assert!(c.look().hfov_deg() > 80.0);
         for _ in 0..20 {
             c.key(KeyAction::ZoomIn);
         }
-        assert_eq!(c.look().hfov, 60.0, "the start view stays within reach");
-        c.set_home(Look::new(0.0, 0.0, 30.0));
-        assert_eq!(c.look().hfov, 30.0, "a new file's start view too");
+        assert_eq!(
+            c.look().hfov_deg(),
+            60.0,
+            "the start view stays within reach"
+        );
+        c.set_home(steer_rect(0.0, 0.0, 30.0));
+        assert_eq!(c.look().hfov_deg(), 30.0, "a new file's start view too");
     }
 
     #[test]
@@ -1436,20 +1440,20 @@ mod tests {
         let mut c = Controller::default();
         c.set_zoom_range(50.0, HFOV_MAX);
         c.wheel(10.0, None, SIZE);
-        assert_eq!(c.look().hfov, 50.0);
+        assert_eq!(c.look().hfov_deg(), 50.0);
         c.set_zoom_range(70.0, HFOV_MAX);
-        assert_eq!(c.look().hfov, 70.0, "pulled out in the wider scene");
+        assert_eq!(c.look().hfov_deg(), 70.0, "pulled out in the wider scene");
         c.set_zoom_range(60.0, HFOV_MAX);
-        assert_eq!(c.look().hfov, 60.0, "as close as the range allows");
+        assert_eq!(c.look().hfov_deg(), 60.0, "as close as the range allows");
         c.set_zoom_range(50.0, HFOV_MAX);
-        assert_eq!(c.look().hfov, 50.0, "back as it was");
+        assert_eq!(c.look().hfov_deg(), 50.0, "back as it was");
         // A zoom by the user in between is the new view to keep.
         c.set_zoom_range(70.0, HFOV_MAX);
         c.wheel(-1.0, None, SIZE);
-        let h = c.look().hfov;
+        let h = c.look().hfov_deg();
         assert!(h > 70.0);
         c.set_zoom_range(50.0, HFOV_MAX);
-        assert_eq!(c.look().hfov, h, "the user's zoom stays");
+        assert_eq!(c.look().hfov_deg(), h, "the user's zoom stays");
     }
 
     #[test]
@@ -1461,18 +1465,23 @@ mod tests {
         c.double_click(p, SIZE, 0.0);
         assert!(c.animating());
         let mut t = 0.0;
-        let mut prev = c.look().hfov;
+        let mut prev = c.look().hfov_deg();
         while c.animating() {
             t += 1.0 / 60.0;
             c.frame(t);
-            assert!(c.look().hfov <= prev, "zooms in monotonically");
-            prev = c.look().hfov;
+            assert!(c.look().hfov_deg() <= prev, "zooms in monotonically");
+            prev = c.look().hfov_deg();
             let q = screen_pos(&c.look(), dir);
             close(q.0, p.0, 1e-6, "x under the cursor");
             close(q.1, p.1, 1e-6, "y under the cursor");
             assert!(t < DOUBLE_CLICK_S + 0.1);
         }
-        close(c.look().hfov, 90.0 / DOUBLE_CLICK_ZOOM, 1e-9, "halved");
+        close(
+            c.look().hfov_deg(),
+            90.0 / DOUBLE_CLICK_ZOOM,
+            1e-9,
+            "halved",
+        );
         // At the limit a double-click does nothing.
         let mut c = Controller::default();
         c.set_zoom_range(90.0, HFOV_MAX);
@@ -1496,7 +1505,7 @@ mod tests {
         assert!(!c.animating());
         assert_eq!(c.wake_at(), Some(2.0), "wakes when the idle delay ends");
         c.frame(1.0);
-        assert_eq!(c.look().yaw, 0.0, "nothing before the delay");
+        assert_eq!(c.look().yaw_deg(), 0.0, "nothing before the delay");
         c.frame(2.0);
         assert!(c.animating());
         let mut t = 2.0;
@@ -1504,14 +1513,14 @@ mod tests {
             t += 1.0 / 60.0;
             c.frame(t);
         }
-        close(c.look().yaw, speed, 1e-6, "one second of rotation");
+        close(c.look().yaw_deg(), speed, 1e-6, "one second of rotation");
         // At the default speed the view does not count as moving fast.
         assert!(!c.frame(t).fast);
         // A key stops it; it resumes after the delay.
         c.interacted(t);
         assert!(!c.animating());
         c.frame(t + 1.0);
-        close(c.look().yaw, speed, 1e-6, "stopped");
+        close(c.look().yaw_deg(), speed, 1e-6, "stopped");
         assert_eq!(c.wake_at(), Some(t + 2.0));
         c.auto_rotate.enabled = false;
         assert_eq!(c.wake_at(), None);
@@ -1530,7 +1539,7 @@ mod tests {
         }
         let speed = c.auto_rotate.speed_deg_s;
         close(
-            c.look().yaw,
+            c.look().yaw_deg(),
             speed * 0.5,
             1e-6,
             "half a second of rotation, no delay",
@@ -1542,8 +1551,8 @@ mod tests {
         let mut c = Controller::default();
         let t = drag(&mut c, CENTER, (CENTER.0 - 200.0, CENTER.1), 10, 0.0);
         c.release(t);
-        c.set_home(Look::new(120.0, -10.0, 70.0));
-        assert_eq!(c.look(), Look::new(120.0, -10.0, 70.0));
+        c.set_home(steer_rect(120.0, -10.0, 70.0));
+        assert_eq!(c.look(), steer_rect(120.0, -10.0, 70.0));
         assert!(!c.animating(), "the old file's inertia does not carry over");
         c.wheel(2.0, None, SIZE);
         c.key(KeyAction::Reset);

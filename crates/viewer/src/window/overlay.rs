@@ -4,9 +4,9 @@
 //! of [`super::keys::BINDINGS`] and every mouse action. Immediate mode from plain data, so
 //! the tests paint it offscreen.
 
-use super::input::Look;
 use super::keys::{BINDINGS, MOUSE_HELP};
 use super::notices::{Level, Notices};
+use lut_core::View;
 use std::path::PathBuf;
 
 /// Toolbar button labels (glyphs the default egui fonts have: a test checks): open,
@@ -198,12 +198,12 @@ pub const COMPASS_RADIUS: f32 = 22.0;
 /// The compass at the top right of the scene: the needle points to north when the
 /// panorama knows its heading (GPano `PoseHeadingDegrees`), else to the map's centre
 /// (yaw 0); the text is the heading (or the yaw).
-pub fn compass(ctx: &egui::Context, scene: egui::Rect, look: &Look, pose_heading: Option<f64>) {
+pub fn compass(ctx: &egui::Context, scene: egui::Rect, look: &View, pose_heading: Option<f64>) {
     let r = COMPASS_RADIUS;
     let center = egui::pos2(scene.max.x - r - 12.0, scene.min.y + r + 12.0);
-    let heading = pose_heading.map(|p| lut_core::compass_heading(p, look.yaw));
+    let heading = pose_heading.map(|p| lut_core::compass_heading(p, look.yaw_deg()));
     // Screen angle of north (or yaw 0), clockwise from up: minus the view's heading.
-    let ahead = heading.unwrap_or(look.yaw);
+    let ahead = heading.unwrap_or(look.yaw_deg());
     egui::Area::new(egui::Id::new("compass"))
         .fixed_pos(center - egui::vec2(r, r))
         .order(egui::Order::Foreground)
@@ -231,7 +231,7 @@ pub fn compass(ctx: &egui::Context, scene: egui::Rect, look: &Look, pose_heading
             ));
             let text = match heading {
                 Some(h) => format!("{h:.0}° {}", lut_core::compass_point(h)),
-                None => format!("yaw {:.0}°", look.yaw),
+                None => format!("yaw {:.0}°", look.yaw_deg()),
             };
             let galley = p.layout_no_wrap(text, egui::FontId::proportional(11.0), v.text_color());
             let at = egui::pos2(c.x - galley.size().x / 2.0, rect.max.y - galley.size().y);

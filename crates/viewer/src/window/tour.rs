@@ -19,9 +19,10 @@ mod edit;
 
 pub use edit::{edit_panel, typing, EditRequest, Editor};
 
-use super::input::Look;
+use super::input::moved;
 use super::loader::Source;
 use crate::tour::{self, markers, Angles, HotspotKind, Tour};
+use lut_core::View;
 use std::path::{Path, PathBuf};
 
 /// How long the glide toward a clicked scene link lasts, seconds.
@@ -59,7 +60,7 @@ struct Pending {
 /// The glide toward a clicked link.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Glide {
-    from: Look,
+    from: View,
     to: (f64, f64, f64),
     t0: f64,
 }
@@ -249,11 +250,11 @@ impl TourNav {
     }
 
     /// The view `look` as tour angles.
-    fn angles(look: Look) -> Angles {
+    fn angles(look: View) -> Angles {
         Angles {
-            yaw: look.yaw,
-            pitch: look.pitch,
-            hfov: look.hfov,
+            yaw: look.yaw_deg(),
+            pitch: look.pitch_deg(),
+            hfov: look.hfov_deg(),
         }
     }
 
@@ -279,7 +280,7 @@ impl TourNav {
     /// A click on hotspot `index` of the scene shown, seen at `look`, at time `t`: a
     /// scene link glides toward the hotspot and loads its target (the view it arrives at
     /// by Pannellum's rules); an info hotspot gives its text and link.
-    pub fn click(&mut self, index: usize, look: Look, t: f64) -> Option<TourAction> {
+    pub fn click(&mut self, index: usize, look: View, t: f64) -> Option<TourAction> {
         let scene = self.tour.scenes.get(self.current)?;
         let hs = scene.hotspots.get(index)?;
         match &hs.kind {
@@ -311,7 +312,7 @@ impl TourNav {
                 self.forward.clear();
                 self.glide = Some(Glide {
                     from: look,
-                    to: (hs.yaw, hs.pitch, look.hfov * GLIDE_ZOOM),
+                    to: (hs.yaw, hs.pitch, look.hfov_deg() * GLIDE_ZOOM),
                     t0: t,
                 });
                 Some(self.go(i, view))
@@ -320,7 +321,7 @@ impl TourNav {
     }
 
     /// The scene list's choice: scene `i` at its start view.
-    pub fn choose(&mut self, i: usize, look: Look) -> Option<TourAction> {
+    pub fn choose(&mut self, i: usize, look: View) -> Option<TourAction> {
         if i >= self.tour.scenes.len() || (i == self.current && self.pending.is_none()) {
             return None;
         }
@@ -335,7 +336,7 @@ impl TourNav {
 
     /// Back (`forward` false) or forward through the scenes visited, each at the view
     /// it was left at.
-    pub fn step(&mut self, forward: bool, look: Look) -> Option<TourAction> {
+    pub fn step(&mut self, forward: bool, look: View) -> Option<TourAction> {
         let here = Visit {
             scene: self.current,
             view: Self::angles(look),
@@ -385,15 +386,16 @@ impl TourNav {
 
     /// The glide's look at time `t` (`None`: no glide). The glide ends at the hotspot,
     /// zoomed in; it stops when the target scene arrives.
-    pub fn glide_look(&mut self, t: f64) -> Option<Look> {
+    pub fn glide_look(&mut self, t: f64) -> Option<View> {
         let g = self.glide?;
         let p = ((t - g.t0) / GLIDE_S).clamp(0.0, 1.0);
         let e = ease(p);
         let (yaw, pitch, hfov) = g.to;
-        let look = g.from.moved(
-            g.from.yaw + wrap(yaw - g.from.yaw) * e,
-            g.from.pitch + (pitch - g.from.pitch) * e,
-            g.from.hfov * (hfov / g.from.hfov).powf(e),
+        let look = moved(
+            g.from,
+            g.from.yaw_deg() + wrap(yaw - g.from.yaw_deg()) * e,
+            g.from.pitch_deg() + (pitch - g.from.pitch_deg()) * e,
+            g.from.hfov_deg() * (hfov / g.from.hfov_deg()).powf(e),
         );
         if p >= 1.0 {
             self.glide = None;
@@ -407,11 +409,11 @@ impl TourNav {
     }
 
     /// The hotspot of the scene shown under (`x`, `y`) of a `w × h` frame of `look`.
-    pub fn hotspot_at(&self, look: &Look, w: u32, h: u32, x: f64, y: f64) -> Option<usize> {
+    pub fn hotspot_at(&self, look: &View, w: u32, h: u32, x: f64, y: f64) -> Option<usize> {
         if self.pending.is_some() && self.glide.is_some() {
             return None;
         }
-        markers::placed(self.scene(), look.view(), w, h)
+        markers::placed(self.scene(), *look, w, h)
             .into_iter()
             .map(|p| (p.index, (p.x - x).hypot(p.y - y)))
             .filter(|(_, d)| *d <= PICK_RADIUS)
@@ -427,7 +429,7 @@ impl TourNav {
     /// The scene as shown: `scene` (`w × h`, the frame of `look`) faded from the old
     /// scene while the crossfade runs, with the hotspot markers over it (not while
     /// fading or gliding into another scene).
-    pub fn compose(&mut self, scene: &[u32], w: u32, h: u32, look: &Look, t: f64) -> &[u32] {
+    pub fn compose(&mut self, scene: &[u32], w: u32, h: u32, look: &View, t: f64) -> &[u32] {
         self.buf.clear();
         self.buf.extend_from_slice(scene);
         let fade_s = self.fade_s();
@@ -447,7 +449,7 @@ impl TourNav {
             }
         }
         if !fading && self.glide.is_none() {
-            let view = look.view();
+            let view = *look;
             let placed = markers::draw(&self.tour.scenes[self.current], view, &mut self.buf, w, h);
             if let Some(p) = placed.iter().find(|p| Some(p.index) == self.hover) {
                 ring(&mut self.buf, w, h, p.x, p.y);
@@ -471,9 +473,9 @@ impl TourNav {
 
     /// One line for `--print-view` naming the scene shown and where each of its
     /// hotspots is in a `w × h` frame of `look`: `tour scene ID i/n hotspots 0@x,y ...`.
-    pub fn describe(&self, look: &Look, w: u32, h: u32) -> String {
+    pub fn describe(&self, look: &View, w: u32, h: u32) -> String {
         let s = self.scene();
-        let list: Vec<String> = markers::placed(s, look.view(), w, h)
+        let list: Vec<String> = markers::placed(s, *look, w, h)
             .iter()
             .map(|p| format!("{}@{:.1},{:.1}", p.index, p.x, p.y))
             .collect();
@@ -643,6 +645,7 @@ pub fn hover_text(ctx: &egui::Context, at: egui::Pos2, text: &str) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::window::input::steer_rect;
 
     /// The Pannellum test tour, started (its first scene loading).
     pub fn sample() -> TourNav {
@@ -669,16 +672,16 @@ mod tests {
         // The first scene arrives at its start view.
         let start = nav.arrived(&src, None, 0.0).unwrap();
         assert_eq!((start.yaw, start.pitch, start.hfov), (20.0, -5.0, 90.0));
-        let look = Look::new(start.yaw, start.pitch, start.hfov);
+        let look = steer_rect(start.yaw, start.pitch, start.hfov);
         // Hotspot 0: to "interior", targetYaw sameAzimuth, targetPitch 0.
         let a = nav.click(0, look, 10.0).unwrap();
         assert!(nav.animating(10.0));
         let mid = nav.glide_look(10.0 + GLIDE_S / 2.0).unwrap();
-        assert!(mid.yaw > 20.0 && mid.yaw < 60.0, "{mid:?}");
+        assert!(mid.yaw_deg() > 20.0 && mid.yaw_deg() < 60.0, "{mid:?}");
         // Just past its duration: the glide's last look, at the hotspot (zoomed in).
         let end = nav.glide_look(10.0 + GLIDE_S + 1e-3).unwrap();
-        assert!((end.yaw - 60.0).abs() < 1e-9 && (end.pitch + 2.0).abs() < 1e-9);
-        assert!((end.hfov - 90.0 * GLIDE_ZOOM).abs() < 1e-9);
+        assert!((end.yaw_deg() - 60.0).abs() < 1e-9 && (end.pitch_deg() + 2.0).abs() < 1e-9);
+        assert!((end.hfov_deg() - 90.0 * GLIDE_ZOOM).abs() < 1e-9);
         assert!(nav.glide_look(11.0).is_none(), "the glide ended");
         let v = arrive(&mut nav, &a, 11.0);
         assert_eq!(nav.scene().id, "interior");
@@ -688,12 +691,12 @@ mod tests {
         // The crossfade runs for the tour's 1000 ms.
         assert!(nav.animating(11.5) && !nav.animating(12.01));
         // Back returns to the courtyard at the view it was left at; forward again.
-        let back = nav.step(false, Look::new(v.yaw, v.pitch, v.hfov)).unwrap();
+        let back = nav.step(false, steer_rect(v.yaw, v.pitch, v.hfov)).unwrap();
         let v0 = arrive(&mut nav, &back, 13.0);
         assert_eq!(nav.scene().id, "courtyard");
         assert_eq!((v0.yaw, v0.pitch, v0.hfov), (20.0, -5.0, 90.0));
         assert_eq!(nav.can_go(), (false, true));
-        let fwd = nav.step(true, Look::new(1.0, 2.0, 80.0)).unwrap();
+        let fwd = nav.step(true, steer_rect(1.0, 2.0, 80.0)).unwrap();
         let v1 = arrive(&mut nav, &fwd, 14.0);
         assert_eq!(nav.scene().id, "interior");
         assert!((v1.yaw + 70.0).abs() < 1e-9);
@@ -707,7 +710,7 @@ mod tests {
     #[test]
     fn info_hotspots_give_their_text_and_the_scene_list_goes_to_start_views() {
         let mut nav = sample();
-        let look = Look::new(0.0, 0.0, 90.0);
+        let look = steer_rect(0.0, 0.0, 90.0);
         assert_eq!(
             nav.click(1, look, 0.0),
             Some(TourAction::Info(
@@ -730,7 +733,7 @@ mod tests {
         let mut nav = sample();
         let src = scene_source(&nav.tour, 0).unwrap();
         nav.arrived(&src, None, 0.0);
-        let look = Look::new(60.0, -2.0, 90.0);
+        let look = steer_rect(60.0, -2.0, 90.0);
         let (w, h) = (400, 300);
         // Hotspot 0 is at yaw 60, pitch -2: the centre of this view.
         let (cx, cy) = (200.0, 150.0);

@@ -4,10 +4,10 @@
 //! so a test can paint it offscreen without a window. The viewing overlay (toolbar,
 //! compass, notices, help) is `overlay.rs`.
 
-use super::input::{AutoRotate, Held, Look};
+use super::input::{AutoRotate, Held};
 use super::quality::{Level, Settings, FRAME_BUDGET_MS};
 use crate::lighting::LightsState;
-use lut_core::{CubeRenderer, Named, Projection, RenderPath, Sampler};
+use lut_core::{CubeRenderer, Named, Projection, RenderPath, Sampler, View};
 
 mod projection;
 pub use projection::{heat_label, PANEL_PANNINI_D_MAX};
@@ -222,7 +222,7 @@ pub struct PanelModel<'a> {
     /// Projection choice for the current file (`None` = auto); the panel edits it.
     pub projection: &'a mut Option<Projection>,
     /// The current view.
-    pub look: Look,
+    pub look: View,
     /// Readouts.
     pub readouts: &'a Readouts,
     /// A load in progress.
@@ -286,21 +286,21 @@ pub fn path_label(p: Option<RenderPath>) -> &'static str {
 
 /// The readout rows (label, value) the panel shows, in order; `--print-view` prints the
 /// same strings, so a test reads what is drawn.
-pub fn readout_rows(look: &Look, r: &Readouts) -> Vec<(&'static str, String)> {
+pub fn readout_rows(look: &View, r: &Readouts) -> Vec<(&'static str, String)> {
     let mut rows = vec![
-        ("yaw", format!("{:8.2}°", look.yaw)),
-        ("pitch", format!("{:8.2}°", look.pitch)),
-        ("hfov", format!("{:8.2}°", look.hfov)),
+        ("yaw", format!("{:8.2}°", look.yaw_deg())),
+        ("pitch", format!("{:8.2}°", look.pitch_deg())),
+        ("hfov", format!("{:8.2}°", look.hfov_deg())),
     ];
-    if !look.projection.is_rectilinear() {
-        rows.push(("projection", look.projection.to_string()));
+    if !look.projection().is_rectilinear() {
+        rows.push(("projection", look.projection().to_string()));
     }
     if let Some((max, mean)) = r.heat {
         rows.push(("error max", format!("{max:.4} px")));
         rows.push(("error mean", format!("{mean:.5} px")));
     }
     if let Some(p) = r.pose_heading {
-        let h = lut_core::compass_heading(p, look.yaw);
+        let h = lut_core::compass_heading(p, look.yaw_deg());
         rows.push((
             "heading",
             format!("{h:8.2}° {}", lut_core::compass_point(h)),
@@ -670,7 +670,7 @@ mod tests {
     #[test]
     fn every_readout_has_a_hover_text() {
         use super::{readout_help, readout_rows, Readouts};
-        use crate::window::input::Look;
+        use crate::window::input::steer_rect;
         let r = Readouts {
             full_ms: Some(20.0),
             heat: Some((0.01, 0.001)),
@@ -679,7 +679,7 @@ mod tests {
             exact_pixels: 5,
             ..Readouts::default()
         };
-        for (k, _) in readout_rows(&Look::new(0.0, 0.0, 90.0), &r) {
+        for (k, _) in readout_rows(&steer_rect(0.0, 0.0, 90.0), &r) {
             assert!(!readout_help(k).is_empty(), "no hover text for {k}");
         }
         assert!(readout_help("render").starts_with("render: "));

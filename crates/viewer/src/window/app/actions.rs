@@ -384,7 +384,7 @@ impl App {
             .current_mut()
             .ok_or_else(|| "no panorama loaded".to_string())?;
         let opts = self.ctl.settings.render_options(Level::Full);
-        let view = self.ctl.look().view();
+        let view = self.ctl.look();
         let mut buf = vec![0u32; w as usize * h as usize];
         self.lights
             .render_lit(

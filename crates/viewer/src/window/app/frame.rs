@@ -5,14 +5,14 @@
 use super::{App, SceneKey};
 use crate::scene::{measure_errors, render_scene, render_scene_lit};
 use crate::window::dialogs::Chosen;
-use crate::window::input::{resolution_hfov, wheel_notches, Held, Look, WIDE_HFOV_MAX};
+use crate::window::input::{resolution_hfov, wheel_notches, Held, WIDE_HFOV_MAX};
 use crate::window::keys::{KeyAction, Route};
 use crate::window::overlay::{self, NoticesOutput, ToolbarModel};
 use crate::window::paint::SceneRect;
 use crate::window::quality::{frame_level, FRAME_BUDGET_MS};
 use crate::window::ui::{self, PanelModel, PanelOutput};
 use anyhow::{anyhow, Result};
-use lut_core::{Camera, CubeRenderer, RenderOptions, RenderPath, Sampler};
+use lut_core::{Camera, CubeRenderer, RenderOptions, RenderPath, Sampler, View};
 use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -316,7 +316,7 @@ impl App {
         let mut frame = self.ctl.frame(t);
         let tour_moving = self.tour.as_ref().is_some_and(|n| n.animating(t));
         frame.fast |= gliding;
-        if self.ctl.take_zoomed_past_widest() && frame.look.projection.is_rectilinear() {
+        if self.ctl.take_zoomed_past_widest() && frame.look.projection().is_rectilinear() {
             self.notices.info(
                 "widest rectilinear view: V for a wide projection, L for a little planet",
                 t,
@@ -468,7 +468,7 @@ impl App {
 
     /// Render the scene for `rect` at the quality the rule picks (unless the cached one
     /// already shows it), then light it when there are luminaires.
-    fn render_scene(&mut self, rect: SceneRect, look: Look, fast: bool) {
+    fn render_scene(&mut self, rect: SceneRect, look: View, fast: bool) {
         let generation = self.doc.generation();
         let pixels = u64::from(rect.w) * u64::from(rect.h);
         let s = self.ctl.settings;
@@ -516,7 +516,7 @@ impl App {
         };
         fit(&mut self.scene, rect.w as usize * rect.h as usize);
         let t0 = Instant::now();
-        let view = look.view();
+        let view = look;
         let k = level.scale();
         // A full-size frame is lit as its rows are drawn (no second pass over it); a
         // smaller one is lit after it is scaled up, in `light_scene`.
@@ -632,16 +632,16 @@ impl App {
             let _ = crate::outln!(
                 "view yaw={:.4} pitch={:.4} hfov={:.4} path={path} sampler={} level={} fast={} \
                  ms={ms:.2} size={}x{} lights={} proj={} lit={}",
-                look.yaw,
-                look.pitch,
-                look.hfov,
+                look.yaw_deg(),
+                look.pitch_deg(),
+                look.hfov_deg(),
                 opts.sampler.name(),
                 level.label().replace(' ', "-"),
                 fast,
                 rect.w,
                 rect.h,
                 self.lights.lights.len(),
-                look.projection.name(),
+                look.projection().name(),
                 match (from_baked, &lit) {
                     (true, _) => "baked",
                     (false, Some(_)) => "frame",
@@ -691,14 +691,14 @@ impl App {
         &mut self,
         cursor: Option<(f64, f64)>,
         rect: Option<SceneRect>,
-        look: Look,
+        look: View,
     ) -> bool {
         // The scene the illuminance map was built from: its inter-reflections come from
         // the solving thread (never solved here, on the UI thread).
         let lux =
             match (cursor, rect, self.lit.scene()) {
                 (Some((x, y)), Some(r), Some(scene)) if r.w > 0 && r.h > 0 => Some(
-                    lut_core::lux_at(scene, &lut_core::Camera::new(look.view(), r.w, r.h), x, y),
+                    lut_core::lux_at(scene, &lut_core::Camera::new(look, r.w, r.h), x, y),
                 ),
                 _ => None,
             };

@@ -100,7 +100,7 @@ impl App {
         let st = self.lights.clone();
         let mut pano = self.doc.current().map(|c| c.scene.share());
         let look = self.ctl.look();
-        let view = [look.yaw, look.pitch, look.hfov];
+        let view = [look.yaw_deg(), look.pitch_deg(), look.hfov_deg()];
         let (tx, rx) = std::sync::mpsc::channel();
         let proxy = self.proxy.clone();
         let spawned = std::thread::Builder::new()
@@ -275,7 +275,7 @@ impl App {
         if !self.lights.show_room {
             return;
         }
-        let view = self.ctl.look().view();
+        let view = self.ctl.look();
         self.lights.selected = pick_light(&self.lights, view, size.0, size.1, at, PICK_RADIUS);
         self.print_selection();
     }
@@ -298,7 +298,7 @@ impl App {
         if !self.lights.show_room {
             return None;
         }
-        let view = self.ctl.look().view();
+        let view = self.ctl.look();
         if let Some(i) = pick_light(&self.lights, view, size.0, size.1, at, PICK_RADIUS) {
             return Some(SceneDrag::Light(i));
         }
@@ -324,7 +324,7 @@ impl App {
         let Ok(room) = self.lights.room_box() else {
             return;
         };
-        let cam = Camera::new(self.ctl.look().view(), size.0, size.1);
+        let cam = Camera::new(self.ctl.look(), size.0, size.1);
         let walls = match self.scene_drag {
             Some(SceneDrag::Corner(c)) => drag_room_corner(&room, &cam, c, at),
             Some(SceneDrag::Edge(e)) => drag_room_edge(&room, &cam, e, at),
@@ -462,9 +462,9 @@ impl App {
             .map_or_else(Vec::new, |c| c.source.paths());
         let look = self.ctl.look();
         let view = SceneView {
-            yaw: look.yaw,
-            pitch: look.pitch,
-            hfov: look.hfov,
+            yaw: look.yaw_deg(),
+            pitch: look.pitch_deg(),
+            hfov: look.hfov_deg(),
         };
         let dir = match path.parent() {
             Some(d) if !d.as_os_str().is_empty() => d,

@@ -2,10 +2,10 @@
 //! hotspots, back/forward and the scene list (the state is `crate::window::tour`).
 
 use super::App;
-use crate::window::input::{Look, HFOV_HOME};
+use crate::window::input::{steer_rect, HFOV_HOME};
 use crate::window::loader::Source;
 use crate::window::tour::{self, TourAction, TourNav};
-use lut_core::StartView;
+use lut_core::{StartView, View};
 use std::path::PathBuf;
 
 impl App {
@@ -85,8 +85,8 @@ impl App {
     /// A panorama was shown at start view `v` (the document's effect): a tour scene
     /// arrives at the view its link names (crossfading from the last frame); anything
     /// else leaves the tour.
-    pub(super) fn tour_start_view(&mut self, v: StartView) -> Look {
-        let file = Look::new(v.yaw_deg, v.pitch_deg, v.hfov_deg.unwrap_or(HFOV_HOME));
+    pub(super) fn tour_start_view(&mut self, v: StartView) -> View {
+        let file = steer_rect(v.yaw_deg, v.pitch_deg, v.hfov_deg.unwrap_or(HFOV_HOME));
         let Some(nav) = self.tour.as_mut() else {
             return file;
         };
@@ -115,7 +115,7 @@ impl App {
                     );
                 }
                 self.printed_tour.clear();
-                Look::new(a.yaw, a.pitch, a.hfov)
+                steer_rect(a.yaw, a.pitch, a.hfov)
             }
             None => {
                 self.tour = None;
@@ -273,7 +273,7 @@ impl App {
     }
 
     /// `--print-view`: the tour scene and where its hotspots are, when that changed.
-    pub(super) fn print_tour(&mut self, look: &Look, size: (u32, u32)) {
+    pub(super) fn print_tour(&mut self, look: &View, size: (u32, u32)) {
         let Some(nav) = &self.tour else {
             return;
         };

@@ -2,8 +2,9 @@
 //! pitch that put a direction at a point (grab drags and zooms toward the cursor, in every
 //! output projection), and the zoom limit from the map's resolution.
 
-use super::{Look, HFOV_MAX, HFOV_MIN};
+use super::{moved, steer_rect, HFOV_MAX, HFOV_MIN};
 use glam::DVec3;
+use lut_core::View;
 use lut_core::{dir_to_lat_long, wrap_deg, Camera};
 
 /// The narrowest hfov at which one map pixel covers `screen_px_per_map_px` screen pixels
@@ -23,8 +24,8 @@ pub fn resolution_hfov(map_px_deg: f64, scene_width: u32, screen_px_per_map_px: 
 
 /// World direction (unit) through image-plane point `pos` of a `size` scene for `look`
 /// (in its projection); zero where the projection has none (outside a fisheye's disc).
-pub fn dir_at(look: &Look, pos: (f64, f64), size: (u32, u32)) -> DVec3 {
-    Camera::new(look.view(), size.0.max(1), size.1.max(1))
+pub fn dir_at(look: &View, pos: (f64, f64), size: (u32, u32)) -> DVec3 {
+    Camera::new(*look, size.0.max(1), size.1.max(1))
         .ray(pos.0, pos.1)
         .map_or(DVec3::ZERO, DVec3::normalize_or_zero)
 }
@@ -41,7 +42,7 @@ pub fn solve_grab(
     hfov: f64,
     prev_pitch: f64,
 ) -> (f64, f64) {
-    let base = Look::new(0.0, 0.0, hfov);
+    let base = steer_rect(0.0, 0.0, hfov);
     solve_grab_in(dir, pos, size, base, prev_pitch).unwrap_or((0.0, prev_pitch))
 }
 
@@ -51,11 +52,11 @@ pub fn solve_grab_in(
     dir: DVec3,
     pos: (f64, f64),
     size: (u32, u32),
-    base: Look,
+    base: View,
     prev_pitch: f64,
 ) -> Option<(f64, f64)> {
-    let base = base.moved(0.0, 0.0, base.hfov);
-    let cam = Camera::new(base.view(), size.0.max(1), size.1.max(1));
+    let base = moved(base, 0.0, 0.0, base.hfov_deg());
+    let cam = Camera::new(base, size.0.max(1), size.1.max(1));
     // At yaw 0 and pitch 0 the world ray is the camera-space ray.
     let c = cam.ray(pos.0, pos.1)?.normalize_or_zero();
     if dir == DVec3::ZERO || c == DVec3::ZERO {

@@ -10,8 +10,8 @@
 //!   the look it leaves (returns to), so the centre of the picture does not jump where the
 //!   projection changes; only the periphery does. Any input finishes a transition at once.
 
-use super::{Controller, Look, HFOV_MAX, HFOV_MIN};
-use lut_core::{wrap_deg, Named, ViewProjection};
+use super::{moved, steer, Controller, HFOV_MAX, HFOV_MIN};
+use lut_core::{wrap_deg, Named, View, ViewProjection};
 
 /// The widest hfov the window allows in any projection (a full-sphere fisheye).
 pub const WIDE_HFOV_MAX: f64 = 360.0;
@@ -39,8 +39,8 @@ pub fn widest_hfov(p: ViewProjection) -> f64 {
 
 /// The stereographic hfov whose centre scale (the focal length: every projection maps
 /// small angles θ to radius f·θ) equals `l`'s.
-fn stereo_hfov_like(l: Look) -> f64 {
-    let f = l.projection.focal(1000, l.hfov.to_radians());
+fn stereo_hfov_like(l: View) -> f64 {
+    let f = l.projection().focal(1000, l.hfov_deg().to_radians());
     let h = (4.0 * (250.0 / f).atan()).to_degrees();
     h.clamp(HFOV_MIN, widest_hfov(ViewProjection::Stereographic))
 }
@@ -49,15 +49,15 @@ fn stereo_hfov_like(l: Look) -> f64 {
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Planet {
     /// The look before the little planet (where the key returns).
-    back: Look,
+    back: View,
     /// The transition in progress.
     moving: Option<Transition>,
 }
 
 #[derive(Debug, Clone, Copy)]
 struct Transition {
-    from: Look,
-    to: Look,
+    from: View,
+    to: View,
     t0: f64,
     /// True when leaving the little planet (`back`'s projection returns at the end).
     leaving: bool,
@@ -69,14 +69,14 @@ impl Controller {
     pub fn set_projection(&mut self, p: ViewProjection) {
         self.planet = None;
         let l = self.look;
-        self.look = Look::in_projection(l.yaw, l.pitch, l.hfov, p);
+        self.look = steer(l.yaw_deg(), l.pitch_deg(), l.hfov_deg(), p);
     }
 
     /// The next projection of [`ViewProjection::ALL`] after the one in use (Pannini with
     /// parameter `pannini_d`); returns it.
     pub fn cycle_projection(&mut self, pannini_d: f64) -> ViewProjection {
         let all = ViewProjection::ALL;
-        let name = self.look.projection.name();
+        let name = self.look.projection().name();
         let i = all.iter().position(|p| p.name() == name).unwrap_or(0);
         let next = all[(i + 1) % all.len()].with_pannini_d(pannini_d);
         self.set_projection(next);
@@ -95,16 +95,12 @@ impl Controller {
         self.finish_planet_transition();
         let stereo = ViewProjection::Stereographic;
         let l = self.look;
-        let from = Look::in_projection(l.yaw, l.pitch, stereo_hfov_like(l), stereo);
+        let from = steer(l.yaw_deg(), l.pitch_deg(), stereo_hfov_like(l), stereo);
         let (back, to, leaving) = match self.planet {
-            None => (
-                l,
-                Look::in_projection(l.yaw, -90.0, PLANET_HFOV, stereo),
-                false,
-            ),
+            None => (l, steer(l.yaw_deg(), -90.0, PLANET_HFOV, stereo), false),
             Some(p) => {
                 let b = p.back;
-                let to = Look::in_projection(b.yaw, b.pitch, stereo_hfov_like(b), stereo);
+                let to = steer(b.yaw_deg(), b.pitch_deg(), stereo_hfov_like(b), stereo);
                 (b, to, true)
             }
         };
@@ -139,9 +135,14 @@ impl Controller {
         }
         let e = s * s * (3.0 - 2.0 * s);
         let (f, to) = (m.from, m.to);
-        let yaw = f.yaw + wrap_deg(to.yaw - f.yaw) * e;
+        let yaw = f.yaw_deg() + wrap_deg(to.yaw_deg() - f.yaw_deg()) * e;
         let lerp = |a: f64, b: f64| a + (b - a) * e;
-        self.look = f.moved(yaw, lerp(f.pitch, to.pitch), lerp(f.hfov, to.hfov));
+        self.look = moved(
+            f,
+            yaw,
+            lerp(f.pitch_deg(), to.pitch_deg()),
+            lerp(f.hfov_deg(), to.hfov_deg()),
+        );
     }
 
     /// End a transition at its target now (any input does).
@@ -154,7 +155,7 @@ impl Controller {
         };
         if m.leaving {
             let b = p.back;
-            self.look = b.moved(b.yaw, b.pitch, self.clamp_hfov(b.hfov));
+            self.look = moved(b, b.yaw_deg(), b.pitch_deg(), self.clamp_hfov(b.hfov_deg()));
             self.planet = None;
         } else {
             self.look = m.to;
@@ -166,8 +167,7 @@ impl Controller {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::window::input::{dir_at, DEFAULT_FRAME_S};
-    use lut_core::View;
+    use crate::window::input::{dir_at, steer_rect, DEFAULT_FRAME_S};
 
     const SIZE: (u32, u32) = (400, 300);
 
@@ -176,7 +176,7 @@ mod tests {
     }
 
     /// A controller as the window sets it up: the zoom range up to the widest view.
-    fn controller(look: Look) -> Controller {
+    fn controller(look: View) -> Controller {
         let mut c = Controller::new(look);
         c.set_zoom_range(HFOV_MIN, WIDE_HFOV_MAX);
         c
@@ -206,19 +206,19 @@ mod tests {
             P::Pannini(0.5),
             P::Pannini(3.0),
         ] {
-            let l = Look::in_projection(10.0, -30.0, 1000.0, p);
-            assert_eq!(l.hfov, widest_hfov(p), "{p}");
+            let l = steer(10.0, -30.0, 1000.0, p);
+            assert_eq!(l.hfov_deg(), widest_hfov(p), "{p}");
             assert!(
-                View::with_projection(l.yaw, l.pitch, l.hfov, p).is_ok(),
+                View::with_projection(l.yaw_deg(), l.pitch_deg(), l.hfov_deg(), p).is_ok(),
                 "{p}"
             );
-            assert_eq!(l.view().projection(), p);
+            assert_eq!(l.projection(), p);
         }
     }
 
     #[test]
     fn cycling_visits_every_projection_and_clamps_hfov() {
-        let mut c = controller(Look::new(30.0, 10.0, 90.0));
+        let mut c = controller(steer_rect(30.0, 10.0, 90.0));
         let names: Vec<&str> = (0..5).map(|_| c.cycle_projection(0.7).name()).collect();
         assert_eq!(
             names,
@@ -230,25 +230,25 @@ mod tests {
                 "rectilinear"
             ]
         );
-        assert_eq!((c.look().yaw, c.look().pitch), (30.0, 10.0));
+        assert_eq!((c.look().yaw_deg(), c.look().pitch_deg()), (30.0, 10.0));
         // Pannini carries the panel's d.
         c.set_projection(ViewProjection::Pannini(0.7));
-        assert_eq!(c.look().view().projection(), ViewProjection::Pannini(0.7));
+        assert_eq!(c.look().projection(), ViewProjection::Pannini(0.7));
         // Zoomed out to a 300° fisheye, back to rectilinear: hfov comes in to 170.
         c.set_projection(ViewProjection::Fisheye);
         c.zoom_to(300.0, None, SIZE);
-        assert_eq!(c.look().hfov, 300.0);
+        assert_eq!(c.look().hfov_deg(), 300.0);
         c.set_projection(ViewProjection::Rectilinear);
-        assert_eq!(c.look().hfov, HFOV_MAX);
+        assert_eq!(c.look().hfov_deg(), HFOV_MAX);
         assert_eq!(c.zoom_range().1, HFOV_MAX);
         c.zoom_to(200.0, None, SIZE);
-        assert_eq!(c.look().hfov, HFOV_MAX);
+        assert_eq!(c.look().hfov_deg(), HFOV_MAX);
         assert!(c.take_zoomed_past_widest(), "past the rectilinear widest");
     }
 
     #[test]
     fn little_planet_goes_in_and_comes_back_animated() {
-        let start = Look::new(40.0, 10.0, 80.0);
+        let start = steer_rect(40.0, 10.0, 80.0);
         let mut c = controller(start);
         c.frame(0.0);
         assert!(c.toggle_planet(1.0), "going in");
@@ -257,18 +257,23 @@ mod tests {
         // Halfway: stereographic, between the two looks (smoothstep: half way).
         c.frame(1.0 + PLANET_S / 2.0);
         let mid = c.look();
-        assert_eq!(mid.projection, ViewProjection::Stereographic);
-        close(mid.pitch, (10.0 - 90.0) / 2.0, 1e-9, "pitch half way");
+        assert_eq!(mid.projection(), ViewProjection::Stereographic);
+        close(mid.pitch_deg(), (10.0 - 90.0) / 2.0, 1e-9, "pitch half way");
         // From the stereographic hfov with rectilinear 80°'s centre scale (91.0°).
         let h0 = 4.0 * (40f64.to_radians().tan() / 2.0).atan().to_degrees();
         close(h0, 91.0, 0.05, "matched hfov");
-        close(mid.hfov, (h0 + PLANET_HFOV) / 2.0, 1e-9, "hfov half way");
+        close(
+            mid.hfov_deg(),
+            (h0 + PLANET_HFOV) / 2.0,
+            1e-9,
+            "hfov half way",
+        );
         assert!(
             c.frame(1.0 + PLANET_S / 2.0 + 0.05).fast,
             "the transition is motion"
         );
         c.frame(1.0 + PLANET_S + 0.01);
-        let planet = Look::in_projection(40.0, -90.0, PLANET_HFOV, ViewProjection::Stereographic);
+        let planet = steer(40.0, -90.0, PLANET_HFOV, ViewProjection::Stereographic);
         assert_eq!(c.look(), planet);
         assert!(!c.animating() && c.in_planet());
         // Turn the planet, then leave: back to the look it left, projection included.
@@ -281,14 +286,14 @@ mod tests {
         );
         c.frame(3.05);
         c.set_held(crate::window::input::Held::default(), 3.05);
-        assert!(c.look().yaw != 40.0 && c.look().pitch == -90.0);
+        assert!(c.look().yaw_deg() != 40.0 && c.look().pitch_deg() == -90.0);
         assert!(!c.toggle_planet(4.0), "coming back");
         assert!(!c.in_planet());
         c.frame(4.0 + PLANET_S / 3.0);
-        assert_eq!(c.look().projection, ViewProjection::Stereographic);
+        assert_eq!(c.look().projection(), ViewProjection::Stereographic);
         // Just before the end: the stereographic hfov of the same centre scale.
         c.frame(4.0 + PLANET_S * 0.999);
-        close(c.look().hfov, h0, 1e-3, "glides to the matched hfov");
+        close(c.look().hfov_deg(), h0, 1e-3, "glides to the matched hfov");
         c.frame(4.0 + PLANET_S + 0.01);
         assert_eq!(c.look(), start);
         assert!(!c.animating());
@@ -296,19 +301,19 @@ mod tests {
 
     #[test]
     fn input_during_the_transition_finishes_it() {
-        let mut c = controller(Look::new(0.0, 0.0, 90.0));
+        let mut c = controller(steer_rect(0.0, 0.0, 90.0));
         c.frame(0.0);
         c.toggle_planet(0.0);
         c.frame(0.1);
         c.interacted(0.1);
-        assert_eq!(c.look().pitch, -90.0);
-        assert_eq!(c.look().hfov, PLANET_HFOV);
+        assert_eq!(c.look().pitch_deg(), -90.0);
+        assert_eq!(c.look().hfov_deg(), PLANET_HFOV);
         assert!(!c.animating());
         // Reset leaves the little planet: the start view in the projection in use.
         c.key(crate::window::keys::KeyAction::Reset);
         assert_eq!(
             c.look(),
-            Look::in_projection(0.0, 0.0, 90.0, ViewProjection::Stereographic)
+            steer(0.0, 0.0, 90.0, ViewProjection::Stereographic)
         );
         assert!(!c.in_planet());
     }
@@ -323,7 +328,7 @@ mod tests {
             ViewProjection::Equisolid,
             ViewProjection::Pannini(1.0),
         ] {
-            let mut c = controller(Look::in_projection(20.0, -30.0, 150.0, p));
+            let mut c = controller(steer(20.0, -30.0, 150.0, p));
             let (a, b) = ((150.0, 120.0), (230.0, 170.0));
             let dir = dir_at(&c.look(), a, SIZE);
             c.press(a, SIZE, 0.0);
@@ -333,7 +338,7 @@ mod tests {
             assert!(got.dot(dir) > 1.0 - 1e-9, "{p}: drag {got} vs {dir}");
             let before = dir_at(&c.look(), a, SIZE);
             c.wheel(-2.0, Some(a), SIZE);
-            assert!(c.look().hfov > 150.0, "{p}");
+            assert!(c.look().hfov_deg() > 150.0, "{p}");
             let after = dir_at(&c.look(), a, SIZE);
             assert!(
                 after.dot(before) > 1.0 - 1e-9,
@@ -341,12 +346,7 @@ mod tests {
             );
         }
         // A 360° fisheye in a wide window: the corners have no direction.
-        let mut c = controller(Look::in_projection(
-            0.0,
-            0.0,
-            360.0,
-            ViewProjection::Fisheye,
-        ));
+        let mut c = controller(steer(0.0, 0.0, 360.0, ViewProjection::Fisheye));
         let look = c.look();
         assert_eq!(dir_at(&look, (1.0, 1.0), SIZE), glam::DVec3::ZERO);
         c.press((1.0, 1.0), SIZE, 0.0);

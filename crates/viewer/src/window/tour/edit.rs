@@ -12,7 +12,7 @@
 use super::{scene_source, Pending, TourAction, TourNav};
 use crate::tour::edit::{self, History, Op};
 use crate::tour::{markers, Angles, Format, Horizon};
-use crate::window::input::Look;
+use lut_core::View;
 use std::path::PathBuf;
 
 /// The horizon sliders' range, degrees.
@@ -69,13 +69,13 @@ pub enum EditRequest {
 impl TourNav {
     /// In edit mode, a click at (`x`, `y`) of a `w × h` frame of `look`: on a marker it
     /// selects the hotspot, elsewhere it picks the spot. False when not editing.
-    pub fn edit_click(&mut self, look: &Look, w: u32, h: u32, x: f64, y: f64) -> bool {
+    pub fn edit_click(&mut self, look: &View, w: u32, h: u32, x: f64, y: f64) -> bool {
         if !self.editor.on {
             return false;
         }
         match self.hotspot_at(look, w, h, x, y) {
             Some(i) => self.editor.selected = Some(i),
-            None => self.editor.spot = markers::direction_at(look.view(), w, h, x, y),
+            None => self.editor.spot = markers::direction_at(*look, w, h, x, y),
         }
         true
     }
@@ -91,7 +91,7 @@ impl TourNav {
 
     /// Carry out `req` at the view `look`: the notice to show and, when the scene shown
     /// changed or must reload (a new horizon), what to load.
-    pub fn edit_request(&mut self, req: EditRequest, look: Look) -> Vec<TourAction> {
+    pub fn edit_request(&mut self, req: EditRequest, look: View) -> Vec<TourAction> {
         let cur = self.current;
         let spot = self.editor.spot;
         let sel = self
@@ -175,9 +175,9 @@ impl TourNav {
                 Op::SetStart {
                     scene: cur,
                     start: Angles {
-                        yaw: look.yaw,
-                        pitch: look.pitch,
-                        hfov: look.hfov,
+                        yaw: look.yaw_deg(),
+                        pitch: look.pitch_deg(),
+                        hfov: look.hfov_deg(),
                     },
                 },
             ),
@@ -185,7 +185,7 @@ impl TourNav {
                 "set north",
                 Op::SetNorth {
                     scene: cur,
-                    north: edit::north_facing(look.yaw),
+                    north: edit::north_facing(look.yaw_deg()),
                 },
             ),
             EditRequest::Horizon(h) => (
@@ -284,7 +284,7 @@ impl TourNav {
     /// After an edit: the scene shown found again by its id (or the first scene, when an
     /// undo took it away); the history of visits dropped when scenes came or went (its
     /// indices would be wrong); a reload when the shown scene's horizon changed.
-    fn after(&mut self, (id, n, horizon): (String, usize, Horizon), look: Look) -> Vec<TourAction> {
+    fn after(&mut self, (id, n, horizon): (String, usize, Horizon), look: View) -> Vec<TourAction> {
         if self.tour.scenes.len() != n {
             self.back.clear();
             self.forward.clear();
@@ -319,7 +319,7 @@ impl TourNav {
     }
 
     /// Load the scene shown again (a new horizon), arriving at `look`, no crossfade.
-    fn reload(&mut self, look: Look) -> TourAction {
+    fn reload(&mut self, look: View) -> TourAction {
         match scene_source(&self.tour, self.current) {
             Ok(source) => {
                 self.pending = Some(Pending {
@@ -519,6 +519,7 @@ mod tests {
     use super::super::tests::sample;
     use super::*;
     use crate::tour::HotspotKind;
+    use crate::window::input::steer_rect;
     use crate::window::loader::Source;
 
     fn shown(nav: &mut TourNav) {
@@ -530,7 +531,7 @@ mod tests {
     fn a_click_picks_a_spot_or_selects_a_marker_and_the_panel_edits_there() {
         let mut nav = sample();
         shown(&mut nav);
-        let look = Look::new(60.0, -2.0, 90.0);
+        let look = steer_rect(60.0, -2.0, 90.0);
         let (w, h) = (400, 300);
         assert!(
             !nav.edit_click(&look, w, h, 100.0, 100.0),
@@ -540,7 +541,7 @@ mod tests {
         // A spot: the direction under the pointer, which the markers put back there.
         assert!(nav.edit_click(&look, w, h, 100.0, 80.0));
         let (yaw, pitch) = nav.editor.spot.unwrap();
-        let (x, y) = markers::place(look.view(), w, h, yaw, pitch).unwrap();
+        let (x, y) = markers::place(look, w, h, yaw, pitch).unwrap();
         assert!(
             (x - 100.0).abs() < 1e-6 && (y - 80.0).abs() < 1e-6,
             "{x},{y}"
@@ -591,7 +592,7 @@ mod tests {
         let mut nav = sample();
         shown(&mut nav);
         nav.editor.on = true;
-        let look = Look::new(-25.0, 4.0, 70.0);
+        let look = steer_rect(-25.0, 4.0, 70.0);
         nav.edit_request(EditRequest::SetStart, look);
         assert_eq!(
             nav.scene().start,
@@ -630,7 +631,7 @@ mod tests {
         let mut nav = sample();
         shown(&mut nav);
         nav.editor.on = true;
-        let look = Look::new(0.0, 0.0, 90.0);
+        let look = steer_rect(0.0, 0.0, 90.0);
         // The scene shown cannot be removed.
         assert!(matches!(
             nav.edit_request(EditRequest::RemoveScene(0), look)[..],
@@ -683,7 +684,7 @@ mod tests {
         let (mut nav, _) = TourNav::start(loaded.tour, path.clone()).unwrap();
         shown(&mut nav);
         nav.editor.on = true;
-        let look = Look::new(10.0, 0.0, 90.0);
+        let look = steer_rect(10.0, 0.0, 90.0);
         nav.editor.spot = Some((12.0, -3.0));
         nav.editor.text = "A plaque".into();
         nav.edit_request(EditRequest::AddInfo, look);

@@ -16,7 +16,7 @@ pub fn heat_label(max: f64, mean: f64) -> String {
 
 pub(super) fn projection_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, out: &mut PanelOutput) {
     let s = &mut *m.settings;
-    let current = m.look.projection;
+    let current = m.look.projection();
     section(ui, "Projection", true, |ui| {
         egui::Grid::new("projection").num_columns(2).show(ui, |ui| {
             ui.label("Output");
