@@ -155,8 +155,8 @@ pub fn scene_source(tour: &Tour, i: usize) -> Result<Source, String> {
                 Ok(Source::File(d))
             } else {
                 Err(format!(
-                    "scene \"{}\": Marzipano tiles ({}) do not open in the window yet: \
-                     `viewer tour convert` and `viewer tile` make a pyramid it opens",
+                    "scene \"{}\": Marzipano tiles open from a Marzipano export's data.js \
+                     beside tiles/<id> ({} is not such a folder)",
                     s.id,
                     d.display()
                 ))
