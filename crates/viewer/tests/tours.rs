@@ -697,7 +697,10 @@ fn root_members_of_a_tour_stay_at_the_root_and_saving_is_stable() {
 
 /// The scenes of `tests/data/tours/marzipano-tiles` (their `data.js` levels as
 /// `(tileSize, size)`, with a preview strip or not) and their sources.
-const MARZIPANO_TILES: [(&str, &str, &[(u32, u32)], bool); 2] = [
+/// A scene of that tour: id, source image, levels `(tileSize, size)`, with a preview.
+type MarzipanoScene = (&'static str, &'static str, &'static [(u32, u32)], bool);
+
+const MARZIPANO_TILES: [MarzipanoScene; 2] = [
     (
         "0-courtyard",
         "pannellum/courtyard.jpg",

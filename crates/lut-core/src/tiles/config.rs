@@ -963,7 +963,8 @@ mod tests {
             root.join("1/b/0/0.jpg")
         );
         // Refused, one line each, naming the file and the scene's folder.
-        let bad: &[(&[(u32, u32, bool)], &str)] = &[
+        type Levels<'a> = &'a [(u32, u32, bool)];
+        let bad: &[(Levels, &str)] = &[
             (&[], "no levels"),
             (&[(512, 1000, false)], "not a multiple of its tileSize 512"),
             (&[(256, 256, true)], "fallbackOnly"),

@@ -578,6 +578,8 @@ pub struct TourBarOutput {
     pub chosen: Option<usize>,
     /// The Edit toggle pressed.
     pub edit: bool,
+    /// The Edit toggle's centre (window points), for `--print-view`'s `tour ui` line.
+    pub edit_at: Option<egui::Pos2>,
 }
 
 /// The tour bar below the toolbar: back, forward, and the scene list.
@@ -614,13 +616,12 @@ pub fn tour_bar(ctx: &egui::Context, scene: egui::Rect, nav: &TourNav) -> TourBa
                                     }
                                 }
                             });
-                        out.edit = ui
-                            .selectable_label(nav.editor.on, "Edit")
-                            .on_hover_text(
-                                "Edit the tour: hotspots, start view, north, horizon, scenes; \
+                        let edit = ui.selectable_label(nav.editor.on, "Edit").on_hover_text(
+                            "Edit the tour: hotspots, start view, north, horizon, scenes; \
                                  undo, save",
-                            )
-                            .clicked();
+                        );
+                        out.edit_at = Some(edit.rect.center());
+                        out.edit = edit.clicked();
                     });
                 });
         });
