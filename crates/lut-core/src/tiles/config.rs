@@ -640,7 +640,7 @@ impl MultiresConfig {
     /// No level, no level that is not `fallbackOnly`, more than [`MAX_LEVELS`], a size
     /// outside 1..=[`MAX_CUBE_RESOLUTION`], a tile side outside
     /// [`MIN_TILE_RESOLUTION`]..=[`MAX_TILE_RESOLUTION`] (smaller allowed when it is
-    /// the whole face), a size that is not a multiple of its tile side (Marzipano refuses
+    /// the whole face of a level smaller than that), a size that is not a multiple of its tile side (Marzipano refuses
     /// it too), two levels of one size, a smallest level of more than
     /// [`MAX_BASE_TILES`]² tiles a face, or a preview whose level is more than one tile.
     pub fn marzipano(
@@ -665,7 +665,10 @@ impl MultiresConfig {
                     "level size {size} is not in 1..={MAX_CUBE_RESOLUTION}"
                 )));
             }
-            if !(tile == size || (MIN_TILE_RESOLUTION..=MAX_TILE_RESOLUTION).contains(&tile)) {
+            // A level smaller than the smallest tile is one tile; no tile is larger than
+            // MAX_TILE_RESOLUTION (a tile is decoded whole).
+            let small = tile == size && size < MIN_TILE_RESOLUTION;
+            if !(small || (MIN_TILE_RESOLUTION..=MAX_TILE_RESOLUTION).contains(&tile)) {
                 return Err(bad(format!(
                     "level of size {size}: tileSize {tile} is not in {MIN_TILE_RESOLUTION}..={MAX_TILE_RESOLUTION}"
                 )));
@@ -973,6 +976,7 @@ mod tests {
                 "two levels of size 512",
             ),
             (&[(8, 512, false)], "tileSize 8"),
+            (&[(8, 8, false), (16384, 16384, false)], "tileSize 16384"),
             (&[(0, 512, false)], "tileSize 0"),
             (&[(512, 0, false)], "size 0"),
             (&[(512, 1 << 22, false)], "not in 1..="),
@@ -988,6 +992,8 @@ mod tests {
             );
             assert!(!e.contains('\n'), "{e}");
         }
+        // A level smaller than a tile is one tile.
+        assert!(m(&[(8, 8, true), (16, 32, false)]).is_ok());
         let many: Vec<(u32, u32, bool)> = (1..=30).map(|k| (16, 16 * k, false)).collect();
         assert!(m(&many)
             .unwrap_err()
