@@ -662,3 +662,55 @@ fn a_marzipano_scene_renders_its_levels_cubes() {
     assert!(best_wrong < 30.0, "mirrored faces score {best_wrong:.1} dB");
     eprintln!("Marzipano tiles against their cubes: worst {worst:.1} dB, mirrored faces {best_wrong:.1} dB");
 }
+
+/// A flat Marzipano scene with uneven levels and tiles of three sizes (the preview
+/// strip, 48, 64) is exactly flat at every level, nearest and bilinear, across every tile
+/// and face edge, both in frames that wait for their tiles and in frames drawn at once
+/// from whatever is decoded (tiles of the wanted level missing: drawn from ancestors of
+/// another tile size, borders filled from them): no hole, no background, no read out of
+/// a tile's buffer (a panic). (Where texels land is the test above's: a flat scene
+/// cannot show it.)
+#[test]
+fn a_flat_marzipano_scene_is_flat_across_levels_of_different_tile_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("tiles/flat");
+    let c = 0x00_4a_91_c3;
+    let levels: Vec<(u32, u32)> = MARZIPANO_LEVELS.iter().map(|l| (l.0, l.1)).collect();
+    lut_core::write_marzipano(&scene, &levels, true, None, &|_, _, _, _, w, h| {
+        vec![c; (w * h) as usize]
+    })
+    .unwrap();
+    let cfg =
+        lut_core::MultiresConfig::marzipano(&dir.path().join("data.js"), &scene, &MARZIPANO_LEVELS)
+            .unwrap();
+    let flat = |px: &[u32], what: &str| {
+        let bad: Vec<(usize, u32)> = px
+            .iter()
+            .copied()
+            .enumerate()
+            .filter(|&(_, p)| p != c)
+            .collect();
+        assert!(bad.is_empty(), "{what}: {bad:x?}");
+    };
+    // At once: a fresh pyramid (only the preview decoded), each frame at the top level.
+    let mut pano = TiledPanorama::with_config(cfg.clone(), 64 << 20, 2);
+    for view in views() {
+        for sampler in [Sampler::Nearest, Sampler::Bilinear] {
+            let mut px = vec![0u32; 97 * 61];
+            pano.render(view, sampler, 4, &mut px, 97, 61, true);
+            flat(&px, &format!("{view:?} at once {sampler:?}"));
+        }
+    }
+    let mut pano = TiledPanorama::with_config(cfg, 64 << 20, 2);
+    for view in views() {
+        for level in 1..=4 {
+            for sampler in [Sampler::Nearest, Sampler::Bilinear] {
+                let mut px = vec![0u32; 97 * 61];
+                let f = pano.render_wait(view, sampler, level, &mut px, 97, 61);
+                assert!(!f.coarser(), "{view:?} level {level}");
+                flat(&px, &format!("{view:?} level {level} {sampler:?}"));
+            }
+        }
+    }
+    assert!(pano.take_notices().is_empty());
+}
