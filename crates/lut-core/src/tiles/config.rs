@@ -1002,6 +1002,62 @@ mod tests {
     }
 
     #[test]
+    fn any_marzipano_levels_are_refused_or_give_a_sound_pyramid() {
+        // Level lists as a data.js may hold them (the tour reader takes whole numbers in
+        // 1..=65536): refused in one line, or every tile within its level and its
+        // children within the next.
+        let (file, root) = (Path::new("t/data.js"), Path::new("t/tiles/s"));
+        let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut next = |n: u64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed % n
+        };
+        let mut ok = 0;
+        for _ in 0..3000 {
+            let k = 1 + next(5) as usize;
+            let levels: Vec<(u32, u32, bool)> = (0..k)
+                .map(|_| {
+                    let tile = [1, 8, 16, 48, 64, 256, 512, 8192, 65536][next(9) as usize];
+                    let size = tile * (1 + next(12) as u32).min(65536 / tile.max(1)).max(1);
+                    let size = if next(4) == 0 {
+                        size + next(7) as u32
+                    } else {
+                        size
+                    };
+                    (tile, size.min(65536), next(3) == 0)
+                })
+                .collect();
+            match MultiresConfig::marzipano(file, root, &levels) {
+                Err(e) => assert!(!e.to_string().contains('\n')),
+                Ok(c) => {
+                    ok += 1;
+                    for l in 1..=c.max_level {
+                        let n = c.tiles_across(l);
+                        assert!(n >= 1 && (l > 1 || n <= MAX_BASE_TILES));
+                        for (x, y) in [(0, 0), (n - 1, n - 1)] {
+                            let id = TileId {
+                                level: l as u8,
+                                face: Face::Right,
+                                y,
+                                x,
+                            };
+                            assert_eq!(c.tile_dims(id), (c.tile_size(l), c.tile_size(l)));
+                            assert!(c.tile_path(id).starts_with(root));
+                            for k in c.children(id) {
+                                let m = c.tiles_across(l + 1);
+                                assert!(k.x < m && k.y < m && k.level as u32 == l + 1);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(ok > 100, "only {ok} level lists accepted");
+    }
+
+    #[test]
     fn level_size_is_repeated_integer_halving() {
         for cube in [1u32, 7, 648, 5216, 8432, 81_488, MAX_CUBE_RESOLUTION] {
             let mut s = cube;
