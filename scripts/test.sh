@@ -69,6 +69,8 @@ if [ -f scripts/window-smoke.sh ]; then
 fi
 stage "tour window test under Xvfb (a hotspot clicked, back and forward)"
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-tour.sh
+stage "tour editor window test under Xvfb (an info hotspot added at a clicked spot, saved)"
+VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-tour-edit.sh
 stage "tiled pyramid window test under Xvfb (tiles loading, coarser then sharp, the cache budget kept)"
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-tiles.sh
 stage "window soak under Xvfb (one minute of random input, drops and the memory curve)"

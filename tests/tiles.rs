@@ -529,3 +529,188 @@ fn a_waited_frame_reads_only_its_own_level_across_tile_edges() {
         }
     }
 }
+
+/// Marzipano's cube geometry, ported from its `src/geometries/Cube.js` and
+/// `src/views/Rectilinear.js` (google/marzipano 7936a4e): texel `(i, j)` of face
+/// `letter` on a level of `size` texels is the vertex `(x, y, −½)`, `x = (i + ½)/size − ½`,
+/// `y = ½ − (j + ½)/size`, rotated about X then Y by the face's `faceRotation`; its
+/// coordinates are `yaw = atan2(x, −z)`, `pitch = acos(y / r) − π/2` (positive down,
+/// `screenToCoordinates`). Returned in this project's world (yaw right, pitch up: our
+/// direction `(cos p · sin y, sin p, cos p · cos y)` with `p = −pitch`). `mirror` mirrors
+/// `x` (a control: a face written the wrong way round).
+fn marzipano_dir(letter: char, size: u32, i: f64, j: f64, mirror: bool) -> glam::DVec3 {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let (rx, ry) = match letter {
+        'f' => (0.0, 0.0),
+        'b' => (0.0, PI),
+        'l' => (0.0, FRAC_PI_2),
+        'r' => (0.0, -FRAC_PI_2),
+        'u' => (FRAC_PI_2, 0.0),
+        'd' => (-FRAC_PI_2, 0.0),
+        _ => unreachable!(),
+    };
+    let mut x = (i + 0.5) / size as f64 - 0.5;
+    if mirror {
+        x = -x;
+    }
+    let (y, z) = (0.5 - (j + 0.5) / size as f64, -0.5);
+    // gl-matrix vec3.rotateX, then vec3.rotateY, about the origin.
+    let (y, z) = (y * rx.cos() - z * rx.sin(), y * rx.sin() + z * rx.cos());
+    let (x, z) = (z * ry.sin() + x * ry.cos(), z * ry.cos() - x * ry.sin());
+    let r = (x * x + y * y + z * z).sqrt();
+    let (yaw, pitch) = (x.atan2(-z), (y / r).acos() - FRAC_PI_2);
+    let p = -pitch;
+    glam::DVec3::new(p.cos() * yaw.sin(), p.sin(), p.cos() * yaw.cos())
+}
+
+/// Uneven Marzipano levels as `(tileSize, size, fallbackOnly)`: a 32-px preview
+/// (fallback only), then 96 (tiles of 48: three times the preview), 192 (tiles of 64),
+/// 320 (tiles of 64: 5/3 of its parent, which Marzipano itself would refuse; drawn here).
+const MARZIPANO_LEVELS: [(u32, u32, bool); 4] = [
+    (32, 32, true),
+    (48, 96, false),
+    (64, 192, false),
+    (64, 320, false),
+];
+
+/// A Marzipano scene written with Marzipano's own geometry ([`marzipano_dir`]) from the
+/// cubes `CubeMap::from_envmap` makes of `map` at each level's size: each texel the
+/// nearest texel of that cube in the texel's Marzipano direction (the very texel when our
+/// reading of Marzipano's faces is right), lossless; level 0 as `preview.jpg`.
+fn marzipano_from_map(dir: &Path, map: &EnvMap, mirror: bool) -> Vec<CubeMap> {
+    let cubes: Vec<CubeMap> = MARZIPANO_LEVELS
+        .iter()
+        .map(|l| CubeMap::from_envmap(map, l.1, Sampler::Bilinear).unwrap())
+        .collect();
+    let levels: Vec<(u32, u32)> = MARZIPANO_LEVELS.iter().map(|l| (l.0, l.1)).collect();
+    lut_core::write_marzipano(dir, &levels, true, None, &|z, f, x0, y0, w, h| {
+        let (cube, size) = (&cubes[z as usize], MARZIPANO_LEVELS[z as usize].1);
+        (y0..y0 + h)
+            .flat_map(|j| (x0..x0 + w).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                let d = marzipano_dir(f, size, i as f64, j as f64, mirror);
+                cube.sample_dir(Sampler::Nearest, d)
+            })
+            .collect()
+    })
+    .unwrap();
+    cubes
+}
+
+/// A Marzipano scene (uneven levels, a preview strip, tiles of two sizes) read through the
+/// second reader renders, at every level, the views of the cube it was cut from (≥ 45 dB:
+/// the same texels); the same scene written with each face mirrored scores far lower, so
+/// the faces' letters and orientation are Marzipano's. The fallback-only preview is never
+/// the level a frame is drawn at.
+#[test]
+fn a_marzipano_scene_renders_its_levels_cubes() {
+    let map = courtyard();
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("tiles/0-courtyard");
+    let cubes = marzipano_from_map(&scene, &map, false);
+    let mirrored = dir.path().join("tiles/mirrored");
+    marzipano_from_map(&mirrored, &map, true);
+    let open = |root: &Path| {
+        let cfg = lut_core::MultiresConfig::marzipano(
+            &dir.path().join("data.js"),
+            root,
+            &MARZIPANO_LEVELS,
+        )
+        .unwrap();
+        TiledPanorama::with_config(cfg, 256 << 20, 2)
+    };
+    let (mut pano, mut wrong) = (open(&scene), open(&mirrored));
+    assert_eq!(
+        (
+            pano.config().cube,
+            pano.config().max_level,
+            pano.config().first_level()
+        ),
+        (320, 4, 2)
+    );
+    let (w, h) = (160, 120);
+    let (mut worst, mut best_wrong) = (f64::INFINITY, 0.0f64);
+    for view in views() {
+        for (l, cube) in cubes.iter().enumerate() {
+            let level = l as u32 + 1;
+            let mut px = vec![0u32; (w * h) as usize];
+            let f = pano.render_wait(view, Sampler::Bilinear, level, &mut px, w, h);
+            assert!(!f.coarser(), "{view:?} level {level}: drawn coarser");
+            let want = cube_frame(cube, view, w, h);
+            let p = psnr(&px, &want);
+            worst = worst.min(p);
+            assert!(p >= 45.0, "{view:?} level {level}: {p:.1} dB");
+            let mut bad = vec![0u32; (w * h) as usize];
+            wrong.render_wait(view, Sampler::Bilinear, level, &mut bad, w, h);
+            best_wrong = best_wrong.max(psnr(&bad, &want));
+        }
+        // A frame never picks the fallback-only preview: a 4 × 3 frame has 8 preview
+        // texels a pixel (level 1 without the rule), and is drawn from level 2, not
+        // blended with the preview.
+        for still in [true, false] {
+            assert_eq!(
+                lut_core::tile_frame_level(pano.store(), view, 4, 3, still),
+                2
+            );
+            assert_eq!(
+                lut_core::tile_trilinear_levels(pano.store(), view, 4, 3, still),
+                (2, 0.0)
+            );
+        }
+    }
+    assert!(pano.take_notices().is_empty());
+    assert!(best_wrong < 30.0, "mirrored faces score {best_wrong:.1} dB");
+    eprintln!("Marzipano tiles against their cubes: worst {worst:.1} dB, mirrored faces {best_wrong:.1} dB");
+}
+
+/// A flat Marzipano scene with uneven levels and tiles of three sizes (the preview
+/// strip, 48, 64) is exactly flat at every level, nearest and bilinear, across every tile
+/// and face edge, both in frames that wait for their tiles and in frames drawn at once
+/// from whatever is decoded (tiles of the wanted level missing: drawn from ancestors of
+/// another tile size, borders filled from them): no hole, no background, no read out of
+/// a tile's buffer (a panic). (Where texels land is the test above's: a flat scene
+/// cannot show it.)
+#[test]
+fn a_flat_marzipano_scene_is_flat_across_levels_of_different_tile_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("tiles/flat");
+    let c = 0x00_4a_91_c3;
+    let levels: Vec<(u32, u32)> = MARZIPANO_LEVELS.iter().map(|l| (l.0, l.1)).collect();
+    lut_core::write_marzipano(&scene, &levels, true, None, &|_, _, _, _, w, h| {
+        vec![c; (w * h) as usize]
+    })
+    .unwrap();
+    let cfg =
+        lut_core::MultiresConfig::marzipano(&dir.path().join("data.js"), &scene, &MARZIPANO_LEVELS)
+            .unwrap();
+    let flat = |px: &[u32], what: &str| {
+        let bad: Vec<(usize, u32)> = px
+            .iter()
+            .copied()
+            .enumerate()
+            .filter(|&(_, p)| p != c)
+            .collect();
+        assert!(bad.is_empty(), "{what}: {bad:x?}");
+    };
+    // At once: a fresh pyramid (only the preview decoded), each frame at the top level.
+    let mut pano = TiledPanorama::with_config(cfg.clone(), 64 << 20, 2);
+    for view in views() {
+        for sampler in [Sampler::Nearest, Sampler::Bilinear] {
+            let mut px = vec![0u32; 97 * 61];
+            pano.render(view, sampler, 4, &mut px, 97, 61, true);
+            flat(&px, &format!("{view:?} at once {sampler:?}"));
+        }
+    }
+    let mut pano = TiledPanorama::with_config(cfg, 64 << 20, 2);
+    for view in views() {
+        for level in 1..=4 {
+            for sampler in [Sampler::Nearest, Sampler::Bilinear] {
+                let mut px = vec![0u32; 97 * 61];
+                let f = pano.render_wait(view, sampler, level, &mut px, 97, 61);
+                assert!(!f.coarser(), "{view:?} level {level}");
+                flat(&px, &format!("{view:?} level {level} {sampler:?}"));
+            }
+        }
+    }
+    assert!(pano.take_notices().is_empty());
+}

@@ -190,11 +190,13 @@ pub use cube::{
     LayoutProblem, UsageProblem, MAX_FACE_SIZE,
 };
 pub use tiles::store::DEFAULT_CACHE_BYTES as DEFAULT_TILE_CACHE_BYTES;
-pub use tiles::{decode_bytes as decode_tile_bytes, generator_levels, write_pyramid};
+pub use tiles::{
+    decode_bytes as decode_tile_bytes, generator_levels, write_marzipano, write_pyramid,
+};
 pub use tiles::{
     frame_level as tile_frame_level, render_tiles, trilinear_levels as tile_trilinear_levels,
-    CacheStats, DecodeStats, MultiresConfig, TileFrame, TileId, TileLoader, TileStore,
-    TiledPanorama, TilesError,
+    CacheStats, DecodeStats, LevelInfo, MultiresConfig, TileFrame, TileId, TileLoader, TileStore,
+    TiledPanorama, TilesError, MARZIPANO_PREVIEW_ORDER,
 };
 
 // Lights.

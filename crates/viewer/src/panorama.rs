@@ -121,28 +121,71 @@ pub fn load_cube(inputs: &[PathBuf], cube: CubeArgs) -> Result<CubeMap> {
 }
 
 /// True when `path` is a tiled pyramid: a folder holding `config.json`, or a `.json`
-/// file (Pannellum's multires configuration; anything else in it is refused when opened).
+/// file (Pannellum's multires configuration; anything else in it is refused when opened),
+/// or a Marzipano scene's folder ([`marzipano_data_js`]).
 pub fn is_tiled(path: &Path) -> bool {
     if path.is_dir() {
-        path.join("config.json").exists()
+        path.join("config.json").exists() || marzipano_data_js(path).is_some()
     } else {
         path.extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"))
     }
 }
 
-/// Open the tiled pyramid at `path` with a cache of `cache_mib` MiB and a decoding
-/// thread per core (at most 8).
+/// The `data.js` of the Marzipano tool export whose scene folder `path` is: a folder
+/// (without `config.json`) named `tiles/<id>`, the export's `data.js` beside `tiles/`.
+pub fn marzipano_data_js(path: &Path) -> Option<PathBuf> {
+    if !path.is_dir() || path.join("config.json").exists() {
+        return None;
+    }
+    let tiles = path.parent()?;
+    if tiles.file_name()? != "tiles" {
+        return None;
+    }
+    let js = tiles.parent()?.join("data.js");
+    js.is_file().then_some(js)
+}
+
+/// The pyramid of the Marzipano scene whose tile folder is `dir` (`tiles/<id>`): its
+/// levels as the `data.js` beside `tiles/` lists them for scene `<id>`.
+///
+/// # Errors
+/// The `data.js` does not read as a tour, does not list the scene (or lists it without
+/// levels), or the levels are refused ([`lut_core::MultiresConfig::marzipano`]).
+pub fn marzipano_config(js: &Path, dir: &Path) -> Result<lut_core::MultiresConfig> {
+    let id = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let loaded = crate::tour::load(js)?;
+    let scene = loaded.tour.scene(&id).ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: no scene \"{}\" (the tile folder {}) opens in it",
+            js.display(),
+            lut_core::one_line(&id),
+            dir.display()
+        )
+    })?;
+    let crate::tour::Source::MarzipanoTiles { levels, .. } = &scene.source else {
+        anyhow::bail!("{}: scene \"{id}\" is not Marzipano tiles", js.display());
+    };
+    Ok(lut_core::MultiresConfig::marzipano(js, dir, levels)?)
+}
+
+/// Open the tiled pyramid at `path` (a Pannellum multires folder or configuration, or a
+/// Marzipano scene's tile folder) with a cache of `cache_mib` MiB and a decoding thread
+/// per core (at most 8).
 pub fn open_tiled(path: &Path, cache_mib: u64) -> Result<lut_core::TiledPanorama> {
     let threads = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(2)
         .clamp(1, 8);
-    Ok(lut_core::TiledPanorama::open(
-        path,
-        (cache_mib as usize).saturating_mul(1 << 20),
-        threads,
-    )?)
+    let budget = (cache_mib as usize).saturating_mul(1 << 20);
+    if let Some(js) = marzipano_data_js(path) {
+        let cfg = marzipano_config(&js, path)?;
+        return Ok(lut_core::TiledPanorama::with_config(cfg, budget, threads));
+    }
+    Ok(lut_core::TiledPanorama::open(path, budget, threads)?)
 }
 
 /// True when `inputs` look like a cube map rather than one panorama image: a folder, six

@@ -694,3 +694,211 @@ fn root_members_of_a_tour_stay_at_the_root_and_saving_is_stable() {
     let t2 = tour::pannellum::to_text(&tour::parse(t1.as_bytes(), path).unwrap().tour).0;
     assert_eq!(t1, t2);
 }
+
+/// The scenes of `tests/data/tours/marzipano-tiles` (their `data.js` levels as
+/// `(tileSize, size)`, with a preview strip or not) and their sources.
+/// A scene of that tour: id, source image, levels `(tileSize, size)`, with a preview.
+type MarzipanoScene = (&'static str, &'static str, &'static [(u32, u32)], bool);
+
+const MARZIPANO_TILES: [MarzipanoScene; 2] = [
+    (
+        "0-courtyard",
+        "pannellum/courtyard.jpg",
+        &[(16, 16), (16, 32), (48, 96)],
+        true,
+    ),
+    (
+        "1-interior",
+        "pannellum/interior.jpg",
+        &[(32, 32), (32, 64)],
+        false,
+    ),
+];
+
+/// Writes `tests/data/tours/marzipano-tiles/tiles/` (run once by hand, the files kept;
+/// README.md there): each level the cube `CubeMap::from_envmap` makes of the scene's
+/// source at the level's size (bilinear), cut as the Marzipano tool cuts it, JPEG q90.
+#[test]
+#[ignore = "writes the test data; run by hand (see tests/data/tours/marzipano-tiles/README.md)"]
+fn make_marzipano_tiles_test_data() {
+    use lut_core::{CubeMap, Face, Sampler};
+    let root = data("marzipano-tiles/tiles");
+    for (id, src, levels, preview) in MARZIPANO_TILES {
+        let map = lut_core::load_map(&data(src), &Default::default(), &mut |_| {}).unwrap();
+        let cubes: Vec<CubeMap> = levels
+            .iter()
+            .map(|l| CubeMap::from_envmap(&map, l.1, Sampler::Bilinear).unwrap())
+            .collect();
+        let dir = root.join(id);
+        let _ = std::fs::remove_dir_all(&dir);
+        lut_core::write_marzipano(&dir, levels, preview, Some(90), &|z, f, x0, y0, w, h| {
+            // Marzipano's letters are our faces in the same orientation (tests/tiles.rs,
+            // a_marzipano_scene_renders_its_levels_cubes, checks it with its geometry).
+            let face = match f {
+                'b' => Face::Back,
+                'd' => Face::Down,
+                'f' => Face::Front,
+                'l' => Face::Left,
+                'r' => Face::Right,
+                _ => Face::Up,
+            };
+            let c = &cubes[z as usize];
+            (y0..y0 + h)
+                .flat_map(|y| (x0..x0 + w).map(move |x| c.pixel(face, x, y)))
+                .collect()
+        })
+        .unwrap();
+    }
+}
+
+/// The Marzipano test tour's scenes open their tiles (the courtyard: a fallback-only
+/// preview strip and levels of 32 and 96 texels, three times apart; the interior: no
+/// preview, level 0 from its tiles): `viewer render --tour data.js --scene ID` and the
+/// scene's tile folder opened alone render the views of the scene's source (the
+/// equirectangular image the tiles were cut from) at ≥ 30 dB (the tiles are q90 JPEG of
+/// cubes resampled from that image, up to 1.5 times its resolution and down to 0.8;
+/// measured worst 32 dB), and the source turned 90° comes nowhere near (measured 20 dB).
+#[test]
+fn marzipano_tour_scenes_render_their_tiles_like_their_sources() {
+    use test_support::pixels::psnr;
+    let tour = data("marzipano-tiles/data.js");
+    let d = tmpdir("marzipano-tiles");
+    let render = |out: &Path, pano: &[&str], view: (f64, f64, f64)| {
+        let (y, p, f) = (view.0.to_string(), view.1.to_string(), view.2.to_string());
+        let mut args = vec!["render"];
+        args.extend_from_slice(pano);
+        args.extend_from_slice(&[
+            "--yaw",
+            &y,
+            "--pitch",
+            &p,
+            "--hfov",
+            &f,
+            "--size",
+            "96x72",
+            "-o",
+            s(out),
+        ]);
+        let o = viewer(&args);
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let img = image::open(out).unwrap().to_rgb8();
+        img.pixels()
+            .map(|p| u32::from(p[0]) << 16 | u32::from(p[1]) << 8 | u32::from(p[2]))
+            .collect::<Vec<u32>>()
+    };
+    // Away from the hotspots (markers are drawn on the tour's renders).
+    let views = [
+        (0.0, 0.0, 70.0),
+        (150.0, 20.0, 80.0),
+        (-100.0, -60.0, 60.0),
+        (45.0, 80.0, 90.0),
+        (200.0, -80.0, 100.0),
+    ];
+    let (mut worst, mut best_wrong) = (f64::INFINITY, 0.0f64);
+    for (id, src, _, _) in MARZIPANO_TILES {
+        let folder = data(&format!("marzipano-tiles/tiles/{id}"));
+        for (k, v) in views.iter().enumerate() {
+            let a = render(
+                &d.join(format!("{id}-{k}-tour.png")),
+                &["--tour", s(&tour), "--scene", id],
+                *v,
+            );
+            let b = render(&d.join(format!("{id}-{k}-folder.png")), &[s(&folder)], *v);
+            let want = render(&d.join(format!("{id}-{k}-src.png")), &[s(&data(src))], *v);
+            for (what, got) in [("tour", &a), ("folder", &b)] {
+                let p = psnr(got, &want);
+                worst = worst.min(p);
+                assert!(p >= 30.0, "{id} {what} {v:?}: {p:.1} dB");
+            }
+            let turned = (v.0 + 90.0, v.1, v.2);
+            let wrong = render(
+                &d.join(format!("{id}-{k}-turned.png")),
+                &[s(&data(src))],
+                turned,
+            );
+            best_wrong = best_wrong.max(psnr(&a, &wrong));
+        }
+    }
+    assert!(
+        best_wrong < worst - 6.0,
+        "control {best_wrong:.1} dB, worst {worst:.1} dB"
+    );
+    eprintln!("Marzipano tour tiles against their sources: worst {worst:.1} dB, turned {best_wrong:.1} dB");
+    let o = viewer(&["tour", "check", s(&tour)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+}
+
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let p = e.unwrap().path();
+        let q = to.join(p.file_name().unwrap());
+        if p.is_dir() {
+            copy_tree(&p, &q);
+        } else {
+            std::fs::copy(&p, &q).unwrap();
+        }
+    }
+}
+
+/// Marzipano levels the reader refuses (a size that is not a multiple of its tile side,
+/// as Marzipano refuses it) and a missing preview: `tour check` names each with its
+/// place, `render` of that scene fails in one line naming the data.js, and the other
+/// scene still renders.
+#[test]
+fn bad_marzipano_levels_are_named_by_check_and_render() {
+    let d = tmpdir("marzipano-bad");
+    copy_tree(&data("marzipano-tiles"), &d);
+    let js = d.join("data.js");
+    let text = std::fs::read_to_string(&js).unwrap().replacen(
+        "\"tileSize\": 48,\n          \"size\": 96",
+        "\"tileSize\": 48,\n          \"size\": 100",
+        1,
+    );
+    std::fs::write(&js, text).unwrap();
+    std::fs::remove_file(d.join("tiles/1-interior/0/u/0/0.jpg")).unwrap();
+    let (ok, lines, _) = check_lines(&js);
+    assert!(!ok);
+    assert!(
+        lines.iter().any(|l| l.contains("scenes.0-courtyard.levels")
+            && l.contains("size 100 is not a multiple of its tileSize 48")),
+        "{lines:?}"
+    );
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.contains("scenes.1-interior.levels (face u, level 0)")),
+        "{lines:?}"
+    );
+    let out = d.join("c.png");
+    let o = viewer(&[
+        "render",
+        "--tour",
+        s(&js),
+        "--scene",
+        "0-courtyard",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    let last = err.lines().last().unwrap_or("");
+    assert!(
+        last.contains("data.js") && last.contains("not a multiple of its tileSize 48"),
+        "{err}"
+    );
+    let o = viewer(&[
+        "render",
+        "--tour",
+        s(&js),
+        "--scene",
+        "1-interior",
+        "-o",
+        s(&out),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

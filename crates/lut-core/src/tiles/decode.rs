@@ -15,6 +15,13 @@ pub const MAX_TILE_FILE_BYTES: u64 = 64 << 20;
 /// The file cannot be read, is not a JPEG or PNG of the tile's size, or is corrupt.
 pub fn decode_tile(cfg: &MultiresConfig, id: TileId) -> Result<Vec<u32>, String> {
     let want = cfg.tile_dims(id);
+    if let Some((path, k)) = cfg.preview_face(id) {
+        // A Marzipano preview: the six faces of level 1 stacked top to bottom.
+        let (w, h) = want;
+        let strip = decode_file(&path, (w, 6 * h))?;
+        let n = w as usize * h as usize;
+        return Ok(strip[k * n..(k + 1) * n].to_vec());
+    }
     decode_file(&cfg.tile_path(id), want)
 }
 

@@ -1,5 +1,5 @@
-//! Tiled multiresolution pyramids (Pannellum's `multires` format) read from disk: the
-//! configuration ([`MultiresConfig`]), decoded tiles in an LRU cache under a byte budget
+//! Tiled multiresolution pyramids (Pannellum's `multires` format, and a Marzipano scene's
+//! tiles) read from disk: the configuration ([`MultiresConfig`]), decoded tiles in an LRU cache under a byte budget
 //! ([`TileStore`]), a background decode pool ([`TileLoader`]) and frames drawn from the
 //! tiles with the cube renderer's kernels ([`render_tiles`]). [`TiledPanorama`] holds the
 //! three together. -> docs/huge.md, "Gigapixel panoramas from tiles".
@@ -11,12 +11,12 @@ pub(crate) mod render;
 pub(crate) mod store;
 pub(crate) mod write;
 
-pub use config::{MultiresConfig, TileId, TilesError};
+pub use config::{LevelInfo, MultiresConfig, TileId, TilesError, MARZIPANO_PREVIEW_ORDER};
 pub use decode::decode_bytes;
 pub use loader::{DecodeStats, TileLoader};
 pub use render::{frame_level, render_tiles, trilinear_levels, TileFrame};
 pub use store::{CacheStats, TileStore};
-pub use write::{generator_levels, write_pyramid};
+pub use write::{generator_levels, write_marzipano, write_pyramid};
 
 use crate::cube::Face;
 use crate::geom::camera::View;
@@ -41,7 +41,17 @@ impl TiledPanorama {
     /// The configuration's [`TilesError`]. Tiles that cannot be decoded are not errors:
     /// they are drawn from their ancestor, or the background, with a notice.
     pub fn open(path: &Path, budget: usize, threads: usize) -> Result<TiledPanorama, TilesError> {
-        let cfg = Arc::new(MultiresConfig::open(path)?);
+        Ok(Self::with_config(
+            MultiresConfig::open(path)?,
+            budget,
+            threads,
+        ))
+    }
+
+    /// Open the pyramid `cfg` describes (a Marzipano scene's,
+    /// [`MultiresConfig::marzipano`]), as [`TiledPanorama::open`].
+    pub fn with_config(cfg: MultiresConfig, budget: usize, threads: usize) -> TiledPanorama {
+        let cfg = Arc::new(cfg);
         let mut store = TileStore::new(cfg.clone(), budget);
         let mut loader = TileLoader::new(cfg.clone(), threads);
         let n = cfg.tiles_across(1);
@@ -59,7 +69,7 @@ impl TiledPanorama {
             })
             .collect();
         loader.load_now(&mut store, &base);
-        Ok(TiledPanorama { store, loader })
+        TiledPanorama { store, loader }
     }
 
     /// The configuration.
@@ -144,19 +154,8 @@ impl TiledPanorama {
         }
         if f.level < cfg.max_level {
             // The next level's tiles under the nearest quarter of those read.
-            let n = cfg.tiles_across(f.level + 1);
             for (id, _, _) in f.touched.iter().take(f.touched.len().div_ceil(4)) {
-                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                    let (x, y) = (id.x * 2 + dx, id.y * 2 + dy);
-                    if x < n && y < n {
-                        out.push(TileId {
-                            level: id.level + 1,
-                            x,
-                            y,
-                            ..*id
-                        });
-                    }
-                }
+                out.extend(cfg.children(*id));
             }
         }
         out

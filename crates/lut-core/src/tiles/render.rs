@@ -106,9 +106,11 @@ pub fn frame_level(store: &TileStore, view: View, width: u32, height: u32, still
     if !m.is_finite() || m <= 0.0 {
         return cfg.max_level;
     }
-    for l in 1..=cfg.max_level {
+    // Levels below `first_level` are fallbacks only (Marzipano's `fallbackOnly`).
+    for l in cfg.first_level()..=cfg.max_level {
         let fl = m * cfg.level_size(l) as f64 / cfg.cube as f64;
-        // Levels halve, so the first with fl ≥ 1/√2 has fl in [0.71, 1.41).
+        // Where levels halve, the first with fl ≥ 1/√2 has fl in [0.71, 1.41) (a level
+        // r times its parent's: [0.71, 0.71·r)).
         if fl >= std::f64::consts::FRAC_1_SQRT_2 {
             return l;
         }
@@ -118,10 +120,12 @@ pub fn frame_level(store: &TileStore, view: View, width: u32, height: u32, still
 
 /// Trilinear between two levels: `(fine, t)`, the frame drawn as `(1 − t)·fine + t·(fine −
 /// 1)`. `fine` is the coarsest level whose texels are at least one per pixel (footprint
-/// `m_l` ≥ 1, [`frame_footprint`] scaled to the level), `t = log2(m_l)` in [0, 1): 0 when
-/// a texel is a pixel, toward 1 as `fine` gets minified by 2 (where its parent's texels
-/// are one per pixel). `t` is 0 when the top level is magnified (no finer level) and on
-/// level 1 (no coarser one).
+/// `m_l` ≥ 1, [`frame_footprint`] scaled to the level), `t = log(m_l) / log(r)` in
+/// [0, 1), `r` the ratio of `fine`'s size to its parent's (2 where levels halve, so
+/// `log2(m_l)`): 0 when a texel is a pixel, toward 1 as `fine` gets minified by `r`
+/// (where its parent's texels are one per pixel). `t` is 0 when the top level is
+/// magnified (no finer level) and on the first level a frame may use (no coarser one:
+/// level 1, or the first that is not a fallback only).
 pub fn trilinear_levels(
     store: &TileStore,
     view: View,
@@ -134,13 +138,15 @@ pub fn trilinear_levels(
     if !m.is_finite() || m <= 0.0 {
         return (cfg.max_level, 0.0);
     }
-    for l in 1..=cfg.max_level {
+    let first = cfg.first_level();
+    for l in first..=cfg.max_level {
         let ml = m * cfg.level_size(l) as f64 / cfg.cube as f64;
         if ml >= 1.0 {
-            let t = if l == 1 {
+            let t = if l == first {
                 0.0
             } else {
-                ml.log2().clamp(0.0, 1.0)
+                let r = cfg.level_size(l) as f64 / cfg.level_size(l - 1) as f64;
+                (ml.ln() / r.ln()).clamp(0.0, 1.0)
             };
             return (l, t);
         }
@@ -227,7 +233,7 @@ impl Ctx<'_> {
             return;
         }
         let cfg = self.store.config();
-        let t = cfg.tile as f64;
+        let t = cfg.tile_size(l) as f64;
         let tiles = cfg.tiles_across(l);
         let at = |i: usize| {
             let dx = run.dx + i as f64;
@@ -299,7 +305,7 @@ impl Ctx<'_> {
         x: usize,
         y: usize,
     ) {
-        let t = self.store.config().tile as f64;
+        let t = self.store.config().tile_size(id.level as u32) as f64;
         let at = |i: usize| {
             let dx = run.dx + i as f64;
             let (a, b, m) = (
@@ -356,14 +362,14 @@ impl Ctx<'_> {
             if self.bilinear && l == self.level && !tile.stale_border().is_empty() {
                 self.note_stale_border(band, id, tile, run, out.len(), x, y);
             }
-            let t = cfg.tile as f64;
+            let t = cfg.tile_size(l) as f64;
             let (kx, ky) = (id.x as f64 * t / run.half, id.y as f64 * t / run.half);
             let shifted = FaceRun {
                 p: [run.p[0] - kx * run.p[2], run.p[1] + ky * run.p[2], run.p[2]],
                 d: [run.d[0] - kx * run.d[2], run.d[1] + ky * run.d[2], run.d[2]],
                 ..*run
             };
-            let side = cfg.tile + 1;
+            let side = cfg.tile_size(l) + 1;
             let texels = Texels::new(&tile.px, side, side, false).expect("a bordered tile");
             if self.bilinear {
                 active().face_rows::<true>(&texels, &shifted, out, &mut band.buf);

@@ -200,10 +200,10 @@ impl TileStore {
         Some(t)
     }
 
-    /// The side of a bordered tile buffer.
+    /// The side of a bordered tile buffer of `level`.
     #[inline]
-    pub(crate) fn stride(&self) -> usize {
-        self.cfg.tile as usize + 2
+    pub(crate) fn stride(&self, level: u32) -> usize {
+        self.cfg.tile_size(level) as usize + 2
     }
 
     /// Record that `id` could not be decoded: drawn from its ancestor from now on, and
@@ -230,7 +230,7 @@ impl TileStore {
         if px.len() != (w as usize) * (h as usize) || w == 0 || h == 0 {
             return Err(format!("{} texels, not {w}×{h}", px.len()));
         }
-        let s = self.stride();
+        let s = self.stride(id.level as u32);
         let mut buf = vec![0u32; s * s];
         for (row, src) in buf[s..]
             .chunks_exact_mut(s)
@@ -326,11 +326,9 @@ impl TileStore {
     fn fill_border(&mut self, id: TileId) {
         let Some(t) = self.tiles.get(&id) else { return };
         let (w, h) = (t.w as i64, t.h as i64);
-        let (x0, y0) = (
-            id.x as i64 * self.cfg.tile as i64,
-            id.y as i64 * self.cfg.tile as i64,
-        );
-        let s = self.stride();
+        let tile = self.cfg.tile_size(id.level as u32) as i64;
+        let (x0, y0) = (id.x as i64 * tile, id.y as i64 * tile);
+        let s = self.stride(id.level as u32);
         let mut ring = Vec::with_capacity(2 * (w + h + 4) as usize);
         let mut stale = Vec::new();
         let mut at = |bx: i64, by: i64| {
@@ -382,7 +380,7 @@ impl TileStore {
     fn texel(&self, level: u32, face: Face, ix: i64, iy: i64, stale: &mut Vec<TileId>) -> u32 {
         let size = self.cfg.level_size(level) as i64;
         if (0..size).contains(&ix) && (0..size).contains(&iy) {
-            let t = self.cfg.tile as i64;
+            let t = self.cfg.tile_size(level) as i64;
             let id = TileId {
                 level: level as u8,
                 face,
@@ -390,7 +388,7 @@ impl TileStore {
                 y: (iy / t) as u32,
             };
             if let Some(tile) = self.tiles.get(&id) {
-                let s = self.stride();
+                let s = self.stride(level);
                 return tile.px[((iy % t) + 1) as usize * s + (ix % t) as usize + 1];
             }
             stale.push(id);
@@ -415,7 +413,7 @@ impl TileStore {
         // The neighbour face's sample reads the tile holding (u, v) and, within half a
         // texel of its edge, that tile's border: the tile is the one wanted.
         let n = self.cfg.tiles_across(level);
-        let t = self.cfg.tile as f64;
+        let t = self.cfg.tile_size(level) as f64;
         let cell = |c: f64| ((c.max(0.0) / t) as u32).min(n - 1);
         let want = TileId {
             level: level as u8,
@@ -445,7 +443,7 @@ impl TileStore {
             let size = self.cfg.level_size(l);
             let sc = size as f64 / top;
             let n = self.cfg.tiles_across(l);
-            let t = self.cfg.tile as f64;
+            let t = self.cfg.tile_size(l) as f64;
             let col = (((u * sc).max(0.0) / t) as u32).min(n - 1);
             let row = (((v * sc).max(0.0) / t) as u32).min(n - 1);
             let id = TileId {
@@ -478,7 +476,7 @@ impl TileStore {
             self.count(l == level);
         }
         let sc = self.cfg.level_size(l) as f64 / size;
-        let t = self.cfg.tile as f64;
+        let t = self.cfg.tile_size(l) as f64;
         let (lu, lv) = (u * sc - id.x as f64 * t, v * sc - id.y as f64 * t);
         let (lu, lv) = (
             lu.max(0.0).min(tile.w as f64),
@@ -489,7 +487,7 @@ impl TileStore {
         let (x0, y0) = ((uu >> FX_BITS) as usize, (vv >> FX_BITS) as usize);
         let fx = ((uu >> (FX_BITS - 8)) & 0xFF) as u32;
         let fy = ((vv >> (FX_BITS - 8)) & 0xFF) as u32;
-        let s = self.stride();
+        let s = self.stride(l);
         let i = y0 * s + x0;
         let (r0, r1) = (&tile.px[i..i + 2], &tile.px[i + s..i + s + 2]);
         lerp_px(lerp_px(r0[0], r0[1], fx), lerp_px(r1[0], r1[1], fx), fy)
@@ -505,9 +503,9 @@ impl TileStore {
             self.count(l == level);
         }
         let sc = self.cfg.level_size(l) as f64 / size;
-        let t = self.cfg.tile as f64;
+        let t = self.cfg.tile_size(l) as f64;
         let x = ((u * sc - id.x as f64 * t).max(0.0) as usize).min(tile.w as usize - 1);
         let y = ((v * sc - id.y as f64 * t).max(0.0) as usize).min(tile.h as usize - 1);
-        tile.px[(y + 1) * self.stride() + x + 1]
+        tile.px[(y + 1) * self.stride(l) + x + 1]
     }
 }

@@ -91,3 +91,73 @@ pub fn write_pyramid(
         .map_err(|e| format!("{}: {e}", dir.display()))?;
     Ok(levels)
 }
+
+/// Write a Marzipano scene's tiles into `dir` (created; the scene's `tiles/<id>`) as the
+/// Marzipano tool lays them out: `{z}/{f}/{y}/{x}.jpg` for `levels` given as
+/// `(tileSize, size)` in size order (`z` the index), faces `b d f l r u`; with `preview`,
+/// level 0 (one tile a face) as `preview.jpg` instead, its six faces stacked in
+/// `bdflru` order. `texels(z, letter, x0, y0, w, h)` gives the tile's `w × h` 0RGB texels
+/// (its top-left texel at `(x0, y0)` of face `letter` at level `z`). `quality`: JPEG
+/// quality, or `None` for PNG bytes under the `.jpg` names (lossless, for tests that
+/// compare pixels; the reader, as browsers, goes by the bytes).
+///
+/// # Errors
+/// A file that cannot be written, as a message naming it.
+pub fn write_marzipano(
+    dir: &Path,
+    levels: &[(u32, u32)],
+    preview: bool,
+    quality: Option<u8>,
+    texels: &(dyn Fn(u32, char, u32, u32, u32, u32) -> Vec<u32> + Sync),
+) -> Result<(), String> {
+    use rayon::prelude::*;
+    let save = |path: &Path, w: u32, h: u32, px: &[u32]| -> Result<(), String> {
+        let rgb: Vec<u8> = px
+            .iter()
+            .flat_map(|p| [(p >> 16) as u8, (p >> 8) as u8, *p as u8])
+            .collect();
+        if let Some(d) = path.parent() {
+            std::fs::create_dir_all(d).map_err(|e| format!("{}: {e}", d.display()))?;
+        }
+        let img = image::RgbImage::from_raw(w, h, rgb).ok_or("tile buffer")?;
+        let r = match quality {
+            None => img.save_with_format(path, image::ImageFormat::Png),
+            Some(q) => {
+                let f =
+                    std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+                image::codecs::jpeg::JpegEncoder::new_with_quality(std::io::BufWriter::new(f), q)
+                    .encode_image(&img)
+            }
+        };
+        r.map_err(|e| format!("{}: {e}", path.display()))
+    };
+    let mut jobs = Vec::new();
+    for (z, &(tile, size)) in levels.iter().enumerate() {
+        if preview && z == 0 {
+            continue;
+        }
+        let n = size.div_ceil(tile);
+        for f in "bdflru".chars() {
+            for y in 0..n {
+                for x in 0..n {
+                    jobs.push((z as u32, f, y, x, tile, size));
+                }
+            }
+        }
+    }
+    jobs.par_iter().try_for_each(|&(z, f, y, x, tile, size)| {
+        let (x0, y0) = (x * tile, y * tile);
+        let (w, h) = ((size - x0).min(tile), (size - y0).min(tile));
+        let px = texels(z, f, x0, y0, w, h);
+        save(&dir.join(format!("{z}/{f}/{y}/{x}.jpg")), w, h, &px)
+    })?;
+    if preview {
+        let s = levels.first().map_or(0, |l| l.1);
+        let strip: Vec<u32> = "bdflru"
+            .chars()
+            .flat_map(|f| texels(0, f, 0, 0, s, s))
+            .collect();
+        save(&dir.join("preview.jpg"), s, 6 * s, &strip)?;
+    }
+    Ok(())
+}

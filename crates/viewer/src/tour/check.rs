@@ -28,6 +28,8 @@ pub fn check(tour: &Tour, file: &Path) -> Vec<Problem> {
                 format!("scenes.{}.{k}", s.id)
             }
         };
+        // A problem found while `file_exists` holds `add`.
+        let mut late: Option<(String, String)> = None;
         let mut file_exists = |rel: &str, what: String| match tour.resolve(rel) {
             Err(why) => add(s.source_line, what, why),
             Ok(p) => match std::fs::metadata(&p) {
@@ -91,22 +93,31 @@ pub fn check(tour: &Tour, file: &Path) -> Vec<Problem> {
                         ),
                     );
                 }
-                // The first tile of the smallest level on every face.
-                if let Some(z) = levels
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, l)| !l.2)
-                    .min_by_key(|(_, l)| l.1)
-                    .map(|(z, _)| z)
-                {
-                    for face in ["b", "d", "f", "l", "r", "u"] {
-                        file_exists(
-                            &format!("{dir}/{z}/{face}/0/0.jpg"),
-                            format!("{} (face {face}, level {z})", place("levels")),
-                        );
+                // The levels as the pyramid reader takes them (sorted by size, `z` the
+                // sorted index), and the smallest level on every face: read at open,
+                // from preview.jpg when the folder has one, else its first tiles.
+                if !levels.is_empty() {
+                    if let Ok(root) = tour.resolve(dir) {
+                        if let Err(e) = lut_core::MultiresConfig::marzipano(file, &root, levels) {
+                            late = Some((place("levels"), e.reason));
+                        }
+                    }
+                    let preview = format!("{dir}/preview.jpg");
+                    if tour.resolve(&preview).is_ok_and(|p| p.is_file()) {
+                        file_exists(&preview, format!("{} (level 0)", place("levels")));
+                    } else {
+                        for face in ["b", "d", "f", "l", "r", "u"] {
+                            file_exists(
+                                &format!("{dir}/0/{face}/0/0.jpg"),
+                                format!("{} (face {face}, level 0)", place("levels")),
+                            );
+                        }
                     }
                 }
             }
+        }
+        if let Some((place, message)) = late {
+            add(s.source_line, place, message);
         }
     }
     // Every scene reachable from the first.

@@ -35,7 +35,7 @@ pub fn level(map: EnvMap, pitch: Option<f64>, roll: Option<f64>) -> Result<EnvMa
 ///
 /// # Errors
 /// The tour does not open, the scene is not in it, or its panorama is a kind `render`
-/// cannot read (tiles), or --tour with --panorama files.
+/// cannot read (Pannellum multires), or --tour with --panorama files.
 pub fn prepare(a: &mut RenderArgs, tour: &Path) -> Result<TourScene> {
     if !a.panorama.is_empty() {
         return Err(usage!(
@@ -75,9 +75,21 @@ pub fn prepare(a: &mut RenderArgs, tour: &Path) -> Result<TourScene> {
             }
             a.panorama = list;
         }
-        Source::Multires(_) | Source::MarzipanoTiles { .. } => {
+        Source::MarzipanoTiles { dir, .. } => {
+            // Opened as a tiled pyramid through the data.js beside tiles/.
+            let d = files(dir)?;
+            if crate::panorama::marzipano_data_js(&d).is_none() {
+                return Err(anyhow!(
+                    "{}: scene \"{id}\": its tiles open from a Marzipano export's data.js beside tiles/<id> ({} is not such a folder)",
+                    tour.display(),
+                    d.display()
+                ));
+            }
+            a.panorama = vec![d];
+        }
+        Source::Multires(_) => {
             return Err(anyhow!(
-                "{}: scene \"{id}\" is tiles (multires / Marzipano): render reads equirectangular and cube scenes",
+                "{}: scene \"{id}\" is multires tiles: render reads equirectangular, cube and Marzipano scenes",
                 tour.display()
             ))
         }

@@ -159,6 +159,8 @@ struct App {
     tour: Option<super::tour::TourNav>,
     /// The tour's scene and hotspot positions as last printed (`--print-view`).
     printed_tour: String,
+    /// The last `tour ui` line printed (`--print-view`).
+    printed_tour_ui: String,
 }
 
 /// Open the window and run until it is closed.
@@ -244,6 +246,7 @@ pub fn run(args: OpenArgs, lights: LightsState) -> Result<()> {
         printed_markers: String::new(),
         tour: None,
         printed_tour: String::new(),
+        printed_tour_ui: String::new(),
     };
     app.take_prefs();
     app.ctl.settings.view_limit = !args.no_view_limit;

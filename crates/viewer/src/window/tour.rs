@@ -156,8 +156,8 @@ pub fn scene_source(tour: &Tour, i: usize) -> Result<Source, String> {
                 Ok(Source::File(d))
             } else {
                 Err(format!(
-                    "scene \"{}\": Marzipano tiles ({}) do not open in the window yet: \
-                     `viewer tour convert` and `viewer tile` make a pyramid it opens",
+                    "scene \"{}\": Marzipano tiles open from a Marzipano export's data.js \
+                     beside tiles/<id> ({} is not such a folder)",
                     s.id,
                     d.display()
                 ))
@@ -580,6 +580,8 @@ pub struct TourBarOutput {
     pub chosen: Option<usize>,
     /// The Edit toggle pressed.
     pub edit: bool,
+    /// The Edit toggle's centre (window points), for `--print-view`'s `tour ui` line.
+    pub edit_at: Option<egui::Pos2>,
 }
 
 /// The tour bar below the toolbar: back, forward, and the scene list.
@@ -616,13 +618,12 @@ pub fn tour_bar(ctx: &egui::Context, scene: egui::Rect, nav: &TourNav) -> TourBa
                                     }
                                 }
                             });
-                        out.edit = ui
-                            .selectable_label(nav.editor.on, "Edit")
-                            .on_hover_text(
-                                "Edit the tour: hotspots, start view, north, horizon, scenes; \
+                        let edit = ui.selectable_label(nav.editor.on, "Edit").on_hover_text(
+                            "Edit the tour: hotspots, start view, north, horizon, scenes; \
                                  undo, save",
-                            )
-                            .clicked();
+                        );
+                        out.edit_at = Some(edit.rect.center());
+                        out.edit = edit.clicked();
                     });
                 });
         });

@@ -194,8 +194,25 @@ impl App {
         let mut edits = if nav.editor.on && !self.dialogs.is_open() {
             tour::edit_panel(ui.ctx(), scene, nav)
         } else {
+            nav.editor.ui_at.clear();
             Vec::new()
         };
+        if self.print_view {
+            // Where the Edit toggle and the edit panel's controls are, when that changed
+            // (scripts/window-tour-edit.sh clicks them).
+            let mut line = String::from("tour ui");
+            let at = bar.edit_at.map(|p| ("edit", p));
+            for (name, p) in at.iter().chain(nav.editor.ui_at.iter()) {
+                line += &format!(" {name}={:.0},{:.0}", p.x, p.y);
+            }
+            if tour::typing(ui.ctx()) {
+                line += " typing";
+            }
+            if line != self.printed_tour_ui {
+                let _ = crate::outln!("{line}");
+                self.printed_tour_ui = line;
+            }
+        }
         if nav.editor.on && !tour::typing(ui.ctx()) {
             edits.extend(ui.input(|i| {
                 let key = |k: egui::Key, shift: bool| {
@@ -247,6 +264,18 @@ impl App {
         let look = self.ctl.look();
         // Editing: the click picks a spot or selects a hotspot.
         if nav.edit_click(&look, size.0, size.1, at.0, at.1) {
+            if self.print_view {
+                let ed = &nav.editor;
+                let _ = match (ed.spot, ed.selected) {
+                    (Some((y, p)), _) => {
+                        crate::outln!(
+                            "tour edit spot yaw={y:.4} pitch={p:.4} selected={:?}",
+                            ed.selected
+                        )
+                    }
+                    (None, s) => crate::outln!("tour edit spot - selected={s:?}"),
+                };
+            }
             return true;
         }
         let Some(i) = nav.hotspot_at(&look, size.0, size.1, at.0, at.1) else {

@@ -35,6 +35,10 @@ pub struct Editor {
     pub target: usize,
     /// A panorama file to add as a scene (a path, relative to the tour's folder or not).
     pub scene_file: String,
+    /// Where the edit panel's text field and Add info and Save buttons were drawn
+    /// (centres, window points; empty when the panel is not shown), for `--print-view`'s
+    /// `tour ui` line (the Xvfb test clicks them).
+    pub ui_at: Vec<(&'static str, egui::Pos2)>,
 }
 
 /// What the edit panel's user asked.
@@ -360,6 +364,7 @@ pub fn edit_panel(ctx: &egui::Context, scene: egui::Rect, nav: &mut TourNav) -> 
     let modified = nav.editor.history.modified();
     let save_to = nav.save_path();
     let ed = &mut nav.editor;
+    ed.ui_at.clear();
     egui::Area::new(egui::Id::new("tour-edit"))
         .fixed_pos(scene.min + egui::vec2(8.0, 84.0))
         .order(egui::Order::Foreground)
@@ -388,14 +393,12 @@ pub fn edit_panel(ctx: &egui::Context, scene: egui::Rect, nav: &mut TourNav) -> 
                             out.push(EditRequest::Redo);
                         }
                         let label = if modified { "Save*" } else { "Save" };
-                        if ui
-                            .button(label)
-                            .on_hover_text(format!(
-                                "Save as a Pannellum config: {}",
-                                save_to.display()
-                            ))
-                            .clicked()
-                        {
+                        let save = ui.button(label).on_hover_text(format!(
+                            "Save as a Pannellum config: {}",
+                            save_to.display()
+                        ));
+                        ed.ui_at.push(("save", save.rect.center()));
+                        if save.clicked() {
                             out.push(EditRequest::Save);
                         }
                     });
@@ -407,11 +410,12 @@ pub fn edit_panel(ctx: &egui::Context, scene: egui::Rect, nav: &mut TourNav) -> 
                     });
                     ui.horizontal(|ui| {
                         ui.label("Text");
-                        ui.add(
+                        let text = ui.add(
                             egui::TextEdit::singleline(&mut ed.text)
                                 .id(egui::Id::new(TEXT_IDS[0]))
                                 .desired_width(160.0),
                         );
+                        ed.ui_at.push(("text", text.rect.center()));
                     });
                     ui.horizontal(|ui| {
                         egui::ComboBox::from_id_salt("tour-edit-target")
@@ -428,11 +432,11 @@ pub fn edit_panel(ctx: &egui::Context, scene: egui::Rect, nav: &mut TourNav) -> 
                         {
                             out.push(EditRequest::AddLink);
                         }
-                        if ui
+                        let info = ui
                             .button("Add info")
-                            .on_hover_text("An info hotspot with the text at the spot")
-                            .clicked()
-                        {
+                            .on_hover_text("An info hotspot with the text at the spot");
+                        ed.ui_at.push(("add-info", info.rect.center()));
+                        if info.clicked() {
                             out.push(EditRequest::AddInfo);
                         }
                     });
