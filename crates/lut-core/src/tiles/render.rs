@@ -15,7 +15,7 @@
 //! tile, whose border holds the neighbours' texels). A pixel assigned to the wrong side of
 //! an edge by rounding reads the same texels through the border.
 
-use super::config::TileId;
+use super::config::{TileId, TileMap, TileSet};
 use super::store::TileStore;
 use crate::cube::{face_axes, face_of, face_uv, Face};
 use crate::geom::camera::{Camera, View};
@@ -23,7 +23,6 @@ use crate::map::sample::Sampler;
 use crate::render::kernel::{active, FaceBuf, FaceRun, Texels};
 use glam::DVec3;
 use rayon::prelude::*;
-use std::collections::HashMap;
 use std::sync::Mutex;
 
 /// What a frame from tiles did.
@@ -188,8 +187,8 @@ impl Rays {
 #[derive(Default)]
 struct Band {
     buf: FaceBuf,
-    touched: HashMap<TileId, (f64, bool)>,
-    ancestors: std::collections::HashSet<TileId>,
+    touched: TileMap<(f64, bool)>,
+    ancestors: TileSet,
 }
 
 /// One frame's fixed inputs.
@@ -453,8 +452,8 @@ pub fn render_tiles(
         cx: w as f64 / 2.0,
         cy: h as f64 / 2.0,
     };
-    let seen: Mutex<HashMap<TileId, (f64, bool)>> = Mutex::new(HashMap::new());
-    let up: Mutex<std::collections::HashSet<TileId>> = Mutex::default();
+    let seen: Mutex<TileMap<(f64, bool)>> = Mutex::default();
+    let up: Mutex<TileSet> = Mutex::default();
     if w == 0 || h == 0 {
         return TileFrame {
             level,
