@@ -119,8 +119,8 @@ impl TileLoader {
     /// Want `ids` (the first the most), instead of whatever was wanted before: tiles
     /// not listed and not yet started are cancelled.
     pub fn request(&mut self, ids: &[TileId]) {
-        let mut q = self.shared.q.lock().unwrap_or_else(|e| e.into_inner());
-        let q = &mut *q;
+        let mut guard = self.shared.q.lock().unwrap_or_else(|e| e.into_inner());
+        let q = &mut *guard;
         let mut seen = HashSet::new();
         q.wanted = ids
             .iter()
@@ -135,7 +135,7 @@ impl TileLoader {
             .chain(q.sent.iter())
             .copied()
             .collect();
-        drop(q);
+        drop(guard);
         self.shared.cv.notify_all();
     }
 
