@@ -189,6 +189,10 @@ struct Band {
     buf: FaceBuf,
     touched: TileMap<(f64, bool)>,
     ancestors: TileSet,
+    /// Pieces read at the frame's level and from an ancestor, added to the store's
+    /// counters once a band (shared atomics per piece cost both threads).
+    hits: u64,
+    misses: u64,
 }
 
 /// One frame's fixed inputs.
@@ -205,7 +209,11 @@ impl Ctx<'_> {
         let d = (x - self.cx).powi(2) + (y - self.cy).powi(2);
         let e = band.touched.entry(id).or_insert((d, hit));
         e.0 = e.0.min(d);
-        self.store.count(hit);
+        if hit {
+            band.hits += 1;
+        } else {
+            band.misses += 1;
+        }
     }
 
     /// Draw `run` (face coordinates of level `l`) on `face` into `out` (row `y`, first
@@ -517,6 +525,7 @@ pub fn render_tiles(
                 ctx.run(level, face, &run, &mut line[a..e], &mut band, a, y);
             }
         }
+        store.count_many(band.hits, band.misses);
         up.lock()
             .unwrap_or_else(|e| e.into_inner())
             .extend(band.ancestors);

@@ -209,6 +209,12 @@ impl TileStore {
         std::mem::take(&mut self.notices)
     }
 
+    /// Add a band's reads to the counters.
+    pub(crate) fn count_many(&self, hits: u64, misses: u64) {
+        self.hits.fetch_add(hits, Ordering::Relaxed);
+        self.misses.fetch_add(misses, Ordering::Relaxed);
+    }
+
     pub(crate) fn count(&self, hit: bool) {
         if hit {
             self.hits.fetch_add(1, Ordering::Relaxed);
