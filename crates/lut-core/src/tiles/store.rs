@@ -291,9 +291,9 @@ impl TileStore {
         self.failed.remove(&id);
         // Refilled: the new tile's whole border, the side (and corners) of each decoded
         // neighbour on its face that faces it, and where it touches a face edge the whole
-        // border of the decoded tiles across that edge near it. Twice: a border across a
-        // face edge is a bilinear sample of the neighbour face, which near a corner reads
-        // that face's own border (refilled in the first pass).
+        // border of the decoded tiles across that edge near it. Those reaching across a
+        // face edge twice: such a border is a bilinear sample of the neighbour face, which
+        // near a corner reads that face's own border (refilled in the first pass).
         let mut refill: Vec<(TileId, u8)> = self
             .neighbours(id)
             .into_iter()
@@ -301,8 +301,15 @@ impl TileStore {
             .collect();
         refill.sort_unstable();
         refill.push((id, ALL_SIDES));
-        for _ in 0..2 {
-            for &(n, sides) in &refill {
+        for &(n, sides) in &refill {
+            self.fill_border(n, sides);
+        }
+        // The second pass only where a border reaches across a face edge: a border inside
+        // the face repeats texels of its own level (never a border) or samples an
+        // ancestor's, and neither changed in the first pass.
+        let across = self.cfg.tiles_across(id.level as u32) - 1;
+        for &(n, sides) in &refill {
+            if n.x == 0 || n.y == 0 || n.x == across || n.y == across {
                 self.fill_border(n, sides);
             }
         }
