@@ -5,7 +5,7 @@
 
 use super::config::{MultiresConfig, TileId};
 use super::decode::decode_tile;
-use super::store::TileStore;
+use super::store::{bordered, TileStore};
 use std::collections::HashSet;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{channel, Receiver, Sender};
@@ -13,13 +13,29 @@ use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+/// A tile decoded (its texels laid out for the store's border, [`bordered`]) or why not.
 type Done = (TileId, Result<Vec<u32>, String>);
+
+/// What the pool's threads call to read and decode a tile: [`decode_tile`], or a test's
+/// stand-in (one that blocks proves frames never wait for a decode).
+pub(crate) type Decoder = dyn Fn(&MultiresConfig, TileId) -> Result<Vec<u32>, String> + Send + Sync;
+
+/// The most tiles one [`TileLoader::pump_some`] call takes in by default, and the time
+/// after which it stops early: each arrival fills its border and refills its
+/// neighbours' (work on the frame's thread), so a burst of arrivals is spread over frames
+/// instead of stalling one (the 0.5–1 s frames of the first bench, docs/huge.md).
+pub const PUMP_MAX_TILES: usize = 32;
+/// See [`PUMP_MAX_TILES`].
+pub const PUMP_MAX_TIME: Duration = Duration::from_millis(4);
 
 #[derive(Default)]
 struct Queue {
     /// Wanted tiles, the next to decode last.
     wanted: Vec<TileId>,
     busy: HashSet<TileId>,
+    /// Decoded and sent, not yet taken in by [`TileLoader::pump_some`]: not decoded
+    /// again when requested meanwhile.
+    sent: HashSet<TileId>,
     stop: bool,
 }
 
@@ -65,6 +81,15 @@ impl std::fmt::Debug for TileLoader {
 impl TileLoader {
     /// Start `threads` decoding threads (at least one) for `cfg`.
     pub fn new(cfg: Arc<MultiresConfig>, threads: usize) -> TileLoader {
+        TileLoader::with_decoder(cfg, threads, Arc::new(decode_tile))
+    }
+
+    /// [`TileLoader::new`] with the threads calling `decoder` instead of [`decode_tile`].
+    pub(crate) fn with_decoder(
+        cfg: Arc<MultiresConfig>,
+        threads: usize,
+        decoder: Arc<Decoder>,
+    ) -> TileLoader {
         let shared = Arc::new(Shared {
             q: Mutex::new(Queue::default()),
             cv: Condvar::new(),
@@ -76,9 +101,10 @@ impl TileLoader {
         let threads = (0..threads.max(1))
             .map(|i| {
                 let (s, c, tx) = (shared.clone(), cfg.clone(), tx.clone());
+                let d = decoder.clone();
                 std::thread::Builder::new()
                     .name(format!("tiles-{i}"))
-                    .spawn(move || worker(&s, &c, &tx))
+                    .spawn(move || worker(&s, &c, &*d, &tx))
                     .expect("spawn a tile decoding thread")
             })
             .collect();
@@ -93,18 +119,23 @@ impl TileLoader {
     /// Want `ids` (the first the most), instead of whatever was wanted before: tiles
     /// not listed and not yet started are cancelled.
     pub fn request(&mut self, ids: &[TileId]) {
-        let mut q = self.shared.q.lock().unwrap_or_else(|e| e.into_inner());
-        let busy = q.busy.clone();
+        let mut guard = self.shared.q.lock().unwrap_or_else(|e| e.into_inner());
+        let q = &mut *guard;
+        let mut seen = HashSet::new();
         q.wanted = ids
             .iter()
             .rev()
-            .filter(|id| !busy.contains(id))
+            .filter(|id| !q.busy.contains(id) && !q.sent.contains(id) && seen.insert(**id))
             .copied()
             .collect();
-        let mut seen = HashSet::new();
-        q.wanted.retain(|id| seen.insert(*id));
-        self.outstanding = q.wanted.iter().chain(q.busy.iter()).copied().collect();
-        drop(q);
+        self.outstanding = q
+            .wanted
+            .iter()
+            .chain(q.busy.iter())
+            .chain(q.sent.iter())
+            .copied()
+            .collect();
+        drop(guard);
         self.shared.cv.notify_all();
     }
 
@@ -125,17 +156,42 @@ impl TileLoader {
     /// Hand the decoded tiles to `store` (a tile that failed: its one notice); returns
     /// how many arrived.
     pub fn pump(&mut self, store: &mut TileStore) -> usize {
+        self.pump_some(store, usize::MAX, None)
+    }
+
+    /// [`TileLoader::pump`] of at most `max` tiles, stopping early once `time` has passed
+    /// (after one tile at least); the rest wait in the channel for the next call. Never
+    /// waits for a tile.
+    pub fn pump_some(
+        &mut self,
+        store: &mut TileStore,
+        max: usize,
+        time: Option<Duration>,
+    ) -> usize {
+        let t = Instant::now();
         let mut n = 0;
-        while let Ok((id, r)) = self.rx.try_recv() {
+        while n < max {
+            let Ok((id, r)) = self.rx.try_recv() else {
+                break;
+            };
             self.arrive(store, id, r);
             n += 1;
+            if time.is_some_and(|d| t.elapsed() >= d) {
+                break;
+            }
         }
         n
     }
 
     fn arrive(&mut self, store: &mut TileStore, id: TileId, r: Result<Vec<u32>, String>) {
         self.outstanding.remove(&id);
-        match r.and_then(|px| store.insert(id, &px)) {
+        self.shared
+            .q
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .sent
+            .remove(&id);
+        match r.and_then(|buf| store.insert_bordered(id, buf)) {
             Ok(()) => {}
             Err(e) => store.fail(id, &e),
         }
@@ -180,7 +236,7 @@ impl Drop for TileLoader {
     }
 }
 
-fn worker(s: &Shared, cfg: &MultiresConfig, tx: &Sender<Done>) {
+fn worker(s: &Shared, cfg: &MultiresConfig, decoder: &Decoder, tx: &Sender<Done>) {
     loop {
         let id = {
             let mut q = s.q.lock().unwrap_or_else(|e| e.into_inner());
@@ -199,18 +255,22 @@ fn worker(s: &Shared, cfg: &MultiresConfig, tx: &Sender<Done>) {
         // Behind the decoders' one containment as a whole (the file's read, the path's
         // making): a panic is this tile's error, so the thread lives on and the tile is
         // settled, never waited for (docs/reliability.md, class 2).
-        let r = crate::guard::catch_quiet(|| decode_tile(cfg, id))
+        let r = crate::guard::catch_quiet(|| decoder(cfg, id))
             .unwrap_or_else(|m| Err(format!("the decoder failed on this file ({m})")));
+        let texels = r.as_ref().map_or(0, |px| px.len() as u64);
+        // Laid out for the store here, off the frame's thread.
+        let r = r.and_then(|px| bordered(cfg.tile_size(id.level as u32), cfg.tile_dims(id), &px));
         let ns = u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX);
         s.busy_ns.fetch_add(ns, Ordering::Relaxed);
-        if let Ok(px) = &r {
+        if r.is_ok() {
             s.tiles.fetch_add(1, Ordering::Relaxed);
-            s.texels.fetch_add(px.len() as u64, Ordering::Relaxed);
+            s.texels.fetch_add(texels, Ordering::Relaxed);
         }
-        s.q.lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .busy
-            .remove(&id);
+        {
+            let mut q = s.q.lock().unwrap_or_else(|e| e.into_inner());
+            q.busy.remove(&id);
+            q.sent.insert(id);
+        }
         if tx.send((id, r)).is_err() {
             return;
         }

@@ -13,7 +13,7 @@ pub(crate) mod write;
 
 pub use config::{LevelInfo, MultiresConfig, TileId, TilesError, MARZIPANO_PREVIEW_ORDER};
 pub use decode::decode_bytes;
-pub use loader::{DecodeStats, TileLoader};
+pub use loader::{DecodeStats, TileLoader, PUMP_MAX_TILES, PUMP_MAX_TIME};
 pub use render::{frame_level, render_tiles, trilinear_levels, TileFrame};
 pub use store::{CacheStats, TileStore};
 pub use write::{generator_levels, write_marzipano, write_pyramid};
@@ -41,19 +41,40 @@ impl TiledPanorama {
     /// The configuration's [`TilesError`]. Tiles that cannot be decoded are not errors:
     /// they are drawn from their ancestor, or the background, with a notice.
     pub fn open(path: &Path, budget: usize, threads: usize) -> Result<TiledPanorama, TilesError> {
-        Ok(Self::with_config(
-            MultiresConfig::open(path)?,
-            budget,
-            threads,
-        ))
+        TiledPanorama::open_with(path, budget, threads, Arc::new(decode::decode_tile))
     }
 
     /// Open the pyramid `cfg` describes (a Marzipano scene's,
     /// [`MultiresConfig::marzipano`]), as [`TiledPanorama::open`].
     pub fn with_config(cfg: MultiresConfig, budget: usize, threads: usize) -> TiledPanorama {
+        TiledPanorama::with_config_and_decoder(cfg, budget, threads, Arc::new(decode::decode_tile))
+    }
+
+    /// [`TiledPanorama::open`] with the pool's threads calling `decoder`.
+    pub(crate) fn open_with(
+        path: &Path,
+        budget: usize,
+        threads: usize,
+        decoder: Arc<loader::Decoder>,
+    ) -> Result<TiledPanorama, TilesError> {
+        Ok(TiledPanorama::with_config_and_decoder(
+            MultiresConfig::open(path)?,
+            budget,
+            threads,
+            decoder,
+        ))
+    }
+
+    /// [`TiledPanorama::with_config`] with the pool's threads calling `decoder`.
+    pub(crate) fn with_config_and_decoder(
+        cfg: MultiresConfig,
+        budget: usize,
+        threads: usize,
+        decoder: Arc<loader::Decoder>,
+    ) -> TiledPanorama {
         let cfg = Arc::new(cfg);
         let mut store = TileStore::new(cfg.clone(), budget);
-        let mut loader = TileLoader::new(cfg.clone(), threads);
+        let mut loader = TileLoader::with_decoder(cfg.clone(), threads, decoder);
         let n = cfg.tiles_across(1);
         let base: Vec<TileId> = Face::ALL
             .iter()
@@ -97,9 +118,12 @@ impl TiledPanorama {
         self.loader.pending()
     }
 
-    /// Take the tiles decoded since the last call into the cache; returns how many.
+    /// Take tiles decoded since the last call into the cache, at most
+    /// [`PUMP_MAX_TILES`] and for about [`PUMP_MAX_TIME`] (the rest on the next call:
+    /// a frame is never held up by a burst of arrivals); returns how many.
     pub fn pump(&mut self) -> usize {
-        self.loader.pump(&mut self.store)
+        self.loader
+            .pump_some(&mut self.store, PUMP_MAX_TILES, Some(PUMP_MAX_TIME))
     }
 
     /// A frame that waits for nothing: drawn from what is decoded (missing tiles from
@@ -251,5 +275,118 @@ impl TiledPanorama {
     /// Notices since the last call (one per tile that could not be decoded).
     pub fn take_notices(&mut self) -> Vec<String> {
         self.store.take_notices()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::mpsc;
+    use std::sync::Mutex;
+    use std::time::{Duration, Instant};
+
+    /// A pyramid of faces of `cube` texels in `tile` tiles, each level one flat colour of
+    /// its own (`0x10_00_00 · level`), as PNG (exact colours).
+    fn flat_levels(dir: &Path, cube: u32, tile: u32) -> u32 {
+        write_pyramid(dir, cube, tile, "png", &|id: TileId, _, _, w, h| {
+            vec![0x10_00_00 * id.level as u32; (w * h) as usize]
+        })
+        .unwrap()
+    }
+
+    /// Run `f` on a thread; fail (instead of hanging) when it has not returned within
+    /// 60 s.
+    fn within_a_minute<T: Send + 'static>(what: &str, f: impl FnOnce() -> T + Send + 'static) -> T {
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = tx.send(f());
+        });
+        rx.recv_timeout(Duration::from_secs(60))
+            .unwrap_or_else(|_| panic!("{what}: still waiting after 60 s"))
+    }
+
+    #[test]
+    fn a_frame_never_waits_for_a_decode_that_does_not_finish() {
+        let dir = tempfile::tempdir().unwrap();
+        let levels = flat_levels(dir.path(), 256, 32);
+        assert!(levels >= 3);
+        // Level 1 decodes (the open waits for it); every other tile's decode blocks until
+        // the test lets it go, which it does only after the frames.
+        let (release, gate) = mpsc::channel::<()>();
+        let gate = Arc::new(Mutex::new(gate));
+        let decoder: Arc<loader::Decoder> = Arc::new(move |cfg: &MultiresConfig, id: TileId| {
+            if id.level > 1 {
+                let _ = gate.lock().unwrap().recv();
+                return Err("released".into());
+            }
+            decode::decode_tile(cfg, id)
+        });
+        let mut pano = TiledPanorama::open_with(dir.path(), 64 << 20, 2, decoder).unwrap();
+        let (w, h) = (96u32, 64u32);
+        let frames = within_a_minute("frames with every decode blocked", move || {
+            let mut out = Vec::new();
+            for (k, yaw) in [0.0, 50.0, 130.0, -100.0].into_iter().enumerate() {
+                let view = View::new(yaw, 20.0 * k as f64 - 30.0, 30.0).unwrap();
+                let mut px = vec![0u32; (w * h) as usize];
+                let f = pano.render(view, Sampler::Bilinear, levels, &mut px, w, h, true);
+                out.push((f, px, pano.pending()));
+            }
+            (out, pano)
+        });
+        let (out, pano) = frames;
+        for (f, px, pending) in &out {
+            assert_eq!(f.level, levels);
+            assert!(f.coarser(), "nothing of the top level is decoded");
+            assert!(*pending > 0, "the frame's tiles are requested");
+            // Every pixel from level 1, the one level decoded: no hole, no other colour.
+            assert!(
+                px.iter().all(|&p| p == 0x10_00_00),
+                "drawn from level 1 alone"
+            );
+        }
+        drop(release);
+        drop(pano);
+    }
+
+    #[test]
+    fn a_burst_of_arrivals_is_taken_in_over_several_frames() {
+        let dir = tempfile::tempdir().unwrap();
+        let levels = flat_levels(dir.path(), 512, 16);
+        let mut pano = TiledPanorama::open(dir.path(), 256 << 20, 2).unwrap();
+        let (w, h) = (160u32, 120u32);
+        let view = View::new(10.0, 5.0, 120.0).unwrap();
+        let mut px = vec![0u32; (w * h) as usize];
+        let f = pano.render(view, Sampler::Bilinear, levels, &mut px, w, h, false);
+        let wanted = f.missed().len();
+        assert!(
+            wanted > 2 * PUMP_MAX_TILES,
+            "a burst larger than one frame takes in: {wanted}"
+        );
+        // Let every requested tile be decoded before the next frame.
+        let base = pano.store().stats().decoded;
+        let t = Instant::now();
+        while (pano.decode_stats().tiles as usize) < base as usize + pano.pending() {
+            assert!(t.elapsed() < Duration::from_secs(60), "decoding stalled");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        let mut frames = 0;
+        let mut last = base;
+        while pano.pending() > 0 {
+            pano.render(view, Sampler::Bilinear, levels, &mut px, w, h, false);
+            let now = pano.store().stats().decoded;
+            assert!(
+                now - last <= PUMP_MAX_TILES as u64,
+                "a frame took in {} tiles",
+                now - last
+            );
+            last = now;
+            frames += 1;
+            assert!(frames < 10_000, "the arrivals never all arrive");
+        }
+        assert!(frames >= 2, "the burst was spread over frames");
+        // And then the frame is the top level's colour everywhere.
+        let f = pano.render(view, Sampler::Bilinear, levels, &mut px, w, h, false);
+        assert!(!f.coarser());
+        assert!(px.iter().all(|&p| p == 0x10_00_00 * levels));
     }
 }

@@ -15,7 +15,7 @@
 //! tile, whose border holds the neighbours' texels). A pixel assigned to the wrong side of
 //! an edge by rounding reads the same texels through the border.
 
-use super::config::TileId;
+use super::config::{TileId, TileMap, TileSet};
 use super::store::TileStore;
 use crate::cube::{face_axes, face_of, face_uv, Face};
 use crate::geom::camera::{Camera, View};
@@ -23,7 +23,6 @@ use crate::map::sample::Sampler;
 use crate::render::kernel::{active, FaceBuf, FaceRun, Texels};
 use glam::DVec3;
 use rayon::prelude::*;
-use std::collections::HashMap;
 use std::sync::Mutex;
 
 /// What a frame from tiles did.
@@ -194,8 +193,12 @@ impl Rays {
 #[derive(Default)]
 struct Band {
     buf: FaceBuf,
-    touched: HashMap<TileId, (f64, bool)>,
-    ancestors: std::collections::HashSet<TileId>,
+    touched: TileMap<(f64, bool)>,
+    ancestors: TileSet,
+    /// Pieces read at the frame's level and from an ancestor, added to the store's
+    /// counters once a band (shared atomics per piece cost both threads).
+    hits: u64,
+    misses: u64,
 }
 
 /// One frame's fixed inputs.
@@ -212,7 +215,11 @@ impl Ctx<'_> {
         let d = (x - self.cx).powi(2) + (y - self.cy).powi(2);
         let e = band.touched.entry(id).or_insert((d, hit));
         e.0 = e.0.min(d);
-        self.store.count(hit);
+        if hit {
+            band.hits += 1;
+        } else {
+            band.misses += 1;
+        }
     }
 
     /// Draw `run` (face coordinates of level `l`) on `face` into `out` (row `y`, first
@@ -459,8 +466,8 @@ pub fn render_tiles(
         cx: w as f64 / 2.0,
         cy: h as f64 / 2.0,
     };
-    let seen: Mutex<HashMap<TileId, (f64, bool)>> = Mutex::new(HashMap::new());
-    let up: Mutex<std::collections::HashSet<TileId>> = Mutex::default();
+    let seen: Mutex<TileMap<(f64, bool)>> = Mutex::default();
+    let up: Mutex<TileSet> = Mutex::default();
     if w == 0 || h == 0 {
         return TileFrame {
             level,
@@ -524,6 +531,7 @@ pub fn render_tiles(
                 ctx.run(level, face, &run, &mut line[a..e], &mut band, a, y);
             }
         }
+        store.count_many(band.hits, band.misses);
         up.lock()
             .unwrap_or_else(|e| e.into_inner())
             .extend(band.ancestors);

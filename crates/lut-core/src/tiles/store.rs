@@ -22,13 +22,19 @@
 //! format, corrupt, a decompression bomb) is remembered as failed, drawn from its
 //! ancestor for good, with one notice.
 
-use super::config::{MultiresConfig, TileId};
+use super::config::{MultiresConfig, TileId, TileMap, TileSet};
 use crate::cube::{face_dir, face_of, face_uv, Face};
 use crate::geom::fixed::{FX_BITS, FX_HALF, FX_ONE};
 use crate::map::sample::lerp_px;
-use std::collections::{HashMap, HashSet};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
+
+/// Sides of a tile's border ([`TileStore::fill_border`]'s mask).
+const TOP: u8 = 1;
+const BOTTOM: u8 = 2;
+const LEFT: u8 = 4;
+const RIGHT: u8 = 8;
+const ALL_SIDES: u8 = TOP | BOTTOM | LEFT | RIGHT;
 
 /// The default cache budget: 1 GiB of decoded tiles.
 pub const DEFAULT_CACHE_BYTES: usize = 1 << 30;
@@ -60,6 +66,27 @@ impl Tile {
     pub fn stale_border(&self) -> &[TileId] {
         &self.stale
     }
+}
+
+/// `w × h` row-major texels `px` (a tile of `dims`) placed in a bordered buffer of
+/// `(tile + 2)²` texels, the border left to fill ([`TileStore::insert`]).
+///
+/// # Errors
+/// When `px` is not `dims`' size, or `dims` is empty or larger than `tile`.
+pub(crate) fn bordered(tile: u32, dims: (u32, u32), px: &[u32]) -> Result<Vec<u32>, String> {
+    let (w, h) = dims;
+    if px.len() != (w as usize) * (h as usize) || w == 0 || h == 0 || w > tile || h > tile {
+        return Err(format!("{} texels, not {w}×{h}", px.len()));
+    }
+    let s = tile as usize + 2;
+    let mut buf = vec![0u32; s * s];
+    for (row, src) in buf[s..]
+        .chunks_exact_mut(s)
+        .zip(px.chunks_exact(w as usize))
+    {
+        row[1..=w as usize].copy_from_slice(src);
+    }
+    Ok(buf)
 }
 
 /// Counters the panel and the bench read.
@@ -99,8 +126,8 @@ impl CacheStats {
 #[derive(Debug)]
 pub struct TileStore {
     cfg: Arc<MultiresConfig>,
-    tiles: HashMap<TileId, Tile>,
-    failed: HashSet<TileId>,
+    tiles: TileMap<Tile>,
+    failed: TileSet,
     bytes: usize,
     budget: usize,
     frame: u64,
@@ -117,8 +144,8 @@ impl TileStore {
     pub fn new(cfg: Arc<MultiresConfig>, budget: usize) -> TileStore {
         TileStore {
             cfg,
-            tiles: HashMap::new(),
-            failed: HashSet::new(),
+            tiles: TileMap::default(),
+            failed: TileSet::default(),
             bytes: 0,
             budget,
             frame: 1,
@@ -182,6 +209,12 @@ impl TileStore {
         std::mem::take(&mut self.notices)
     }
 
+    /// Add a band's reads to the counters.
+    pub(crate) fn count_many(&self, hits: u64, misses: u64) {
+        self.hits.fetch_add(hits, Ordering::Relaxed);
+        self.misses.fetch_add(misses, Ordering::Relaxed);
+    }
+
     pub(crate) fn count(&self, hit: bool) {
         if hit {
             self.hits.fetch_add(1, Ordering::Relaxed);
@@ -226,17 +259,25 @@ impl TileStore {
     /// # Errors
     /// When `px` is not the tile's size (then nothing changes).
     pub fn insert(&mut self, id: TileId, px: &[u32]) -> Result<(), String> {
+        let buf = bordered(
+            self.cfg.tile_size(id.level as u32),
+            self.cfg.tile_dims(id),
+            px,
+        )?;
+        self.insert_bordered(id, buf)
+    }
+
+    /// [`TileStore::insert`] of texels already laid out with room for the border
+    /// ([`bordered`], done by the decoding thread: the frame's thread only fills the
+    /// border).
+    ///
+    /// # Errors
+    /// When `buf` is not a bordered buffer of this pyramid's tiles.
+    pub(crate) fn insert_bordered(&mut self, id: TileId, buf: Vec<u32>) -> Result<(), String> {
         let (w, h) = self.cfg.tile_dims(id);
-        if px.len() != (w as usize) * (h as usize) || w == 0 || h == 0 {
-            return Err(format!("{} texels, not {w}×{h}", px.len()));
-        }
         let s = self.stride(id.level as u32);
-        let mut buf = vec![0u32; s * s];
-        for (row, src) in buf[s..]
-            .chunks_exact_mut(s)
-            .zip(px.chunks_exact(w as usize))
-        {
-            row[1..=w as usize].copy_from_slice(src);
+        if buf.len() != s * s || w == 0 || h == 0 {
+            return Err(format!("{} bordered texels, not {s}×{s}", buf.len()));
         }
         let tile = Tile {
             w,
@@ -252,52 +293,130 @@ impl TileStore {
         self.bytes += s * s * 4;
         self.decoded += 1;
         self.failed.remove(&id);
-        // Twice: a border across a face edge is a bilinear sample of the neighbour face,
-        // which near a corner reads that face's own border (refilled in the first pass).
-        let mut refill: Vec<TileId> = self
+        // Refilled: the new tile's whole border, the side (and corners) of each decoded
+        // neighbour on its face that faces it, and where it touches a face edge the whole
+        // border of the decoded tiles across that edge near it. Those reaching across a
+        // face edge twice: such a border is a bilinear sample of the neighbour face, which
+        // near a corner reads that face's own border (refilled in the first pass).
+        let mut refill: Vec<(TileId, u8)> = self
             .neighbours(id)
             .into_iter()
-            .filter(|n| self.tiles.contains_key(n))
+            .filter(|(n, _)| self.tiles.contains_key(n))
             .collect();
         refill.sort_unstable();
-        refill.push(id);
-        for _ in 0..2 {
-            for &n in &refill {
-                self.fill_border(n);
+        refill.push((id, ALL_SIDES));
+        for &(n, sides) in &refill {
+            self.fill_border(n, sides);
+        }
+        // The second pass only where a border reaches across a face edge: a border inside
+        // the face repeats texels of its own level (never a border) or samples an
+        // ancestor's, and neither changed in the first pass.
+        let across = self.cfg.tiles_across(id.level as u32) - 1;
+        for &(n, sides) in &refill {
+            if n.x == 0 || n.y == 0 || n.x == across || n.y == across {
+                self.fill_border(n, sides);
             }
         }
         self.evict(Some(id));
         Ok(())
     }
 
-    /// Tiles whose border may read `id`: the eight around it on its face, and where it
-    /// touches a face edge the decoded tiles of the same level along the other faces'
-    /// edges.
-    fn neighbours(&self, id: TileId) -> Vec<TileId> {
+    /// Tiles whose border may read `id`, each with the sides of its border to refill:
+    /// the eight around it on its face (the side facing it; corners are always
+    /// refilled), and where it touches a face edge the tiles of the same level across that
+    /// edge whose texels its own border reads, with their neighbours along the edge (the
+    /// tile grids of two faces need not line up; whole borders).
+    fn neighbours(&self, id: TileId) -> Vec<(TileId, u8)> {
         let n = self.cfg.tiles_across(id.level as u32) as i64;
         let mut out = Vec::new();
         for dy in -1i64..=1 {
             for dx in -1i64..=1 {
                 let (x, y) = (id.x as i64 + dx, id.y as i64 + dy);
                 if (dx, dy) != (0, 0) && (0..n).contains(&x) && (0..n).contains(&y) {
-                    out.push(TileId {
-                        x: x as u32,
-                        y: y as u32,
-                        ..id
-                    });
+                    // The neighbour's side toward `id` (none for a diagonal one: corners).
+                    let side = match (dx, dy) {
+                        (-1, 0) => RIGHT,
+                        (1, 0) => LEFT,
+                        (0, -1) => BOTTOM,
+                        (0, 1) => TOP,
+                        _ => 0,
+                    };
+                    out.push((
+                        TileId {
+                            x: x as u32,
+                            y: y as u32,
+                            ..id
+                        },
+                        side,
+                    ));
                 }
             }
         }
         let edge = |t: &TileId| t.x == 0 || t.y == 0 || t.x as i64 == n - 1 || t.y as i64 == n - 1;
         if edge(&id) {
-            out.extend(
-                self.tiles
-                    .keys()
-                    .filter(|t| t.level == id.level && t.face != id.face && edge(t))
-                    .copied(),
-            );
+            let mut across = Vec::new();
+            self.border_reads(id, &mut across);
+            across.sort_unstable();
+            across.dedup();
+            let mut near = TileSet::default();
+            for a in across.into_iter().filter(|a| a.face != id.face) {
+                for dy in -1i64..=1 {
+                    for dx in -1i64..=1 {
+                        let (x, y) = (a.x as i64 + dx, a.y as i64 + dy);
+                        if (0..n).contains(&x) && (0..n).contains(&y) {
+                            let t = TileId {
+                                x: x as u32,
+                                y: y as u32,
+                                ..a
+                            };
+                            if edge(&t) && near.insert(t) {
+                                out.push((t, ALL_SIDES));
+                            }
+                        }
+                    }
+                }
+            }
         }
         out
+    }
+
+    /// The tiles of `id`'s level holding the positions its border reads outside its face
+    /// (the neighbouring faces' tiles at those directions), pushed on `out`.
+    fn border_reads(&self, id: TileId, out: &mut Vec<TileId>) {
+        let level = id.level as u32;
+        let size = self.cfg.level_size(level) as i64;
+        let (w, h) = self.cfg.tile_dims(id);
+        let (w, h) = (w as i64, h as i64);
+        let t = self.cfg.tile_size(level) as i64;
+        let (x0, y0) = (id.x as i64 * t, id.y as i64 * t);
+        let n = self.cfg.tiles_across(level);
+        let half = size as f64 / 2.0;
+        let tf = t as f64;
+        let cell = |c: f64| ((c.max(0.0) / tf) as u32).min(n - 1);
+        let mut at = |ix: i64, iy: i64| {
+            if (0..size).contains(&ix) && (0..size).contains(&iy) {
+                return;
+            }
+            let s = 2.0 * (ix as f64 + 0.5) / size as f64 - 1.0;
+            let tt = 1.0 - 2.0 * (iy as f64 + 0.5) / size as f64;
+            let d = face_dir(id.face, s, tt);
+            let f2 = face_of(d);
+            let (u, v) = face_uv(f2, d, half);
+            out.push(TileId {
+                level: id.level,
+                face: f2,
+                x: cell(u),
+                y: cell(v),
+            });
+        };
+        for bx in -1..=w {
+            at(x0 + bx, y0 - 1);
+            at(x0 + bx, y0 + h);
+        }
+        for by in 0..h {
+            at(x0 - 1, y0 + by);
+            at(x0 + w, y0 + by);
+        }
     }
 
     fn evict(&mut self, keep: Option<TileId>) {
@@ -322,36 +441,77 @@ impl TileStore {
         }
     }
 
-    /// Fill the border of decoded tile `id` from its neighbours (or their ancestors).
-    fn fill_border(&mut self, id: TileId) {
+    /// Fill the `sides` ([`TOP`], [`BOTTOM`], [`LEFT`], [`RIGHT`]) and the four corners
+    /// of decoded tile `id`'s border from its neighbours (or their ancestors). A side
+    /// inside the face whose neighbour is decoded is copied from that neighbour's edge
+    /// row or column (one lookup a side); any other texel is [`TileStore::texel`]'s.
+    fn fill_border(&mut self, id: TileId, sides: u8) {
         let Some(t) = self.tiles.get(&id) else { return };
-        let (w, h) = (t.w as i64, t.h as i64);
-        let tile = self.cfg.tile_size(id.level as u32) as i64;
-        let (x0, y0) = (id.x as i64 * tile, id.y as i64 * tile);
-        let s = self.stride(id.level as u32);
-        let mut ring = Vec::with_capacity(2 * (w + h + 4) as usize);
+        let (w, h) = (t.w as usize, t.h as usize);
+        let level = id.level as u32;
+        let tile = self.cfg.tile_size(level) as usize;
+        let n = self.cfg.tiles_across(level);
+        let (x0, y0) = (id.x as i64 * tile as i64, id.y as i64 * tile as i64);
+        let s = self.stride(level);
+        let mut ring: Vec<(usize, u32)> = Vec::with_capacity(2 * (w + h + 4));
         let mut stale = Vec::new();
-        let mut at = |bx: i64, by: i64| {
+        let mut slow = |bx: usize, by: usize, ring: &mut Vec<(usize, u32)>| {
             let v = self.texel(
-                id.level as u32,
+                level,
                 id.face,
-                x0 + bx - 1,
-                y0 + by - 1,
+                x0 + bx as i64 - 1,
+                y0 + by as i64 - 1,
                 &mut stale,
             );
-            ring.push((by as usize * s + bx as usize, v));
+            ring.push((by * s + bx, v));
         };
-        for bx in 0..=w + 1 {
-            at(bx, 0);
-            at(bx, h + 1);
+        for (bx, by) in [(0, 0), (w + 1, 0), (0, h + 1), (w + 1, h + 1)] {
+            slow(bx, by, &mut ring);
         }
-        for by in 1..=h {
-            at(0, by);
-            at(w + 1, by);
+        // Each side: the neighbour on this face, if any, and its length.
+        let plan = [
+            (TOP, id.y.checked_sub(1).map(|y| (id.x, y)), w),
+            (BOTTOM, (id.y + 1 < n).then_some((id.x, id.y + 1)), w),
+            (LEFT, id.x.checked_sub(1).map(|x| (x, id.y)), h),
+            (RIGHT, (id.x + 1 < n).then_some((id.x + 1, id.y)), h),
+        ];
+        for (side, nb, len) in plan {
+            if sides & side == 0 {
+                continue;
+            }
+            let from = nb.and_then(|(x, y)| self.tiles.get(&TileId { x, y, ..id }));
+            for k in 1..=len {
+                // Border position k of this side in this tile's buffer, and the texel of
+                // the neighbour's buffer it repeats (a tile above or left of another is
+                // never short: its last row or column is `tile`).
+                let (bx, by, src) = match side {
+                    TOP => (k, 0, tile * s + k),
+                    BOTTOM => (k, h + 1, s + k),
+                    LEFT => (0, k, k * s + tile),
+                    _ => (w + 1, k, k * s + 1),
+                };
+                match from {
+                    Some(f) => ring.push((by * s + bx, f.px[src])),
+                    None => slow(bx, by, &mut ring),
+                }
+            }
         }
         stale.sort_unstable();
         stale.dedup();
         stale.retain(|&n| n != id);
+        if sides != ALL_SIDES {
+            // The sides not refilled keep what they stood in for, less what has arrived
+            // since (whose arrival refilled them).
+            let old = &self.tiles[&id].stale;
+            let keep: Vec<TileId> = old
+                .iter()
+                .copied()
+                .filter(|k| !self.tiles.contains_key(k))
+                .collect();
+            stale.extend(keep);
+            stale.sort_unstable();
+            stale.dedup();
+        }
         let t = self.tiles.get_mut(&id).expect("present");
         for (i, v) in ring {
             t.px[i] = v;
@@ -360,7 +520,6 @@ impl TileStore {
         // The texels right of and below a short tile's border repeat it (positions inside
         // the tile never read them; a position rounded a hair past the edge reads the
         // border's value).
-        let (w, h) = (w as usize, h as usize);
         for row in t.px.chunks_exact_mut(s).take(h + 2) {
             let edge = row[w + 1];
             row[w + 2..].fill(edge);

@@ -103,6 +103,19 @@ pub struct TilesSample {
     /// The view stopped (after the pan with tiles arriving) to every tile of the view
     /// at the wanted level drawn; `null` when not sharp within 60 s.
     pub sharp_ms: Option<f64>,
+    /// The level the stopped view wants (still: no pixel magnified by more than √2).
+    #[serde(default)]
+    pub sharp_level: u32,
+    /// Tiles decoded from the stop until sharp (the view's missing tiles, their
+    /// ancestors and whatever prefetch was already queued).
+    #[serde(default)]
+    pub sharp_tiles_decoded: u64,
+    /// Tiles of that level the stopped view reads.
+    #[serde(default)]
+    pub sharp_view_tiles: u32,
+    /// Frames drawn from the stop until sharp.
+    #[serde(default)]
+    pub sharp_frames: u32,
     /// Pan over resident tiles: median frame time.
     pub pan_resident_ms_median: f64,
     /// Pan over resident tiles: 99th percentile frame time.
@@ -324,9 +337,15 @@ fn measure(dir: &Path, a: &BenchTilesArgs) -> Result<TilesSample> {
     let stop = pose(n - 1)?;
     let t_stop = Instant::now();
     let mut sharp_ms = None;
+    let decoded_at_stop = pano.decode_stats().tiles;
+    let sharp_level = level(&pano, stop, true);
+    let mut sharp_frames = 0u32;
+    let mut sharp_view_tiles = 0u32;
     while t_stop.elapsed() < Duration::from_secs(60) {
         let l = level(&pano, stop, true);
         let f = pano.render(stop, Sampler::Bilinear, l, &mut px, w, h, true);
+        sharp_frames += 1;
+        sharp_view_tiles = u32::try_from(f.touched.len()).unwrap_or(u32::MAX);
         if !f.coarser() {
             sharp_ms = Some(t_stop.elapsed().as_secs_f64() * 1e3);
             break;
@@ -337,6 +356,8 @@ fn measure(dir: &Path, a: &BenchTilesArgs) -> Result<TilesSample> {
         }
         std::thread::sleep(Duration::from_millis(1));
     }
+
+    let sharp_tiles_decoded = pano.decode_stats().tiles - decoded_at_stop;
 
     // Pan over resident tiles: a slow pan around the stop, its tiles loaded first.
     let resident_pose = |i: u32| -> Result<View> {
@@ -378,6 +399,10 @@ fn measure(dir: &Path, a: &BenchTilesArgs) -> Result<TilesSample> {
         first_picture_ms,
         open_ms,
         sharp_ms,
+        sharp_level,
+        sharp_tiles_decoded,
+        sharp_view_tiles,
+        sharp_frames,
         pan_resident_ms_median: median(&resident),
         pan_resident_ms_p99: quantile(&resident, 0.99),
         pan_resident_coarser: resident_coarser,
@@ -410,12 +435,12 @@ fn print_table(rows: &[TilesSample], a: &BenchTilesArgs) -> Result<()> {
         a.cache_mib
     )?;
     crate::outln!(
-        "| panorama | cube face | levels | cold | first picture ms (open) | sharp ms | pan resident ms median / p99 | pan arriving ms median / p99 (coarser frames) | peak RSS MiB | tiles decoded | tiles/s/thread | Mpx/s/thread |"
+        "| panorama | cube face | levels | cold | first picture ms (open) | sharp ms (level, view's tiles, tiles decoded, frames) | pan resident ms median / p99 | pan arriving ms median / p99 (coarser frames) | peak RSS MiB | tiles decoded | tiles/s/thread | Mpx/s/thread |"
     )?;
     crate::outln!("|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|")?;
     for s in rows {
         crate::outln!(
-            "| {}x{} | {} | {} | {} | {:.0} ({:.0}) | {} | {:.1} / {:.1} | {:.1} / {:.1} ({}) | {:.0} | {} | {:.0} | {:.1} |",
+            "| {}x{} | {} | {} | {} | {:.0} ({:.0}) | {} ({}, {}, {}, {}) | {:.1} / {:.1} | {:.1} / {:.1} ({}) | {:.0} | {} | {:.0} | {:.1} |",
             s.width,
             s.width / 2,
             s.cube,
@@ -424,6 +449,10 @@ fn print_table(rows: &[TilesSample], a: &BenchTilesArgs) -> Result<()> {
             s.first_picture_ms,
             s.open_ms,
             s.sharp_ms.map_or("not sharp".into(), |m| format!("{m:.0}")),
+            s.sharp_level,
+            s.sharp_view_tiles,
+            s.sharp_tiles_decoded,
+            s.sharp_frames,
             s.pan_resident_ms_median,
             s.pan_resident_ms_p99,
             s.pan_arriving_ms_median,
