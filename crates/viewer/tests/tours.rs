@@ -902,3 +902,97 @@ fn bad_marzipano_levels_are_named_by_check_and_render() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// A Pannellum tour's multires scene (its `multiRes` block naming the pyramid folder in
+/// `basePath`, as Pannellum's tours do) renders through `viewer render --tour` as the
+/// pyramid folder rendered alone does (the same pixels: one reader, the window's rule),
+/// and a basePath that holds no pyramid, or leaves the tour's folder, is one line naming
+/// the scene.
+#[test]
+fn a_pannellum_multires_scene_renders_through_its_base_path() {
+    let d = tmpdir("pannellum-multires");
+    copy_tree(
+        &test_support::test_data("multires/generate-py"),
+        &d.join("tiles/court"),
+    );
+    let tour = d.join("tour.json");
+    std::fs::write(
+        &tour,
+        r#"{"default": {"firstScene": "court"}, "scenes": {
+  "court": {"type": "multires", "hfov": 80, "yaw": 30, "pitch": -10,
+            "multiRes": {"basePath": "tiles/court", "path": "/%l/%s%y_%x",
+                         "fallbackPath": "/fallback/%s", "extension": "jpg",
+                         "tileResolution": 64, "maxLevel": 3, "cubeResolution": 160}},
+  "empty": {"type": "multires", "multiRes": {"basePath": "nothing-here"}},
+  "out": {"type": "multires", "multiRes": {"basePath": "../elsewhere"}}}}"#,
+    )
+    .unwrap();
+    let pixels = |args: &[&str], out: &Path| {
+        let mut a = vec!["render"];
+        a.extend_from_slice(args);
+        a.extend_from_slice(&["--size", "96x72", "-o", s(out)]);
+        let o = viewer(&a);
+        assert!(
+            o.status.success(),
+            "{a:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        image::open(out).unwrap().to_rgb8().into_raw()
+    };
+    let via_tour = pixels(&["--tour", s(&tour), "--scene", "court"], &d.join("a.png"));
+    let alone = pixels(
+        &[
+            s(&d.join("tiles/court")),
+            "--yaw",
+            "30",
+            "--pitch",
+            "-10",
+            "--hfov",
+            "80",
+        ],
+        &d.join("b.png"),
+    );
+    assert_eq!(
+        via_tour, alone,
+        "the tour's scene is not its pyramid at its start view"
+    );
+    let turned = pixels(
+        &[
+            s(&d.join("tiles/court")),
+            "--yaw",
+            "120",
+            "--pitch",
+            "-10",
+            "--hfov",
+            "80",
+        ],
+        &d.join("c.png"),
+    );
+    assert_ne!(
+        via_tour, turned,
+        "the control view renders the same picture"
+    );
+    for (scene, says) in [("empty", "nothing-here"), ("out", "scene \"out\"")] {
+        let out = d.join(format!("{scene}.png"));
+        let o = viewer(&[
+            "render",
+            "--tour",
+            s(&tour),
+            "--scene",
+            scene,
+            "-o",
+            s(&out),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{scene}: {err}");
+        // The tour's own problems come first (the "out" scene is left out at load); the
+        // error is one line, the last, naming the scene.
+        let last = err.trim().lines().last().unwrap_or_default();
+        assert!(
+            last.starts_with("viewer: ") && last.contains(says),
+            "{scene}: {err}"
+        );
+        assert_eq!(err.matches("viewer: ").count(), 1, "{scene}: {err}");
+        assert!(!out.exists(), "{scene}: an output was written");
+    }
+}

@@ -386,6 +386,33 @@ impl Tour {
         }
     }
 
+    /// The pyramid folder of a Pannellum multires scene whose `multiRes` block is `m`:
+    /// the tour's folder plus `basePath`, when it holds a tiled pyramid this viewer reads
+    /// (the `config.json` that Pannellum's `generate.py` and `viewer tile` write beside
+    /// the tiles). One rule for the window and `viewer render --tour`.
+    ///
+    /// # Errors
+    /// `basePath` leaves the tour's folder or is a URL, or the folder holds no pyramid:
+    /// one line naming the scene.
+    pub fn multires_dir(&self, scene: &str, m: &serde_json::Value) -> Result<PathBuf, String> {
+        let base = m.get("basePath").and_then(|b| b.as_str()).unwrap_or("");
+        let dir = if base.is_empty() {
+            self.dir.clone()
+        } else {
+            self.resolve(base)
+                .map_err(|why| format!("scene \"{scene}\": {why}"))?
+        };
+        if crate::panorama::is_tiled(&dir) && dir.is_dir() {
+            Ok(dir)
+        } else {
+            Err(format!(
+                "scene \"{scene}\": a multires scene opens when its basePath is a tiled pyramid \
+                 folder with config.json ({} is not)",
+                dir.display()
+            ))
+        }
+    }
+
     /// The view a scene link from `from` (the current scene, seen at `current`) arrives
     /// at, in the target scene: Pannellum's rules (`same`, `sameAzimuth`, or the target's
     /// start view for parts not given). `None` if the target is not in the tour.

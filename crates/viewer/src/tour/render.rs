@@ -34,8 +34,8 @@ pub fn level(map: EnvMap, pitch: Option<f64>, roll: Option<f64>) -> Result<EnvMa
 /// tour's problems are printed on stderr; the scene must open.
 ///
 /// # Errors
-/// The tour does not open, the scene is not in it, or its panorama is a kind `render`
-/// cannot read (Pannellum multires), or --tour with --panorama files.
+/// The tour does not open, the scene is not in it, or its panorama cannot be found (a
+/// multires scene whose basePath holds no tiled pyramid), or --tour with --panorama files.
 pub fn prepare(a: &mut RenderArgs, tour: &Path) -> Result<TourScene> {
     if !a.panorama.is_empty() {
         return Err(usage!(
@@ -69,7 +69,10 @@ pub fn prepare(a: &mut RenderArgs, tour: &Path) -> Result<TourScene> {
             let mut list = Vec::new();
             for f in faces {
                 let Some(f) = f else {
-                    return Err(anyhow!("{}: scene \"{id}\": a cube face is missing (null): render needs all six", tour.display()));
+                    return Err(anyhow!(
+                        "{}: scene \"{id}\": a cube face is missing (null): render needs all six",
+                        tour.display()
+                    ));
                 };
                 list.push(files(f)?);
             }
@@ -87,11 +90,12 @@ pub fn prepare(a: &mut RenderArgs, tour: &Path) -> Result<TourScene> {
             }
             a.panorama = vec![d];
         }
-        Source::Multires(_) => {
-            return Err(anyhow!(
-                "{}: scene \"{id}\" is multires tiles: render reads equirectangular, cube and Marzipano scenes",
-                tour.display()
-            ))
+        Source::Multires(m) => {
+            // Opened as the tiled pyramid in its basePath (the window's rule).
+            let d = t
+                .multires_dir(&id, m)
+                .map_err(|why| anyhow!("{}: {why}", tour.display()))?;
+            a.panorama = vec![d];
         }
     }
     a.yaw = a.yaw.or(Some(scene.start.yaw));

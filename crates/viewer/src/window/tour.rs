@@ -130,26 +130,7 @@ pub fn scene_source(tour: &Tour, i: usize) -> Result<Source, String> {
                 layout: None,
             })
         }
-        tour::Source::Multires(v) => {
-            // A multires scene whose basePath is a pyramid folder this viewer reads
-            // (`viewer tile` writes config.json there).
-            let base = v.get("basePath").and_then(|b| b.as_str()).unwrap_or("");
-            let dir = if base.is_empty() {
-                tour.dir.clone()
-            } else {
-                file(base)?
-            };
-            if crate::panorama::is_tiled(&dir) {
-                Ok(Source::File(dir))
-            } else {
-                Err(format!(
-                    "scene \"{}\": a multires scene opens when its basePath is a tiled pyramid \
-                     folder with config.json ({} is not)",
-                    s.id,
-                    dir.display()
-                ))
-            }
-        }
+        tour::Source::Multires(v) => tour.multires_dir(&s.id, v).map(Source::File),
         tour::Source::MarzipanoTiles { dir, .. } => {
             let d = file(dir)?;
             if crate::panorama::is_tiled(&d) {
