@@ -35,16 +35,17 @@ impl Half {
     /// The right half of `scan` (`None`: the table covers none of it).
     #[inline]
     pub(super) fn of(scan: &Scan, fr: &Setup) -> Option<Half> {
-        if !scan.lut || scan.lut_lo > scan.lut_hi {
+        let lut = scan.lut_cols;
+        if !scan.lut || lut.is_empty() {
             return None;
         }
         let w = fr.w_out as i64;
         let mut xa = w / 2;
-        let (zl, zh) = (scan.zone_lo.max(scan.lut_lo), scan.zone_hi.min(scan.lut_hi));
-        if zl <= zh {
-            xa = xa.max(zh + 1);
+        let zone = scan.zone_cols.and(lut);
+        if !zone.is_empty() {
+            xa = xa.max(zone.hi + 1);
         }
-        let xe = scan.lut_hi.min(w - 1);
+        let xe = lut.hi.min(w - 1);
         if xe < xa {
             return None;
         }
