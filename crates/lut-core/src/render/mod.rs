@@ -301,16 +301,8 @@ impl Renderer {
         debug_assert_eq!(self.geometry, Some(geometry));
         let _ = self.table(opts.surface, kind);
         let table = find(&self.tables, opts.surface, kind);
-        prepare(
-            table,
-            kind,
-            geometry,
-            &mut self.scans,
-            view,
-            opts,
-            width,
-            height,
-        )
+        let cam = Camera::new(view, width, height);
+        prepare(table, kind, geometry, &mut self.scans, &cam, opts)
     }
 
     /// Which table `opts` selects for `view`.

@@ -8,7 +8,7 @@
 use super::steps::{step_for, StepBounds, StepLine, XRange, ADAPTIVE_MAX_STEP, STEP_REGIONS};
 use super::{IndexStep, RenderOptions, RenderPath, RenderReport};
 use crate::error::ViewError;
-use crate::geom::camera::{Camera, View};
+use crate::geom::camera::Camera;
 use crate::geom::fixed::{to_fx, Fx, FX_BITS, FX_ONE};
 use crate::geom::projection::Projection;
 use crate::lut::{LutTable, Surface, TableKind};
@@ -189,19 +189,16 @@ impl Setup {
 /// runs threaded).
 const PARALLEL_SETUP_ROWS: usize = 64;
 
-/// Per-frame setup: one [`Scan`] per output row.
-#[allow(clippy::too_many_arguments)]
+/// Per-frame setup: one [`Scan`] per output row of `cam`'s frame.
 pub(crate) fn prepare(
     table: &LutTable,
     kind: TableKind,
     map: MapGeometry,
     scans: &mut Vec<Scan>,
-    view: View,
+    cam: &Camera,
     opts: &RenderOptions,
-    width: u32,
-    height: u32,
 ) -> (Setup, RenderReport) {
-    let cam = Camera::new(view, width, height);
+    let (view, width, height) = (cam.view(), cam.width, cam.height);
     let f = cam.focal;
     let (mwf, mhf) = (map.width as f64, map.height as f64);
     let proj = map.projection;
