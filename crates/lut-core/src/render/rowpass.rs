@@ -26,7 +26,7 @@ use super::setup::{Lv, LvStep, Scan, Setup, Unfold};
 use super::sink::Sink;
 use super::sink::{PixelSink, PosSink, TriSink};
 use super::steps::STEP_REGIONS;
-use super::walk::{read_at, span_step, wrap_u, Half, HalfBuf, HalfRun, HALF_CHUNK};
+use super::walk::{read_at, span_step, wrap_u, Half, HalfBuf, HalfRun, Nodes, HALF_CHUNK};
 use crate::geom::fixed::FX_ONE;
 use crate::lut::LutTable;
 use crate::map::envmap::EnvMap;
@@ -95,7 +95,7 @@ pub(crate) fn row_pass<S: Sink>(
             let lim = step_limit(fr, n as usize);
             while d + n <= stop {
                 c += dc;
-                let p1 = un.apply(nodes.lookup_q(c).into());
+                let p1 = un.apply(nodes.read_q(c));
                 let (p1, step) = span_step(fr, p0, p1, n, shift);
                 if S::LOD {
                     let lod = sink.span_lod(step, r);
