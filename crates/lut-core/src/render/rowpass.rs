@@ -312,12 +312,24 @@ pub(crate) fn tri_row(lut: LutRow<'_>, scratch: &mut RowScratch, s: &mut TriSink
 /// else k = `lod >> 8` clamped to `last`, weight `lod & 0xFF` (the second level, k + 1,
 /// counts only below `last`).
 #[inline(always)]
-fn resolve(lod: i32, last: usize) -> (usize, u32) {
+fn resolve(lod: i32, last: usize) -> Resolved {
     if lod <= 0 {
-        (0, 0)
+        Resolved { k: 0, weight: 0 }
     } else {
-        (((lod >> 8) as usize).min(last), (lod & 0xFF) as u32)
+        Resolved {
+            k: ((lod >> 8) as usize).min(last),
+            weight: (lod & 0xFF) as u32,
+        }
     }
+}
+
+/// A level of detail resolved to pyramid levels ([`resolve`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Resolved {
+    /// The first level, k.
+    k: usize,
+    /// The weight of the second level, k + 1, out of 256 (0: the first level alone).
+    weight: u32,
 }
 
 /// A trilinear run (`levels`: level 0, the map `wq` / 256 wide, and its pyramid; `dv`:
@@ -378,9 +390,9 @@ fn tri_groups(
     let end = |i: usize| segs.get(i).map_or(n, |s| s.start as usize);
     let mut i = 0;
     while i < segs.len() {
-        let ka = resolve(segs[i].lod, last).0;
+        let ka = resolve(segs[i].lod, last).k;
         let mut e = i + 1;
-        while e < segs.len() && resolve(segs[e].lod, last).0 == ka {
+        while e < segs.len() && resolve(segs[e].lod, last).k == ka {
             e += 1;
         }
         let (a, b) = (segs[i].start as usize, end(e));
@@ -389,7 +401,7 @@ fn tri_groups(
         pass(ka, None, Uv { u: ul, v }, Out::Left(&mut row[left]));
         pass(ka, None, Uv { u, v }, Out::Right(&mut row[right]));
         // The second level over the segments from the first to the last with a weight.
-        let weighted = |j: &usize| resolve(segs[*j].lod, last).1 != 0;
+        let weighted = |j: &usize| resolve(segs[*j].lod, last).weight != 0;
         let (Some(f), Some(l)) = ((i..e).find(weighted), (i..e).rev().find(weighted)) else {
             i = e;
             continue;
@@ -400,7 +412,7 @@ fn tri_groups(
         }
         let (a, b) = (segs[f].start as usize, end(l + 1));
         for (j, s) in segs.iter().enumerate().take(l + 1).skip(f) {
-            let w = resolve(s.lod, last).1;
+            let w = resolve(s.lod, last).weight;
             r.w[s.start as usize - a..end(j + 1) - a].fill(w);
         }
         let w = Some(&r.w[..b - a]);
