@@ -38,7 +38,7 @@
 
 use super::exact::render_exact;
 use super::frame::Frame;
-use super::kernel::{active, ChunkWeights, FaceBuf, FaceRun, Texels};
+use super::kernel::{active, ChunkLevels, ChunkWeights, FaceBuf, FaceRun, Texels};
 use super::rows::{rows_per_task, Loan};
 use super::setup::check_step;
 use super::{RenderOptions, RenderPath, RenderReport};
@@ -295,7 +295,10 @@ impl Fetch for TrilinearFetch {
             let lod = lod_q8(footprint((at(0), at(1), at(2)), sx, sy, frame.half_face));
             let (k, frac) = ((lod.max(0) >> 8) as usize, (lod.max(0) & 0xFF) as u32);
             let (ka, kb) = (cube.level(k).1, cube.level(k + 1).1);
-            levels.push((ka, kb));
+            levels.push(ChunkLevels {
+                first: ka,
+                second: kb,
+            });
             fracs.push(if ka == kb { 0 } else { frac });
         }
         // The run on level `k` from chunk `cs.start` and its pixels.
@@ -311,11 +314,11 @@ impl Fetch for TrilinearFetch {
             let t = toward_next(face_texels(l, face), frame, face, &sub, px.len());
             (t, sub, px)
         };
-        for (k, cs) in same_runs(levels.len(), |c| Some(levels[c].0)) {
+        for (k, cs) in same_runs(levels.len(), |c| Some(levels[c].first)) {
             let (t, sub, px) = on(k, &cs);
             active().face_rows::<true>(&t, &sub, &mut out[px], buf);
         }
-        let blended = |c: usize| (fracs[c] != 0).then_some(levels[c].1);
+        let blended = |c: usize| (fracs[c] != 0).then_some(levels[c].second);
         for (k, cs) in same_runs(levels.len(), blended) {
             let (t, sub, px) = on(k, &cs);
             let w = ChunkWeights {

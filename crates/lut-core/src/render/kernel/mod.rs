@@ -152,7 +152,7 @@ pub use select::{
 };
 pub use span::{SpanJob, Steps, Window, MAX_JOBS, TRILINEAR_CHUNK};
 
-pub(crate) use face::{ChunkWeights, FaceBuf, FaceRun};
+pub(crate) use face::{ChunkLevels, ChunkWeights, FaceBuf, FaceRun};
 pub(crate) use row::{wrap_q8, Level, Positions, Q16Start, Q16Step, SpanAt, SpanQ8};
 pub(crate) use select::active;
 pub(crate) use shade::{Light, ShadeTable};

@@ -81,8 +81,17 @@ pub(crate) struct FaceBuf {
     under: Vec<u32>,
     /// The caller's per-chunk scratch (trilinear: each chunk's two levels, and the
     /// weights of the second), kept here so a band allocates it once.
-    pub(crate) levels: Vec<(usize, usize)>,
+    pub(crate) levels: Vec<ChunkLevels>,
     pub(crate) fracs: Vec<u32>,
+}
+
+/// The two pyramid levels a trilinear chunk of a face run reads ([`FaceBuf::levels`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct ChunkLevels {
+    /// The first level's index in the cube's pyramid (0: the cube itself).
+    pub(crate) first: usize,
+    /// The second level's index (the same as `first` at the pyramid's last level).
+    pub(crate) second: usize,
 }
 
 /// The bordered Q.8 positions of the run's pixels 0..m with kernel `k` (the buffers
