@@ -450,11 +450,11 @@ mod tests {
         let mut buf = FaceBuf::default();
         let want: Vec<u32> = (0..len)
             .map(|i| {
-                let (u, v, _) = scalar::exact(r, i);
+                let at = scalar::exact(r, i);
                 if bilinear {
-                    c.bilinear(f, u, v)
+                    c.bilinear(f, at.u, at.v)
                 } else {
-                    c.nearest(f, u, v)
+                    c.nearest(f, at.u, at.v)
                 }
             })
             .collect();
@@ -491,8 +491,8 @@ mod tests {
             .collect();
         let want: Vec<u32> = (0..len)
             .map(|i| {
-                let (u, v, _) = scalar::exact(r, i);
-                lerp_px(under[i], c.bilinear(f, u, v), fracs[i / chunk])
+                let at = scalar::exact(r, i);
+                lerp_px(under[i], c.bilinear(f, at.u, at.v), fracs[i / chunk])
             })
             .collect();
         for k in Kernel::available() {
