@@ -147,7 +147,7 @@ pub use map::tone::{tone_map, Tone};
 pub use lut::{LutTable, Surface, TableKind, TableSpec, TABLE_ERROR_BUDGET};
 
 // Rendering.
-pub use render::cube::{scanline_runs, CubeRenderer};
+pub use render::cube::{scanline_runs, CubeRenderer, ScanlineRun};
 pub use render::exact::{render_exact, render_exact_supersampled, sample_at, sample_at_lod};
 pub use render::frame::Frame;
 pub use render::grid::{GRID_CELL, GRID_CELL_BUDGET, GRID_MIN_CELL};

@@ -531,12 +531,12 @@ mod tests {
             (10.0, 10.0, 1.0, 5, 540),
         ] {
             let v = View::new(yaw, pitch, hfov).unwrap();
-            for (a, e, face, ok) in scanline_runs(v, w, 1080, 61, y) {
-                let (f, r) = view_run((yaw, pitch, hfov), (w, 1080), (a, y), 61);
-                if ok {
-                    assert_eq!(f, face);
+            for run in scanline_runs(v, w, 1080, 61, y) {
+                let (f, r) = view_run((yaw, pitch, hfov), (w, 1080), (run.start, y), 61);
+                if run.verified {
+                    assert_eq!(f, run.face);
                 }
-                check(4, f, &r, (e - a) as usize, 1);
+                check(4, f, &r, (run.end - run.start) as usize, 1);
             }
         }
     }
