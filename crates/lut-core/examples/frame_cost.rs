@@ -33,7 +33,9 @@
 
 use lut_core::grid_map;
 use lut_core::{CubeMap, CubeRenderer, Face};
-use lut_core::{Frame, IndexStep, Panorama, Projection, RenderOptions, Renderer, Sampler, View};
+use lut_core::{
+    Frame, IndexStep, MapGeometry, Panorama, Projection, RenderOptions, Renderer, Sampler, View,
+};
 use std::time::Instant;
 
 fn main() {
@@ -295,9 +297,7 @@ fn run() -> Result<(), String> {
         // Indices of the padded map (stride W + 1) for the first view's nearest samples.
         let (pos, _) = r
             .positions(
-                map.width(),
-                map.height(),
-                Projection::Equirect,
+                MapGeometry::new(map.width(), map.height(), Projection::Equirect),
                 view(0)?,
                 &opts,
                 w,

@@ -14,7 +14,8 @@
 //! `viewer bench` (pitches 0 to 80) once each and prints wall-clock milliseconds too.
 
 use lut_core::{
-    EnvMap, Frame, Projection, RenderOptions, Renderer, RendererKind, View, ViewProjection,
+    EnvMap, Frame, MapGeometry, Projection, RenderOptions, Renderer, RendererKind, View,
+    ViewProjection,
 };
 use std::time::Instant;
 
@@ -72,8 +73,14 @@ fn main() {
     ] {
         let view = View::with_projection(yaw, pitch, hfov, proj).expect("view");
         let rep = if mode == "build" {
-            r.build_grid(mw, mh, Projection::Equirect, view, w, h, false)
-                .expect("build")
+            r.build_grid(
+                MapGeometry::new(mw, mh, Projection::Equirect),
+                view,
+                w,
+                h,
+                false,
+            )
+            .expect("build")
         } else {
             let mut f = Frame::new(&mut out, w, h).expect("frame");
             r.render(&map, view, &opts, &mut f).expect("render")

@@ -161,8 +161,8 @@ pub use render::kernel::{
 };
 pub use render::steps::{ADAPTIVE_MAX_STEP, SPAN_ERROR_BUDGET};
 pub use render::{
-    build_frame_levels, BandHook, IndexStep, LutChoice, Positions, RenderOptions, RenderPath,
-    RenderReport, Renderer, RendererKind, HOOK_BAND_ROWS, LUT_SWITCH_HFOV,
+    build_frame_levels, BandHook, IndexStep, LutChoice, MapGeometry, Positions, RenderOptions,
+    RenderPath, RenderReport, Renderer, RendererKind, HOOK_BAND_ROWS, LUT_SWITCH_HFOV,
 };
 
 // The one panorama type (a map with its renderer, a cube map) and its one dispatch.

@@ -47,7 +47,6 @@ pub(crate) mod walk;
 use crate::error::ViewError;
 use crate::geom::camera::{check_size, Camera, View};
 use crate::geom::mapping::exact_uv;
-use crate::geom::projection::Projection;
 use crate::lut::{LutTable, Surface, TableKind, TableSpec};
 use crate::map::envmap::EnvMap;
 use crate::map::pyramid::lod_q8;
@@ -59,13 +58,14 @@ use kernel::{level_texels, texels};
 use rowpass::{pixel_row, position_row, tri_row, LutRow};
 use rows::{for_each_band_init, for_each_row, for_each_row_init, post_bands};
 use scanline::{RowScratch, ScratchLoan, ROW_SCALE_ONE};
-use setup::{check_step, prepare, MapGeometry, Scan, Setup};
+use setup::{check_step, prepare, Scan, Setup};
 use sink::{Batch, PixelRows, PosRows, RowSinks, TriRows, TriSink};
 use std::sync::Arc;
 
 pub use levels::build_frame_levels;
 use levels::{centre_footprint, frame_level, frame_max_footprint, frame_min_footprint};
 pub use options::*;
+pub use setup::MapGeometry;
 
 /// The renderer: owns the tables for one map geometry and per-frame scratch.
 #[derive(Debug, Default)]
@@ -250,9 +250,10 @@ impl Renderer {
         map: &'m EnvMap,
         view: View,
         sampler: Sampler,
-        size: (u32, u32),
+        width: u32,
+        height: u32,
     ) -> Option<(&'m EnvMap, &mut Renderer)> {
-        let level = self.level_map(map, view, sampler, size)?;
+        let level = self.level_map(map, view, sampler, width, height)?;
         let r = self
             .level
             .get_or_insert_with(|| Box::new(Renderer::new(level)));
@@ -267,7 +268,8 @@ impl Renderer {
         map: &'m EnvMap,
         view: View,
         sampler: Sampler,
-        (width, height): (u32, u32),
+        width: u32,
+        height: u32,
     ) -> Option<&'m EnvMap> {
         if map.crop().is_some() {
             return None;
@@ -383,7 +385,7 @@ impl Renderer {
         check_step(opts.index_step)?;
         let (width, height) = (frame.width(), frame.height());
         let pixels = width as u64 * height as u64;
-        if let Some((level, r)) = self.level_renderer(map, view, opts.sampler, (width, height)) {
+        if let Some((level, r)) = self.level_renderer(map, view, opts.sampler, width, height) {
             // A frame drawn from a pyramid level (`set_bilinear_level`, `set_still_level`):
             // a plain frame of the level, with tables for its geometry, as the level
             // would be drawn were it the map (the exact renderer's too).
@@ -535,49 +537,39 @@ impl Renderer {
         grid_report(stats, width, height)
     }
 
-    /// Build the grid renderer's cells for `view` of a `map_w × map_h` map in
-    /// `projection` on a `width × height` output without drawing them: the per-view part
-    /// of a grid frame alone (its cost is inside every grid frame; `viewer bench` times
-    /// it). The report counts the exact pixels and the cell sizes as a grid frame's does.
+    /// Build the grid renderer's cells for `view` of a map of `geometry` on a
+    /// `width × height` output without drawing them: the per-view part of a grid frame
+    /// alone (its cost is inside every grid frame; `viewer bench` times it). The report
+    /// counts the exact pixels and the cell sizes as a grid frame's does.
     ///
     /// # Errors
     /// [`ViewError::BadSize`] for a bad output size.
-    #[allow(clippy::too_many_arguments)]
     pub fn build_grid(
         &mut self,
-        map_w: u32,
-        map_h: u32,
-        projection: Projection,
+        geometry: MapGeometry,
         view: View,
         width: u32,
         height: u32,
         threads: bool,
     ) -> Result<RenderReport, ViewError> {
         check_size(width, height)?;
-        let geometry = MapGeometry {
-            width: map_w,
-            height: map_h,
-            projection,
-        };
         self.set_geometry(geometry);
         let setup = Setup::new(width, geometry, 0.0);
         let grid = Grid::new(view, width, height, &setup, &self.row_scale);
         Ok(grid_report(grid.build(threads), width, height))
     }
 
-    /// The map positions the renderer `opts` selects samples for `view` (row-major,
+    /// The map positions the renderer `opts` selects samples for `view` of a map of
+    /// `geometry` (row-major,
     /// `None` = background): the same kernels as [`Renderer::render`] (the LUT's or the
     /// grid's), writing positions instead of pixels; the exact positions for the exact
     /// renderer. Used to measure the sampling-position error against the exact map.
     ///
     /// # Errors
     /// As [`Renderer::render`].
-    #[allow(clippy::too_many_arguments)]
     pub fn positions(
         &mut self,
-        map_w: u32,
-        map_h: u32,
-        projection: Projection,
+        geometry: MapGeometry,
         view: View,
         opts: &RenderOptions,
         width: u32,
@@ -585,11 +577,11 @@ impl Renderer {
     ) -> Result<(Positions, RenderReport), ViewError> {
         check_size(width, height)?;
         check_step(opts.index_step)?;
-        let geometry = MapGeometry {
+        let MapGeometry {
             width: map_w,
             height: map_h,
             projection,
-        };
+        } = geometry;
         self.set_geometry(geometry);
         let pixels = width as u64 * height as u64;
         let mut out = vec![None; pixels as usize];
@@ -644,11 +636,7 @@ pub(crate) fn run_hook(frame: &mut Frame<'_>, opts: &RenderOptions, hook: BandHo
 
 /// The map geometry the renderers use: the full panorama's.
 fn geometry_of(map: &EnvMap) -> MapGeometry {
-    MapGeometry {
-        width: map.width(),
-        height: map.height(),
-        projection: map.projection(),
-    }
+    MapGeometry::of(map)
 }
 
 /// True when the grid draws a map frame: asked for, or a view the table cannot draw.
@@ -675,6 +663,7 @@ mod tests {
     //! footprint, byte identity where magnified, and the supersampled truth at the poles.
     use super::*;
     use crate::geom::mapping::exact_uv_at;
+    use crate::geom::projection::Projection;
     use crate::render::exact::render_exact_supersampled;
     use crate::render::rowpass::{applies, row_pass};
     use crate::render::sink::nearest_level;

@@ -12,19 +12,41 @@ use crate::geom::camera::Camera;
 use crate::geom::fixed::{to_fx, Fx, FX_BITS, FX_ONE};
 use crate::geom::projection::Projection;
 use crate::lut::{LutTable, Surface, TableKind};
+use crate::map::envmap::EnvMap;
 use crate::map::sample::Sampler;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// The map a renderer draws from, as its geometry: the full panorama's size in pixels
-/// and its projection (a partial map's full size).
+/// and its projection (a partial map's full size). What [`crate::Renderer::positions`]
+/// and [`crate::Renderer::build_grid`] need of a map without its pixels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct MapGeometry {
+pub struct MapGeometry {
     /// Width in pixels.
-    pub(crate) width: u32,
+    pub width: u32,
     /// Height in pixels.
-    pub(crate) height: u32,
+    pub height: u32,
     /// The map's projection.
-    pub(crate) projection: Projection,
+    pub projection: Projection,
+}
+
+impl MapGeometry {
+    /// A `width × height` map in `projection`.
+    pub const fn new(width: u32, height: u32, projection: Projection) -> MapGeometry {
+        MapGeometry {
+            width,
+            height,
+            projection,
+        }
+    }
+
+    /// The geometry of `map` (a partial map's full size).
+    pub fn of(map: &EnvMap) -> MapGeometry {
+        MapGeometry {
+            width: map.width(),
+            height: map.height(),
+            projection: map.projection(),
+        }
+    }
 }
 
 /// A point of the table's plane: Λ (map pixels of longitude from the view's centre
