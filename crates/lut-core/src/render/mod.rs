@@ -424,8 +424,8 @@ impl Renderer {
         let bilinear = opts.sampler != Sampler::Nearest;
         if opts.sampler == Sampler::Trilinear || region_lod {
             // The pyramid is built here once, before the rows run in parallel.
-            let (levels, n) = level_texels(map);
-            let levels = &levels[..n];
+            let levels = level_texels(map);
+            let levels = &levels[..];
             let fp = ExactFootprint::new(view, width, height, geometry_of(map));
             let row = |scratch: &mut ScratchLoan, y: usize, row: &mut [u32]| {
                 let scan = &scans[y];
@@ -518,11 +518,11 @@ impl Renderer {
             g.render(out, r, t, false)
         }
         let stats = if opts.sampler == Sampler::Trilinear {
-            let (levels, n) = level_texels(map); // builds the pyramid
+            let levels = level_texels(map); // builds the pyramid
             let exact = ExactFootprint::new(view, width, height, geometry);
             let rows = TriRows {
                 map,
-                levels: &levels[..n],
+                levels: &levels,
                 exact: &exact,
             };
             grid.render(out, &rows, t, true)
@@ -708,7 +708,7 @@ mod tests {
         let (setup, _) = r.prepare_frame(geometry_of(map), view, &tri, w, h);
         assert!(applies(&setup));
         let table = find(&r.tables, tri.surface, Renderer::table_kind(view, &tri));
-        let (levels, n) = level_texels(map);
+        let levels = level_texels(map);
         let fp = ExactFootprint::new(view, w, h, geometry_of(map));
         let mut scratch = RowScratch::new();
         let mut out = vec![None; (w * h) as usize];
@@ -719,7 +719,7 @@ mod tests {
             let mut s = TriSink {
                 row: &mut row,
                 map,
-                levels: &levels[..n],
+                levels: &levels,
                 fy: scan.fy,
                 lod: 0,
                 exact: (&fp, y),

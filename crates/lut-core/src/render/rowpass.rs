@@ -777,7 +777,7 @@ mod tests {
                 .map(|i| i.wrapping_mul(2_654_435_761) & 0xFF_FFFF)
                 .collect();
             let m = EnvMap::from_pixels(w, h, &px, Projection::Equirect).unwrap();
-            let (levels, nl) = level_texels(&m);
+            let levels = level_texels(&m);
             let (wq, hq) = ((w as i64) << 8, (h as i64) << 8);
             for _ in 0..60 {
                 let n = 1 + rnd(600) as usize;
@@ -798,7 +798,7 @@ mod tests {
                 };
                 check_run(
                     (&u, &ul, &v, &segs),
-                    |r, row| tri_run(&levels[..nl], wq as i32, 0, r, row),
+                    |r, row| tri_run(&levels, wq as i32, 0, r, row),
                     at,
                     &format!("{w}x{h}"),
                 );
@@ -832,8 +832,8 @@ mod tests {
             let m = EnvMap::from_pixels(cw, ch, &px, Projection::Equirect).unwrap();
             let mut m = m.into_partial(crop).unwrap();
             m.set_background(0x12_3456);
-            let (levels, nl) = level_texels(&m);
-            let crop_lv = crop_levels(&m, &levels[..nl]);
+            let levels = level_texels(&m);
+            let crop_lv = crop_levels(&m, &levels);
             let (wq, hq) = ((fw as i64) << 8, (fh as i64) << 8);
             for _ in 0..60 {
                 let n = 1 + rnd(600) as usize;

@@ -271,8 +271,8 @@ proptest! {
         let (w, h) = wh;
         let px: Vec<u32> = (0..w * h).map(|i| i.wrapping_mul(2_654_435_761) & 0xFF_FFFF).collect();
         let m = EnvMap::from_pixels(w, h, &px, Projection::Equirect).unwrap();
-        let (levels, nl) = level_texels(&m);
-        let last = nl - 1;
+        let levels = level_texels(&m);
+        let last = levels.len() - 1;
         let (ka, frac) = (((lod >> 8) as usize).min(last), (lod & 0xFF) as u32);
         let wq = (w as i32) << 8;
         let wts = [frac; 64];
