@@ -435,7 +435,8 @@ impl Renderer {
                     levels,
                     fy: scan.fy,
                     lod: 0,
-                    exact: (&fp, y),
+                    fp: &fp,
+                    y,
                     batch: Batch::new(),
                     nearest: region_lod,
                 };
@@ -722,7 +723,8 @@ mod tests {
                 levels: &levels,
                 fy: scan.fy,
                 lod: 0,
-                exact: (&fp, y),
+                fp: &fp,
+                y,
                 batch: Batch::new(),
                 nearest: true,
             };
