@@ -71,7 +71,7 @@ pub use setup::MapGeometry;
 #[derive(Debug, Default)]
 pub struct Renderer {
     /// The tables built so far (shared with the renderers made by [`Renderer::share`]).
-    tables: Vec<(Surface, TableKind, Arc<LutTable>)>,
+    tables: Vec<BuiltTable>,
     geometry: Option<MapGeometry>,
     scans: Vec<Scan>,
     /// Row scale per map row (Q.30: multiplied by Λ up to W/2, so Q.16 would lose up to
@@ -91,18 +91,32 @@ pub struct Renderer {
     level: Option<Box<Renderer>>,
 }
 
+/// A table a renderer built, and what it was built for.
+#[derive(Debug, Clone)]
+struct BuiltTable {
+    /// The surface the table's cells lie on.
+    surface: Surface,
+    /// Its kind (wide or high).
+    kind: TableKind,
+    /// The table (shared with the renderers made by [`Renderer::share`]).
+    table: Arc<LutTable>,
+}
+
+impl BuiltTable {
+    /// Built for `surface` and `kind`.
+    fn is(&self, surface: Surface, kind: TableKind) -> bool {
+        self.surface == surface && self.kind == kind
+    }
+}
+
 /// The table of `surface` and `kind` among `tables` (built by [`Renderer::table`]; every
 /// caller builds it first, with the geometry set, so the look-up always finds it).
-fn find(
-    tables: &[(Surface, TableKind, Arc<LutTable>)],
-    surface: Surface,
-    kind: TableKind,
-) -> &LutTable {
+fn find(tables: &[BuiltTable], surface: Surface, kind: TableKind) -> &LutTable {
     &tables
         .iter()
-        .find(|(s, k, _)| *s == surface && *k == kind)
+        .find(|t| t.is(surface, kind))
         .expect("table built before it is looked up")
-        .2
+        .table
 }
 
 impl Renderer {
@@ -226,20 +240,20 @@ impl Renderer {
             height: h,
             projection: p,
         } = self.geometry?;
-        let i = match self
-            .tables
-            .iter()
-            .position(|(s, k, _)| *s == surface && *k == kind)
-        {
+        let i = match self.tables.iter().position(|t| t.is(surface, kind)) {
             Some(i) => i,
             None => {
                 let spec = TableSpec::default_for(surface, kind, w);
                 let table = LutTable::build(spec, p, w, h);
-                self.tables.push((surface, kind, Arc::new(table)));
+                self.tables.push(BuiltTable {
+                    surface,
+                    kind,
+                    table: Arc::new(table),
+                });
                 self.tables.len() - 1
             }
         };
-        Some(&self.tables[i].2)
+        Some(&self.tables[i].table)
     }
 
     /// The pyramid level a frame of `view` on `width × height` pixels is drawn from instead
