@@ -252,12 +252,12 @@ fn accelerated_renderer_really_runs_segments() {
         for y in 0..h {
             let r = lut_core::scanline_runs(view, w, h, 64, y);
             let mut next = 0;
-            for &(a, e, _, ok) in &r {
-                assert_eq!(a, next, "runs must tile the row");
-                next = e;
-                total += e - a;
-                if ok {
-                    proven += e - a;
+            for run in &r {
+                assert_eq!(run.start, next, "runs must tile the row");
+                next = run.end;
+                total += run.end - run.start;
+                if run.verified {
+                    proven += run.end - run.start;
                     runs += 1;
                 }
             }
@@ -274,7 +274,7 @@ fn accelerated_renderer_really_runs_segments() {
     let view = View::new(45.0, 35.26, 90.0).unwrap();
     let faces: std::collections::BTreeSet<Face> = (0..h)
         .flat_map(|y| lut_core::scanline_runs(view, w, h, 64, y))
-        .map(|r| r.2)
+        .map(|r| r.face)
         .collect();
     assert_eq!(faces.len(), 3, "a corner view shows three faces: {faces:?}");
 }

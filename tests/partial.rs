@@ -9,8 +9,8 @@ use lut_core::LoadOptions;
 use lut_core::{dir_to_lat_long, Camera};
 use lut_core::{insert_xmp, xmp_packet};
 use lut_core::{
-    limit_view, Coverage, CoverageSource, EnvMap, IndexStep, Projection, RenderOptions, Renderer,
-    RendererKind, Sampler, View,
+    limit_view, Coverage, CoverageSource, EnvMap, IndexStep, MapGeometry, Projection,
+    RenderOptions, Renderer, RendererKind, Sampler, View,
 };
 use test_support::render::render_frame;
 
@@ -464,7 +464,13 @@ fn non_square_pixel_geometry_keeps_the_lut_bound() {
                 ..RenderOptions::default()
             };
             let (pos, _) = r
-                .positions(mw, mh, Projection::Equirect, view, &opts, 160, 90)
+                .positions(
+                    MapGeometry::new(mw, mh, Projection::Equirect),
+                    view,
+                    &opts,
+                    160,
+                    90,
+                )
                 .unwrap();
             let st = compare_positions(&pos, view, 160, 90, Projection::Equirect, mw, mh);
             assert!(

@@ -7,7 +7,9 @@
 use lut_core::Frame;
 use lut_core::Surface;
 use lut_core::{compare_positions, ErrorStats};
-use lut_core::{IndexStep, LutChoice, Projection, RenderOptions, Renderer, Sampler, View};
+use lut_core::{
+    IndexStep, LutChoice, MapGeometry, Projection, RenderOptions, Renderer, Sampler, View,
+};
 use proptest::prelude::*;
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
@@ -34,7 +36,9 @@ fn measure(
 ) -> ErrorStats {
     let mut guard = renderers().lock().unwrap_or_else(|e| e.into_inner());
     let r = guard.entry((mw, mh, p)).or_default();
-    let (pos, _) = r.positions(mw, mh, p, view, &opts, w, h).unwrap();
+    let (pos, _) = r
+        .positions(MapGeometry::new(mw, mh, p), view, &opts, w, h)
+        .unwrap();
     compare_positions(&pos, view, w, h, p, mw, mh)
 }
 

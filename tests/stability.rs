@@ -7,7 +7,7 @@
 
 use lut_core::compare_positions;
 use lut_core::Frame;
-use lut_core::{IndexStep, Projection, RenderOptions, Renderer, View};
+use lut_core::{IndexStep, MapGeometry, Projection, RenderOptions, Renderer, View};
 use test_support::render::render_frame;
 
 const BOUND: f64 = 0.05;
@@ -27,7 +27,9 @@ fn check(
         index_step: step,
         ..RenderOptions::default()
     };
-    let (pos, _) = r.positions(mw, mh, p, view, &opts, w, h).unwrap();
+    let (pos, _) = r
+        .positions(MapGeometry::new(mw, mh, p), view, &opts, w, h)
+        .unwrap();
     let label = format!(
         "{p} {mw}x{mh} yaw {} pitch {} hfov {} {w}x{h} {step:?}",
         view.yaw_deg(),

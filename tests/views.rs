@@ -16,7 +16,7 @@
 //!   panoramas in every projection.
 
 use lut_core::{compare_positions, grid_map, CubeMap, EnvMap, ErrorStats, Named, Projection};
-use lut_core::{Camera, Renderer, View, ViewProjection};
+use lut_core::{Camera, MapGeometry, Renderer, View, ViewProjection};
 use lut_core::{RenderOptions, RenderPath, RendererKind, Sampler, ViewError};
 use proptest::prelude::*;
 use std::f64::consts::PI;
@@ -370,7 +370,13 @@ fn measure(
     (w, h): (u32, u32),
 ) -> (ErrorStats, lut_core::RenderReport) {
     let (pos, rep) = r
-        .positions(mw, mh, p, view, &grid_opts(renderer), w, h)
+        .positions(
+            MapGeometry::new(mw, mh, p),
+            view,
+            &grid_opts(renderer),
+            w,
+            h,
+        )
         .unwrap();
     (compare_positions(&pos, view, w, h, p, mw, mh), rep)
 }
@@ -532,7 +538,13 @@ fn building_the_grid_alone_finds_the_frames_cells() {
         );
         for threads in [false, true] {
             let built = r
-                .build_grid(2048, 1024, Projection::Equirect, view, 640, 400, threads)
+                .build_grid(
+                    MapGeometry::new(2048, 1024, Projection::Equirect),
+                    view,
+                    640,
+                    400,
+                    threads,
+                )
                 .unwrap();
             assert_eq!(built, frame, "{vp} threads {threads}");
         }
@@ -724,7 +736,13 @@ fn heat_map_max_is_the_measured_max() {
         let opts = grid_opts(renderer);
         let em = lut_core::ErrorMap::measure(&mut r, &map, view, &opts, w, h).unwrap();
         let (pos, _) = r
-            .positions(2048, 1024, Projection::Equirect, view, &opts, w, h)
+            .positions(
+                MapGeometry::new(2048, 1024, Projection::Equirect),
+                view,
+                &opts,
+                w,
+                h,
+            )
             .unwrap();
         let st = compare_positions(&pos, view, w, h, Projection::Equirect, 2048, 1024);
         assert_eq!(em.stats, st, "{view:?}");

@@ -43,7 +43,9 @@
 use lut_core::grid_map;
 use lut_core::{Camera, IlluminanceMap, MapOptions, ShadeOptions};
 use lut_core::{CubeMap, CubeRenderer, Face};
-use lut_core::{Frame, IndexStep, Panorama, Projection, RenderOptions, Renderer, Sampler, View};
+use lut_core::{
+    Frame, IndexStep, MapGeometry, Panorama, Projection, RenderOptions, Renderer, Sampler, View,
+};
 use std::time::Instant;
 use test_support::light_fixtures::{bench_table, ring};
 
@@ -333,9 +335,7 @@ fn run() -> Result<(), String> {
         // Indices of the padded map (stride W + 1) for the first view's nearest samples.
         let (pos, _) = r
             .positions(
-                map.width(),
-                map.height(),
-                Projection::Equirect,
+                MapGeometry::new(map.width(), map.height(), Projection::Equirect),
                 view(0)?,
                 &opts,
                 w,

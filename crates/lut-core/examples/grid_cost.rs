@@ -11,10 +11,12 @@
 //!
 //! Arguments: `build|grid|lut|exact PROJECTION HFOV [WIDTHxHEIGHT [MAP_WIDTH]]` (default
 //! 1920x1080 from an 8192x4096 equirectangular map); it renders the five fixed views of
-//! `viewer bench` (pitches 0 to 80) once each and prints wall-clock milliseconds too.
+//! `viewer bench` (pitches 0 to 80) once each and prints wall-clock milliseconds too, and
+//! a checksum of the frames' pixels (0 for `build`, which draws none).
 
 use lut_core::{
-    EnvMap, Frame, Projection, RenderOptions, Renderer, RendererKind, View, ViewProjection,
+    EnvMap, Frame, MapGeometry, Projection, RenderOptions, Renderer, RendererKind, View,
+    ViewProjection,
 };
 use std::time::Instant;
 
@@ -63,6 +65,8 @@ fn main() {
     let mut out = vec![0u32; (w * h) as usize];
     let t = Instant::now();
     let (mut exact, mut cells) = (0u64, (u32::MAX, 0u32));
+    // Of every frame's pixels (as frame_cost's): the same before and after a refactor.
+    let mut checksum = 0u64;
     for (yaw, pitch) in [
         (0.0, 0.0),
         (180.0, 0.0),
@@ -72,17 +76,27 @@ fn main() {
     ] {
         let view = View::with_projection(yaw, pitch, hfov, proj).expect("view");
         let rep = if mode == "build" {
-            r.build_grid(mw, mh, Projection::Equirect, view, w, h, false)
-                .expect("build")
+            r.build_grid(
+                MapGeometry::new(mw, mh, Projection::Equirect),
+                view,
+                w,
+                h,
+                false,
+            )
+            .expect("build")
         } else {
             let mut f = Frame::new(&mut out, w, h).expect("frame");
-            r.render(&map, view, &opts, &mut f).expect("render")
+            let rep = r.render(&map, view, &opts, &mut f).expect("render");
+            checksum = out
+                .iter()
+                .fold(checksum, |a, &p| a.wrapping_mul(31).wrapping_add(p as u64));
+            rep
         };
         exact += rep.exact_pixels;
         cells = (cells.0.min(rep.min_step), cells.1.max(rep.max_step));
     }
     println!(
-        "{mode} {} hfov {hfov} {w}x{h} from {mw}x{mh}: {:.1} ms per view (one thread), {:.2} % exact, cells/steps {}..{}",
+        "{mode} {} hfov {hfov} {w}x{h} from {mw}x{mh}: {:.1} ms per view (one thread), {:.2} % exact, cells/steps {}..{} (checksum {checksum:016x})",
         proj.name(),
         t.elapsed().as_secs_f64() * 1e3 / 5.0,
         exact as f64 * 100.0 / (5.0 * w as f64 * h as f64),

@@ -148,7 +148,7 @@ pub use map::tone::{tone_map, Tone};
 pub use lut::{LutTable, Surface, TableKind, TableSpec, TABLE_ERROR_BUDGET};
 
 // Rendering.
-pub use render::cube::{scanline_runs, CubeRenderer};
+pub use render::cube::{scanline_runs, CubeRenderer, ScanlineRun};
 pub use render::exact::{render_exact, render_exact_supersampled, sample_at, sample_at_lod};
 pub use render::frame::Frame;
 pub use render::grid::{GRID_CELL, GRID_CELL_BUDGET, GRID_MIN_CELL};
@@ -162,8 +162,8 @@ pub use render::kernel::{
 };
 pub use render::steps::{ADAPTIVE_MAX_STEP, SPAN_ERROR_BUDGET};
 pub use render::{
-    build_frame_levels, BandHook, IndexStep, LutChoice, Positions, RenderOptions, RenderPath,
-    RenderReport, Renderer, RendererKind, HOOK_BAND_ROWS, LUT_SWITCH_HFOV,
+    build_frame_levels, BandHook, IndexStep, LutChoice, MapGeometry, Positions, RenderOptions,
+    RenderPath, RenderReport, Renderer, RendererKind, HOOK_BAND_ROWS, LUT_SWITCH_HFOV,
 };
 
 // The one panorama type (a map with its renderer, a cube map) and its one dispatch.

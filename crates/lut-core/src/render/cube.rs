@@ -38,7 +38,7 @@
 
 use super::exact::render_exact;
 use super::frame::Frame;
-use super::kernel::{active, ChunkWeights, FaceBuf, FaceRun, Texels};
+use super::kernel::{active, ChunkLevels, ChunkWeights, FaceBuf, FaceRun, Texels};
 use super::rows::{rows_per_task, Loan};
 use super::setup::check_step;
 use super::{RenderOptions, RenderPath, RenderReport};
@@ -295,7 +295,10 @@ impl Fetch for TrilinearFetch {
             let lod = lod_q8(footprint((at(0), at(1), at(2)), sx, sy, frame.half_face));
             let (k, frac) = ((lod.max(0) >> 8) as usize, (lod.max(0) & 0xFF) as u32);
             let (ka, kb) = (cube.level(k).1, cube.level(k + 1).1);
-            levels.push((ka, kb));
+            levels.push(ChunkLevels {
+                first: ka,
+                second: kb,
+            });
             fracs.push(if ka == kb { 0 } else { frac });
         }
         // The run on level `k` from chunk `cs.start` and its pixels.
@@ -311,11 +314,11 @@ impl Fetch for TrilinearFetch {
             let t = toward_next(face_texels(l, face), frame, face, &sub, px.len());
             (t, sub, px)
         };
-        for (k, cs) in same_runs(levels.len(), |c| Some(levels[c].0)) {
+        for (k, cs) in same_runs(levels.len(), |c| Some(levels[c].first)) {
             let (t, sub, px) = on(k, &cs);
             active().face_rows::<true>(&t, &sub, &mut out[px], buf);
         }
-        let blended = |c: usize| (fracs[c] != 0).then_some(levels[c].1);
+        let blended = |c: usize| (fracs[c] != 0).then_some(levels[c].second);
         for (k, cs) in same_runs(levels.len(), blended) {
             let (t, sub, px) = on(k, &cs);
             let w = ChunkWeights {
@@ -581,16 +584,29 @@ fn accel_row<S: Fetch>(
     }
 }
 
-/// How the accelerated renderer splits row `y` of a `width × height` view: the runs
-/// `(start, end_exclusive, face, verified)` in order, where unverified runs (and peeled
-/// single pixels) were rendered per pixel. For tests and the docs' statistics.
+/// One run of a row as the accelerated cube renderer splits it ([`scanline_runs`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ScanlineRun {
+    /// The run's first pixel column.
+    pub start: u32,
+    /// The column after its last pixel (exclusive).
+    pub end: u32,
+    /// The cube face its pixels are drawn from.
+    pub face: Face,
+    /// Whether both ends were proven inside `face` (the run drawn as one face run);
+    /// unverified runs (and peeled single pixels) were rendered per pixel.
+    pub verified: bool,
+}
+
+/// How the accelerated renderer splits row `y` of a `width × height` view: its runs in
+/// order. For tests and the docs' statistics.
 pub fn scanline_runs(
     view: View,
     width: u32,
     height: u32,
     face_size: u32,
     y: u32,
-) -> Vec<(u32, u32, Face, bool)> {
+) -> Vec<ScanlineRun> {
     let frame = Rays::new(view, width, height, face_size);
     let w = width as usize;
     let p = frame.row(frame.dy(y as usize));
@@ -603,18 +619,29 @@ pub fn scanline_runs(
         let ok = |x: usize| margin(seg.face, ray(p, b, frame.dx(x))) > frame.delta;
         let (mut a, mut e) = (seg.start, seg.end + 1);
         let mut tail = Vec::new();
+        let pixel = |x: usize| ScanlineRun {
+            start: x as u32,
+            end: x as u32 + 1,
+            face: face_at(x),
+            verified: false,
+        };
         for _ in 0..2 {
             if a < e && !ok(a) {
-                out.push((a as u32, a as u32 + 1, face_at(a), false));
+                out.push(pixel(a));
                 a += 1;
             }
             if a < e && !ok(e - 1) {
-                tail.push((e as u32 - 1, e as u32, face_at(e - 1), false));
+                tail.push(pixel(e - 1));
                 e -= 1;
             }
         }
         if a < e {
-            out.push((a as u32, e as u32, seg.face, ok(a) && ok(e - 1)));
+            out.push(ScanlineRun {
+                start: a as u32,
+                end: e as u32,
+                face: seg.face,
+                verified: ok(a) && ok(e - 1),
+            });
         }
         out.extend(tail.into_iter().rev());
     }

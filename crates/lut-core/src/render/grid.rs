@@ -202,6 +202,37 @@ impl Valid {
     }
 }
 
+/// A point of the table's plane in f64 map pixels (the grid's [`Lv`] before rounding to
+/// Q.16): a node's position, or one interpolated between nodes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct LvF {
+    /// Λ, map pixels of longitude from the view's centre column (unwrapped next to the
+    /// cell's first corner).
+    l: f64,
+    /// V, map pixels above the horizon.
+    v: f64,
+}
+
+impl LvF {
+    /// The point halfway to `b`.
+    #[inline]
+    fn mid(self, b: LvF) -> LvF {
+        LvF {
+            l: (self.l + b.l) * 0.5,
+            v: (self.v + b.v) * 0.5,
+        }
+    }
+
+    /// The point a fraction `t` of the way to `b`.
+    #[inline]
+    fn toward(self, b: LvF, t: f64) -> LvF {
+        LvF {
+            l: self.l + (b.l - self.l) * t,
+            v: self.v + (b.v - self.v) * t,
+        }
+    }
+}
+
 /// An interpolated cell to draw: its top-left pixel (`x0`, `y0`), its side `g` in
 /// pixels, and its corner nodes `k` (as [`Leaf::Interp`]).
 #[derive(Debug, Clone, Copy)]
@@ -209,7 +240,7 @@ struct InterpCell {
     x0: u32,
     y0: u32,
     g: u32,
-    k: [(f64, f64); 4],
+    k: [LvF; 4],
 }
 
 /// What a cell becomes.
@@ -217,7 +248,7 @@ struct InterpCell {
 enum Leaf {
     /// Bilinear between the four corner nodes (Λ unwrapped, V): top-left, top-right,
     /// bottom-left, bottom-right.
-    Interp([(f64, f64); 4]),
+    Interp([LvF; 4]),
     /// A cell of the smallest size: its pixels (x0, y0), (x0 + 1, y0), (x0, y0 + 1),
     /// (x0 + 1, y0 + 1) evaluated exactly (`None`: no direction, the background).
     Exact([Option<Node>; 4]),
@@ -463,7 +494,12 @@ impl<'a> Grid<'a> {
     /// to the first.
     fn leaf_of(&self, k: &[Option<Node>; 4]) -> Leaf {
         let r = k[0].map_or(0.0, |n| n.l);
-        let at = |n: &Option<Node>| n.map_or((r, 0.0), |n| (self.unwrap(n.l, r), n.v));
+        let at = |n: &Option<Node>| {
+            n.map_or(LvF { l: r, v: 0.0 }, |n| LvF {
+                l: self.unwrap(n.l, r),
+                v: n.v,
+            })
+        };
         Leaf::Interp([at(&k[0]), at(&k[1]), at(&k[2]), at(&k[3])])
     }
 
@@ -493,8 +529,11 @@ impl<'a> Grid<'a> {
             w_min = w_min.min(w);
         }
         let r = c0.l;
-        let k = |n: &Node| (self.unwrap(n.l, r), n.v);
-        let mid = |a: (f64, f64), b: (f64, f64)| ((a.0 + b.0) * 0.5, (a.1 + b.1) * 0.5);
+        let k = |n: &Node| LvF {
+            l: self.unwrap(n.l, r),
+            v: n.v,
+        };
+        let mid = LvF::mid;
         // Weighted distance between the exact position of `e` and the (Λ, V) `got`.
         // Weighted distance between the exact position of `e` and the (Λ, V) `got`. On
         // elliptical and diamond maps u = W/2 + s(v)·Λ: the u error is bounded by
@@ -503,9 +542,9 @@ impl<'a> Grid<'a> {
         // add on the other); seam-crossing cells are split before (`crosses_seam`).
         let half = self.fr.mw * 0.5;
         let ds_dv = p.row_scale_coupling(self.fr.mw, self.fr.mh) / half;
-        let err = |e: &Node, got: (f64, f64)| {
-            let (el, ev) = k(e);
-            let (dl, dv) = ((got.0 - el).abs(), (got.1 - ev).abs());
+        let err = |e: &Node, got: LvF| {
+            let LvF { l: el, v: ev } = k(e);
+            let (dl, dv) = ((got.l - el).abs(), (got.v - ev).abs());
             let du = if self.fr.scaled {
                 let a = if el > half || el <= -half {
                     half - (half - el).rem_euclid(self.fr.mw)
@@ -534,8 +573,8 @@ impl<'a> Grid<'a> {
         // of the map the metric's weight changes fast (cos φ → 0), and near a singular
         // point of the view (the centre of a 360° little planet holds a hemisphere) the
         // scale does: split such cells rather than trust five points.
-        let len = |a: (f64, f64), b: (f64, f64)| {
-            let (du, dv) = ((b.0 - a.0) * w_max, b.1 - a.1);
+        let len = |a: LvF, b: LvF| {
+            let (du, dv) = ((b.l - a.l) * w_max, b.v - a.v);
             (du * du + dv * dv).sqrt()
         };
         let even = |a: f64, b: f64| a.max(b) <= 2.0 * a.min(b) + 0.01;
@@ -668,7 +707,7 @@ impl<'a> Grid<'a> {
         let m = (x0 + g).min(self.w) - x0;
         let fp = if footprint {
             // The larger per-pixel step of the cell, along x or y, in map pixels.
-            let d = |a: (f64, f64), b: (f64, f64)| (b.0 - a.0).abs().max((b.1 - a.1).abs());
+            let d = |a: LvF, b: LvF| (b.l - a.l).abs().max((b.v - a.v).abs());
             d(k[0], k[1])
                 .max(d(k[0], k[2]))
                 .max(d(k[2], k[3]))
@@ -679,15 +718,7 @@ impl<'a> Grid<'a> {
         };
         for y in y0..(y0 + g).min(self.h) {
             let t = (y - y0) as f64 / gf;
-            let left = (
-                k[0].0 + (k[2].0 - k[0].0) * t,
-                k[0].1 + (k[2].1 - k[0].1) * t,
-            );
-            let right = (
-                k[1].0 + (k[3].0 - k[1].0) * t,
-                k[1].1 + (k[3].1 - k[1].1) * t,
-            );
-            let step = ((right.0 - left.0) / gf, (right.1 - left.1) / gf);
+            let (left, right) = (k[0].toward(k[2], t), k[1].toward(k[3], t));
             let r = (y - band_y0) as usize;
             let mut s = sinks.sink(&mut rows[r * w..(r + 1) * w], y as usize);
             if footprint {
@@ -699,12 +730,12 @@ impl<'a> Grid<'a> {
                 x0 as i64,
                 m as i64,
                 Lv {
-                    l: to_fx(left.0),
-                    v: to_fx(left.1),
+                    l: to_fx(left.l),
+                    v: to_fx(left.v),
                 },
                 LvStep {
-                    dl: to_fx(step.0),
-                    dv: to_fx(step.1),
+                    dl: to_fx((right.l - left.l) / gf),
+                    dv: to_fx((right.v - left.v) / gf),
                 },
                 &mut s,
             );

@@ -4,7 +4,7 @@
 //! [`HEAT_MAX`] pixels. A diagnostic: it costs about one exact render (the exact position
 //! of every pixel) plus the renderer's positions.
 
-use super::{RenderOptions, Renderer};
+use super::{MapGeometry, RenderOptions, Renderer};
 use crate::error::ViewError;
 use crate::geom::accuracy::{position_errors, ErrorStats};
 use crate::geom::camera::{check_size, Camera, View};
@@ -83,12 +83,11 @@ impl ErrorMap {
         height: u32,
     ) -> Result<ErrorMap, ViewError> {
         check_size(width, height)?;
-        if let Some((level, r)) = renderer.level_renderer(map, view, opts.sampler, (width, height))
-        {
+        if let Some((level, r)) = renderer.level_renderer(map, view, opts.sampler, width, height) {
             return ErrorMap::measure(r, level, view, opts, width, height);
         }
         let (mw, mh, p) = (map.width(), map.height(), map.projection());
-        let (positions, _) = renderer.positions(mw, mh, p, view, opts, width, height)?;
+        let (positions, _) = renderer.positions(MapGeometry::of(map), view, opts, width, height)?;
         let (errors, stats) = position_errors(&positions, view, width, height, p, mw, mh);
         Ok(ErrorMap {
             width,

@@ -47,7 +47,6 @@ pub(crate) mod walk;
 use crate::error::ViewError;
 use crate::geom::camera::{check_size, Camera, View};
 use crate::geom::mapping::exact_uv;
-use crate::geom::projection::Projection;
 use crate::lut::{LutTable, Surface, TableKind, TableSpec};
 use crate::map::envmap::EnvMap;
 use crate::map::pyramid::lod_q8;
@@ -59,19 +58,20 @@ use kernel::{level_texels, texels};
 use rowpass::{pixel_row, position_row, tri_row, LutRow};
 use rows::{for_each_band_init, for_each_row, for_each_row_init, post_bands};
 use scanline::{RowScratch, ScratchLoan, ROW_SCALE_ONE};
-use setup::{check_step, prepare, MapGeometry, Scan, Setup};
+use setup::{check_step, prepare, Scan, Setup};
 use sink::{Batch, PixelRows, PosRows, RowSinks, TriRows, TriSink};
 use std::sync::Arc;
 
 pub use levels::build_frame_levels;
 use levels::{centre_footprint, frame_level, frame_max_footprint, frame_min_footprint};
 pub use options::*;
+pub use setup::MapGeometry;
 
 /// The renderer: owns the tables for one map geometry and per-frame scratch.
 #[derive(Debug, Default)]
 pub struct Renderer {
     /// The tables built so far (shared with the renderers made by [`Renderer::share`]).
-    tables: Vec<(Surface, TableKind, Arc<LutTable>)>,
+    tables: Vec<BuiltTable>,
     geometry: Option<MapGeometry>,
     scans: Vec<Scan>,
     /// Row scale per map row (Q.30: multiplied by Λ up to W/2, so Q.16 would lose up to
@@ -91,18 +91,32 @@ pub struct Renderer {
     level: Option<Box<Renderer>>,
 }
 
+/// A table a renderer built, and what it was built for.
+#[derive(Debug, Clone)]
+struct BuiltTable {
+    /// The surface the table's cells lie on.
+    surface: Surface,
+    /// Its kind (wide or high).
+    kind: TableKind,
+    /// The table (shared with the renderers made by [`Renderer::share`]).
+    table: Arc<LutTable>,
+}
+
+impl BuiltTable {
+    /// Built for `surface` and `kind`.
+    fn is(&self, surface: Surface, kind: TableKind) -> bool {
+        self.surface == surface && self.kind == kind
+    }
+}
+
 /// The table of `surface` and `kind` among `tables` (built by [`Renderer::table`]; every
 /// caller builds it first, with the geometry set, so the look-up always finds it).
-fn find(
-    tables: &[(Surface, TableKind, Arc<LutTable>)],
-    surface: Surface,
-    kind: TableKind,
-) -> &LutTable {
+fn find(tables: &[BuiltTable], surface: Surface, kind: TableKind) -> &LutTable {
     &tables
         .iter()
-        .find(|(s, k, _)| *s == surface && *k == kind)
+        .find(|t| t.is(surface, kind))
         .expect("table built before it is looked up")
-        .2
+        .table
 }
 
 impl Renderer {
@@ -226,20 +240,20 @@ impl Renderer {
             height: h,
             projection: p,
         } = self.geometry?;
-        let i = match self
-            .tables
-            .iter()
-            .position(|(s, k, _)| *s == surface && *k == kind)
-        {
+        let i = match self.tables.iter().position(|t| t.is(surface, kind)) {
             Some(i) => i,
             None => {
                 let spec = TableSpec::default_for(surface, kind, w);
                 let table = LutTable::build(spec, p, w, h);
-                self.tables.push((surface, kind, Arc::new(table)));
+                self.tables.push(BuiltTable {
+                    surface,
+                    kind,
+                    table: Arc::new(table),
+                });
                 self.tables.len() - 1
             }
         };
-        Some(&self.tables[i].2)
+        Some(&self.tables[i].table)
     }
 
     /// The pyramid level a frame of `view` on `width × height` pixels is drawn from instead
@@ -250,9 +264,10 @@ impl Renderer {
         map: &'m EnvMap,
         view: View,
         sampler: Sampler,
-        size: (u32, u32),
+        width: u32,
+        height: u32,
     ) -> Option<(&'m EnvMap, &mut Renderer)> {
-        let level = self.level_map(map, view, sampler, size)?;
+        let level = self.level_map(map, view, sampler, width, height)?;
         let r = self
             .level
             .get_or_insert_with(|| Box::new(Renderer::new(level)));
@@ -267,7 +282,8 @@ impl Renderer {
         map: &'m EnvMap,
         view: View,
         sampler: Sampler,
-        (width, height): (u32, u32),
+        width: u32,
+        height: u32,
     ) -> Option<&'m EnvMap> {
         if map.crop().is_some() {
             return None;
@@ -301,16 +317,8 @@ impl Renderer {
         debug_assert_eq!(self.geometry, Some(geometry));
         let _ = self.table(opts.surface, kind);
         let table = find(&self.tables, opts.surface, kind);
-        prepare(
-            table,
-            kind,
-            geometry,
-            &mut self.scans,
-            view,
-            opts,
-            width,
-            height,
-        )
+        let cam = Camera::new(view, width, height);
+        prepare(table, kind, geometry, &mut self.scans, &cam, opts)
     }
 
     /// Which table `opts` selects for `view`.
@@ -391,7 +399,7 @@ impl Renderer {
         check_step(opts.index_step)?;
         let (width, height) = (frame.width(), frame.height());
         let pixels = width as u64 * height as u64;
-        if let Some((level, r)) = self.level_renderer(map, view, opts.sampler, (width, height)) {
+        if let Some((level, r)) = self.level_renderer(map, view, opts.sampler, width, height) {
             // A frame drawn from a pyramid level (`set_bilinear_level`, `set_still_level`):
             // a plain frame of the level, with tables for its geometry, as the level
             // would be drawn were it the map (the exact renderer's too).
@@ -430,8 +438,8 @@ impl Renderer {
         let bilinear = opts.sampler != Sampler::Nearest;
         if opts.sampler == Sampler::Trilinear || region_lod {
             // The pyramid is built here once, before the rows run in parallel.
-            let (levels, n) = level_texels(map);
-            let levels = &levels[..n];
+            let levels = level_texels(map);
+            let levels = &levels[..];
             let fp = ExactFootprint::new(view, width, height, geometry_of(map));
             let row = |scratch: &mut ScratchLoan, y: usize, row: &mut [u32]| {
                 let scan = &scans[y];
@@ -441,7 +449,8 @@ impl Renderer {
                     levels,
                     fy: scan.fy,
                     lod: 0,
-                    exact: (&fp, y),
+                    fp: &fp,
+                    y,
                     batch: Batch::new(),
                     nearest: region_lod,
                 };
@@ -524,11 +533,11 @@ impl Renderer {
             g.render(out, r, t, false)
         }
         let stats = if opts.sampler == Sampler::Trilinear {
-            let (levels, n) = level_texels(map); // builds the pyramid
+            let levels = level_texels(map); // builds the pyramid
             let exact = ExactFootprint::new(view, width, height, geometry);
             let rows = TriRows {
                 map,
-                levels: &levels[..n],
+                levels: &levels,
                 exact: &exact,
             };
             grid.render(out, &rows, t, true)
@@ -543,49 +552,39 @@ impl Renderer {
         grid_report(stats, width, height)
     }
 
-    /// Build the grid renderer's cells for `view` of a `map_w × map_h` map in
-    /// `projection` on a `width × height` output without drawing them: the per-view part
-    /// of a grid frame alone (its cost is inside every grid frame; `viewer bench` times
-    /// it). The report counts the exact pixels and the cell sizes as a grid frame's does.
+    /// Build the grid renderer's cells for `view` of a map of `geometry` on a
+    /// `width × height` output without drawing them: the per-view part of a grid frame
+    /// alone (its cost is inside every grid frame; `viewer bench` times it). The report
+    /// counts the exact pixels and the cell sizes as a grid frame's does.
     ///
     /// # Errors
     /// [`ViewError::BadSize`] for a bad output size.
-    #[allow(clippy::too_many_arguments)]
     pub fn build_grid(
         &mut self,
-        map_w: u32,
-        map_h: u32,
-        projection: Projection,
+        geometry: MapGeometry,
         view: View,
         width: u32,
         height: u32,
         threads: bool,
     ) -> Result<RenderReport, ViewError> {
         check_size(width, height)?;
-        let geometry = MapGeometry {
-            width: map_w,
-            height: map_h,
-            projection,
-        };
         self.set_geometry(geometry);
         let setup = Setup::new(width, geometry, 0.0);
         let grid = Grid::new(view, width, height, &setup, &self.row_scale);
         Ok(grid_report(grid.build(threads), width, height))
     }
 
-    /// The map positions the renderer `opts` selects samples for `view` (row-major,
+    /// The map positions the renderer `opts` selects samples for `view` of a map of
+    /// `geometry` (row-major,
     /// `None` = background): the same kernels as [`Renderer::render`] (the LUT's or the
     /// grid's), writing positions instead of pixels; the exact positions for the exact
     /// renderer. Used to measure the sampling-position error against the exact map.
     ///
     /// # Errors
     /// As [`Renderer::render`].
-    #[allow(clippy::too_many_arguments)]
     pub fn positions(
         &mut self,
-        map_w: u32,
-        map_h: u32,
-        projection: Projection,
+        geometry: MapGeometry,
         view: View,
         opts: &RenderOptions,
         width: u32,
@@ -593,11 +592,11 @@ impl Renderer {
     ) -> Result<(Positions, RenderReport), ViewError> {
         check_size(width, height)?;
         check_step(opts.index_step)?;
-        let geometry = MapGeometry {
+        let MapGeometry {
             width: map_w,
             height: map_h,
             projection,
-        };
+        } = geometry;
         self.set_geometry(geometry);
         let pixels = width as u64 * height as u64;
         let mut out = vec![None; pixels as usize];
@@ -652,11 +651,7 @@ pub(crate) fn run_hook(frame: &mut Frame<'_>, opts: &RenderOptions, hook: BandHo
 
 /// The map geometry the renderers use: the full panorama's.
 fn geometry_of(map: &EnvMap) -> MapGeometry {
-    MapGeometry {
-        width: map.width(),
-        height: map.height(),
-        projection: map.projection(),
-    }
+    MapGeometry::of(map)
 }
 
 /// True when the grid draws a map frame: asked for, or a view the table cannot draw.
@@ -683,6 +678,7 @@ mod tests {
     //! footprint, byte identity where magnified, and the supersampled truth at the poles.
     use super::*;
     use crate::geom::mapping::exact_uv_at;
+    use crate::geom::projection::Projection;
     use crate::render::exact::render_exact_supersampled;
     use crate::render::rowpass::{applies, row_pass};
     use crate::render::sink::nearest_level;
@@ -742,7 +738,7 @@ mod tests {
         let (setup, _) = r.prepare_frame(geometry_of(map), view, &tri, w, h);
         assert!(applies(&setup));
         let table = find(&r.tables, tri.surface, Renderer::table_kind(view, &tri));
-        let (levels, n) = level_texels(map);
+        let levels = level_texels(map);
         let fp = ExactFootprint::new(view, w, h, geometry_of(map));
         let mut scratch = RowScratch::new();
         let mut out = vec![None; (w * h) as usize];
@@ -753,10 +749,11 @@ mod tests {
             let mut s = TriSink {
                 row: &mut row,
                 map,
-                levels: &levels[..n],
+                levels: &levels,
                 fy: scan.fy,
                 lod: 0,
-                exact: (&fp, y),
+                fp: &fp,
+                y,
                 batch: Batch::new(),
                 nearest: true,
             };

@@ -26,7 +26,7 @@ use super::setup::{Lv, LvStep, Scan, Setup, Unfold};
 use super::sink::Sink;
 use super::sink::{PixelSink, PosSink, TriSink};
 use super::steps::STEP_REGIONS;
-use super::walk::{read_at, span_step, wrap_u, Half, HalfBuf, HalfRun, HALF_CHUNK};
+use super::walk::{read_at, span_step, wrap_u, Half, HalfBuf, HalfRun, Nodes, HALF_CHUNK};
 use crate::geom::fixed::FX_ONE;
 use crate::lut::LutTable;
 use crate::map::envmap::EnvMap;
@@ -95,7 +95,7 @@ pub(crate) fn row_pass<S: Sink>(
             let lim = step_limit(fr, n as usize);
             while d + n <= stop {
                 c += dc;
-                let p1 = un.apply(nodes.lookup_q(c).into());
+                let p1 = un.apply(nodes.read_q(c));
                 let (p1, step) = span_step(fr, p0, p1, n, shift);
                 if S::LOD {
                     let lod = sink.span_lod(step, r);
@@ -312,12 +312,24 @@ pub(crate) fn tri_row(lut: LutRow<'_>, scratch: &mut RowScratch, s: &mut TriSink
 /// else k = `lod >> 8` clamped to `last`, weight `lod & 0xFF` (the second level, k + 1,
 /// counts only below `last`).
 #[inline(always)]
-fn resolve(lod: i32, last: usize) -> (usize, u32) {
+fn resolve(lod: i32, last: usize) -> Resolved {
     if lod <= 0 {
-        (0, 0)
+        Resolved { k: 0, weight: 0 }
     } else {
-        (((lod >> 8) as usize).min(last), (lod & 0xFF) as u32)
+        Resolved {
+            k: ((lod >> 8) as usize).min(last),
+            weight: (lod & 0xFF) as u32,
+        }
     }
+}
+
+/// A level of detail resolved to pyramid levels ([`resolve`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Resolved {
+    /// The first level, k.
+    k: usize,
+    /// The weight of the second level, k + 1, out of 256 (0: the first level alone).
+    weight: u32,
 }
 
 /// A trilinear run (`levels`: level 0, the map `wq` / 256 wide, and its pyramid; `dv`:
@@ -378,9 +390,9 @@ fn tri_groups(
     let end = |i: usize| segs.get(i).map_or(n, |s| s.start as usize);
     let mut i = 0;
     while i < segs.len() {
-        let ka = resolve(segs[i].lod, last).0;
+        let ka = resolve(segs[i].lod, last).k;
         let mut e = i + 1;
-        while e < segs.len() && resolve(segs[e].lod, last).0 == ka {
+        while e < segs.len() && resolve(segs[e].lod, last).k == ka {
             e += 1;
         }
         let (a, b) = (segs[i].start as usize, end(e));
@@ -389,7 +401,7 @@ fn tri_groups(
         pass(ka, None, Uv { u: ul, v }, Out::Left(&mut row[left]));
         pass(ka, None, Uv { u, v }, Out::Right(&mut row[right]));
         // The second level over the segments from the first to the last with a weight.
-        let weighted = |j: &usize| resolve(segs[*j].lod, last).1 != 0;
+        let weighted = |j: &usize| resolve(segs[*j].lod, last).weight != 0;
         let (Some(f), Some(l)) = ((i..e).find(weighted), (i..e).rev().find(weighted)) else {
             i = e;
             continue;
@@ -400,7 +412,7 @@ fn tri_groups(
         }
         let (a, b) = (segs[f].start as usize, end(l + 1));
         for (j, s) in segs.iter().enumerate().take(l + 1).skip(f) {
-            let w = resolve(s.lod, last).1;
+            let w = resolve(s.lod, last).weight;
             r.w[s.start as usize - a..end(j + 1) - a].fill(w);
         }
         let w = Some(&r.w[..b - a]);
@@ -765,7 +777,7 @@ mod tests {
                 .map(|i| i.wrapping_mul(2_654_435_761) & 0xFF_FFFF)
                 .collect();
             let m = EnvMap::from_pixels(w, h, &px, Projection::Equirect).unwrap();
-            let (levels, nl) = level_texels(&m);
+            let levels = level_texels(&m);
             let (wq, hq) = ((w as i64) << 8, (h as i64) << 8);
             for _ in 0..60 {
                 let n = 1 + rnd(600) as usize;
@@ -786,7 +798,7 @@ mod tests {
                 };
                 check_run(
                     (&u, &ul, &v, &segs),
-                    |r, row| tri_run(&levels[..nl], wq as i32, 0, r, row),
+                    |r, row| tri_run(&levels, wq as i32, 0, r, row),
                     at,
                     &format!("{w}x{h}"),
                 );
@@ -820,8 +832,8 @@ mod tests {
             let m = EnvMap::from_pixels(cw, ch, &px, Projection::Equirect).unwrap();
             let mut m = m.into_partial(crop).unwrap();
             m.set_background(0x12_3456);
-            let (levels, nl) = level_texels(&m);
-            let crop_lv = crop_levels(&m, &levels[..nl]);
+            let levels = level_texels(&m);
+            let crop_lv = crop_levels(&m, &levels);
             let (wq, hq) = ((fw as i64) << 8, (fh as i64) << 8);
             for _ in 0..60 {
                 let n = 1 + rnd(600) as usize;

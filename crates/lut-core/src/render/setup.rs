@@ -8,23 +8,45 @@
 use super::steps::{step_for, StepBounds, StepLine, XRange, ADAPTIVE_MAX_STEP, STEP_REGIONS};
 use super::{IndexStep, RenderOptions, RenderPath, RenderReport};
 use crate::error::ViewError;
-use crate::geom::camera::{Camera, View};
+use crate::geom::camera::Camera;
 use crate::geom::fixed::{to_fx, Fx, FX_BITS, FX_ONE};
 use crate::geom::projection::Projection;
 use crate::lut::{LutTable, Surface, TableKind};
+use crate::map::envmap::EnvMap;
 use crate::map::sample::Sampler;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// The map a renderer draws from, as its geometry: the full panorama's size in pixels
-/// and its projection (a partial map's full size).
+/// and its projection (a partial map's full size). What [`crate::Renderer::positions`]
+/// and [`crate::Renderer::build_grid`] need of a map without its pixels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct MapGeometry {
+pub struct MapGeometry {
     /// Width in pixels.
-    pub(crate) width: u32,
+    pub width: u32,
     /// Height in pixels.
-    pub(crate) height: u32,
+    pub height: u32,
     /// The map's projection.
-    pub(crate) projection: Projection,
+    pub projection: Projection,
+}
+
+impl MapGeometry {
+    /// A `width × height` map in `projection`.
+    pub const fn new(width: u32, height: u32, projection: Projection) -> MapGeometry {
+        MapGeometry {
+            width,
+            height,
+            projection,
+        }
+    }
+
+    /// The geometry of `map` (a partial map's full size).
+    pub fn of(map: &EnvMap) -> MapGeometry {
+        MapGeometry {
+            width: map.width(),
+            height: map.height(),
+            projection: map.projection(),
+        }
+    }
 }
 
 /// A point of the table's plane: Λ (map pixels of longitude from the view's centre
@@ -53,6 +75,47 @@ pub(crate) struct LvStep {
     pub(crate) dl: Fx,
     /// dV per pixel, Q.16.
     pub(crate) dv: Fx,
+}
+
+/// An inclusive range of a row's pixel columns (empty when `lo > hi`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Cols {
+    /// The first column.
+    pub(crate) lo: i64,
+    /// The last column (inclusive).
+    pub(crate) hi: i64,
+}
+
+impl Cols {
+    /// No column.
+    pub(crate) const EMPTY: Cols = Cols { lo: 0, hi: -1 };
+
+    /// The columns in both ranges.
+    #[inline]
+    pub(crate) fn and(self, o: Cols) -> Cols {
+        Cols {
+            lo: self.lo.max(o.lo),
+            hi: self.hi.min(o.hi),
+        }
+    }
+
+    /// Column `x` is in the range.
+    #[inline]
+    pub(crate) fn contains(self, x: i64) -> bool {
+        x >= self.lo && x <= self.hi
+    }
+
+    /// No column in the range.
+    #[inline]
+    pub(crate) fn is_empty(self) -> bool {
+        self.lo > self.hi
+    }
+}
+
+impl Default for Cols {
+    fn default() -> Cols {
+        Cols::EMPTY
+    }
 }
 
 /// Per-scanline setup, computed once per frame.
@@ -85,10 +148,10 @@ pub(crate) struct Scan {
     /// the next scanline's: the row kernels prefetch the rows it will read
     /// (`Texels::toward_next_scanline`).
     pub(crate) next_dv: i32,
-    pub(crate) lut_lo: i64,
-    pub(crate) lut_hi: i64,
-    pub(crate) zone_lo: i64,
-    pub(crate) zone_hi: i64,
+    /// The columns the table covers (empty: none).
+    pub(crate) lut_cols: Cols,
+    /// The columns of the table's zone this row evaluates exactly (empty: none).
+    pub(crate) zone_cols: Cols,
 }
 
 /// Per-frame constants shared by all rows.
@@ -148,19 +211,16 @@ impl Setup {
 /// runs threaded).
 const PARALLEL_SETUP_ROWS: usize = 64;
 
-/// Per-frame setup: one [`Scan`] per output row.
-#[allow(clippy::too_many_arguments)]
+/// Per-frame setup: one [`Scan`] per output row of `cam`'s frame.
 pub(crate) fn prepare(
     table: &LutTable,
     kind: TableKind,
     map: MapGeometry,
     scans: &mut Vec<Scan>,
-    view: View,
+    cam: &Camera,
     opts: &RenderOptions,
-    width: u32,
-    height: u32,
 ) -> (Setup, RenderReport) {
-    let cam = Camera::new(view, width, height);
+    let (view, width, height) = (cam.view(), cam.width, cam.height);
     let f = cam.focal;
     let (mwf, mhf) = (map.width as f64, map.height as f64);
     let proj = map.projection;
@@ -207,10 +267,8 @@ pub(crate) fn prepare(
             ca,
             t_per_x: 1.0 / rho,
             row_angle: f / (f * f + yc * yc),
-            lut_lo: 0,
-            lut_hi: -1,
-            zone_lo: 0,
-            zone_hi: -1,
+            lut_cols: Cols::EMPTY,
+            zone_cols: Cols::EMPTY,
             ..Scan::default()
         };
         let row_coord = match opts.surface {
@@ -243,16 +301,12 @@ pub(crate) fn prepare(
             // (At most 2^47: times 2|X| ≤ 2^15 it cannot overflow; a column that far clamps.)
             scan.node_per_2x = q.round().min((1u64 << 47) as f64) as i64;
             let xc = table.col_max() / scan.col_per_x;
-            let (lo, hi) = x_range(half_w, xc, width);
-            scan.lut_lo = lo;
-            scan.lut_hi = hi;
+            scan.lut_cols = x_range(half_w, xc, width);
             let zone = table.zone(band);
             let mut t_min = 0.0;
             if zone >= 0.0 {
                 let xz = zone / scan.col_per_x;
-                let (zl, zh) = x_range(half_w, xz, width);
-                scan.zone_lo = zl;
-                scan.zone_hi = zh;
+                scan.zone_cols = x_range(half_w, xz, width);
                 t_min = xz * scan.t_per_x;
             }
             let line = StepLine {
@@ -341,9 +395,7 @@ fn vertical_footprints(scans: &mut [Scan], table: &LutTable, fr: &Setup, threads
         for (r, f) in fy.iter_mut().enumerate() {
             let x = ((half_w + (r as f64 + 0.5) * reg_x - 0.5).round() as i64)
                 .clamp(0, fr.w_out as i64 - 1);
-            let usable = |s: &Scan| {
-                s.lut && x >= s.lut_lo && x <= s.lut_hi && !(x >= s.zone_lo && x <= s.zone_hi)
-            };
+            let usable = |s: &Scan| s.lut && s.lut_cols.contains(x) && !s.zone_cols.contains(x);
             *f = match other {
                 Some(o) if usable(row) && usable(o) => {
                     let (p0, p1) = (read(row, table, fr, x), read(o, table, fr, x));
@@ -391,25 +443,25 @@ pub(crate) fn check_step(s: IndexStep) -> Result<(), ViewError> {
 }
 
 /// Inclusive pixel range with |x + ½ − W/2| ≤ r, clamped to the row (empty: lo > hi).
-fn x_range(half_w: f64, r: f64, width: u32) -> (i64, i64) {
+fn x_range(half_w: f64, r: f64, width: u32) -> Cols {
     if r.is_nan() || r < 0.0 {
-        return (0, -1);
+        return Cols::EMPTY;
     }
     let r = r.min(1e12);
     let lo = (half_w - 0.5 - r).ceil().max(0.0) as i64;
     let hi = (half_w - 0.5 + r).floor().min(width as f64 - 1.0) as i64;
-    (lo, hi)
+    Cols { lo, hi }
 }
 
 /// Pixels of a row the LUT path evaluates exactly.
 fn exact_count(s: &Scan, w: i64) -> u64 {
-    if !s.lut || s.lut_lo > s.lut_hi {
+    let lut = s.lut_cols;
+    if !s.lut || lut.is_empty() {
         return w as u64;
     }
-    let outside = s.lut_lo + (w - 1 - s.lut_hi);
-    let zl = s.zone_lo.max(s.lut_lo);
-    let zh = s.zone_hi.min(s.lut_hi);
-    let zone = if zl <= zh { zh - zl + 1 } else { 0 };
+    let outside = lut.lo + (w - 1 - lut.hi);
+    let z = s.zone_cols.and(lut);
+    let zone = if z.is_empty() { 0 } else { z.hi - z.lo + 1 };
     (outside + zone) as u64
 }
 

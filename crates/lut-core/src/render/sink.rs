@@ -210,8 +210,10 @@ pub(crate) struct TriSink<'a> {
     /// Vertical footprint per region of this scanline, in level-0 map pixels.
     pub(crate) fy: [f32; STEP_REGIONS],
     pub(crate) lod: i32,
-    /// The frame's exact footprints and this row's index.
-    pub(crate) exact: (&'a ExactFootprint, usize),
+    /// The frame's exact footprints.
+    pub(crate) fp: &'a ExactFootprint,
+    /// This row's index (in the frame).
+    pub(crate) y: usize,
     /// Spans waiting for the batch kernel, with their levels of detail.
     pub(crate) batch: Batch,
     /// Bilinear with a level per region (`Renderer::set_region_lod`): every level of
@@ -275,8 +277,7 @@ impl Sink for TriSink<'_> {
         // Pole zones, pixels beyond the table: their own exact footprint, as the exact
         // renderer (a span's or the scanline's footprint can be far off there: at hfov
         // 170 the edge columns beyond the wide table see a fraction of the centre's).
-        let (fp, y) = self.exact;
-        let lod = fp.lod(x, y, uv);
+        let lod = self.fp.lod(x, self.y, uv);
         self.row[x] = sample_at_lod(self.map, uv, lod);
     }
     #[inline(always)]
@@ -372,7 +373,8 @@ impl RowSinks for TriRows<'_> {
             levels: self.levels,
             fy: [0.0; STEP_REGIONS],
             lod: 0,
-            exact: (self.exact, y),
+            fp: self.exact,
+            y,
             batch: Batch::new(),
             nearest: false,
         }

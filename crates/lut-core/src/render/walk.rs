@@ -35,16 +35,17 @@ impl Half {
     /// The right half of `scan` (`None`: the table covers none of it).
     #[inline]
     pub(super) fn of(scan: &Scan, fr: &Setup) -> Option<Half> {
-        if !scan.lut || scan.lut_lo > scan.lut_hi {
+        let lut = scan.lut_cols;
+        if !scan.lut || lut.is_empty() {
             return None;
         }
         let w = fr.w_out as i64;
         let mut xa = w / 2;
-        let (zl, zh) = (scan.zone_lo.max(scan.lut_lo), scan.zone_hi.min(scan.lut_hi));
-        if zl <= zh {
-            xa = xa.max(zh + 1);
+        let zone = scan.zone_cols.and(lut);
+        if !zone.is_empty() {
+            xa = xa.max(zone.hi + 1);
         }
-        let xe = scan.lut_hi.min(w - 1);
+        let xe = lut.hi.min(w - 1);
         if xe < xa {
             return None;
         }
@@ -86,27 +87,28 @@ impl Half {
 
 /// The table reads of a scanline: straight from its band, or from its nodes blended once.
 pub(super) trait Nodes {
-    fn lookup_q(&self, c: i64) -> (Fx, Fx);
+    /// The table's (Λ, V) at node coordinate `c` ([`Band::lookup_q`]), before unfolding.
+    fn read_q(&self, c: i64) -> Lv;
 }
 
 impl Nodes for Band<'_> {
     #[inline(always)]
-    fn lookup_q(&self, c: i64) -> (Fx, Fx) {
-        Band::lookup_q(self, c)
+    fn read_q(&self, c: i64) -> Lv {
+        Band::lookup_q(self, c).into()
     }
 }
 
 impl Nodes for Blended<'_> {
     #[inline(always)]
-    fn lookup_q(&self, c: i64) -> (Fx, Fx) {
-        Blended::lookup_q(self, c)
+    fn read_q(&self, c: i64) -> Lv {
+        Blended::lookup_q(self, c).into()
     }
 }
 
 /// The unfolded read at offset d of the half `h`.
 #[inline(always)]
 pub(super) fn read_at<N: Nodes>(scan: &Scan, nodes: &N, h: &Half, u: &Unfold, d: i64) -> Lv {
-    u.apply(nodes.lookup_q((h.a0 + 2 * d) * scan.node_per_2x).into())
+    u.apply(nodes.read_q((h.a0 + 2 * d) * scan.node_per_2x))
 }
 
 /// The span from `p0` to the next read `p1` over `m` pixels (`shift`: log2 of the

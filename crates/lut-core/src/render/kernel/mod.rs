@@ -152,7 +152,7 @@ pub use select::{
 };
 pub use span::{SpanJob, Steps, Window, MAX_JOBS, TRILINEAR_CHUNK};
 
-pub(crate) use face::{ChunkWeights, FaceBuf, FaceRun};
+pub(crate) use face::{ChunkLevels, ChunkWeights, FaceBuf, FaceRun};
 pub(crate) use row::{wrap_q8, Level, Positions, Q16Start, Q16Step, SpanAt, SpanQ8};
 pub(crate) use select::active;
 pub(crate) use shade::{Light, ShadeTable};
@@ -239,13 +239,31 @@ pub(crate) fn texels(map: &EnvMap) -> Texels<'_> {
 }
 
 /// The texels of level 0 (`map`) and of each pyramid level, as the span kernels take
-/// them, and how many there are (the pyramid is built here if it was not).
-pub(crate) fn level_texels(map: &EnvMap) -> ([Texels<'_>; MAX_LEVELS], usize) {
+/// them (the pyramid is built here if it was not).
+pub(crate) fn level_texels(map: &EnvMap) -> LevelTexels<'_> {
     let mut t = [texels(map); MAX_LEVELS];
     let levels = map.pyramid();
     let n = 1 + levels.len().min(MAX_LEVELS - 1);
     for (d, l) in t[1..n].iter_mut().zip(levels) {
         *d = texels(l);
     }
-    (t, n)
+    LevelTexels { t, n }
+}
+
+/// A map's levels as [`level_texels`] returns them, without allocating: derefs to the
+/// slice of the first `n` (level 0 first).
+#[derive(Clone, Copy)]
+pub(crate) struct LevelTexels<'a> {
+    /// The levels' texels; past `n`, copies of level 0.
+    t: [Texels<'a>; MAX_LEVELS],
+    /// How many levels there are (1 to [`MAX_LEVELS`]).
+    n: usize,
+}
+
+impl<'a> std::ops::Deref for LevelTexels<'a> {
+    type Target = [Texels<'a>];
+
+    fn deref(&self) -> &[Texels<'a>] {
+        &self.t[..self.n]
+    }
 }

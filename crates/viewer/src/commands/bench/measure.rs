@@ -13,7 +13,8 @@ use anyhow::{bail, Context, Result};
 use lut_core::exact_uv;
 use lut_core::position_error;
 use lut_core::{
-    Camera, EnvMap, Frame, Named, Panorama, Projection, Renderer, RendererKind, Sampler, View,
+    Camera, EnvMap, Frame, MapGeometry, Named, Panorama, Projection, Renderer, RendererKind,
+    Sampler, View,
 };
 use rayon::prelude::*;
 use std::time::Instant;
@@ -164,6 +165,7 @@ pub fn measure_errors(
     let n = w as usize * h as usize;
     let map = ctx.map;
     let (mw, mh, proj) = (map.width(), map.height(), map.projection());
+    let geometry = MapGeometry::of(map);
     let mut acc = vec![ErrAcc::default(); cfgs.len()];
     let mut gather_idx = Vec::with_capacity(ctx.set.views.len());
     let first = export.as_ref().map_or(0, |ex| ex.len());
@@ -213,7 +215,7 @@ pub fn measure_errors(
             if let (Sampler::Nearest, Some(opts)) =
                 (cfg.sampler(), position_opts(*cfg, ctx.set.table))
             {
-                let (pos, rep) = renderer.positions(mw, mh, proj, view, &opts, w, h)?;
+                let (pos, rep) = renderer.positions(geometry, view, &opts, w, h)?;
                 let (max, sum, cnt) = compare(&pos, &exact, proj, mw, mh);
                 e.max = e.max.max(max);
                 e.sum += sum;
@@ -363,12 +365,12 @@ pub fn time_config(
 /// Milliseconds of the grid's per-view build alone (`Renderer::build_grid`, no drawing)
 /// for each frame of the set: one warm-up pass, then `passes` timed passes.
 pub fn time_grid_build(ctx: &Ctx, renderer: &mut Renderer, passes: u32) -> Result<Vec<f64>> {
-    let (mw, mh, p) = (ctx.map.width(), ctx.map.height(), ctx.map.projection());
+    let geometry = MapGeometry::of(ctx.map);
     let mut times = Vec::new();
     for pass in 0..=passes {
         for &view in &ctx.set.views {
             let t = Instant::now();
-            let rep = renderer.build_grid(mw, mh, p, view, ctx.w, ctx.h, true)?;
+            let rep = renderer.build_grid(geometry, view, ctx.w, ctx.h, true)?;
             std::hint::black_box(rep);
             if pass > 0 {
                 times.push(t.elapsed().as_secs_f64() * 1e3);

@@ -81,8 +81,17 @@ pub(crate) struct FaceBuf {
     under: Vec<u32>,
     /// The caller's per-chunk scratch (trilinear: each chunk's two levels, and the
     /// weights of the second), kept here so a band allocates it once.
-    pub(crate) levels: Vec<(usize, usize)>,
+    pub(crate) levels: Vec<ChunkLevels>,
     pub(crate) fracs: Vec<u32>,
+}
+
+/// The two pyramid levels a trilinear chunk of a face run reads ([`FaceBuf::levels`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct ChunkLevels {
+    /// The first level's index in the cube's pyramid (0: the cube itself).
+    pub(crate) first: usize,
+    /// The second level's index (the same as `first` at the pyramid's last level).
+    pub(crate) second: usize,
 }
 
 /// The bordered Q.8 positions of the run's pixels 0..m with kernel `k` (the buffers
@@ -441,11 +450,11 @@ mod tests {
         let mut buf = FaceBuf::default();
         let want: Vec<u32> = (0..len)
             .map(|i| {
-                let (u, v, _) = scalar::exact(r, i);
+                let at = scalar::exact(r, i);
                 if bilinear {
-                    c.bilinear(f, u, v)
+                    c.bilinear(f, at.u, at.v)
                 } else {
-                    c.nearest(f, u, v)
+                    c.nearest(f, at.u, at.v)
                 }
             })
             .collect();
@@ -482,8 +491,8 @@ mod tests {
             .collect();
         let want: Vec<u32> = (0..len)
             .map(|i| {
-                let (u, v, _) = scalar::exact(r, i);
-                lerp_px(under[i], c.bilinear(f, u, v), fracs[i / chunk])
+                let at = scalar::exact(r, i);
+                lerp_px(under[i], c.bilinear(f, at.u, at.v), fracs[i / chunk])
             })
             .collect();
         for k in Kernel::available() {
@@ -522,12 +531,12 @@ mod tests {
             (10.0, 10.0, 1.0, 5, 540),
         ] {
             let v = View::new(yaw, pitch, hfov).unwrap();
-            for (a, e, face, ok) in scanline_runs(v, w, 1080, 61, y) {
-                let (f, r) = view_run((yaw, pitch, hfov), (w, 1080), (a, y), 61);
-                if ok {
-                    assert_eq!(f, face);
+            for run in scanline_runs(v, w, 1080, 61, y) {
+                let (f, r) = view_run((yaw, pitch, hfov), (w, 1080), (run.start, y), 61);
+                if run.verified {
+                    assert_eq!(f, run.face);
                 }
-                check(4, f, &r, (e - a) as usize, 1);
+                check(4, f, &r, (run.end - run.start) as usize, 1);
             }
         }
     }

@@ -4,17 +4,29 @@
 use super::FaceRun;
 use crate::geom::fixed::{FX_BITS, FX_ONE};
 
-/// The exact face position of pixel `i` of the run (the arithmetic of `face_uv`) and its
-/// `m`.
+/// A position on a cube face, in face texels from its top-left corner (unbordered; the
+/// arithmetic of `face_uv`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct FacePos {
+    /// Texels right of the face's left edge.
+    pub(super) u: f64,
+    /// Texels down from the face's top edge.
+    pub(super) v: f64,
+}
+
+/// The exact face position of pixel `i` of the run (the arithmetic of `face_uv`).
 #[inline(always)]
-pub(super) fn exact(r: &FaceRun, i: usize) -> (f64, f64, f64) {
+pub(super) fn exact(r: &FaceRun, i: usize) -> FacePos {
     // (Runs are shorter than 2³² pixels: u32 converts to f64 in one instruction.)
     let dx = r.dx + f64::from(i as u32);
     let a = r.p[0] + dx * r.d[0];
     let b = r.p[1] + dx * r.d[1];
     let m = r.p[2] + dx * r.d[2];
     let q = r.half / m;
-    (r.half + a * q, r.half - b * q, m)
+    FacePos {
+        u: r.half + a * q,
+        v: r.half - b * q,
+    }
 }
 
 /// The bordered Q.8 positions of the run's pixels 0..m, exact (see the module docs), one
@@ -40,9 +52,9 @@ pub(super) fn positions<const BILINEAR: bool>(
     };
     let mut top = i32::MIN;
     for (i, (pu, pv)) in u[..m].iter_mut().zip(&mut v[..m]).enumerate() {
-        let (x, y, _) = exact(r, i);
-        *pu = q8(x);
-        *pv = q8(y);
+        let at = exact(r, i);
+        *pu = q8(at.u);
+        *pv = q8(at.v);
         top = top.max(*pv);
     }
     top

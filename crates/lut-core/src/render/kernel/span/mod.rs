@@ -556,8 +556,8 @@ pub(crate) fn trilinear_span(map: &EnvMap, out: &mut [u32], s: Steps, lod: i32) 
         // Partial maps: per pixel (their levels are read as the padded map's).
         return put_trilinear(map, out, s, lod);
     }
-    let (levels, n) = level_texels(map);
-    if trilinear(active(), &levels[..n], out, s, lod) {
+    let levels = level_texels(map);
+    if trilinear(active(), &levels, out, s, lod) {
         return;
     }
     trilinear_span_slow(map, out, s, lod);

@@ -194,22 +194,21 @@ proptest! {
 }
 
 /// The trilinear row kernel `k` (`row::sample_lv_with` on a level, blended with `BLEND`)
-/// on case `c` (level-0 positions, the level `lk` below a map `wq` / 256 wide), written
-/// into `base` (the pixels it blends into) inside a sentinel-filled buffer.
+/// on case `c` (level-0 positions, the level `lv`), written into `base` (the pixels it
+/// blends into) inside a sentinel-filled buffer.
 fn run_level<const M: bool, const BLEND: bool>(
     k: Kernel,
     t: &Texels,
     c: &RowCase,
-    (lk, wq, w): (u32, i32, &[u32]),
+    lv: &row::Level,
     base: &[u32],
 ) -> Vec<u32> {
     let n = c.u.len();
     let mut buf = vec![SENTINEL; n + 16];
     buf[c.off..c.off + n].copy_from_slice(&base[..n]);
-    let lv = row::Level { k: lk, wq, w };
     let out = &mut buf[c.off..c.off + n];
     k.selected()
-        .sample_lv::<true, M, true, BLEND>(t, &c.u, &c.v, out, &lv);
+        .sample_lv::<true, M, true, BLEND>(t, &c.u, &c.v, out, lv);
     buf
 }
 
@@ -235,7 +234,7 @@ proptest! {
         let wq = ((*w as i32) << lk) << 8;
         for (c, wts, base) in &cases {
             let base: Vec<u32> = base.iter().map(|p| p & 0xFF_FFFF).collect();
-            let a = (lk, wq, &wts[..]);
+            let a = &row::Level { k: lk, wq, w: wts };
             let want = [
                 run_level::<false, false>(Kernel::Scalar, &t, c, a, &base),
                 run_level::<true, false>(Kernel::Scalar, &t, c, a, &base),
@@ -271,8 +270,8 @@ proptest! {
         let (w, h) = wh;
         let px: Vec<u32> = (0..w * h).map(|i| i.wrapping_mul(2_654_435_761) & 0xFF_FFFF).collect();
         let m = EnvMap::from_pixels(w, h, &px, Projection::Equirect).unwrap();
-        let (levels, nl) = level_texels(&m);
-        let last = nl - 1;
+        let levels = level_texels(&m);
+        let last = levels.len() - 1;
         let (ka, frac) = (((lod >> 8) as usize).min(last), (lod & 0xFF) as u32);
         let wq = (w as i32) << 8;
         let wts = [frac; 64];
