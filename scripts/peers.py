@@ -205,12 +205,12 @@ def main():
         imgs["cv_fixed_nn"].append((o, ex_nn))
 
         # Per view: build the map in numpy, then remap (float maps).
-        def per_view():
+        def np_remap_per_view():
             t = time.perf_counter()
             bx, by = numpy_maps(v["yaw"], v["pitch"], v["hfov"], w, h, mw, mh)
             res["np_build"].append(time.perf_counter() - t)
             return cv2.remap(srcp, bx + 1.0, by, bil, borderMode=rep), bx, by
-        o, bx, by = timed("np_build_remap", per_view, reps=1)
+        o, bx, by = timed("np_build_remap", np_remap_per_view, reps=1)
         imgs["np_build_remap"].append((o, ex_bil))
         np_map_err = max(np_map_err, float(np.max(np.abs(bx + 1.0 - mx))),
                          float(np.max(np.abs(by - my))))
