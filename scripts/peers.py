@@ -383,9 +383,13 @@ def main():
         if extra:
             ms += median_ms(res[extra])
         p = pooled_psnr(imgs[key]) if key in imgs and imgs[key] else None
+        # Identical images have an infinite PSNR, which JSON cannot hold (Python would
+        # write `Infinity`, which `viewer bench --replot` rightly refuses): null with
+        # "identical": true instead.
+        same = p is not None and math.isinf(p)
         rows.append({"peer": name, "key": key, "ms_median": ms, "ours_ms": ours_ms,
                      "ours": what, "ratio_ours_over_theirs": ours_ms / ms if ours_ms and ms > 0 else None,
-                     "psnr_db_vs_exact": p})
+                     "psnr_db_vs_exact": None if same else p, "identical": same})
 
     add("OpenCV remap, float maps, bilinear", "cv_float_bil", lut_bil, "lut bilinear adaptive")
     add("OpenCV remap, fixed-point maps, bilinear", "cv_fixed_bil", lut_bil, "lut bilinear adaptive")
@@ -421,7 +425,7 @@ def main():
             o = row["ours_lut_bilinear_adaptive_ms"]
             row["ratio_ours_over_" + key] = o / ms if o and ms else None
         summary["per_view"].append(row)
-    json.dump(summary, open(os.path.join(a.out, "peers.json"), "w"), indent=2)
+    json.dump(summary, open(os.path.join(a.out, "peers.json"), "w"), indent=2, allow_nan=False)
     print(f"peers: {w}x{h} from {mw}x{mh}, {n} threads, {len(meta['views'])} views x {a.reps} reps")
     print(f"| peer | their ms (median) | ours | our ms | ours/theirs | their PSNR vs our exact |")
     print("|---|---:|---|---:|---:|---:|")
@@ -429,7 +433,7 @@ def main():
         ratio = f"{r['ratio_ours_over_theirs']:.3f}" if r["ratio_ours_over_theirs"] else "-"
         om = f"{r['ours_ms']:.2f}" if r["ours_ms"] else "-"
         p = r["psnr_db_vs_exact"]
-        ps = "-" if p is None else ("identical" if p == float("inf") else f"{p:.1f} dB")
+        ps = "identical" if r["identical"] else ("-" if p is None else f"{p:.1f} dB")
         print(f"| {r['peer']} | {r['ms_median']:.2f} | {r['ours']} | {om} | {ratio} | {ps} |")
     print(f"numpy-built maps vs our exported exact maps: max |diff| {np_map_err:.2e} px")
     if given:

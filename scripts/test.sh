@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The whole test suite: formatting, lints, unit/integration/golden/property tests, the
-# real window under Xvfb (a smoke test and a one-minute soak), and every fuzz target
-# briefly on its committed seeds (FUZZ_SECONDS each, default 12). Works on a fresh
+# real window under Xvfb (a smoke test, tours, the tour editor, tiles and a one-minute
+# soak), the measuring scripts on tiny sizes (scripts/peers-smoke.sh), and every fuzz
+# target briefly on its committed seeds (FUZZ_SECONDS each, default 12). Works on a fresh
 # machine with the Rust toolchain: it installs the Debian packages the window tests need
-# when they are missing (as root, via apt-get), and the nightly toolchain and cargo-fuzz
-# for the fuzz targets.
+# when they are missing (as root, via apt-get), OpenCV for Python with pip, and the
+# nightly toolchain and cargo-fuzz for the fuzz targets.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # Each stage line carries the minutes:seconds since the start, so a slow CI run shows where
@@ -80,6 +81,8 @@ stage "tour editor window test under Xvfb (an info hotspot added at a clicked sp
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-tour-edit.sh
 stage "tiled pyramid window test under Xvfb (tiles loading, coarser then sharp, the cache budget kept)"
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-tiles.sh
+stage "the measuring scripts' smoke test (peers.py with OpenCV and the chart redrawn; tiny sizes, numbers meaningless)"
+VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/peers-smoke.sh
 stage "window soak under Xvfb (one minute of random input, drops and the memory curve)"
 t0=$SECONDS
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-soak.sh --duration 60

@@ -136,6 +136,10 @@ struct PeerRow {
     key: String,
     ms_median: Option<f64>,
     psnr_db_vs_exact: Option<f64>,
+    /// The peer's images equal our exact render (an infinite PSNR, which JSON cannot
+    /// hold: `psnr_db_vs_exact` is null then).
+    #[serde(default)]
+    identical: bool,
 }
 
 fn read_text(path: &Path) -> Result<String> {
@@ -189,7 +193,11 @@ pub fn read_peers(path: &Path) -> Result<Vec<Peer>> {
             out.push(Peer {
                 name: r.peer.clone(),
                 ms,
-                psnr_db: r.psnr_db_vs_exact,
+                psnr_db: if r.identical {
+                    Some(f64::INFINITY)
+                } else {
+                    r.psnr_db_vs_exact
+                },
             });
         }
     }
@@ -657,9 +665,13 @@ pub fn plot(path: &Path, rows: &[Row], peers: &[Peer]) -> Result<()> {
             ));
         }
         for (i, p) in peers.iter().enumerate() {
-            let psnr = p
-                .psnr_db
-                .map_or("no image".to_string(), |d| format!("{d:.1} dB"));
+            let psnr = p.psnr_db.map_or("no image".to_string(), |d| {
+                if d.is_infinite() {
+                    "identical images".to_string()
+                } else {
+                    format!("{d:.1} dB")
+                }
+            });
             entries.push(Entry::Dashed(
                 peer_colour(i),
                 format!("{} {}: {psnr}", i + 1, p.name),
@@ -907,7 +919,10 @@ mod tests {
          "psnr_db_vs_exact": 71.7},
         {"peer": "OpenCV convertMaps (map building only)", "key": "cv_convert", "ms_median": 0.3,
          "ours_ms": null, "ours": "-", "ratio_ours_over_theirs": null, "psnr_db_vs_exact": null},
-        {"peer": "again", "key": "cv_float_bil", "ms_median": 0.8, "psnr_db_vs_exact": 71.7}
+        {"peer": "again", "key": "cv_float_bil", "ms_median": 0.8, "psnr_db_vs_exact": 71.7},
+        {"peer": "OpenCV remap, float maps, nearest", "key": "cv_float_nn", "ms_median": 0.2,
+         "ours_ms": 0.3, "ours": "lut nearest adaptive", "ratio_ours_over_theirs": 1.5,
+         "psnr_db_vs_exact": null, "identical": true}
     ]}"#;
 
     /// A reference line's legend names a stepped row's bound (as rows of older JSON files
@@ -959,6 +974,11 @@ mod tests {
                     name: "OpenCV convertMaps (map building only)".into(),
                     ms: 0.3,
                     psnr_db: None
+                },
+                Peer {
+                    name: "OpenCV remap, float maps, nearest".into(),
+                    ms: 0.2,
+                    psnr_db: Some(f64::INFINITY)
                 },
             ]
         );
