@@ -3,7 +3,8 @@
 //! from its header), decoded behind the decoders' one containment (`guard::catch_quiet`:
 //! a decoder's panic is the tile's error, never the viewer's), into 0RGB texels.
 
-use super::config::{MultiresConfig, TileId};
+use super::config::MultiresConfig;
+use super::id::TileId;
 use std::path::Path;
 
 /// A tile file is read up to 64 MiB (a 512² tile is ~50 KiB as JPEG, 1 MiB as PNG).

@@ -3,8 +3,9 @@
 //! already being decoded finish), results handed to the owner of the [`TileStore`] between
 //! frames ([`TileLoader::pump`]), so a frame never waits for a tile.
 
-use super::config::{MultiresConfig, TileId};
+use super::config::MultiresConfig;
 use super::decode::decode_tile;
+use super::id::TileId;
 use super::store::{bordered, TileStore};
 use std::collections::HashSet;
 use std::sync::atomic::{AtomicU64, Ordering};

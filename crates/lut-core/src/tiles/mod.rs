@@ -6,14 +6,18 @@
 
 pub(crate) mod config;
 pub(crate) mod decode;
+pub(crate) mod id;
 pub(crate) mod loader;
+pub(crate) mod marzipano;
 pub(crate) mod render;
 pub(crate) mod store;
 pub(crate) mod write;
 
-pub use config::{LevelInfo, MultiresConfig, TileId, TilesError, MARZIPANO_PREVIEW_ORDER};
+pub use config::{LevelInfo, MultiresConfig, TilesError};
 pub use decode::decode_bytes;
+pub use id::TileId;
 pub use loader::{DecodeStats, TileLoader, PUMP_MAX_TILES, PUMP_MAX_TIME};
+pub use marzipano::MARZIPANO_PREVIEW_ORDER;
 pub use render::{frame_level, render_tiles, trilinear_levels, TileFrame};
 pub use store::{CacheStats, TileStore};
 pub use write::{generator_levels, write_marzipano, write_pyramid};

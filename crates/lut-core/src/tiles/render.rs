@@ -15,7 +15,7 @@
 //! tile, whose border holds the neighbours' texels). A pixel assigned to the wrong side of
 //! an edge by rounding reads the same texels through the border.
 
-use super::config::{TileId, TileMap, TileSet};
+use super::id::{TileId, TileMap, TileSet};
 use super::store::TileStore;
 use crate::cube::{face_axes, face_of, face_uv, Face};
 use crate::geom::camera::{Camera, View};

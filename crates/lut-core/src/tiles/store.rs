@@ -22,7 +22,8 @@
 //! format, corrupt, a decompression bomb) is remembered as failed, drawn from its
 //! ancestor for good, with one notice.
 
-use super::config::{MultiresConfig, TileId, TileMap, TileSet};
+use super::config::MultiresConfig;
+use super::id::{TileId, TileMap, TileSet};
 use crate::cube::{face_dir, face_of, face_uv, Face};
 use crate::geom::fixed::{FX_BITS, FX_HALF, FX_ONE};
 use crate::map::sample::lerp_px;

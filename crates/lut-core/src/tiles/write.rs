@@ -4,7 +4,8 @@
 //! one fewer in its edge case, each `int(size / 2)` of the one above. (`viewer tile`
 //! builds real pyramids from images.)
 
-use super::config::{face_letter, level_size, TileId};
+use super::config::{face_letter, level_size};
+use super::id::TileId;
 use crate::cube::Face;
 use std::path::Path;
 
