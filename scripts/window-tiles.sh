@@ -28,29 +28,16 @@ fail() { echo "window-tiles: FAIL: $*" >&2; exit 1; }
 log() { echo "window-tiles: $*"; }
 # shellcheck source=scripts/lib/xvfb.sh
 . scripts/lib/xvfb.sh
-for tool in Xvfb xdotool xdpyinfo; do
-  command -v "$tool" >/dev/null || fail "$tool not found (scripts/window-smoke.sh --install)"
-done
-TARGET=${CARGO_TARGET_DIR:-$ROOT/target}
-[ -z "${VIEWER_BIN:-}" ] || BUILD=0
-if [ "$BUILD" = 1 ]; then
-  log "building the release binary"
-  cargo build --release -p viewer --bin viewer
-fi
-BIN=${VIEWER_BIN:-$TARGET/release/viewer}
-[ -x "$BIN" ] || fail "$BIN not found"
+# shellcheck source=scripts/lib/window.sh
+. scripts/lib/window.sh
+window_tools Xvfb xdotool xdpyinfo
+window_binary
 
 rm -rf "$OUT"
 mkdir -p "$OUT/config"
 VIEWLOG=$OUT/viewer.stdout
 ERRLOG=$OUT/viewer.stderr
-XVFB_PID=""
-VIEWER_PID=""
-cleanup() {
-  if [ -n "$VIEWER_PID" ] && kill -0 "$VIEWER_PID" 2>/dev/null; then kill "$VIEWER_PID" || true; fi
-  if [ -n "$XVFB_PID" ] && kill -0 "$XVFB_PID" 2>/dev/null; then kill "$XVFB_PID" || true; fi
-}
-trap cleanup EXIT
+window_cleanup_on_exit
 xvfb_start 121 150 "$OUT/xvfb.log"
 export LUTPANO_CONFIG_DIR=$OUT/config
 
@@ -58,16 +45,6 @@ PYR=$OUT/pyramid
 log "writing a synthetic pyramid"
 "$BIN" tile --synthetic 4096x2048 --tile-size 64 -q -o "$PYR"
 
-wait_for() {
-  local pattern=$1 timeout=$2
-  local end=$((SECONDS + timeout))
-  while [ $SECONDS -lt "$end" ]; do
-    if grep -q -- "$pattern" "$VIEWLOG"; then return 0; fi
-    kill -0 "$VIEWER_PID" 2>/dev/null || fail "viewer exited early (see $ERRLOG)"
-    sleep 0.1
-  done
-  fail "timed out waiting for '$pattern' (see $VIEWLOG)"
-}
 start_viewer() {
   : >"$VIEWLOG"
   "$BIN" --size 800x500 --print-view "$@" >"$VIEWLOG" 2>"$ERRLOG" &

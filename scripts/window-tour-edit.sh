@@ -28,21 +28,14 @@ fail() { echo "window-tour-edit: FAIL: $*" >&2; exit 1; }
 log() { echo "window-tour-edit: $*"; }
 # shellcheck source=scripts/lib/xvfb.sh
 . scripts/lib/xvfb.sh
+# shellcheck source=scripts/lib/window.sh
+. scripts/lib/window.sh
 
 IMPORT=/usr/bin/import
-for tool in Xvfb xdotool xdpyinfo python3; do
-  command -v "$tool" >/dev/null || fail "$tool not found (scripts/window-smoke.sh --install)"
-done
+window_tools Xvfb xdotool xdpyinfo python3
 [ -x "$IMPORT" ] || fail "$IMPORT not found (ImageMagick)"
 
-TARGET=${CARGO_TARGET_DIR:-$ROOT/target}
-[ -z "${VIEWER_BIN:-}" ] || BUILD=0
-if [ "$BUILD" = 1 ]; then
-  log "building the release binary"
-  cargo build --release -p viewer --bin viewer
-fi
-BIN=${VIEWER_BIN:-$TARGET/release/viewer}
-[ -x "$BIN" ] || fail "$BIN not found"
+window_binary
 
 rm -rf "$OUT"
 mkdir -p "$OUT/config"
@@ -54,34 +47,9 @@ ERRLOG=$OUT/viewer.stderr
 export LUTPANO_CONFIG_DIR=$OUT/config
 printf '{"panel": false, "zoom_limit": null}\n' >"$OUT/config/settings.json"
 
-XVFB_PID=""
-VIEWER_PID=""
-cleanup() {
-  if [ -n "$VIEWER_PID" ] && kill -0 "$VIEWER_PID" 2>/dev/null; then kill "$VIEWER_PID" || true; fi
-  if [ -n "$XVFB_PID" ] && kill -0 "$XVFB_PID" 2>/dev/null; then kill "$XVFB_PID" || true; fi
-}
-trap cleanup EXIT
+window_cleanup_on_exit
 xvfb_start 170 200 "$OUT/xvfb.log"
 
-wait_for() {
-  local pattern=$1 timeout=$2
-  local end=$((SECONDS + timeout))
-  while [ $SECONDS -lt "$end" ]; do
-    if grep -q -- "$pattern" "$VIEWLOG"; then return 0; fi
-    kill -0 "$VIEWER_PID" 2>/dev/null || fail "viewer exited early (see $ERRLOG)"
-    sleep 0.1
-  done
-  fail "timed out waiting for '$pattern' (see $VIEWLOG)"
-}
-settle() {
-  local n
-  for _ in $(seq 1 60); do
-    n=$(wc -l <"$VIEWLOG")
-    sleep 0.5
-    [ "$(wc -l <"$VIEWLOG")" = "$n" ] && return 0
-  done
-  fail "the view never settled"
-}
 # The position NAME=x,y on the last `tour ui` line, as "x y".
 ui_xy() {
   grep '^tour ui' "$VIEWLOG" | tail -n 1 | tr ' ' '\n' | sed -n "s/^$1=//p" | tr ',' ' '

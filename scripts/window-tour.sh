@@ -28,21 +28,14 @@ fail() { echo "window-tour: FAIL: $*" >&2; exit 1; }
 log() { echo "window-tour: $*"; }
 # shellcheck source=scripts/lib/xvfb.sh
 . scripts/lib/xvfb.sh
+# shellcheck source=scripts/lib/window.sh
+. scripts/lib/window.sh
 
 IMPORT=/usr/bin/import
-for tool in Xvfb xdotool xdpyinfo; do
-  command -v "$tool" >/dev/null || fail "$tool not found (scripts/window-smoke.sh --install)"
-done
+window_tools Xvfb xdotool xdpyinfo
 [ -x "$IMPORT" ] || fail "$IMPORT not found (ImageMagick)"
 
-TARGET=${CARGO_TARGET_DIR:-$ROOT/target}
-[ -z "${VIEWER_BIN:-}" ] || BUILD=0
-if [ "$BUILD" = 1 ]; then
-  log "building the release binary"
-  cargo build --release -p viewer --bin viewer
-fi
-BIN=${VIEWER_BIN:-$TARGET/release/viewer}
-[ -x "$BIN" ] || fail "$BIN not found"
+window_binary
 
 rm -rf "$OUT"
 mkdir -p "$OUT/config"
@@ -51,25 +44,9 @@ ERRLOG=$OUT/viewer.stderr
 export LUTPANO_CONFIG_DIR=$OUT/config
 printf '{"panel": false, "zoom_limit": null}\n' >"$OUT/config/settings.json"
 
-XVFB_PID=""
-VIEWER_PID=""
-cleanup() {
-  if [ -n "$VIEWER_PID" ] && kill -0 "$VIEWER_PID" 2>/dev/null; then kill "$VIEWER_PID" || true; fi
-  if [ -n "$XVFB_PID" ] && kill -0 "$XVFB_PID" 2>/dev/null; then kill "$XVFB_PID" || true; fi
-}
-trap cleanup EXIT
+window_cleanup_on_exit
 xvfb_start 130 160 "$OUT/xvfb.log"
 
-wait_for() {
-  local pattern=$1 timeout=$2
-  local end=$((SECONDS + timeout))
-  while [ $SECONDS -lt "$end" ]; do
-    if grep -q -- "$pattern" "$VIEWLOG"; then return 0; fi
-    kill -0 "$VIEWER_PID" 2>/dev/null || fail "viewer exited early (see $ERRLOG)"
-    sleep 0.1
-  done
-  fail "timed out waiting for '$pattern' (see $VIEWLOG)"
-}
 count() { grep -c -- "$1" "$VIEWLOG" || true; }
 # Wait until the pattern has matched more than `n` lines.
 wait_more() {
@@ -99,15 +76,6 @@ view_is() {
     -v Y="$1" -v P="$2" -v H="$3" 'BEGIN {
       d = y - Y; while (d > 180) d -= 360; while (d < -180) d += 360;
       exit !(d * d < 1e-4 && (p - P) ^ 2 < 1e-4 && (h - H) ^ 2 < 1e-4) }'
-}
-settle() {
-  local n
-  for _ in $(seq 1 60); do
-    n=$(wc -l <"$VIEWLOG")
-    sleep 0.5
-    [ "$(wc -l <"$VIEWLOG")" = "$n" ] && return 0
-  done
-  fail "the view never settled"
 }
 
 TOUR=$ROOT/tests/data/tours/pannellum/tour.json
