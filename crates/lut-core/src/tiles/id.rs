@@ -15,6 +15,25 @@ pub struct TileId {
     pub x: u32,
 }
 
+impl TileId {
+    /// This tile and its eight neighbours on its face, those inside a grid of `n × n`
+    /// tiles (the level's [`tiles_across`](super::MultiresConfig::tiles_across)), row by
+    /// row.
+    pub fn around(self, n: u32) -> impl Iterator<Item = TileId> {
+        let n = i64::from(n);
+        (-1i64..=1).flat_map(move |dy| {
+            (-1i64..=1).filter_map(move |dx| {
+                let (x, y) = (i64::from(self.x) + dx, i64::from(self.y) + dy);
+                ((0..n).contains(&x) && (0..n).contains(&y)).then_some(TileId {
+                    x: x as u32,
+                    y: y as u32,
+                    ..self
+                })
+            })
+        })
+    }
+}
+
 /// A fast hash for [`TileId`] keys (the multiply-rotate of rustc's `FxHasher`): the tile
 /// maps are looked up for every piece of every run and every border texel, where the
 /// standard SipHash cost a fifth of a frame. The keys come from the configuration's
@@ -68,3 +87,32 @@ pub(crate) type TileMap<V> =
 /// A set of tiles, with [`TileHasher`].
 pub(crate) type TileSet =
     std::collections::HashSet<TileId, std::hash::BuildHasherDefault<TileHasher>>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn around_keeps_the_neighbours_inside_the_face() {
+        let t = |x, y| TileId {
+            level: 3,
+            face: Face::Front,
+            y,
+            x,
+        };
+        let xy = |v: Vec<TileId>| v.iter().map(|t| (t.x, t.y)).collect::<Vec<_>>();
+        assert_eq!(
+            xy(t(0, 0).around(4).collect()),
+            [(0, 0), (1, 0), (0, 1), (1, 1)]
+        );
+        assert_eq!(t(1, 2).around(4).count(), 9);
+        assert_eq!(
+            xy(t(3, 3).around(4).collect()),
+            [(2, 2), (3, 2), (2, 3), (3, 3)]
+        );
+        assert_eq!(xy(t(0, 0).around(1).collect()), [(0, 0)]);
+        assert!(t(1, 2)
+            .around(4)
+            .all(|n| n.level == 3 && n.face == Face::Front));
+    }
+}

@@ -163,22 +163,8 @@ impl TiledPanorama {
         let mut out = Vec::new();
         let read: std::collections::HashSet<TileId> = f.touched.iter().map(|t| t.0).collect();
         for (id, _, _) in &f.touched {
-            let n = cfg.tiles_across(id.level as u32) as i64;
-            for dy in -1i64..=1 {
-                for dx in -1i64..=1 {
-                    let (x, y) = (id.x as i64 + dx, id.y as i64 + dy);
-                    if (0..n).contains(&x) && (0..n).contains(&y) {
-                        let t = TileId {
-                            x: x as u32,
-                            y: y as u32,
-                            ..*id
-                        };
-                        if !read.contains(&t) {
-                            out.push(t);
-                        }
-                    }
-                }
-            }
+            let n = cfg.tiles_across(id.level as u32);
+            out.extend(id.around(n).filter(|t| !read.contains(t)));
         }
         if f.level < cfg.max_level {
             // The next level's tiles under the nearest quarter of those read.

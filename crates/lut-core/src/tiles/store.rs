@@ -361,19 +361,9 @@ impl TileStore {
             across.dedup();
             let mut near = TileSet::default();
             for a in across.into_iter().filter(|a| a.face != id.face) {
-                for dy in -1i64..=1 {
-                    for dx in -1i64..=1 {
-                        let (x, y) = (a.x as i64 + dx, a.y as i64 + dy);
-                        if (0..n).contains(&x) && (0..n).contains(&y) {
-                            let t = TileId {
-                                x: x as u32,
-                                y: y as u32,
-                                ..a
-                            };
-                            if edge(&t) && near.insert(t) {
-                                out.push((t, ALL_SIDES));
-                            }
-                        }
+                for t in a.around(n as u32) {
+                    if edge(&t) && near.insert(t) {
+                        out.push((t, ALL_SIDES));
                     }
                 }
             }
