@@ -312,13 +312,14 @@ impl Renderer {
         opts: &RenderOptions,
         width: u32,
         height: u32,
+        lod_cap: Option<u32>,
     ) -> (Setup, RenderReport) {
         let kind = Self::table_kind(view, opts);
         debug_assert_eq!(self.geometry, Some(geometry));
         let _ = self.table(opts.surface, kind);
         let table = find(&self.tables, opts.surface, kind);
         let cam = Camera::new(view, width, height);
-        prepare(table, kind, geometry, &mut self.scans, &cam, opts)
+        prepare(table, kind, geometry, &mut self.scans, &cam, opts, lod_cap)
     }
 
     /// Which table `opts` selects for `view`.
@@ -426,9 +427,11 @@ impl Renderer {
                 sampler: Sampler::Trilinear,
                 ..*opts
             };
-            self.prepare_frame(geometry, view, &tri, width, height)
+            // (Each region's steps within the budget of the level it reads.)
+            let last = map.pyramid().len().min(kernel::MAX_LEVELS - 1) as u32;
+            self.prepare_frame(geometry, view, &tri, width, height, Some(last))
         } else {
-            self.prepare_frame(geometry, view, opts, width, height)
+            self.prepare_frame(geometry, view, opts, width, height, None)
         };
         let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
         let scans = &self.scans;
@@ -616,7 +619,7 @@ impl Renderer {
             let stats = grid.render(&mut out, &PosRows, opts.threads, false);
             return Ok((out, grid_report(stats, width, height)));
         }
-        let (setup, report) = self.prepare_frame(geometry, view, opts, width, height);
+        let (setup, report) = self.prepare_frame(geometry, view, opts, width, height, None);
         let table = find(&self.tables, opts.surface, Self::table_kind(view, opts));
         let scans = &self.scans;
         let row_scale = &self.row_scale[..];
@@ -679,6 +682,7 @@ mod tests {
     use super::*;
     use crate::geom::mapping::exact_uv_at;
     use crate::geom::projection::Projection;
+    use crate::map::pyramid::nearest_level_of;
     use crate::render::exact::render_exact_supersampled;
     use crate::render::rowpass::{applies, row_pass};
     use crate::render::sink::nearest_level;
@@ -735,7 +739,8 @@ mod tests {
     fn region_levels(map: &EnvMap, view: View, (w, h): (u32, u32)) -> Vec<Option<u32>> {
         let mut r = Renderer::new(map);
         let tri = opts(Sampler::Trilinear);
-        let (setup, _) = r.prepare_frame(geometry_of(map), view, &tri, w, h);
+        let last = map.pyramid().len() as u32;
+        let (setup, _) = r.prepare_frame(geometry_of(map), view, &tri, w, h, Some(last));
         assert!(applies(&setup));
         let table = find(&r.tables, tri.surface, Renderer::table_kind(view, &tri));
         let levels = level_texels(map);
@@ -802,7 +807,23 @@ mod tests {
             (1000.0, 10),
         ] {
             assert_eq!(nearest_level(lod_q8(f)), k, "footprint {f}");
+            assert_eq!(nearest_level_of(f), k, "footprint {f}");
         }
+        // Without the logarithm: the same level over footprints from 0.5 to 2^20, except
+        // within 1/256 of a level above a boundary 2^(k − ½), where `lod_q8`'s Q.8
+        // truncation still gives the level below.
+        let mut f = 0.5f64;
+        while f < (1u64 << 20) as f64 {
+            let (a, b) = (nearest_level_of(f), nearest_level(lod_q8(f)));
+            let near = (f.log2() + 0.5).fract() < 1.0 / 256.0;
+            assert!(
+                a == b || (near && a == b + 1),
+                "footprint {f}: {a} against {b}"
+            );
+            f *= 1.001;
+        }
+        assert_eq!(nearest_level_of(f64::NAN), 0);
+        assert_eq!(nearest_level_of(f64::INFINITY), 30);
     }
 
     /// The level each region reads, against the nearest level to the exact footprint of

@@ -87,7 +87,8 @@ pub(crate) fn row_pass<S: Sink>(
             while r + 1 < STEP_REGIONS && d >= h.e[r + 1] {
                 r += 1;
             }
-            let shift = scan.shifts[r] as u32;
+            // (The walk's step: `shifts`, longer with a level per region.)
+            let shift = scan.lod_shifts[r] as u32;
             let n = 1i64 << shift;
             let stop = h.region_end(r).min(dn);
             let mut c = (h.a0 + 2 * d) * npx;
@@ -114,8 +115,9 @@ pub(crate) fn row_pass<S: Sink>(
                 }
             }
             if d < dn && d < h.region_end(r) {
-                // A span that ends short of the step (at the half's end).
-                let d1 = (d + n).min(dn);
+                // A span that ends short of the step (at the half's end, or at the
+                // region's end when the walk's step is longer than `shifts`).
+                let d1 = (d + n).min(dn).min(h.region_end(r));
                 let p1 = read_at(scan, nodes, &h, &un, d1);
                 let m = d1 - d;
                 let (p1, step) = span_step(fr, p0, p1, m, shift);

@@ -139,6 +139,12 @@ pub(crate) struct Scan {
     pub(crate) ca: f64,
     /// log2 of the index step per region of |X| (see [`STEP_REGIONS`]).
     pub(crate) shifts: [u8; STEP_REGIONS],
+    /// log2 of the index step the row pass walks each region with: `shifts`, or with a
+    /// level per region (`Renderer::set_region_lod`) at least that, from the budget of
+    /// the level the region's spans read at least (`steps::lod_budget`). The regions'
+    /// first reads (`walk::Half::of`) stay those of `shifts`, so a region's pixels do not
+    /// depend on the steps of the regions before it.
+    pub(crate) lod_shifts: [u8; STEP_REGIONS],
     /// Angle between this scanline and the next at the centre column (radians).
     pub(crate) row_angle: f64,
     /// Vertical pixel footprint per region (level-0 map pixels; trilinear only): the
@@ -219,6 +225,7 @@ pub(crate) fn prepare(
     scans: &mut Vec<Scan>,
     cam: &Camera,
     opts: &RenderOptions,
+    lod_cap: Option<u32>,
 ) -> (Setup, RenderReport) {
     let (view, width, height) = (cam.view(), cam.width, cam.height);
     let f = cam.focal;
@@ -237,7 +244,17 @@ pub(crate) fn prepare(
         v1,
         v2,
         coupling,
+        lod_cap: None,
     };
+    // Steps on the level read (adaptive steps of the row pass's maps only).
+    let lod_bounds =
+        (opts.index_step == IndexStep::Adaptive && !proj.scaled_rows() && proj.full_sphere())
+            .then_some(lod_cap)
+            .flatten()
+            .map(|cap| StepBounds {
+                lod_cap: Some(cap),
+                ..bounds
+            });
     let pitch = view.pitch();
     let half_w = width as f64 * 0.5;
     // One scanline's setup (independent of the others: the rows are set up in parallel).
@@ -323,6 +340,10 @@ pub(crate) fn prepare(
                 };
                 let n = step_for(&bounds, line, xs, nominal, 1 << hint[r]);
                 *shift = n.trailing_zeros() as u8;
+                scan.lod_shifts[r] = match &lod_bounds {
+                    Some(lb) => step_for(lb, line, xs, nominal, n).trailing_zeros() as u8,
+                    None => *shift,
+                };
             }
         }
         scan
