@@ -886,6 +886,77 @@ mod tests {
         }
     }
 
+    /// With a level per region each region is walked with the steps of the level its
+    /// spans read at least (`steps::lod_budget`): every table-drawn pixel's sampling
+    /// position is within 0.05 pixels of the level it reads of the exact position (the
+    /// angular metric, `geom::accuracy::position_error`, divided by 2^k), at the zenith,
+    /// the nadir, near a pole and across a wide view; and the longer steps are taken
+    /// (some region of some scanline walks a longer step than level 0's).
+    #[test]
+    fn region_steps_keep_the_error_within_the_level_read() {
+        use crate::geom::accuracy::position_error;
+        use crate::geom::camera::dir_to_lat_long;
+        let map = noise_map(2048, 1024);
+        let (mw, mh) = (2048.0, 1024.0);
+        let size = (240, 135);
+        for (yaw, pitch, hfov) in [
+            (30.0, 90.0, 90.0),
+            (30.0, -90.0, 90.0),
+            (30.0, 80.0, 90.0),
+            (10.0, 45.0, 90.0),
+            (30.0, 0.0, 150.0),
+        ] {
+            let view = View::new(yaw, pitch, hfov).unwrap();
+            let levels = region_levels(&map, view, size);
+            let mut r = Renderer::new(&map);
+            let tri = opts(Sampler::Trilinear);
+            let last = map.pyramid().len() as u32;
+            let g = geometry_of(&map);
+            let (setup, _) = r.prepare_frame(g, view, &tri, size.0, size.1, Some(last));
+            let longer = r
+                .scans
+                .iter()
+                .filter(|s| s.lut && s.lod_shifts != s.shifts)
+                .count();
+            let table = find(&r.tables, tri.surface, Renderer::table_kind(view, &tri));
+            let (w, h) = (size.0 as usize, size.1 as usize);
+            let mut pos = vec![None; w * h];
+            let mut scratch = RowScratch::new();
+            let wq = Some((map.width() as i32) << 8);
+            for (y, row) in pos.chunks_mut(w).enumerate() {
+                let lut = LutRow {
+                    scan: &r.scans[y],
+                    table,
+                    fr: &setup,
+                    row_scale: &r.row_scale,
+                };
+                crate::render::rowpass::position_row(lut, &mut scratch, wq, row);
+            }
+            let cam = Camera::new(view, size.0, size.1);
+            let mut worst: f64 = 0.0;
+            for y in 0..h {
+                for x in 0..w {
+                    let (Some(k), Some(got)) = (levels[y * w + x], pos[y * w + x]) else {
+                        continue;
+                    };
+                    let ray = cam.world_ray(x as f64 + 0.5, y as f64 + 0.5);
+                    let (lambda, phi) = dir_to_lat_long(ray);
+                    let exact = Projection::Equirect.uv(lambda, phi, mw, mh).unwrap();
+                    let e = position_error(Projection::Equirect, mw, mh, phi, exact, got);
+                    worst = worst.max(e / (1u64 << k.min(last)) as f64);
+                }
+            }
+            eprintln!("{pitch} {hfov}: {longer} scanlines step longer, worst {worst:.4} px");
+            assert!(
+                worst <= 0.05,
+                "{pitch} {hfov}: {worst} px of the level read"
+            );
+            if pitch != 45.0 {
+                assert!(longer > 0, "{pitch} {hfov}: no longer step");
+            }
+        }
+    }
+
     /// Where pixels magnify, the frame is today's bilinear frame byte for byte: a whole
     /// frame whose footprint stays below √2 (the horizon at 1.36 texels per pixel at the
     /// centre, as 1080p from 8k), and every pixel with an exact footprint up to 1.2 in a
