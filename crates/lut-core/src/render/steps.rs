@@ -42,15 +42,19 @@ pub(crate) struct StepBounds {
 /// t_far = (|X| + reach)·dt) steps at least f = (W/2π)·c·dt/(t_far² + c²) map pixels per
 /// pixel in Λ (its chord is the mean of the slope over it), and a span's level is chosen
 /// from the larger of its |dΛ|, |dV| and the vertical footprint
-/// (`sink::nearest_level_of`): at least the level of f. 3 % is taken off f for the table's
-/// own error in the chord's ends.
+/// (`map::pyramid::nearest_level_of`): at least the level of f, and at least
+/// `line.k_floor`, the level of the vertical footprint (near a pole the larger: there Λ
+/// turns from one scanline to the next). 3 % is taken off f for the table's own error in
+/// the chord's ends.
 pub(crate) fn lod_budget(b: &StepBounds, line: StepLine, xs: XRange, reach: f64) -> f64 {
     let Some(cap) = b.lod_cap else {
         return SPAN_ERROR_BUDGET;
     };
     let t_far = (xs.hi + reach) * line.dt;
     let f = 0.97 * b.lam_px * line.c * line.dt / (t_far * t_far + line.c * line.c);
-    let k = crate::map::pyramid::nearest_level_of(f).min(cap);
+    let k = crate::map::pyramid::nearest_level_of(f)
+        .max(line.k_floor)
+        .min(cap);
     SPAN_ERROR_BUDGET * (1u64 << k) as f64
 }
 
@@ -63,6 +67,10 @@ pub(crate) struct StepLine {
     pub(crate) c: f64,
     pub(crate) t_min: f64,
     pub(crate) dt: f64,
+    /// With a level per region ([`lod_budget`]): a level the region's spans read at
+    /// least whatever their step (from the scanline's vertical footprint there, which
+    /// the level of every span of the region includes); 0 otherwise.
+    pub(crate) k_floor: u32,
 }
 
 /// Where a region's spans start: |X| ∈ [`lo`, `hi`], pixels from the screen's centre
@@ -185,6 +193,7 @@ mod tests {
             nominal in prop::sample::select(vec![1u32, 2, 4, 8, 16, 64]),
             hint_log in 0u32..8,
             lod_cap in prop_oneof![Just(None), (0u32..14).prop_map(Some)],
+            k_floor in 0u32..6,
         ) {
             let b = StepBounds {
                 lam_px: lam.exp2(),
@@ -193,7 +202,7 @@ mod tests {
                 coupling: cpl,
                 lod_cap,
             };
-            let line = StepLine { s: a.sin(), c: a.cos(), t_min, dt };
+            let line = StepLine { s: a.sin(), c: a.cos(), t_min, dt, k_floor };
             let xs = XRange { lo: x_lo, hi: x_lo + w };
             let want = step_from_top(&b, line, xs, nominal);
             let got = step_for(&b, line, xs, nominal, 1 << hint_log);
