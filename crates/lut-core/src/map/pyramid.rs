@@ -87,7 +87,7 @@ pub fn lod_q8(footprint: f64) -> i32 {
 #[inline(always)]
 pub(crate) fn nearest_level_of(f: f64) -> u32 {
     // (NaN compares false.)
-    if !(f > std::f64::consts::SQRT_2) {
+    if f.partial_cmp(&std::f64::consts::SQRT_2) != Some(std::cmp::Ordering::Greater) {
         return 0;
     }
     let e = ((f * std::f64::consts::SQRT_2).to_bits() >> 52) as i64 - 1023;

@@ -124,7 +124,8 @@ impl ExactFootprint {
         let r2 = d.x * d.x + d.z * d.z;
         let n2 = r2 + d.y * d.y;
         let r = r2.sqrt();
-        if !(r > 0.0) {
+        // (On the axis through the poles: r is 0, or NaN for a NaN ray.)
+        if r.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return f64::INFINITY;
         }
         // dV/dφ: H/π; (H/2)·cos φ; (W/2π)/cos² φ (cos φ = r/|d|).

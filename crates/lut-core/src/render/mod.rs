@@ -188,9 +188,17 @@ impl Renderer {
     /// kernel: a region that is magnified is byte for byte the bilinear frame of today,
     /// and a frame whose footprint stays below √2 at 17 × 9 points spanning it
     /// ([`levels::frame_max_footprint`]) is drawn as before without the pyramid. The
-    /// pyramid is built on the first frame that needs it. Partial maps, the grid
-    /// renderer and frames drawn from one level ([`Renderer::set_bilinear_level`],
-    /// [`Renderer::set_still_level`]) are unaffected.
+    /// pyramid is built on the first frame that needs it. Partial maps and the grid
+    /// renderer are unaffected; a frame drawn from one level
+    /// ([`Renderer::set_bilinear_level`], [`Renderer::set_still_level`]) chooses per
+    /// region among that level and the ones below it, as a map of the level's size would.
+    ///
+    /// Each region is walked with the longest index step that keeps the sampling-position
+    /// error within the budget in pixels of the level it reads (`steps::lod_budget`);
+    /// pixels evaluated exactly (pole zones) read the level nearest their footprint from
+    /// the mapping's derivative (`ExactFootprint::derivative`), bilinear on that level.
+    /// The window turns this on for its frames; measured in docs/performance.md (issue
+    /// 34: the pole frame at about 0.65-0.7x the CPU time of bilinear on the map).
     pub fn set_region_lod(&mut self, on: bool) {
         self.region_lod = on;
     }
@@ -268,9 +276,12 @@ impl Renderer {
         height: u32,
     ) -> Option<(&'m EnvMap, &mut Renderer)> {
         let level = self.level_map(map, view, sampler, width, height)?;
+        let region_lod = self.region_lod;
         let r = self
             .level
             .get_or_insert_with(|| Box::new(Renderer::new(level)));
+        // (A level's bilinear frames choose their level per region as the map's would.)
+        r.region_lod = region_lod;
         Some((level, r))
     }
 
