@@ -1021,9 +1021,10 @@ mod tests {
         10.0 * (255.0f64.powi(2) * (3 * a.len()) as f64 / sse.max(1e-9)).log10()
     }
 
-    /// At the zenith and the nadir, the region-lod frame is closer to the exact render
-    /// supersampled 8×8 than today's bilinear frame (PSNR in dB, printed; a map of noise,
-    /// the worst case for aliasing), and faster to read: fewer distinct texels.
+    /// At the zenith, the nadir and pitch 80 the region-lod frame is closer to the exact
+    /// render supersampled 8×8 than today's bilinear frame by at least 0.5 dB, and at
+    /// pitch 45 and across a wide view (hfov 150) at least as close (PSNR in dB, printed;
+    /// a map of noise, the worst case for aliasing).
     #[test]
     fn closer_to_the_supersampled_truth_at_the_poles() {
         let map = noise_map(1024, 512);
@@ -1031,8 +1032,14 @@ mod tests {
         let mut plain = Renderer::new(&map);
         let mut region = Renderer::new(&map);
         region.set_region_lod(true);
-        for pitch in [90.0, -90.0, 80.0] {
-            let view = View::new(30.0, pitch, 90.0).unwrap();
+        for (pitch, hfov) in [
+            (90.0, 90.0),
+            (-90.0, 90.0),
+            (80.0, 90.0),
+            (45.0, 90.0),
+            (0.0, 150.0),
+        ] {
+            let view = View::new(30.0, pitch, hfov).unwrap();
             let mut truth = vec![0u32; (size.0 * size.1) as usize];
             render_exact_supersampled(
                 &map,
@@ -1044,10 +1051,12 @@ mod tests {
             );
             let a = psnr(&frame(&mut plain, &map, view, size), &truth);
             let b = psnr(&frame(&mut region, &map, view, size), &truth);
-            eprintln!("pitch {pitch}: bilinear {a:.2} dB, region lod {b:.2} dB");
+            eprintln!("pitch {pitch} hfov {hfov}: bilinear {a:.2} dB, region lod {b:.2} dB");
+            // (Near the poles clearly closer; elsewhere at least as close.)
+            let gain = if pitch.abs() >= 80.0 { 0.5 } else { 0.0 };
             assert!(
-                b >= a + 0.5,
-                "pitch {pitch}: region lod {b:.2} dB, bilinear {a:.2} dB"
+                b >= a + gain,
+                "pitch {pitch} hfov {hfov}: region lod {b:.2} dB, bilinear {a:.2} dB"
             );
         }
     }
