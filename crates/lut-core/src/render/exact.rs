@@ -112,13 +112,20 @@ impl ExactFootprint {
     /// cylindrical maps (rows that do not scale); the others take
     /// [`ExactFootprint::footprint`]. (`Renderer::set_region_lod`'s exact pixels.)
     pub(crate) fn derivative(&self, x: f64, y: f64, at: (f64, f64)) -> f64 {
+        self.derivative_of(x, y)
+            .unwrap_or_else(|| self.footprint(x, y, at))
+    }
+
+    /// [`ExactFootprint::derivative`] without the exact position: `None` for the views
+    /// and maps it does not cover.
+    pub(crate) fn derivative_of(&self, x: f64, y: f64) -> Option<f64> {
         let slope = match self.proj {
             Projection::Equirect | Projection::Sine | Projection::Cylinder
                 if self.cam.view().projection().is_rectilinear() =>
             {
                 self.proj
             }
-            _ => return self.footprint(x, y, at),
+            _ => return None,
         };
         let d = self.cam.world_ray(x, y);
         let r2 = d.x * d.x + d.z * d.z;
@@ -126,7 +133,7 @@ impl ExactFootprint {
         let r = r2.sqrt();
         // (On the axis through the poles: r is 0, or NaN for a NaN ray.)
         if r.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-            return f64::INFINITY;
+            return Some(f64::INFINITY);
         }
         // dV/dφ: H/π; (H/2)·cos φ; (W/2π)/cos² φ (cos φ = r/|d|).
         let dv_dphi = match slope {
@@ -144,7 +151,7 @@ impl ExactFootprint {
             let dphi = (dd.y * r2 - d.y * (d.x * dd.x + d.z * dd.z)) / (n2 * r);
             f = f.max((dl * lam_px).abs()).max((dphi * dv_dphi).abs());
         }
-        f
+        Some(f)
     }
 
     /// The level of detail (Q.8) of pixel (x, y) whose exact position is `uv` (0 where the

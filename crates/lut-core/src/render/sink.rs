@@ -27,6 +27,18 @@ pub(crate) trait Sink {
     }
     fn background(&mut self, x: usize);
     fn exact(&mut self, x: usize, uv: Option<(f64, f64)>);
+    /// The pyramid level pixel `x` (evaluated exactly) reads, known before its position
+    /// (bilinear with a level per region: from the mapping's derivative); `None`: the
+    /// sink takes positions through [`Sink::exact`].
+    #[inline(always)]
+    fn exact_level(&mut self, _x: usize) -> Option<u32> {
+        None
+    }
+    /// Pixel `x` at `uv` on level `k` (as [`Sink::exact_level`] gave it).
+    #[inline(always)]
+    fn exact_on(&mut self, x: usize, uv: Option<(f64, f64)>, _k: u32) {
+        self.exact(x, uv);
+    }
     /// The per-pixel step (dΛ, dV) of the span about to be emitted (its horizontal
     /// footprint): the trilinear sink picks its pyramid level from it.
     #[inline(always)]
@@ -304,6 +316,21 @@ impl Sink for TriSink<'_> {
         }
         let lod = self.fp.lod(x, self.y, uv);
         self.row[x] = sample_at_lod(self.map, uv, lod);
+    }
+    #[inline]
+    fn exact_level(&mut self, x: usize) -> Option<u32> {
+        if !self.nearest {
+            return None;
+        }
+        let f = self.fp.derivative_of(x as f64 + 0.5, self.y as f64 + 0.5)?;
+        Some(nearest_level_of(f).min(self.levels.len() as u32 - 1))
+    }
+    #[inline]
+    fn exact_on(&mut self, x: usize, uv: Option<(f64, f64)>, k: u32) {
+        self.row[x] = match uv {
+            Some(at) => sample_at_level(self.map, at, k),
+            None => self.map.background(),
+        };
     }
     #[inline(always)]
     fn footprint(&mut self, step: LvStep, region: usize) {
