@@ -10,6 +10,7 @@
 //! * [`check`]: every link, file and scene id (`viewer tour check`).
 //! * [`edit`]: the edit operations and their undo stack (the window's editor).
 //! * [`markers`]: hotspot markers drawn on a rendered view.
+//! * [`level`]: the horizon line and the correction that drags it (the level mode).
 //!
 //! Reading never stops at the first problem: each bad scene or hotspot is left out with a
 //! [`Problem`] naming its place (line and path in the file), and the rest of the tour
@@ -17,6 +18,7 @@
 
 pub mod check;
 pub mod edit;
+pub mod level;
 pub mod literal;
 pub mod markers;
 pub mod marzipano;
