@@ -66,6 +66,7 @@ pub fn check(tour: &Tour, file: &Path) -> Vec<Problem> {
                         // The one tile every face has: level 1, x 0, y 0.
                         for face in ["f", "r", "b", "l", "u", "d"] {
                             let rel = pat
+                                .replace("%l0", "0")
                                 .replace("%l", "1")
                                 .replace("%s", face)
                                 .replace("%x", "0")
