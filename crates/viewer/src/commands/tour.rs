@@ -117,11 +117,12 @@ fn run_convert(path: &std::path::Path, output: &std::path::Path) -> Result<()> {
         crate::errln!("{p}");
     }
     let left_out = pannellum::save(&loaded.tour, output)?;
-    for id in &left_out {
+    // One line per Marzipano scene whose levels Pannellum's multires cannot describe.
+    for entry in &left_out {
         crate::errln!(
             "{}",
             lut_core::one_line(&format!(
-                "{}: scene \"{id}\" is Marzipano tiles, which Pannellum cannot open: left out",
+                "{}: scene {entry}: left out (`viewer tile` on its tile folder writes a Pannellum pyramid for it)",
                 path.display()
             ))
         );

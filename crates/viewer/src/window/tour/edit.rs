@@ -93,7 +93,11 @@ impl TourNav {
     /// `data.js`.
     pub fn save_path(&self) -> PathBuf {
         match crate::tour::sniff(&self.path) {
-            Some(Format::Marzipano) | None => self.path.with_extension("json"),
+            // Beside it, never over it (a Marzipano export named `.json`).
+            Some(Format::Marzipano) | None => match self.path.with_extension("json") {
+                p if p == self.path => self.path.with_extension("pannellum.json"),
+                p => p,
+            },
             Some(Format::Pannellum) => self.path.clone(),
         }
     }
@@ -276,9 +280,12 @@ impl TourNav {
                         self.editor.history.saved();
                         let mut m = format!("saved {}", to.display());
                         if !left_out.is_empty() {
+                            // Each scene left out with its reason (Marzipano levels
+                            // Pannellum's multires cannot describe).
                             m += &format!(
-                                " (left out, Marzipano tiles Pannellum cannot open: {})",
-                                left_out.join(", ")
+                                "; left out: scene {} (`viewer tile tiles/<id> -o DIR` writes \
+                                 a Pannellum pyramid for it)",
+                                left_out.join("; scene ")
                             );
                         }
                         TourAction::Info(m)
