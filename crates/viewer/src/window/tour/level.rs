@@ -12,6 +12,7 @@ use crate::tour::level;
 use crate::tour::{Horizon, Source as SceneSource};
 use glam::DMat3;
 use lut_core::{horizon_rotation, Camera, View};
+use rayon::prelude::*;
 
 /// The horizon line's colour (0RGB).
 const LINE_COLOR: u32 = 0x0040_FF60;
@@ -176,9 +177,9 @@ fn warp(src: &[u32], out: &mut [u32], w: u32, h: u32, look: &View, m: DMat3) {
     };
     let g = WARP_CELL;
     let (gw, gh) = (wu.div_ceil(g) + 1, hu.div_ceil(g) + 1);
-    let nodes: Vec<Option<(f64, f64)>> = (0..gh)
-        .flat_map(|j| (0..gw).map(move |i| (i, j)))
-        .map(|(i, j)| at((i * g) as f64 + 0.5, (j * g) as f64 + 0.5))
+    let nodes: Vec<Option<(f64, f64)>> = (0..gw * gh)
+        .into_par_iter()
+        .map(|k| at((k % gw * g) as f64 + 0.5, (k / gw * g) as f64 + 0.5))
         .collect();
     let pick = |p: Option<(f64, f64)>| -> u32 {
         match p {
@@ -188,33 +189,48 @@ fn warp(src: &[u32], out: &mut [u32], w: u32, h: u32, look: &View, m: DMat3) {
             _ => EMPTY_COLOR,
         }
     };
-    for cj in 0..gh - 1 {
-        for ci in 0..gw - 1 {
-            let n = |i: usize, j: usize| nodes[(cj + j) * gw + ci + i];
-            let corners = [n(0, 0), n(1, 0), n(0, 1), n(1, 1)];
-            // A cell whose corners spread far apart (a seam of the view) is exact too.
-            let smooth = corners.iter().all(Option::is_some) && {
-                let c: Vec<(f64, f64)> = corners.iter().flatten().copied().collect();
-                c.iter()
-                    .all(|p| (p.0 - c[0].0).hypot(p.1 - c[0].1) < 4.0 * g as f64)
-            };
-            for y in cj * g..((cj + 1) * g).min(hu) {
-                for x in ci * g..((ci + 1) * g).min(wu) {
-                    let p = if smooth {
-                        let fx = (x - ci * g) as f64 / g as f64;
-                        let fy = (y - cj * g) as f64 / g as f64;
-                        let [a, b, c, d] = corners.map(|c| c.unwrap_or_default());
-                        let top = (a.0 + (b.0 - a.0) * fx, a.1 + (b.1 - a.1) * fx);
-                        let bot = (c.0 + (d.0 - c.0) * fx, c.1 + (d.1 - c.1) * fx);
-                        Some((top.0 + (bot.0 - top.0) * fy, top.1 + (bot.1 - top.1) * fy))
-                    } else {
-                        at(x as f64 + 0.5, y as f64 + 0.5)
-                    };
-                    out[y * wu + x] = pick(p);
+    // A band of cells per task (rayon); along each pixel row of a cell the position
+    // steps linearly between the cell's left and right edges.
+    out.par_chunks_mut(wu * g)
+        .enumerate()
+        .for_each(|(cj, band)| {
+            let rows = band.len() / wu;
+            for ci in 0..gw - 1 {
+                let n = |i: usize, j: usize| nodes[(cj + j) * gw + ci + i];
+                let corners = [n(0, 0), n(1, 0), n(0, 1), n(1, 1)];
+                // A cell whose corners spread far apart (a seam of the view) is exact.
+                let smooth = match corners {
+                    [Some(a), Some(b), Some(c), Some(d)] => [b, c, d]
+                        .iter()
+                        .all(|p| (p.0 - a.0).hypot(p.1 - a.1) < 4.0 * g as f64)
+                        .then_some((a, b, c, d)),
+                    _ => None,
+                };
+                let x1 = ((ci + 1) * g).min(wu);
+                for r in 0..rows {
+                    let row = &mut band[r * wu..(r + 1) * wu];
+                    match smooth {
+                        Some((a, b, c, d)) => {
+                            let fy = r as f64 / g as f64;
+                            let l = (a.0 + (c.0 - a.0) * fy, a.1 + (c.1 - a.1) * fy);
+                            let rt = (b.0 + (d.0 - b.0) * fy, b.1 + (d.1 - b.1) * fy);
+                            let step = ((rt.0 - l.0) / g as f64, (rt.1 - l.1) / g as f64);
+                            let mut p = l;
+                            for px in &mut row[ci * g..x1] {
+                                *px = pick(Some(p));
+                                p = (p.0 + step.0, p.1 + step.1);
+                            }
+                        }
+                        None => {
+                            let y = (cj * g + r) as f64 + 0.5;
+                            for (x, px) in row.iter_mut().enumerate().take(x1).skip(ci * g) {
+                                *px = pick(at(x as f64 + 0.5, y));
+                            }
+                        }
+                    }
                 }
             }
-        }
-    }
+        });
 }
 
 /// A polyline of half-width `r` pixels in `color`, dashed (`dash` pixels on, as many
@@ -278,6 +294,60 @@ mod tests {
     fn shown(nav: &mut TourNav) {
         let src = scene_source(&nav.tour, nav.current()).unwrap();
         nav.arrived(&src, None, 0.0).unwrap();
+    }
+
+    #[test]
+    fn the_preview_shows_each_pixel_from_where_the_rotation_sends_it() {
+        use lut_core::ViewProjection;
+        let (w, h) = (400u32, 300u32);
+        // Each source pixel holds its own index, so the output names where it came from.
+        let src: Vec<u32> = (0..w * h).collect();
+        let m = horizon_rotation(4.0, -3.0);
+        for proj in [ViewProjection::Rectilinear, ViewProjection::Fisheye] {
+            let look = View::new(20.0, -5.0, 100.0)
+                .unwrap()
+                .projected(proj)
+                .unwrap();
+            let mut out = vec![0u32; src.len()];
+            warp(&src, &mut out, w, h, &look, m);
+            let cam = Camera::new(look, w, h);
+            let (mut checked, mut empty) = (0, 0);
+            for y in (0..h).step_by(7) {
+                for x in (0..w).step_by(5) {
+                    let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+                    let got = out[(y * w + x) as usize];
+                    let want = cam
+                        .ray(px, py)
+                        .and_then(|d| crate::tour::markers::place_dir(&cam, (m * d).normalize()));
+                    match want
+                        .filter(|p| p.0 >= 1.0 && p.1 >= 1.0)
+                        .filter(|p| p.0 < f64::from(w) - 1.0 && p.1 < f64::from(h) - 1.0)
+                    {
+                        Some((sx, sy)) => {
+                            assert!(got < w * h, "{proj} ({x}, {y}): nothing shown");
+                            let (gx, gy) = (f64::from(got % w) + 0.5, f64::from(got / w) + 0.5);
+                            assert!(
+                                (gx - sx).abs() <= 1.0 && (gy - sy).abs() <= 1.0,
+                                "{proj} ({x}, {y}): from {gx},{gy}, not {sx:.2},{sy:.2}"
+                            );
+                            checked += 1;
+                        }
+                        None if want.is_none() => {
+                            assert_eq!(got, EMPTY_COLOR, "{proj} ({x}, {y})");
+                            empty += 1;
+                        }
+                        None => {}
+                    }
+                }
+            }
+            assert!(checked > 2000, "{proj}: {checked}");
+            if proj == ViewProjection::Rectilinear {
+                assert!(
+                    empty > 0,
+                    "a turned rectilinear frame has uncovered corners"
+                );
+            }
+        }
     }
 
     #[test]
