@@ -1141,6 +1141,55 @@ fn a_marzipano_tour_saved_as_pannellum_keeps_its_tile_scenes() {
         assert!(saved.problems.is_empty(), "{:?}", saved.problems);
         let ids: Vec<&str> = saved.tour.scenes.iter().map(|s| s.id.as_str()).collect();
         assert_eq!(ids, fit, "{name}");
+        if let Some((id, why)) = unfit {
+            // --tile: the scene that does not fit re-tiled as a Pannellum pyramid, and
+            // saved reading it: close to the Marzipano tiles (JPEG written again).
+            let out2 = d.join("tiled.json");
+            let o = viewer(&["tour", "convert", "--tile", s(&js), "-o", s(&out2)]);
+            let err = String::from_utf8_lossy(&o.stderr).to_string();
+            assert!(o.status.success(), "{name}: {err}");
+            assert!(
+                err.contains(&format!("scene {id}: "))
+                    && err.contains(why)
+                    && err.contains(&format!("tiles/{id}-pannellum")),
+                "{err}"
+            );
+            let back = tour::load(&out2).unwrap();
+            assert_eq!(back.tour.scenes.len(), fit.len() + 1);
+            let c = viewer(&["tour", "check", s(&out2)]);
+            assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stdout));
+            let (mut worst, mut control) = (f64::INFINITY, 0.0f64);
+            for (k, v) in views.iter().enumerate() {
+                let a = render(
+                    &["--tour", s(&out2), "--scene", id],
+                    *v,
+                    &d.join(format!("t{k}.png")),
+                );
+                let b = render(
+                    &["--tour", s(&js), "--scene", id],
+                    *v,
+                    &d.join(format!("m{k}.png")),
+                );
+                let turned = (v.0 + 90.0, v.1, v.2);
+                let c = render(
+                    &["--tour", s(&js), "--scene", id],
+                    turned,
+                    &d.join(format!("c{k}.png")),
+                );
+                let px = |x: &[u8]| -> Vec<u32> {
+                    x.chunks(3)
+                        .map(|p| u32::from(p[0]) << 16 | u32::from(p[1]) << 8 | u32::from(p[2]))
+                        .collect()
+                };
+                worst = worst.min(test_support::pixels::psnr(&px(&a), &px(&b)));
+                control = control.max(test_support::pixels::psnr(&px(&a), &px(&c)));
+            }
+            eprintln!("{name} {id} re-tiled: worst {worst:.1} dB, turned {control:.1} dB");
+            assert!(
+                worst >= 30.0 && control < worst - 6.0,
+                "worst {worst:.1}, control {control:.1}"
+            );
+        }
         let c = viewer(&["tour", "check", s(&out)]);
         assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stdout));
         for id in fit {

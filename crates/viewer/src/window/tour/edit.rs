@@ -283,7 +283,7 @@ impl TourNav {
                             // Each scene left out with its reason (Marzipano levels
                             // Pannellum's multires cannot describe).
                             m += &format!(
-                                "; left out: scene {} (`viewer tile tiles/<id> -o DIR` writes \
+                                "; left out: scene {} (`viewer tour convert --tile` writes \
                                  a Pannellum pyramid for it)",
                                 left_out.join("; scene ")
                             );
