@@ -1065,6 +1065,16 @@ fn an_inline_multires_scene_renders_with_its_numbers() {
         last.contains("scene \"bad\"") && last.contains("maxLevel"),
         "{err}"
     );
+    // tour check names the refused numbers, once, with the scene's place.
+    let (ok, lines, _) = check_lines(&tour);
+    assert!(!ok);
+    let bad: Vec<&String> = lines.iter().filter(|l| l.contains("maxLevel")).collect();
+    assert_eq!(bad.len(), 1, "{lines:?}");
+    assert!(bad[0].contains("scenes.bad.multiRes"), "{lines:?}");
+    assert!(
+        !lines.iter().any(|l| l.contains("scenes.court")),
+        "{lines:?}"
+    );
 }
 
 /// The Marzipano test tours saved as Pannellum: each tile scene whose levels fit
