@@ -79,6 +79,8 @@ stage "tour window test under Xvfb (a hotspot clicked, back and forward)"
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-tour.sh
 stage "tour editor window test under Xvfb (an info hotspot added at a clicked spot, saved)"
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-tour-edit.sh
+stage "tour horizon window test under Xvfb (the horizon line dragged, the grabbed point under the cursor, saved)"
+VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-tour-level.sh
 stage "tiled pyramid window test under Xvfb (tiles loading, coarser then sharp, the cache budget kept)"
 VIEWER_BIN="${CARGO_TARGET_DIR:-target}/ci/viewer" bash scripts/window-tiles.sh
 stage "the measuring scripts' smoke test (peers.py with OpenCV and the chart redrawn; tiny sizes, numbers meaningless)"

@@ -125,15 +125,37 @@ pub fn load_cube(inputs: &[PathBuf], cube: CubeArgs) -> Result<CubeMap> {
 /// or a Marzipano scene's folder ([`marzipano_data_js`]).
 pub fn is_tiled(path: &Path) -> bool {
     if path.is_dir() {
-        path.join("config.json").exists() || marzipano_data_js(path).is_some()
+        path.join("config.json").exists()
+            || marzipano_data_js(path).is_some()
+            || pannellum_inline(path).is_some()
     } else {
         path.extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"))
     }
 }
 
-/// The `data.js` of the Marzipano tool export whose scene folder `path` is: a folder
-/// (without `config.json`) named `tiles/<id>`, the export's `data.js` beside `tiles/`.
+/// Files of a folder looked at when one describing a tile folder is searched for.
+const MAX_FILES_LOOKED_AT: usize = 256;
+
+/// The regular files of `dir` (at most [`MAX_FILES_LOOKED_AT`]), sorted by name.
+fn files_in(dir: &Path) -> Vec<PathBuf> {
+    let Ok(rd) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut files: Vec<PathBuf> = rd
+        .filter_map(Result::ok)
+        .take(MAX_FILES_LOOKED_AT)
+        .map(|e| e.path())
+        .filter(|p| p.is_file())
+        .collect();
+    files.sort();
+    files
+}
+
+/// The tour file of the Marzipano tool export whose scene folder `path` is: a folder
+/// (without `config.json`) named `tiles/<id>`, the export's `data.js` beside `tiles/`,
+/// or, renamed, the file beside `tiles/` that assigns `APP_DATA` (by content, whatever
+/// its name) and lists scene `<id>`.
 pub fn marzipano_data_js(path: &Path) -> Option<PathBuf> {
     if !path.is_dir() || path.join("config.json").exists() {
         return None;
@@ -142,8 +164,80 @@ pub fn marzipano_data_js(path: &Path) -> Option<PathBuf> {
     if tiles.file_name()? != "tiles" {
         return None;
     }
-    let js = tiles.parent()?.join("data.js");
-    js.is_file().then_some(js)
+    let export = tiles.parent()?;
+    let js = export.join("data.js");
+    if js.is_file() {
+        return Some(js);
+    }
+    let id = path.file_name()?.to_string_lossy().into_owned();
+    files_in(export).into_iter().find(|f| {
+        crate::tour::sniff(f) == Some(crate::tour::Format::Marzipano)
+            && crate::tour::load(f).is_ok_and(|l| {
+                l.tour
+                    .scene(&id)
+                    .is_some_and(|s| matches!(s.source, crate::tour::Source::MarzipanoTiles { .. }))
+            })
+    })
+}
+
+/// The Pannellum config (a tour or a single-scene config) with a multires scene whose
+/// tiles are in `dir` and whose `multiRes` numbers are inline (no `config.json` in
+/// `dir`): the nearest found in `dir` or a folder above it (a scene's `basePath` never
+/// leaves its config's folder), its `.json` files in name order; with the scene's id.
+pub fn pannellum_inline(dir: &Path) -> Option<(PathBuf, String)> {
+    if !dir.is_dir() || dir.join("config.json").exists() {
+        return None;
+    }
+    let want = std::fs::canonicalize(dir).ok()?;
+    for folder in want.ancestors().take(8) {
+        for f in files_in(folder) {
+            let json = f
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+            if !json || crate::tour::sniff(&f) != Some(crate::tour::Format::Pannellum) {
+                continue;
+            }
+            let Ok(loaded) = crate::tour::load(&f) else {
+                continue;
+            };
+            let t = &loaded.tour;
+            let found = t.scenes.iter().find(|s| match &s.source {
+                crate::tour::Source::Multires(m) => t
+                    .multires_base(&s.id, m)
+                    .ok()
+                    .and_then(|d| std::fs::canonicalize(d).ok())
+                    .is_some_and(|d| d == want),
+                _ => false,
+            });
+            if let Some(s) = found {
+                return Some((f.clone(), s.id.clone()));
+            }
+        }
+    }
+    None
+}
+
+/// The pyramid of multires scene `id` of the Pannellum config `file`, from its inline
+/// `multiRes` numbers.
+///
+/// # Errors
+/// The config does not read, has no such multires scene, or its numbers are refused.
+pub fn inline_config(file: &Path, id: &str) -> Result<lut_core::MultiresConfig> {
+    let loaded = crate::tour::load(file)?;
+    let scene = loaded.tour.scene(id).ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: no scene \"{}\" opens in it",
+            file.display(),
+            lut_core::one_line(id)
+        )
+    })?;
+    let crate::tour::Source::Multires(m) = &scene.source else {
+        anyhow::bail!("{}: scene \"{id}\" is not multires", file.display());
+    };
+    loaded
+        .tour
+        .multires_config(file, m)
+        .map_err(anyhow::Error::msg)
 }
 
 /// The pyramid of the Marzipano scene whose tile folder is `dir` (`tiles/<id>`): its
@@ -183,6 +277,10 @@ pub fn open_tiled(path: &Path, cache_mib: u64) -> Result<lut_core::TiledPanorama
     let budget = (cache_mib as usize).saturating_mul(1 << 20);
     if let Some(js) = marzipano_data_js(path) {
         let cfg = marzipano_config(&js, path)?;
+        return Ok(lut_core::TiledPanorama::with_config(cfg, budget, threads));
+    }
+    if let Some((file, id)) = pannellum_inline(path) {
+        let cfg = inline_config(&file, &id)?;
         return Ok(lut_core::TiledPanorama::with_config(cfg, budget, threads));
     }
     Ok(lut_core::TiledPanorama::open(path, budget, threads)?)

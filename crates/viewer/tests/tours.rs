@@ -996,3 +996,242 @@ fn a_pannellum_multires_scene_renders_through_its_base_path() {
         assert!(!out.exists(), "{scene}: an output was written");
     }
 }
+
+/// A multires scene whose `multiRes` numbers are inline in the tour (no config.json in
+/// its basePath folder) renders with those numbers: the same pixels as the pyramid with
+/// its config.json; `tour check` passes it; numbers that are refused are one line.
+#[test]
+fn an_inline_multires_scene_renders_with_its_numbers() {
+    let d = tmpdir("pannellum-inline-multires");
+    let src = test_support::test_data("multires/generate-py");
+    copy_tree(&src, &d.join("tiles/court"));
+    std::fs::remove_file(d.join("tiles/court/config.json")).unwrap();
+    let tour = d.join("tour.json");
+    std::fs::write(
+        &tour,
+        r#"{"default": {"firstScene": "court"}, "scenes": {
+  "court": {"type": "multires", "hfov": 80, "yaw": 30, "pitch": -10,
+            "multiRes": {"basePath": "tiles/court", "path": "/%l/%s%y_%x",
+                         "fallbackPath": "/fallback/%s", "extension": "jpg",
+                         "tileResolution": 64, "maxLevel": 3, "cubeResolution": 160}},
+  "bad": {"type": "multires", "multiRes": {"basePath": "tiles/court", "path": "/%l/%s%y_%x",
+          "extension": "jpg", "tileResolution": 64, "maxLevel": 0, "cubeResolution": 160}}}}"#,
+    )
+    .unwrap();
+    let pixels = |args: &[&str], out: &Path| {
+        let mut a = vec!["render"];
+        a.extend_from_slice(args);
+        a.extend_from_slice(&["--size", "96x72", "-o", s(out)]);
+        let o = viewer(&a);
+        assert!(
+            o.status.success(),
+            "{a:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        image::open(out).unwrap().to_rgb8().into_raw()
+    };
+    let view = ["--yaw", "30", "--pitch", "-10", "--hfov", "80"];
+    let via_tour = pixels(&["--tour", s(&tour), "--scene", "court"], &d.join("a.png"));
+    let mut with_config = vec![s(&src)];
+    with_config.extend_from_slice(&view);
+    let want = pixels(&with_config, &d.join("b.png"));
+    assert_eq!(via_tour, want, "the inline numbers are not the pyramid's");
+    // The folder alone opens through the tour that describes it.
+    let court = d.join("tiles/court");
+    let mut alone = vec![s(&court)];
+    alone.extend_from_slice(&view);
+    assert_eq!(pixels(&alone, &d.join("c.png")), want);
+    let turned = pixels(
+        &[s(&src), "--yaw", "120", "--pitch", "-10", "--hfov", "80"],
+        &d.join("d.png"),
+    );
+    assert_ne!(
+        via_tour, turned,
+        "the control view renders the same picture"
+    );
+    let o = viewer(&[
+        "render",
+        "--tour",
+        s(&tour),
+        "--scene",
+        "bad",
+        "-o",
+        s(&d.join("bad.png")),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    let last = err.trim().lines().last().unwrap_or_default();
+    assert!(
+        last.contains("scene \"bad\"") && last.contains("maxLevel"),
+        "{err}"
+    );
+    // tour check names the refused numbers, once, with the scene's place.
+    let (ok, lines, _) = check_lines(&tour);
+    assert!(!ok);
+    let bad: Vec<&String> = lines.iter().filter(|l| l.contains("maxLevel")).collect();
+    assert_eq!(bad.len(), 1, "{lines:?}");
+    assert!(bad[0].contains("scenes.bad.multiRes"), "{lines:?}");
+    assert!(
+        !lines.iter().any(|l| l.contains("scenes.court")),
+        "{lines:?}"
+    );
+}
+
+/// The Marzipano test tours saved as Pannellum: each tile scene whose levels fit
+/// Pannellum's multires is a multires scene reading the Marzipano tiles unchanged, and
+/// renders the same pixels through the saved tour as through the Marzipano one (and its
+/// tile folder alone, Marzipano's reader); a scene whose levels do not fit is named with
+/// the reason, one line, and left out. The tour file is renamed: a Marzipano export is
+/// recognised by its content, whatever the file's name.
+#[test]
+fn a_marzipano_tour_saved_as_pannellum_keeps_its_tile_scenes() {
+    let render = |args: &[&str], view: (f64, f64, f64), out: &Path| {
+        let (y, p, f) = (view.0.to_string(), view.1.to_string(), view.2.to_string());
+        let mut a = vec!["render"];
+        a.extend_from_slice(args);
+        a.extend_from_slice(&[
+            "--yaw",
+            &y,
+            "--pitch",
+            &p,
+            "--hfov",
+            &f,
+            "--size",
+            "96x72",
+            "-o",
+            s(out),
+        ]);
+        let o = viewer(&a);
+        assert!(
+            o.status.success(),
+            "{a:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        image::open(out).unwrap().to_rgb8().into_raw()
+    };
+    let views = [
+        (0.0, 0.0, 70.0),
+        (150.0, 20.0, 80.0),
+        (-100.0, -60.0, 60.0),
+        (45.0, 80.0, 90.0),
+        (200.0, -80.0, 100.0),
+    ];
+    // (test tour, scenes that fit, scene that does not and why)
+    /// The scene left out and why.
+    type Unfit<'a> = Option<(&'a str, &'a str)>;
+    let cases: [(&str, &[&str], Unfit); 2] = [
+        (
+            "marzipano-tiles",
+            &["1-interior"],
+            Some(("0-courtyard", "tiles of 16 and 48 px")),
+        ),
+        ("marzipano", &["0-courtyard", "1-interior"], None),
+    ];
+    for (name, fit, unfit) in cases {
+        let d = tmpdir(&format!("marzipano-saved-{name}"));
+        copy_tree(&data(name), &d);
+        let js = d.join("my-tour.js");
+        std::fs::rename(d.join("data.js"), &js).unwrap();
+        let out = d.join("tour.json");
+        let o = viewer(&["tour", "convert", s(&js), "-o", s(&out)]);
+        let err = String::from_utf8_lossy(&o.stderr).to_string();
+        assert!(o.status.success(), "{name}: {err}");
+        match unfit {
+            Some((id, why)) => {
+                let lines: Vec<&str> = err.lines().filter(|l| l.contains("left out")).collect();
+                assert_eq!(lines.len(), 1, "{name}: {err}");
+                assert!(
+                    lines[0].contains(&format!("scene {id}: ")) && lines[0].contains(why),
+                    "{name}: {err}"
+                );
+            }
+            None => assert!(!err.contains("left out"), "{name}: {err}"),
+        }
+        let saved = tour::load(&out).unwrap();
+        assert!(saved.problems.is_empty(), "{:?}", saved.problems);
+        let ids: Vec<&str> = saved.tour.scenes.iter().map(|s| s.id.as_str()).collect();
+        assert_eq!(ids, fit, "{name}");
+        if let Some((id, why)) = unfit {
+            // --tile: the scene that does not fit re-tiled as a Pannellum pyramid, and
+            // saved reading it: close to the Marzipano tiles (JPEG written again).
+            let out2 = d.join("tiled.json");
+            let o = viewer(&["tour", "convert", "--tile", s(&js), "-o", s(&out2)]);
+            let err = String::from_utf8_lossy(&o.stderr).to_string();
+            assert!(o.status.success(), "{name}: {err}");
+            assert!(
+                err.contains(&format!("scene {id}: "))
+                    && err.contains(why)
+                    && err.contains(&format!("tiles/{id}-pannellum")),
+                "{err}"
+            );
+            let back = tour::load(&out2).unwrap();
+            assert_eq!(back.tour.scenes.len(), fit.len() + 1);
+            let c = viewer(&["tour", "check", s(&out2)]);
+            assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stdout));
+            let (mut worst, mut control) = (f64::INFINITY, 0.0f64);
+            for (k, v) in views.iter().enumerate() {
+                let a = render(
+                    &["--tour", s(&out2), "--scene", id],
+                    *v,
+                    &d.join(format!("t{k}.png")),
+                );
+                let b = render(
+                    &["--tour", s(&js), "--scene", id],
+                    *v,
+                    &d.join(format!("m{k}.png")),
+                );
+                let turned = (v.0 + 90.0, v.1, v.2);
+                let c = render(
+                    &["--tour", s(&js), "--scene", id],
+                    turned,
+                    &d.join(format!("c{k}.png")),
+                );
+                let px = |x: &[u8]| -> Vec<u32> {
+                    x.chunks(3)
+                        .map(|p| u32::from(p[0]) << 16 | u32::from(p[1]) << 8 | u32::from(p[2]))
+                        .collect()
+                };
+                worst = worst.min(test_support::pixels::psnr(&px(&a), &px(&b)));
+                control = control.max(test_support::pixels::psnr(&px(&a), &px(&c)));
+            }
+            eprintln!("{name} {id} re-tiled: worst {worst:.1} dB, turned {control:.1} dB");
+            assert!(
+                worst >= 30.0 && control < worst - 6.0,
+                "worst {worst:.1}, control {control:.1}"
+            );
+        }
+        let c = viewer(&["tour", "check", s(&out)]);
+        assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stdout));
+        for id in fit {
+            let sc = saved.tour.scene(id).unwrap();
+            let Source::Multires(m) = &sc.source else {
+                panic!("{id}: {:?}", sc.source)
+            };
+            assert_eq!(m["basePath"], format!("tiles/{id}"));
+            let folder = d.join(format!("tiles/{id}"));
+            for (k, v) in views.iter().enumerate() {
+                let a = render(
+                    &["--tour", s(&out), "--scene", id],
+                    *v,
+                    &d.join(format!("{id}-{k}-p.png")),
+                );
+                let b = render(
+                    &["--tour", s(&js), "--scene", id],
+                    *v,
+                    &d.join(format!("{id}-{k}-m.png")),
+                );
+                assert_eq!(a, b, "{name} {id} {v:?}: the saved tour draws other pixels");
+                // Without markers: the Pannellum reading (inline numbers, through the
+                // saved tour) against Marzipano's (the folder beside my-tour.js).
+                let c = render(&[s(&folder)], *v, &d.join(format!("{id}-{k}-f.png")));
+                // The Marzipano tour moved out of the export: the folder opens through
+                // the saved Pannellum config that describes it.
+                let away = d.with_extension("away.js");
+                std::fs::rename(&js, &away).unwrap();
+                let p = render(&[s(&folder)], *v, &d.join(format!("{id}-{k}-fp.png")));
+                std::fs::rename(&away, &js).unwrap();
+                assert_eq!(c, p, "{name} {id} {v:?}: the two readers differ");
+            }
+        }
+    }
+}

@@ -262,6 +262,57 @@ impl TiledPanorama {
         })
     }
 
+    /// The finest level as a cube map, texel for texel (each tile decoded, a row of
+    /// tiles at a time so the cache budget holds): what `viewer tile` re-tiles. A tile
+    /// that cannot be decoded is the background there.
+    ///
+    /// # Errors
+    /// The finest face is larger than [`crate::cube::MAX_FACE_SIZE`].
+    pub fn full_cube(&mut self) -> Result<crate::cube::CubeMap, TilesError> {
+        let cfg = self.config().clone();
+        let level = cfg.max_level;
+        let n = cfg.level_size(level);
+        let too_big = || {
+            TilesError::new(
+                &cfg.file,
+                format!(
+                    "its finest faces are {n} px, more than the {} px a cube map holds",
+                    crate::cube::MAX_FACE_SIZE
+                ),
+            )
+        };
+        if n > crate::cube::MAX_FACE_SIZE {
+            return Err(too_big());
+        }
+        let across = cfg.tiles_across(level);
+        let tile = cfg.tile_size(level);
+        let nu = n as usize;
+        let mut faces = vec![vec![0u32; nu * nu]; 6];
+        for (k, &face) in Face::ALL.iter().enumerate() {
+            for ty in 0..across {
+                let ids: Vec<TileId> = (0..across)
+                    .map(|x| TileId {
+                        level: level as u8,
+                        face,
+                        y: ty,
+                        x,
+                    })
+                    .collect();
+                self.store.next_frame();
+                self.loader.load_now(&mut self.store, &ids);
+                for y in ty * tile..((ty + 1) * tile).min(n) {
+                    for x in 0..n {
+                        faces[k][y as usize * nu + x as usize] =
+                            self.store
+                                .nearest(level, face, x as f64 + 0.5, y as f64 + 0.5, false);
+                    }
+                }
+            }
+        }
+        let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
+        crate::cube::CubeMap::from_faces(n.max(1), refs).map_err(|_| too_big())
+    }
+
     /// Notices since the last call (one per tile that could not be decoded).
     pub fn take_notices(&mut self) -> Vec<String> {
         self.store.take_notices()

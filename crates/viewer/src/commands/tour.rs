@@ -32,6 +32,12 @@ pub enum TourCommand {
         /// The Pannellum config to write (.json), in the same folder as the tour.
         #[arg(short, long)]
         output: PathBuf,
+        /// Marzipano tile scenes whose levels Pannellum's multires cannot describe:
+        /// write a Pannellum pyramid of each (`viewer tile` on its tile folder, into
+        /// `tiles/<id>-pannellum`) and save the scene reading it, instead of leaving it
+        /// out.
+        #[arg(long)]
+        tile: bool,
     },
 }
 
@@ -39,7 +45,7 @@ pub enum TourCommand {
 pub fn run(a: TourArgs) -> Result<()> {
     match a.command {
         TourCommand::Check { tour } => run_check(&tour),
-        TourCommand::Convert { tour, output } => run_convert(&tour, &output),
+        TourCommand::Convert { tour, output, tile } => run_convert(&tour, &output, tile),
     }
 }
 
@@ -77,7 +83,7 @@ fn run_check(path: &std::path::Path) -> Result<()> {
     }
 }
 
-fn run_convert(path: &std::path::Path, output: &std::path::Path) -> Result<()> {
+fn run_convert(path: &std::path::Path, output: &std::path::Path, tile: bool) -> Result<()> {
     if output.extension().and_then(|e| e.to_str()) != Some("json") {
         return Err(usage!(
             "{}: a Pannellum config is written as .json",
@@ -116,12 +122,78 @@ fn run_convert(path: &std::path::Path, output: &std::path::Path) -> Result<()> {
     for p in &loaded.problems {
         crate::errln!("{p}");
     }
-    let left_out = pannellum::save(&loaded.tour, output)?;
-    for id in &left_out {
+    let mut t = loaded.tour;
+    if tile {
+        tile_unfit(&mut t, path)?;
+    }
+    let left_out = pannellum::save(&t, output)?;
+    // One line per Marzipano scene whose levels Pannellum's multires cannot describe.
+    for entry in &left_out {
         crate::errln!(
             "{}",
             lut_core::one_line(&format!(
-                "{}: scene \"{id}\" is Marzipano tiles, which Pannellum cannot open: left out",
+                "{}: scene {entry}: left out (`--tile` writes a Pannellum pyramid for it)",
+                path.display()
+            ))
+        );
+    }
+    Ok(())
+}
+
+/// `convert --tile`: each Marzipano scene of `t` whose levels do not fit Pannellum's
+/// multires re-tiled as a Pannellum pyramid (`viewer tile`, its finest level texel for
+/// texel, the tile side of that level) into `<its tile folder>-pannellum`, and made a
+/// multires scene reading it (the pyramid's `multiRes` numbers inline, as Pannellum
+/// reads a tour's scene). One line per scene on stderr.
+///
+/// # Errors
+/// A tile folder that cannot be re-tiled (its error, naming the scene).
+fn tile_unfit(t: &mut tour::Tour, path: &std::path::Path) -> Result<()> {
+    for i in 0..t.scenes.len() {
+        let tour::Source::MarzipanoTiles { dir, levels, .. } = &t.scenes[i].source else {
+            continue;
+        };
+        let Err(why) = pannellum::marzipano_multires(dir, levels) else {
+            continue;
+        };
+        let id = t.scenes[i].id.clone();
+        let rel = format!("{}-pannellum", dir.trim_end_matches('/'));
+        let (from, to) = (
+            t.resolve(dir).map_err(anyhow::Error::msg)?,
+            t.resolve(&rel).map_err(anyhow::Error::msg)?,
+        );
+        let side = levels.iter().max_by_key(|l| l.1).map_or(512, |l| l.0);
+        let args = [
+            "viewer".to_string(),
+            "tile".into(),
+            from.display().to_string(),
+            "-o".into(),
+            to.display().to_string(),
+            "-q".into(),
+            "--tile-size".into(),
+            side.to_string(),
+        ];
+        let cli = <crate::cli::Cli as clap::Parser>::try_parse_from(&args)
+            .map_err(|e| anyhow!("{}: scene \"{id}\": {e}", path.display()))?;
+        let Some(crate::cli::Command::Tile(a)) = cli.command else {
+            anyhow::bail!("{}: scene \"{id}\": cannot run tile", path.display());
+        };
+        crate::commands::tile::run(*a)
+            .map_err(|e| anyhow!("{}: scene \"{id}\": {e:#}", path.display()))?;
+        let cfg: serde_json::Value = serde_json::from_slice(
+            &std::fs::read(to.join("config.json"))
+                .map_err(|e| anyhow!("{}: {e}", to.join("config.json").display()))?,
+        )?;
+        let mut m = cfg
+            .get("multiRes")
+            .cloned()
+            .ok_or_else(|| anyhow!("{}: no multiRes", to.join("config.json").display()))?;
+        m["basePath"] = serde_json::Value::String(rel.clone());
+        t.scenes[i].source = tour::Source::Multires(m);
+        crate::errln!(
+            "{}",
+            lut_core::one_line(&format!(
+                "{}: scene {id}: {why}: written as a Pannellum pyramid in {rel}",
                 path.display()
             ))
         );

@@ -52,6 +52,21 @@ pub fn check(tour: &Tour, file: &Path) -> Vec<Problem> {
                 }
             }
             Source::Multires(m) => {
+                // Inline numbers (no config.json beside the tiles) are read as the
+                // window reads them: refused ones are named.
+                if m.get("path").is_some() {
+                    if let Ok(dir) = tour.multires_base(&s.id, m) {
+                        if dir.is_dir() && !dir.join("config.json").is_file() {
+                            if let Err(e) = tour.multires_config(file, m) {
+                                let why = e
+                                    .strip_prefix(&format!("{}: ", file.display()))
+                                    .unwrap_or(&e)
+                                    .to_string();
+                                late = Some((place("multiRes"), why));
+                            }
+                        }
+                    }
+                }
                 let base = m.get("basePath").and_then(|b| b.as_str()).unwrap_or(".");
                 let base = base.trim_start_matches("./");
                 let base = if base.is_empty() { "." } else { base };
@@ -66,6 +81,7 @@ pub fn check(tour: &Tour, file: &Path) -> Vec<Problem> {
                         // The one tile every face has: level 1, x 0, y 0.
                         for face in ["f", "r", "b", "l", "u", "d"] {
                             let rel = pat
+                                .replace("%l0", "0")
                                 .replace("%l", "1")
                                 .replace("%s", face)
                                 .replace("%x", "0")

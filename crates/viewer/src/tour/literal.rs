@@ -137,7 +137,15 @@ pub fn parse(text: &str) -> Result<Lit, SyntaxError> {
 /// # Errors
 /// No `APP_DATA =` assignment, or a syntax error in its value.
 pub fn parse_app_data(text: &str) -> Result<Lit, SyntaxError> {
-    let Some(at) = text.find("APP_DATA") else {
+    // The first `APP_DATA` assigned (a comment may name it before).
+    let assigned = text
+        .match_indices("APP_DATA")
+        .map(|(at, _)| at)
+        .find(|&at| {
+            let rest = text[at + "APP_DATA".len()..].trim_start();
+            rest.starts_with('=') && !rest.starts_with("==")
+        });
+    let Some(at) = assigned.or_else(|| text.find("APP_DATA")) else {
         return Err(SyntaxError {
             line: 1,
             message: "no `APP_DATA =` assignment (not a Marzipano data.js)".into(),

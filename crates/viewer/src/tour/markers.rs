@@ -6,6 +6,7 @@
 //! rectilinear viewer, or outside a fisheye's disc, is not drawn), inside the frame.
 
 use super::{HotspotKind, TourScene};
+use glam::DVec3;
 use lut_core::{lat_long_to_dir, Camera, View};
 
 /// Marker radius in pixels (outline included).
@@ -32,7 +33,13 @@ pub struct Placed {
 /// frame, `None` where the view does not show it.
 pub fn place(view: View, w: u32, h: u32, yaw: f64, pitch: f64) -> Option<(f64, f64)> {
     let cam = Camera::new(view, w, h);
-    let d = lat_long_to_dir(yaw.to_radians(), pitch.to_radians());
+    place_dir(&cam, lat_long_to_dir(yaw.to_radians(), pitch.to_radians()))
+}
+
+/// The image position of unit direction `d` in `cam`'s frame, `None` where it does not
+/// show it (the test of [`place`]).
+pub fn place_dir(cam: &Camera, d: DVec3) -> Option<(f64, f64)> {
+    let (w, h) = (cam.width, cam.height);
     let (x, y) = cam.project(d)?;
     if !(x.is_finite() && y.is_finite()) || x < 0.0 || y < 0.0 || x > w as f64 || y > h as f64 {
         return None;

@@ -10,6 +10,7 @@
 //! * [`check`]: every link, file and scene id (`viewer tour check`).
 //! * [`edit`]: the edit operations and their undo stack (the window's editor).
 //! * [`markers`]: hotspot markers drawn on a rendered view.
+//! * [`level`]: the horizon line and the correction that drags it (the level mode).
 //!
 //! Reading never stops at the first problem: each bad scene or hotspot is left out with a
 //! [`Problem`] naming its place (line and path in the file), and the rest of the tour
@@ -17,6 +18,7 @@
 
 pub mod check;
 pub mod edit;
+pub mod level;
 pub mod literal;
 pub mod markers;
 pub mod marzipano;
@@ -255,21 +257,31 @@ pub enum Format {
     Marzipano,
 }
 
-/// Whether `path` looks like a tour file by name and content: a `.js` file assigning
-/// `APP_DATA`, or a `.json` file with `scenes`/`default` or `panorama`/`cubeMap`/
-/// `multiRes`/`hotSpots` (Pannellum). Reads at most the first 64 KiB.
+/// Whether `path` is a tour file, by its content whatever its name: a text that assigns
+/// `APP_DATA` (`var APP_DATA = {`: a Marzipano export's `data.js`, renamed or not; not
+/// the app's `index.js`, which only reads `window.APP_DATA`), or a JSON object (a `.json`
+/// file, or any text starting with `{`) with `scenes`/`firstScene` or `panorama`/
+/// `cubeMap`/`multiRes`/`hotSpots` (Pannellum). Reads at most the first 64 KiB; a file
+/// with a NUL byte there (an image) is none.
 pub fn sniff(path: &Path) -> Option<Format> {
     use std::io::Read;
-    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
-    if ext != "json" && ext != "js" {
-        return None;
-    }
+    let json_ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
     let f = lut_core::open_regular(path).ok()?;
     let mut head = Vec::new();
     f.take(64 * 1024).read_to_end(&mut head).ok()?;
+    if head.contains(&0) {
+        return None;
+    }
     let t = String::from_utf8_lossy(&head);
-    if ext == "js" {
-        return t.contains("APP_DATA").then_some(Format::Marzipano);
+    let body = t.trim_start_matches('\u{feff}').trim_start();
+    if !body.starts_with('{') && assigns_app_data(&t) {
+        return Some(Format::Marzipano);
+    }
+    if !json_ext && !body.starts_with('{') {
+        return None;
     }
     let keys = [
         "\"scenes\"",
@@ -282,6 +294,15 @@ pub fn sniff(path: &Path) -> Option<Format> {
     keys.iter()
         .any(|k| t.contains(k))
         .then_some(Format::Pannellum)
+}
+
+/// Whether `text` assigns `APP_DATA` (`APP_DATA =`, not `==`), as Marzipano's `data.js`
+/// does.
+pub fn assigns_app_data(text: &str) -> bool {
+    text.match_indices("APP_DATA").any(|(at, k)| {
+        let rest = text[at + k.len()..].trim_start();
+        rest.starts_with('=') && !rest.starts_with("==")
+    })
 }
 
 /// Largest tour file read ([`lut_core::limits::MAX_TOUR_FILE_BYTES`]).
@@ -310,10 +331,16 @@ pub fn parse(bytes: &[u8], path: &Path) -> anyhow::Result<Loaded> {
     let text = std::str::from_utf8(bytes)
         .map_err(|_| anyhow::anyhow!("{}: not UTF-8 text: not a tour config", path.display()))?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    // A Marzipano export by its content (`APP_DATA =`), whatever the file's name.
     let is_js = path
         .extension()
         .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("js"));
+        .is_some_and(|e| e.eq_ignore_ascii_case("js"))
+        || (!text
+            .trim_start_matches('\u{feff}')
+            .trim_start()
+            .starts_with('{')
+            && assigns_app_data(text));
     if is_js {
         marzipano::read(text, path, &dir)
     } else {
@@ -386,30 +413,79 @@ impl Tour {
         }
     }
 
-    /// The pyramid folder of a Pannellum multires scene whose `multiRes` block is `m`:
-    /// the tour's folder plus `basePath`, when it holds a tiled pyramid this viewer reads
-    /// (the `config.json` that Pannellum's `generate.py` and `viewer tile` write beside
-    /// the tiles). One rule for the window and `viewer render --tour`.
+    /// The folder a Pannellum multires scene's tiles are in (`multiRes` block `m`): the
+    /// tour's folder plus its `basePath`.
     ///
     /// # Errors
-    /// `basePath` leaves the tour's folder or is a URL, or the folder holds no pyramid:
-    /// one line naming the scene.
-    pub fn multires_dir(&self, scene: &str, m: &serde_json::Value) -> Result<PathBuf, String> {
+    /// `basePath` leaves the tour's folder or is a URL (one line naming the scene).
+    pub fn multires_base(&self, scene: &str, m: &serde_json::Value) -> Result<PathBuf, String> {
         let base = m.get("basePath").and_then(|b| b.as_str()).unwrap_or("");
-        let dir = if base.is_empty() {
-            self.dir.clone()
+        let base = base.trim_start_matches("./").trim_start_matches('/');
+        if base.is_empty() || base == "." {
+            Ok(self.dir.clone())
         } else {
             self.resolve(base)
-                .map_err(|why| format!("scene \"{scene}\": {why}"))?
-        };
-        if crate::panorama::is_tiled(&dir) && dir.is_dir() {
-            Ok(dir)
-        } else {
-            Err(format!(
-                "scene \"{scene}\": a multires scene opens when its basePath is a tiled pyramid \
-                 folder with config.json ({} is not)",
+                .map_err(|why| format!("scene \"{scene}\": {why}"))
+        }
+    }
+
+    /// The pyramid a Pannellum multires scene's inline `multiRes` numbers describe
+    /// (`tileResolution`, `maxLevel`, `cubeResolution`, `path`, `extension`, under
+    /// [`Tour::multires_base`]), read as a `config.json` is; `file` names it in errors.
+    ///
+    /// # Errors
+    /// The numbers or the template are refused ([`lut_core::MultiresConfig::parse`]).
+    pub fn multires_config(
+        &self,
+        file: &Path,
+        m: &serde_json::Value,
+    ) -> Result<lut_core::MultiresConfig, String> {
+        let mut m = m.clone();
+        if let Some(o) = m.as_object_mut() {
+            // Relative to the tour's folder, as the reader keeps it.
+            let b = o
+                .get("basePath")
+                .and_then(|b| b.as_str())
+                .unwrap_or("")
+                .trim_start_matches("./")
+                .to_string();
+            if b.is_empty() || b == "." {
+                o.remove("basePath");
+            } else {
+                o.insert("basePath".into(), serde_json::Value::String(b));
+            }
+        }
+        let one = serde_json::json!({ "type": "multires", "multiRes": m });
+        lut_core::MultiresConfig::parse(one.to_string().as_bytes(), file, &self.dir)
+            .map_err(|e| e.to_string())
+    }
+
+    /// The pyramid folder of a Pannellum multires scene whose `multiRes` block is `m`:
+    /// the tour's folder plus `basePath`, when it holds the `config.json` that
+    /// Pannellum's `generate.py` and `viewer tile` write, or else when the scene's own
+    /// inline `multiRes` numbers describe a pyramid there (the folder then opens through
+    /// the config that describes it, [`crate::panorama::pannellum_inline`]).
+    ///
+    /// # Errors
+    /// `basePath` leaves the tour's folder or is a URL, or the folder holds no pyramid
+    /// and the inline numbers are refused: one line naming the scene.
+    pub fn multires_dir(&self, scene: &str, m: &serde_json::Value) -> Result<PathBuf, String> {
+        let dir = self.multires_base(scene, m)?;
+        if !dir.is_dir() {
+            return Err(format!(
+                "scene \"{scene}\": its basePath {} is not a folder",
                 dir.display()
-            ))
+            ));
+        }
+        if dir.join("config.json").is_file() {
+            return Ok(dir);
+        }
+        match self.multires_config(&dir, m) {
+            Ok(_) => Ok(dir),
+            Err(e) => Err(format!(
+                "scene \"{scene}\": no config.json in {} and its multiRes numbers are refused: {e}",
+                dir.display()
+            )),
         }
     }
 
@@ -448,6 +524,48 @@ impl Tour {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tours_are_recognised_by_content_whatever_their_name() {
+        let d = tempfile::tempdir().unwrap();
+        let put = |name: &str, text: &[u8]| {
+            let p = d.path().join(name);
+            std::fs::write(&p, text).unwrap();
+            p
+        };
+        let js = "// the tour\nvar APP_DATA = {\"scenes\": []};\n";
+        for name in ["data.js", "tour-data.js", "tour.txt", "APP"] {
+            assert_eq!(
+                sniff(&put(name, js.as_bytes())),
+                Some(Format::Marzipano),
+                "{name}"
+            );
+        }
+        // The export's app reads APP_DATA; it assigns none.
+        let app = "var data = window.APP_DATA;\nif (data == APP_DATA) {}\n";
+        assert_eq!(sniff(&put("index.js", app.as_bytes())), None);
+        let json = r#"{"default": {"firstScene": "a"}, "scenes": {}}"#;
+        assert_eq!(
+            sniff(&put("tour.json", json.as_bytes())),
+            Some(Format::Pannellum)
+        );
+        assert_eq!(
+            sniff(&put("tour.cfg", json.as_bytes())),
+            Some(Format::Pannellum)
+        );
+        // A binary file naming APP_DATA is not a tour.
+        let mut bin = b"\xff\xd8\x00\x10 var APP_DATA = {}".to_vec();
+        bin.push(0);
+        assert_eq!(sniff(&put("x.jpg", &bin)), None);
+        // And a renamed data.js reads as Marzipano: its scene, its angles converted.
+        let t = r#"// comment naming APP_DATA first
+var APP_DATA = {"scenes": [{"id": "0-a", "name": "A", "levels": [{"tileSize": 64, "size": 64}],
+  "faceSize": 64, "initialViewParameters": {"yaw": 0, "pitch": 0.1, "fov": 1.2},
+  "linkHotspots": [], "infoHotspots": []}], "name": "t"};"#;
+        let loaded = load(&put("my tour.txt", t.as_bytes())).unwrap();
+        assert_eq!(loaded.tour.scenes.len(), 1, "{:?}", loaded.problems);
+        assert!(loaded.tour.scenes[0].start.pitch < 0.0, "pitch negated");
+    }
 
     #[test]
     fn paths_that_leave_the_folder_are_refused() {

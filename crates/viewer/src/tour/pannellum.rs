@@ -16,7 +16,7 @@ use serde_json::{Map, Value};
 use std::path::Path;
 
 mod write;
-pub use write::{save, to_text};
+pub use write::{marzipano_multires, save, to_text};
 
 /// Members of a scene this module interprets (the rest are kept in `extra`).
 const SCENE_KEYS: [&str; 14] = [

@@ -53,6 +53,8 @@ pub enum KeyAction {
     LittlePlanet,
     /// The error heat map on or off.
     HeatMap,
+    /// A tour: the level-horizon mode on or off (drag the horizon line).
+    LevelHorizon,
     /// Close the window.
     Quit,
 }
@@ -195,6 +197,11 @@ pub const BINDINGS: &[Binding] = &[
         help: "error heat map on/off (sampling error against the exact map)",
     },
     Binding {
+        chords: &[plain(Key::T)],
+        action: KeyAction::LevelHorizon,
+        help: "a tour: level the horizon by dragging its line (Esc or Enter: done)",
+    },
+    Binding {
         chords: &[ctrl(Key::O)],
         action: KeyAction::Open,
         help: "open a panorama (file dialog)",
@@ -232,7 +239,7 @@ pub const BINDINGS: &[Binding] = &[
     Binding {
         chords: &[plain(Key::Escape)],
         action: KeyAction::LeaveFullscreen,
-        help: "leave fullscreen, close the help",
+        help: "leave the level-horizon mode, else leave fullscreen, close the help",
     },
     Binding {
         chords: &[plain(Key::H)],
@@ -271,6 +278,10 @@ pub const MOUSE_HELP: &[(&str, &str)] = &[
     (
         "Shift-drag a floor/ceiling edge",
         "raise or lower the ceiling or the floor (height, camera height)",
+    ),
+    (
+        "drag the horizon line",
+        "a tour, level mode (T): the scene turns with it",
     ),
     ("Tab, Enter", "focus and press the buttons"),
 ];

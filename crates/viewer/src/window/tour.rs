@@ -16,8 +16,10 @@
 //! they are.
 
 mod edit;
+mod level;
 
 pub use edit::{edit_panel, typing, EditRequest, Editor};
+pub use level::LevelMode;
 
 use super::input::moved;
 use super::loader::Source;
@@ -97,6 +99,8 @@ pub struct TourNav {
     hover: Option<usize>,
     /// The editor (edit mode, undo, the spot and hotspot picked).
     pub editor: Editor,
+    /// The horizon correction the scene shown was levelled with at load.
+    shown_horizon: tour::Horizon,
 }
 
 /// The source of scene `i` of `tour`: an equirectangular file, six cube faces, or a
@@ -199,6 +203,7 @@ impl TourNav {
                         buf: Vec::new(),
                         hover: None,
                         editor: Editor::default(),
+                        shown_horizon: tour::Horizon::default(),
                     };
                     return Ok((nav, source));
                 }
@@ -345,8 +350,12 @@ impl TourNav {
         old_frame: Option<(&[u32], (u32, u32))>,
         t: f64,
     ) -> Option<Angles> {
+        let shown = self.horizon_for(source);
         let p = self.pending.take_if(|p| p.source == *source)?;
         self.current = p.scene;
+        self.shown_horizon = shown.map_or_else(tour::Horizon::default, |(pitch, roll)| {
+            tour::Horizon { pitch, roll }
+        });
         self.glide = None;
         self.hover = None;
         self.fade = old_frame
@@ -431,6 +440,11 @@ impl TourNav {
         }
         if !fading && self.glide.is_none() {
             let view = *look;
+            // The level mode: the scene turned while its horizon is dragged (or reloads
+            // levelled), the horizon line.
+            let mut buf = std::mem::take(&mut self.buf);
+            self.level_draw(scene, &mut buf, w, h, look);
+            self.buf = buf;
             let placed = markers::draw(&self.tour.scenes[self.current], view, &mut self.buf, w, h);
             if let Some(p) = placed.iter().find(|p| Some(p.index) == self.hover) {
                 ring(&mut self.buf, w, h, p.x, p.y);

@@ -191,6 +191,15 @@ fn open_source(a: &TileArgs, bar: &mut Bar) -> Result<Box<dyn FaceSource>> {
     if a.inputs.is_empty() {
         return Err(usage!("tile needs an INPUT panorama (or --synthetic WxH)"));
     }
+    // A tiled pyramid (a Pannellum multires folder or config, a Marzipano scene's tile
+    // folder): its finest level, texel for texel, re-tiled.
+    if let [input] = a.inputs.as_slice() {
+        if crate::panorama::is_tiled(input) {
+            let mut t = crate::panorama::open_tiled(input, 256)?;
+            let cube = t.full_cube()?;
+            return Ok(Box::new(CubeSource(cube)));
+        }
+    }
     if a.projection.value.reads_cube(&a.inputs) {
         let cube = crate::panorama::load_cube(&a.inputs, a.cube)?;
         return Ok(Box::new(CubeSource(cube)));

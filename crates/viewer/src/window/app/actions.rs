@@ -247,6 +247,8 @@ impl App {
                         .set_fullscreen((!full).then_some(Fullscreen::Borderless(None)));
                 }
             }
+            KeyAction::LevelHorizon => self.tour_level_key(t),
+            KeyAction::LeaveFullscreen if self.tour_level_leave() => {}
             KeyAction::LeaveFullscreen => {
                 self.show_help = false;
                 if let Some(g) = &self.gfx {

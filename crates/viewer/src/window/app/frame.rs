@@ -114,9 +114,18 @@ impl App {
             if let Some(o) = origin {
                 // On a luminaire's marker the drag moves the luminaire.
                 let shift = ui.input(|i| i.modifiers.shift);
-                if !self.press_light(to_px(o), size, shift) {
+                // In a tour's level mode, on the horizon line the drag levels it.
+                if !self.tour_level_press(to_px(o), size)
+                    && !self.press_light(to_px(o), size, shift)
+                {
                     self.ctl.press(to_px(o), size, t);
                 }
+            }
+        }
+        if self.tour_level_dragging() {
+            match resp.interact_pointer_pos() {
+                Some(p) if resp.dragged_by(primary) => self.tour_level_drag(to_px(p), size),
+                _ => self.tour_level_release(t),
             }
         }
         if self.scene_drag.is_some() {

@@ -190,6 +190,16 @@ impl App {
         });
         if bar.edit {
             nav.editor.on = !nav.editor.on;
+            if !nav.editor.on {
+                nav.level_leave();
+            }
+        }
+        // Enter ends the level mode as Esc does (not while typing in a field).
+        if nav.editor.level.on
+            && !tour::typing(ui.ctx())
+            && ui.input(|i| i.key_pressed(egui::Key::Enter))
+        {
+            nav.level_leave();
         }
         let mut edits = if nav.editor.on && !self.dialogs.is_open() {
             tour::edit_panel(ui.ctx(), scene, nav)
@@ -290,6 +300,78 @@ impl App {
         true
     }
 
+    /// The T key: the level-horizon mode on or off (a tour's; else a notice).
+    pub(super) fn tour_level_key(&mut self, t: f64) {
+        match self.tour.as_mut() {
+            Some(nav) => {
+                let a = nav.edit_request(tour::EditRequest::Level, self.ctl.look());
+                for a in a {
+                    self.tour_do(a, t);
+                }
+            }
+            None => {
+                self.notices.info(
+                    "level horizon: a tour's (open the panorama through a Pannellum config \
+                     to save its horizonPitch/horizonRoll)",
+                    t,
+                );
+            }
+        }
+    }
+
+    /// Esc in the level mode leaves it (true); else Esc is the window's.
+    pub(super) fn tour_level_leave(&mut self) -> bool {
+        match self.tour.as_mut() {
+            Some(nav) if nav.editor.level.on => {
+                nav.level_leave();
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// A press at `at` (scene pixels) of a `size` scene: on the horizon line in the level
+    /// mode it grabs the line (true).
+    pub(super) fn tour_level_press(&mut self, at: (f64, f64), size: (u32, u32)) -> bool {
+        let look = self.ctl.look();
+        let Some(nav) = self.tour.as_mut() else {
+            return false;
+        };
+        let grabbed = nav.level_press(&look, size.0, size.1, at.0, at.1);
+        if grabbed && self.print_view {
+            let _ = crate::outln!("tour level grab {:.1},{:.1}", at.0, at.1);
+        }
+        grabbed
+    }
+
+    /// True while the horizon line is dragged.
+    pub(super) fn tour_level_dragging(&self) -> bool {
+        self.tour.as_ref().is_some_and(|n| n.level_dragging())
+    }
+
+    /// The horizon line dragged to `at`.
+    pub(super) fn tour_level_drag(&mut self, at: (f64, f64), size: (u32, u32)) {
+        let look = self.ctl.look();
+        if let Some(nav) = self.tour.as_mut() {
+            nav.level_drag(&look, size.0, size.1, at.0, at.1);
+        }
+    }
+
+    /// The horizon line let go: one edit, the scene reloads levelled.
+    pub(super) fn tour_level_release(&mut self, t: f64) {
+        let look = self.ctl.look();
+        let Some(nav) = self.tour.as_mut() else {
+            return;
+        };
+        let (set, actions) = nav.level_release(look);
+        if let (Some(h), true) = (set, self.print_view) {
+            let _ = crate::outln!("tour level set pitch={:.4} roll={:.4}", h.pitch, h.roll);
+        }
+        for a in actions {
+            self.tour_do(a, t);
+        }
+    }
+
     /// The glide's view this frame (it moves the view as a start view does).
     pub(super) fn tour_glide(&mut self, t: f64) -> bool {
         match self.tour.as_mut().and_then(|n| n.glide_look(t)) {
@@ -309,7 +391,14 @@ impl App {
         if !self.print_view || nav.animating(self.now()) {
             return;
         }
-        let line = nav.describe(look, size.0, size.1);
+        let mut line = nav.describe(look, size.0, size.1);
+        if nav.editor.level.on {
+            // The level mode: a point of the horizon line near the centre column.
+            line += &match nav.level_line_point(look, size.0, size.1) {
+                Some((x, y)) => format!(" level line={x:.1},{y:.1}"),
+                None => " level line=-".into(),
+            };
+        }
         if line != self.printed_tour {
             let _ = crate::outln!("{line}");
             self.printed_tour = line;

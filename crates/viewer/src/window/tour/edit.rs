@@ -4,7 +4,8 @@
 //! then a link to a scene of the tour or an info hotspot with text is added at the
 //! spot, the selected hotspot is moved there or deleted; the scene's start view is the
 //! current view, north the view's centre; its horizon is levelled with the pitch and
-//! roll sliders (the scene reloads, levelled); scenes are added (a panorama file inside
+//! roll sliders or by dragging its horizon line (the level mode, [`super::level`]; the
+//! scene reloads, levelled); scenes are added (a panorama file inside
 //! the tour's folder) and removed; Ctrl+Z undoes, Ctrl+Shift+Z or Ctrl+Y redoes; Save
 //! writes a Pannellum config (the tour's own file, or `data.json` beside a Marzipano
 //! `data.js`).
@@ -39,6 +40,8 @@ pub struct Editor {
     /// (centres, window points; empty when the panel is not shown), for `--print-view`'s
     /// `tour ui` line (the Xvfb test clicks them).
     pub ui_at: Vec<(&'static str, egui::Pos2)>,
+    /// The level-horizon mode (a drag on the horizon line levels the scene).
+    pub level: super::LevelMode,
 }
 
 /// What the edit panel's user asked.
@@ -58,6 +61,8 @@ pub enum EditRequest {
     SetNorth,
     /// Level the horizon by this pitch and roll.
     Horizon(Horizon),
+    /// The level-horizon mode on or off (drag the horizon line).
+    Level,
     /// Add the panorama file as a scene.
     AddScene,
     /// Remove scene `i`.
@@ -88,7 +93,11 @@ impl TourNav {
     /// `data.js`.
     pub fn save_path(&self) -> PathBuf {
         match crate::tour::sniff(&self.path) {
-            Some(Format::Marzipano) | None => self.path.with_extension("json"),
+            // Beside it, never over it (a Marzipano export named `.json`).
+            Some(Format::Marzipano) | None => match self.path.with_extension("json") {
+                p if p == self.path => self.path.with_extension("pannellum.json"),
+                p => p,
+            },
             Some(Format::Pannellum) => self.path.clone(),
         }
     }
@@ -199,6 +208,17 @@ impl TourNav {
                     horizon: h,
                 },
             ),
+            EditRequest::Level => {
+                return match self.level_toggle() {
+                    Ok(true) => vec![TourAction::Info(
+                        "level horizon: drag the green line (the panorama's horizon) onto \
+                         the level; Esc or Enter: done"
+                            .into(),
+                    )],
+                    Ok(false) => vec![],
+                    Err(e) => vec![TourAction::Error(e)],
+                };
+            }
             EditRequest::AddScene => {
                 let f = PathBuf::from(self.editor.scene_file.trim());
                 let f = if f.is_relative() {
@@ -260,9 +280,12 @@ impl TourNav {
                         self.editor.history.saved();
                         let mut m = format!("saved {}", to.display());
                         if !left_out.is_empty() {
+                            // Each scene left out with its reason (Marzipano levels
+                            // Pannellum's multires cannot describe).
                             m += &format!(
-                                " (left out, Marzipano tiles Pannellum cannot open: {})",
-                                left_out.join(", ")
+                                "; left out: scene {} (`viewer tour convert --tile` writes \
+                                 a Pannellum pyramid for it)",
+                                left_out.join("; scene ")
                             );
                         }
                         TourAction::Info(m)
@@ -474,16 +497,37 @@ pub fn edit_panel(ctx: &egui::Context, scene: egui::Rect, nav: &mut TourNav) -> 
                             out.push(EditRequest::SetNorth);
                         }
                     });
+                    ui.horizontal(|ui| {
+                        let lv = ui
+                            .selectable_label(ed.level.on, "Level horizon")
+                            .on_hover_text(
+                                "Drag the horizon line (green) to level the scene; \
+                                 Esc or Enter: done (T)",
+                            );
+                        ed.ui_at.push(("level", lv.rect.center()));
+                        if lv.clicked() {
+                            out.push(EditRequest::Level);
+                        }
+                        if ed.level.on {
+                            ui.label("drag the green line; Esc/Enter: done");
+                        }
+                    });
                     let (mut p, mut r) = (horizon.pitch, horizon.roll);
                     let range = -HORIZON_RANGE..=HORIZON_RANGE;
                     let sp = ui.add(
                         egui::Slider::new(&mut p, range.clone())
                             .step_by(0.1)
+                            // A value set elsewhere (a drag of the horizon line, a file's
+                            // 40°) is shown as it is, not snapped or clamped into an edit.
+                            .clamping(egui::SliderClamping::Edits)
                             .text("horizon pitch °"),
                     );
                     let sr = ui.add(
                         egui::Slider::new(&mut r, range)
                             .step_by(0.1)
+                            // A value set elsewhere (a drag of the horizon line, a file's
+                            // 40°) is shown as it is, not snapped or clamped into an edit.
+                            .clamping(egui::SliderClamping::Edits)
                             .text("horizon roll °"),
                     );
                     // Applied when the slider is let go (each change re-levels the map).
