@@ -82,7 +82,7 @@ fn err<E: std::fmt::Display>(e: E) -> anyhow::Error {
 /// `16k` for 16384, else the number.
 fn width_label(w: f64) -> String {
     let w = w.round() as u64;
-    if w % 1024 == 0 {
+    if w.is_multiple_of(1024) {
         format!("{}k", w / 1024)
     } else {
         w.to_string()
