@@ -20,6 +20,27 @@ pub const TICKS: [f64; 4] = [0.001, 0.01, 0.1, 1.0];
 /// The product's sampling-position budget, marked on the legend.
 pub const BUDGET_PX: f64 = 0.05;
 
+/// Why the heat map of a panorama of `kind` is 0 everywhere, when it is by construction:
+/// cube maps and tiled pyramids are drawn by the cube renderer, which computes every
+/// pixel's sampling position exactly (no look-up table to interpolate, docs/cube.md), so
+/// there is no position error to show. Said wherever the map is shown (the window's panel
+/// and notice, `viewer render --error-map`), so an all-zero map is never silent.
+pub fn exact_note(kind: lut_core::PanoramaKind) -> Option<&'static str> {
+    match kind {
+        lut_core::PanoramaKind::Cube => Some(
+            "0 everywhere by construction: a cube map's renderer computes every pixel's \
+             sampling position exactly (no look-up table)",
+        ),
+        lut_core::PanoramaKind::Tiled => Some(
+            "0 everywhere by construction: tiles are drawn by the cube renderer, which \
+             computes every pixel's sampling position exactly on the level drawn (no \
+             look-up table); a frame drawn from a coarser level than wanted shows as \
+             \"coarser than wanted\", not here",
+        ),
+        _ => None,
+    }
+}
+
 /// One line summing up a heat map: max and mean error, and the pixels compared.
 pub fn summary(em: &ErrorMap) -> String {
     let mut s = format!(

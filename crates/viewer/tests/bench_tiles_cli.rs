@@ -80,6 +80,36 @@ fn bench_tiles_json_on_a_tiny_pyramid() {
     let before = std::fs::metadata(&cfg).unwrap().modified().unwrap();
     bench(dir.path());
     assert_eq!(std::fs::metadata(&cfg).unwrap().modified().unwrap(), before);
+
+    // --replot: the chart from the JSON; a file that is not that JSON leaves no PNG.
+    let json = dir.path().join("run.json");
+    std::fs::write(&json, serde_json::to_string(&rows).unwrap()).unwrap();
+    let png = dir.path().join("chart.png");
+    let replot = |json: &std::path::Path| {
+        Command::new(env!("CARGO_BIN_EXE_viewer"))
+            .arg("bench-tiles")
+            .arg("--replot")
+            .arg(json)
+            .arg("--plot")
+            .arg(&png)
+            .output()
+            .unwrap()
+    };
+    let o = replot(&json);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (1500, 760));
+    std::fs::remove_file(&png).unwrap();
+    let bad = dir.path().join("bad.json");
+    std::fs::write(&bad, "[{\"width\": 1}]").unwrap();
+    let o = replot(&bad);
+    assert_eq!(o.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("bad.json") && e.trim().lines().count() == 1,
+        "{e}"
+    );
+    assert!(!png.exists());
 }
 
 #[test]

@@ -4,7 +4,10 @@
 //! from the page cache (cold): process start to first picture, view stop to sharp, the
 //! frame times of a pan with tiles arriving (across levels: zooming in and out) and of a
 //! pan over resident tiles (median and p99), the peak resident memory (`VmHWM`) and the
-//! decoding pool's tiles and Mpixel per second per thread. -> docs/huge.md.
+//! decoding pool's tiles and Mpixel per second per thread. `--plot` draws the chart
+//! (`plot.rs`), `--replot JSON` draws it again from a `--json` run. -> docs/huge.md.
+
+pub mod plot;
 
 use super::bench::measure::median;
 use super::bench_load::proc_status_bytes;
@@ -48,6 +51,14 @@ pub struct BenchTilesArgs {
     /// Print one JSON array instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Also draw the chart (times and peak memory against the panorama's width) into
+    /// this PNG.
+    #[arg(long, value_name = "PNG")]
+    pub plot: Option<PathBuf>,
+    /// Measure nothing: draw the chart (`--plot`, required) from the JSON an earlier
+    /// `--json` run printed.
+    #[arg(long, value_name = "JSON", requires = "plot", conflicts_with_all = ["json", "child"])]
+    pub replot: Option<PathBuf>,
     /// Internal: measure this pyramid in this process and print one JSON line.
     #[arg(long, hide = true)]
     pub child: Option<PathBuf>,
@@ -153,6 +164,11 @@ pub fn run(a: BenchTilesArgs) -> Result<()> {
         crate::outln!("{}", serde_json::to_string(&s)?)?;
         return Ok(());
     }
+    if let (Some(json), Some(png)) = (&a.replot, &a.plot) {
+        // Both read before anything is drawn: a bad file leaves no PNG.
+        let rows = plot::read_rows(json)?;
+        return plot::plot(png, &rows);
+    }
     let cache = a
         .cache
         .clone()
@@ -196,6 +212,9 @@ pub fn run(a: BenchTilesArgs) -> Result<()> {
         crate::outln!("{}", serde_json::to_string_pretty(&rows)?)?;
     } else {
         print_table(&rows, &a)?;
+    }
+    if let Some(png) = &a.plot {
+        plot::plot(png, &rows)?;
     }
     Ok(())
 }

@@ -380,6 +380,11 @@ fn frame_with(a: &RenderArgs, tour_scene: Option<&crate::tour::TourScene>) -> Re
     if let (Some(path), Some(em)) = (&a.error_map, &error_map) {
         write_error_map(path, em)?;
     }
+    if error_map.is_some() {
+        if let Some(note) = crate::heatmap::exact_note(scene.kind()) {
+            crate::errln!("note: the sampling-position error is {note}");
+        }
+    }
     if a.verbose && !lights.lights.is_empty() {
         crate::errln!(
             "lit from an illuminance map of {:.1} KiB ({} luminaires, map, render and shading {:.0} ms, exposure {:.0} lx)",

@@ -60,6 +60,9 @@ pub struct Readouts {
     /// The heat map's (max, mean) sampling-position error, source pixels, while it is
     /// shown.
     pub heat: Option<(f64, f64)>,
+    /// Why that heat map is 0 everywhere, when it is by construction (cube maps, tiled
+    /// pyramids: [`crate::heatmap::exact_note`]).
+    pub heat_note: Option<&'static str>,
 }
 
 /// A step of loading a panorama in the window, in order.

@@ -14,6 +14,7 @@ mod jpeg;
 pub mod layout;
 pub mod resample;
 pub mod source;
+mod synth;
 pub mod write;
 
 pub use layout::{Layout, FACES};

@@ -3,7 +3,8 @@
 //! world direction → the input's coordinates → bilinear).
 //!
 //! * [`Synthetic`]: the test scene (`lut_core::scene_color`, a latitude/longitude grid on
-//!   a colour field) as a function of direction: any size, no image anywhere.
+//!   a colour field) as a function of direction, with a fine grain (`synth.rs`): any
+//!   size, no image anywhere.
 //! * [`MapSource`] and [`CubeSource`]: a panorama the viewer opened into memory (any
 //!   projection, partial panoramas, cube maps), sampled by lut-core's samplers.
 //! * [`StoreSource`]: an equirectangular image streamed from its file into a temporary
@@ -78,12 +79,22 @@ impl FaceSource for Synthetic {
         Some(self.width)
     }
     fn render(&self, face: Face, n: u32, r: Rect, out: &mut [u8]) -> Result<()> {
-        per_pixel(face, n, r, out, |d| {
-            let (l, p) = dir_to_lat_long(d);
-            lut_core::scene_color(l, p)
-        });
+        super::synth::render(face, n, (r.x, r.y, r.w), grain_octaves(n), out);
         Ok(())
     }
+}
+
+/// Layers of the synthetic scene's grain for faces of side `n`: one for each time the
+/// face halves before it fits a 512-px tile, plus one (the levels of a pyramid of 512-px
+/// tiles: the coarsest level still has pixel-scale grain). The same for every tile size.
+pub fn grain_octaves(n: u32) -> u32 {
+    let mut k = 1;
+    let mut s = n;
+    while s > 512 {
+        s /= 2;
+        k += 1;
+    }
+    k
 }
 
 /// A map panorama in memory (any projection; partial maps show their background

@@ -232,10 +232,16 @@ impl App {
             KeyAction::HeatMap => {
                 let s = &mut self.ctl.settings;
                 s.heat_map = !s.heat_map;
-                let msg = if s.heat_map {
-                    "error heat map on (E: off; legend in the panel)"
-                } else {
-                    "error heat map off"
+                let exact = self.doc.current().and_then(|c| {
+                    crate::heatmap::exact_note(c.scene.kind()).map(|_| c.scene.kind())
+                });
+                let msg = match (s.heat_map, exact) {
+                    (true, Some(kind)) => format!(
+                        "error heat map on: 0 everywhere, this {}'s renderer computes every position exactly (E: off; why in the panel)",
+                        kind.noun()
+                    ),
+                    (true, None) => "error heat map on (E: off; legend in the panel)".into(),
+                    (false, _) => "error heat map off".into(),
                 };
                 self.notices.info(msg, t);
             }

@@ -586,6 +586,7 @@ impl App {
             }
         };
         self.doc.readouts.heat = None;
+        self.doc.readouts.heat_note = None;
         if s.heat_map {
             self.show_heat_map(view, &opts, rect, k);
         } else {
@@ -680,6 +681,7 @@ impl App {
             return;
         };
         let (sw, sh) = (rect.w.div_ceil(k), rect.h.div_ceil(k));
+        let note = crate::heatmap::exact_note(cur.scene.kind());
         match measure_errors(&mut cur.scene, view, opts, sw, sh) {
             Ok(em) => {
                 let colors = em.colors();
@@ -696,6 +698,7 @@ impl App {
                     );
                 }
                 self.doc.readouts.heat = Some((em.stats.max, em.stats.mean));
+                self.doc.readouts.heat_note = note;
             }
             Err(e) => self.doc.set_error(format!("heat map failed: {e}")),
         }

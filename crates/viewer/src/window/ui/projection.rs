@@ -62,6 +62,9 @@ pub(super) fn projection_section(ui: &mut egui::Ui, m: &mut PanelModel<'_>, out:
             match m.readouts.heat {
                 Some((max, mean)) => {
                     ui.monospace(heat_label(max, mean));
+                    if let Some(note) = m.readouts.heat_note {
+                        ui.label(egui::RichText::new(note).small());
+                    }
                 }
                 None => {
                     ui.label("(measured with the next frame)");
