@@ -42,14 +42,14 @@ use super::kernel::{active, ChunkLevels, ChunkWeights, FaceBuf, FaceRun, Texels}
 use super::rows::{rows_per_task, Loan};
 use super::setup::check_step;
 use super::{RenderOptions, RenderPath, RenderReport};
-use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
+use crate::cube::pyramid::{footprint, footprint_bound, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
     check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
 };
 use crate::error::ViewError;
 use crate::geom::camera::View;
 use crate::map::envmap::EnvMap;
-use crate::map::pyramid::lod_q8;
+use crate::map::pyramid::{lod_q8, LOD0_FOOTPRINT};
 use crate::map::sample::Sampler;
 use crate::named::{parse_name, unknown_name, Named};
 use glam::DVec3;
@@ -289,17 +289,55 @@ impl Fetch for TrilinearFetch {
         let (mut levels, mut fracs) = (take(&mut buf.levels), take(&mut buf.fracs));
         levels.clear();
         fracs.clear();
-        for c in 0..n.div_ceil(C) {
-            let mid = run.dx + (c * C + C.min(n - c * C) / 2) as f64;
+        let chunks = n.div_ceil(C);
+        levels.reserve(chunks);
+        fracs.reserve(chunks);
+        // The levels of the last `k` seen (a run's chunks mostly share theirs): the
+        // pyramid is looked up when `k` changes, not per chunk.
+        let resolve = |k: usize| ChunkLevels {
+            first: cube.level(k).1,
+            second: cube.level(k + 1).1,
+        };
+        let (mut last_k, mut last) = (0, resolve(0));
+        // Chunk c's middle pixel is c·C + C/2 (the last chunk's: its own middle), a
+        // whole number below 2^53 stepped in f64: exact, the same `mid` as
+        // `(c * C + C / 2) as f64`.
+        let mut off = (C / 2) as f64;
+        // Blocks of chunks whose footprint is bounded by √2 (`footprint_bound`) have
+        // level of detail 0 at every middle pixel without computing it (a bounded block
+        // gets what the exact footprint would give it, so the bytes are the same).
+        let mut skip_to = 0;
+        for c in 0..chunks {
+            if c % LOD_BLOCK == 0 && c + LOD_BLOCK < chunks {
+                let ends = (run.dx + off, run.dx + off + ((LOD_BLOCK - 1) * C) as f64);
+                let bound = footprint_bound((run.p, run.d), ends, sx, sy, frame.half_face);
+                if bound <= LOD0_FOOTPRINT {
+                    skip_to = c + LOD_BLOCK;
+                }
+            }
+            if c < skip_to {
+                off += C as f64;
+                if last_k != 0 {
+                    (last_k, last) = (0, resolve(0));
+                }
+                levels.push(last);
+                fracs.push(0);
+                continue;
+            }
+            let mid = if c + 1 < chunks {
+                run.dx + off
+            } else {
+                run.dx + (c * C + (n - c * C) / 2) as f64
+            };
+            off += C as f64;
             let at = |i: usize| run.p[i] + mid * run.d[i];
             let lod = lod_q8(footprint((at(0), at(1), at(2)), sx, sy, frame.half_face));
             let (k, frac) = ((lod.max(0) >> 8) as usize, (lod.max(0) & 0xFF) as u32);
-            let (ka, kb) = (cube.level(k).1, cube.level(k + 1).1);
-            levels.push(ChunkLevels {
-                first: ka,
-                second: kb,
-            });
-            fracs.push(if ka == kb { 0 } else { frac });
+            if k != last_k {
+                (last_k, last) = (k, resolve(k));
+            }
+            levels.push(last);
+            fracs.push(if last.first == last.second { 0 } else { frac });
         }
         // The run on level `k` from chunk `cs.start` and its pixels.
         let on = |k: usize, cs: &Range<usize>| {
@@ -410,6 +448,10 @@ fn same_runs(
         None
     })
 }
+
+/// Chunks of a trilinear face run whose level of detail is bounded together
+/// (`footprint_bound`) before any is computed.
+const LOD_BLOCK: usize = 8;
 
 /// A cube band task's scratch: a scanline's face segments and its runs' position buffers.
 type BandScratch = (Vec<Seg>, FaceBuf);
