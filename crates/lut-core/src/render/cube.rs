@@ -722,7 +722,111 @@ impl CubeMap {
 
 #[cfg(test)]
 mod tests {
-    use super::same_runs;
+    use super::*;
+
+    /// A cube of `n`² faces of hashed noise.
+    fn noise_cube(n: u32) -> CubeMap {
+        let faces: Vec<Vec<u32>> = (0..6u32)
+            .map(|k| {
+                (0..n * n)
+                    .map(|i| {
+                        let mut h = (i + 1).wrapping_mul(2_654_435_761) ^ (k + 7) * 40_503;
+                        h ^= h >> 15;
+                        h = h.wrapping_mul(2_246_822_519);
+                        (h ^ (h >> 13)) & 0x00FF_FFFF
+                    })
+                    .collect()
+            })
+            .collect();
+        let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
+        CubeMap::from_faces(n, refs).unwrap()
+    }
+
+    #[test]
+    fn trilinear_runs_take_each_chunks_exact_level_of_detail() {
+        // Every pixel of a scanline trilinear frame is `trilinear_dir` with the level of
+        // detail of its chunk's middle pixel computed exactly (verified runs; the
+        // per-pixel one elsewhere), whether or not the renderer skipped the chunk's
+        // level in a block bounded below √2: the bytes the renderer gave before blocks
+        // were skipped. The views mix blocks that are skipped and chunks that blend.
+        const C: usize = TRILINEAR_RUN_CHUNK;
+        let cube = noise_cube(256);
+        cube.pyramid();
+        let (w, h) = (400u32, 160u32);
+        let (mut skipped, mut blended) = (0, 0);
+        let views = [
+            (37.3, 0.0, 90.0),
+            (10.0, 30.0, 120.0),
+            (-140.0, -50.0, 100.0),
+        ];
+        for (yaw, pitch, hfov) in views {
+            let view = View::new(yaw, pitch, hfov).unwrap();
+            let mut px = vec![0u32; (w * h) as usize];
+            let mut frame = Frame::new(&mut px, w, h).unwrap();
+            render_cube(
+                &cube,
+                view,
+                Sampler::Trilinear,
+                CubeRenderer::Accelerated,
+                &mut frame,
+                false,
+            );
+            let rays = Rays::new(view, w, h, cube.face_size());
+            let half = rays.half_face;
+            for y in 0..h as usize {
+                let p = rays.row(rays.dy(y));
+                for r in scanline_runs(view, w, h, cube.face_size(), y as u32) {
+                    let face = r.face;
+                    let (sx, sy) = (face_axes(face, rays.b), face_axes(face, rays.r1));
+                    let (s, n) = (r.start as usize, (r.end - r.start) as usize);
+                    for x in s..s + n {
+                        let d = ray(p, rays.b, rays.dx(x));
+                        let lod = if r.verified {
+                            let c = (x - s) / C;
+                            let mid = rays.dx(s) + (c * C + C.min(n - c * C) / 2) as f64;
+                            lod_q8(footprint(
+                                face_axes(face, ray(p, rays.b, mid)),
+                                sx,
+                                sy,
+                                half,
+                            ))
+                        } else {
+                            lod_of(face, d, rays.b, rays.r1, half)
+                        };
+                        let want = cube.trilinear_dir(face, d, lod);
+                        let got = px[y * w as usize + x];
+                        assert_eq!(got, want, "{view:?} ({x}, {y}) lod {lod}");
+                    }
+                    // What the renderer's blocks did on this run.
+                    let chunks = n.div_ceil(C);
+                    for c0 in (0..chunks).step_by(super::LOD_BLOCK) {
+                        if !r.verified || c0 + super::LOD_BLOCK >= chunks {
+                            continue;
+                        }
+                        let mid = |c: usize| rays.dx(s) + (c * C + C / 2) as f64;
+                        let (pa, pb, pm) = face_axes(face, p);
+                        let (ba, bb, bm) = face_axes(face, rays.b);
+                        let ends = (mid(c0), mid(c0 + super::LOD_BLOCK - 1));
+                        let run = ([pa, pb, pm], [ba, bb, bm]);
+                        if footprint_bound(run, ends, sx, sy, half) <= LOD0_FOOTPRINT {
+                            skipped += 1;
+                        }
+                    }
+                    blended += (0..chunks)
+                        .filter(|&c| {
+                            let mid = rays.dx(s) + (c * C + C.min(n - c * C) / 2) as f64;
+                            let at = face_axes(face, ray(p, rays.b, mid));
+                            r.verified && lod_q8(footprint(at, sx, sy, half)) > 0
+                        })
+                        .count();
+                }
+            }
+        }
+        assert!(
+            skipped > 100 && blended > 100,
+            "{skipped} blocks skipped, {blended} chunks blended"
+        );
+    }
 
     #[test]
     fn same_runs_groups_consecutive_keys_and_skips_none() {
