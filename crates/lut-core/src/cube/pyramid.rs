@@ -92,8 +92,8 @@ pub(crate) fn footprint(
 
 /// An upper bound of [`footprint`] over the pixels `dx` in `[x0, x1]` of a face run whose
 /// axes are `(a, b, m) = p + dx · d` (`m` > 0 at both ends), with generous room for the
-/// rounding of [`footprint`] as computed at any of them; infinite where `m` is not
-/// positive at both ends. Each `|∂u|`, `|∂v|` is `|s·m − c·s_m| · half / m²` with `c`
+/// rounding of [`footprint`] as computed at any of them; infinite unless both ends are
+/// finite with `m` > 0. Each `|∂u|`, `|∂v|` is `|s·m − c·s_m| · half / m²` with `c`
 /// the ray's `a` or `b` and `s` a step's: the numerator is linear in `dx` (its largest
 /// magnitude at an end) and `1 / m²` is largest at the end where `m` is smallest (`m` is
 /// linear and positive between), so the product of the two is an upper bound.
@@ -107,10 +107,14 @@ pub(crate) fn footprint_bound(
 ) -> f64 {
     let at = |x: f64| (p[0] + x * d[0], p[1] + x * d[1], p[2] + x * d[2]);
     let ends = [at(x0), at(x1)];
-    let m = ends[0].2.min(ends[1].2);
-    if !(m > 0.0) {
+    // (NaN or infinite ends, or m ≤ 0 at one: no bound.)
+    let usable = ends
+        .iter()
+        .all(|e| e.0.is_finite() && e.1.is_finite() && e.2.is_finite() && e.2 > 0.0);
+    if !usable {
         return f64::INFINITY;
     }
+    let m = ends[0].2.min(ends[1].2);
     let mut num: f64 = 0.0;
     for (sa, sb, sm) in [sx, sy] {
         for (a, b, mm) in ends {

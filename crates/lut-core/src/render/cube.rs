@@ -730,7 +730,7 @@ mod tests {
             .map(|k| {
                 (0..n * n)
                     .map(|i| {
-                        let mut h = (i + 1).wrapping_mul(2_654_435_761) ^ (k + 7) * 40_503;
+                        let mut h = (i + 1).wrapping_mul(2_654_435_761) ^ ((k + 7) * 40_503);
                         h ^= h >> 15;
                         h = h.wrapping_mul(2_246_822_519);
                         (h ^ (h >> 13)) & 0x00FF_FFFF
