@@ -92,6 +92,44 @@ pub fn check_tour(r: anyhow::Result<viewer::tour::Loaded>, path: &std::path::Pat
             }
         }
     }
+    // A Marzipano scene's levels as the pyramid reader takes them (what opening the scene
+    // does with them): refused with one safe line, or a description within the limits.
+    for s in &t.scenes {
+        if let tour::Source::MarzipanoTiles { levels, .. } = &s.source {
+            let root = std::path::Path::new("tour/tiles/scene");
+            match lut_core::MultiresConfig::marzipano(path, root, levels) {
+                Ok(cfg) => {
+                    let limits = lut_core::limits::MIN_TILE_RESOLUTION
+                        ..=lut_core::limits::MAX_TILE_RESOLUTION;
+                    assert!((1..=lut_core::limits::MAX_CUBE_RESOLUTION).contains(&cfg.cube));
+                    assert!((1..=lut_core::limits::MAX_TILE_LEVELS).contains(&cfg.max_level));
+                    for level in 1..=cfg.max_level {
+                        let n = cfg.tiles_across(level);
+                        assert!(n >= 1 && cfg.level_size(level) >= 1);
+                        let tile = cfg.tile_size(level);
+                        assert!(
+                            limits.contains(&tile) || tile == cfg.level_size(level),
+                            "{tile}"
+                        );
+                        let id = lut_core::TileId {
+                            level: level as u8,
+                            face: lut_core::Face::Down,
+                            y: n - 1,
+                            x: n - 1,
+                        };
+                        let (w, h) = cfg.tile_dims(id);
+                        assert!(w >= 1 && h >= 1 && w <= tile && h <= tile);
+                        assert!(cfg.tile_path(id).starts_with(root));
+                    }
+                }
+                Err(e) => {
+                    let line = lut_core::one_line(&e.to_string());
+                    assert_safe(&line);
+                    assert!(line.chars().count() <= lut_core::MESSAGE_MAX_CHARS + 40);
+                }
+            }
+        }
+    }
     for p in &loaded.problems {
         let line = p.to_string();
         assert_safe(&line);

@@ -79,6 +79,21 @@ pub fn lod_q8(footprint: f64) -> i32 {
     }
 }
 
+/// `render::sink::nearest_level` of a footprint `f` (level-0 map pixels per screen pixel) without a
+/// logarithm: 0 up to √2 (and for NaN), else ⌊log2(f) + ½⌋ = the binary exponent of
+/// f·√2, at most 30 (the readers clamp it to their last level). It equals
+/// `nearest_level(lod_q8(f))` (the level of [`lod_q8`]'s level of detail) except within 1/256 of a level above a boundary, where
+/// `lod_q8`'s truncation to Q.8 still says the level below (unit test).
+#[inline(always)]
+pub(crate) fn nearest_level_of(f: f64) -> u32 {
+    // (NaN compares false.)
+    if f.partial_cmp(&std::f64::consts::SQRT_2) != Some(std::cmp::Ordering::Greater) {
+        return 0;
+    }
+    let e = ((f * std::f64::consts::SQRT_2).to_bits() >> 52) as i64 - 1023;
+    e.clamp(1, 30) as u32
+}
+
 impl EnvMap {
     /// The pyramid levels 1, 2, ... (level 0 is the map itself), built on first use
     /// (rayon) and kept, down to a side of 2 (odd sides included). For a partial map, the

@@ -49,6 +49,16 @@ pub fn sample_at_lod(map: &EnvMap, uv: Option<(f64, f64)>, lod: i32) -> u32 {
     }
 }
 
+/// [`sample_at`] bilinear on pyramid level `k` (a level the map has; 0: the map, as
+/// [`sample_at`] with [`Sampler::Bilinear`], byte for byte), at the level-0 position `at`.
+#[inline]
+pub(crate) fn sample_at_level(map: &EnvMap, at: (f64, f64), k: u32) -> u32 {
+    if k == 0 {
+        return sample_at(map, Sampler::Bilinear, Some(at));
+    }
+    map.level_bilinear(k, to_fx(wrap_u(map, at.0)), to_fx(at.1))
+}
+
 /// The exact level of detail of single pixels: the camera and map geometry of a frame.
 /// The exact renderer's trilinear pixels, and the pixels the LUT and grid renderers
 /// evaluate exactly (pole zones, beyond a table, cells at a disc's edge), take their level
@@ -90,6 +100,58 @@ impl ExactFootprint {
             }
         }
         f
+    }
+
+    /// The footprint at image point (x, y) with exact position `at` from the derivative of
+    /// the mapping instead of the positions one pixel away ([`ExactFootprint::footprint`]
+    /// takes two more exact positions, four `atan2`): the larger over the two screen axes
+    /// of max(|dΛ|, |dV|) per pixel, dλ and dφ from the ray and its change per pixel
+    /// (the ray is linear in the pixel), V's slope from the projection. Equal to the
+    /// footprint to first order; near a pole (where the positions one pixel away wrap
+    /// round it) it is larger. For rectilinear views of equirectangular, sine and
+    /// cylindrical maps (rows that do not scale); the others take
+    /// [`ExactFootprint::footprint`]. (`Renderer::set_region_lod`'s exact pixels.)
+    pub(crate) fn derivative(&self, x: f64, y: f64, at: (f64, f64)) -> f64 {
+        self.derivative_of(x, y)
+            .unwrap_or_else(|| self.footprint(x, y, at))
+    }
+
+    /// [`ExactFootprint::derivative`] without the exact position: `None` for the views
+    /// and maps it does not cover.
+    pub(crate) fn derivative_of(&self, x: f64, y: f64) -> Option<f64> {
+        let slope = match self.proj {
+            Projection::Equirect | Projection::Sine | Projection::Cylinder
+                if self.cam.view().projection().is_rectilinear() =>
+            {
+                self.proj
+            }
+            _ => return None,
+        };
+        let d = self.cam.world_ray(x, y);
+        let r2 = d.x * d.x + d.z * d.z;
+        let n2 = r2 + d.y * d.y;
+        let r = r2.sqrt();
+        // (On the axis through the poles: r is 0, or NaN for a NaN ray.)
+        if r.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return Some(f64::INFINITY);
+        }
+        // dV/dφ: H/π; (H/2)·cos φ; (W/2π)/cos² φ (cos φ = r/|d|).
+        let dv_dphi = match slope {
+            Projection::Sine => self.mh * 0.5 * r / n2.sqrt(),
+            Projection::Cylinder => self.mw / std::f64::consts::TAU * n2 / r2,
+            _ => self.mh / std::f64::consts::PI,
+        };
+        let lam_px = self.mw / std::f64::consts::TAU;
+        let mut f: f64 = 0.0;
+        for dd in [
+            self.cam.world_ray(x + 1.0, y) - d,
+            self.cam.world_ray(x, y + 1.0) - d,
+        ] {
+            let dl = (d.z * dd.x - d.x * dd.z) / r2;
+            let dphi = (dd.y * r2 - d.y * (d.x * dd.x + d.z * dd.z)) / (n2 * r);
+            f = f.max((dl * lam_px).abs()).max((dphi * dv_dphi).abs());
+        }
+        Some(f)
     }
 
     /// The level of detail (Q.8) of pixel (x, y) whose exact position is `uv` (0 where the

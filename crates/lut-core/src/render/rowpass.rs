@@ -19,7 +19,9 @@
 //! The pixels sample exactly the positions [`row_pass`] writes; `Renderer::positions`
 //! reads the same buffers, so the measured sampling error is this pass's.
 
-use super::kernel::{active, wrap_q8, Level, Q16Start, Q16Step, SpanAt, SpanQ8, Texels};
+use super::kernel::{
+    active, wrap_q8, Level, Q16Start, Q16Step, SelectedKernel, SpanAt, SpanQ8, Texels,
+};
 use super::scanline::{blend_pays, render_row, with_nodes};
 use super::scanline::{RowScratch, BLEND_NODES};
 use super::setup::{Lv, LvStep, Scan, Setup, Unfold};
@@ -87,7 +89,8 @@ pub(crate) fn row_pass<S: Sink>(
             while r + 1 < STEP_REGIONS && d >= h.e[r + 1] {
                 r += 1;
             }
-            let shift = scan.shifts[r] as u32;
+            // (The walk's step: `shifts`, longer with a level per region.)
+            let shift = scan.lod_shifts[r] as u32;
             let n = 1i64 << shift;
             let stop = h.region_end(r).min(dn);
             let mut c = (h.a0 + 2 * d) * npx;
@@ -114,8 +117,9 @@ pub(crate) fn row_pass<S: Sink>(
                 }
             }
             if d < dn && d < h.region_end(r) {
-                // A span that ends short of the step (at the half's end).
-                let d1 = (d + n).min(dn);
+                // A span that ends short of the step (at the half's end, or at the
+                // region's end when the walk's step is longer than `shifts`).
+                let d1 = (d + n).min(dn).min(h.region_end(r));
                 let p1 = read_at(scan, nodes, &h, &un, d1);
                 let m = d1 - d;
                 let (p1, step) = span_step(fr, p0, p1, m, shift);
@@ -343,6 +347,20 @@ struct Resolved {
 /// `EnvMap::trilinear` at the position (u wrapped into the map) with the span's level of
 /// detail.
 fn tri_run(levels: &[Texels], wq: i32, dv: i32, r: HalfRun<'_>, row: &mut [u32]) {
+    tri_run_with(active(), levels, (wq, dv), r, row);
+}
+
+/// [`tri_run`] with kernel `kernel` (the tests run every kernel the CPU has; `wd`: the
+/// map's width and the next scanline's offset, Q.8).
+#[inline(always)]
+fn tri_run_with(
+    kernel: SelectedKernel,
+    levels: &[Texels],
+    wd: (i32, i32),
+    r: HalfRun<'_>,
+    row: &mut [u32],
+) {
+    let (wq, dv) = wd;
     tri_groups(levels.len() - 1, r, row, |k, w, Uv { u, v }, out| {
         let t = &levels[k].toward_next_scanline(dv);
         let lv = Level {
@@ -351,12 +369,12 @@ fn tri_run(levels: &[Texels], wq: i32, dv: i32, r: HalfRun<'_>, row: &mut [u32])
             w: w.unwrap_or(&[]),
         };
         match (k, w.is_some(), out) {
-            (0, false, Out::Left(o)) => active().sample_q8::<true, true>(t, u, v, o),
-            (0, false, Out::Right(o)) => active().sample_q8::<true, false>(t, u, v, o),
-            (_, false, Out::Left(o)) => active().sample_level::<true, false>(t, u, v, o, &lv),
-            (_, false, Out::Right(o)) => active().sample_level::<false, false>(t, u, v, o, &lv),
-            (_, true, Out::Left(o)) => active().sample_level::<true, true>(t, u, v, o, &lv),
-            (_, true, Out::Right(o)) => active().sample_level::<false, true>(t, u, v, o, &lv),
+            (0, false, Out::Left(o)) => kernel.sample_q8::<true, true>(t, u, v, o),
+            (0, false, Out::Right(o)) => kernel.sample_q8::<true, false>(t, u, v, o),
+            (_, false, Out::Left(o)) => kernel.sample_level::<true, false>(t, u, v, o, &lv),
+            (_, false, Out::Right(o)) => kernel.sample_level::<false, false>(t, u, v, o, &lv),
+            (_, true, Out::Left(o)) => kernel.sample_level::<true, true>(t, u, v, o, &lv),
+            (_, true, Out::Right(o)) => kernel.sample_level::<false, true>(t, u, v, o, &lv),
         }
     });
 }
@@ -802,6 +820,58 @@ mod tests {
                     at,
                     &format!("{w}x{h}"),
                 );
+            }
+        }
+    }
+
+    /// The runs of bilinear with a level per region (`Renderer::set_region_lod`): whole
+    /// levels (weights 0, so no level is blended in), level 0 by the bilinear row kernel
+    /// and the others by the level kernel. With every kernel the CPU runs, the scalar
+    /// twin included, each pixel on both halves is `EnvMap::level_bilinear` of its
+    /// segment's level (clamped to the last) at its position: runs of 1..=600 positions
+    /// within two map widths of the map and beyond the poles, 1..=40 segments of levels
+    /// 0..12, on maps with even and odd level sides.
+    #[test]
+    fn whole_level_runs_agree_on_every_kernel() {
+        use crate::render::kernel::Kernel;
+        let mut rnd = xorshift(0x1234_5678_9ABC_DEF1);
+        for (w, h) in [(64u32, 32u32), (300, 150), (96, 40), (2048, 1024)] {
+            let px: Vec<u32> = (0..w * h)
+                .map(|i| i.wrapping_mul(2_654_435_761) & 0xFF_FFFF)
+                .collect();
+            let m = EnvMap::from_pixels(w, h, &px, Projection::Equirect).unwrap();
+            let levels = level_texels(&m);
+            let last = levels.len() as u32 - 1;
+            let (wq, hq) = ((w as i64) << 8, (h as i64) << 8);
+            for _ in 0..40 {
+                let n = 1 + rnd(600) as usize;
+                let mut pos = |lo: i64, hi: i64| -> Vec<i32> {
+                    (0..n)
+                        .map(|_| (lo + rnd((hi - lo) as u64) as i64) as i32)
+                        .collect()
+                };
+                let (u, ul, v) = (
+                    pos(256 - wq, 2 * wq - 256),
+                    pos(256 - wq, 2 * wq - 256),
+                    pos(-hq / 2, hq + hq / 2),
+                );
+                let mut segs = random_segs(&mut rnd, n);
+                for s in &mut segs {
+                    s.lod = (rnd(13) as i32) << 8;
+                }
+                let at = |uq: i32, vq: i32, lod: i32| {
+                    let uu = ((uq as i64) << 8).rem_euclid((w as i64) << 16);
+                    let k = ((lod >> 8) as u32).min(last);
+                    m.level_bilinear(k, uu, (vq as i64) << 8)
+                };
+                for k in Kernel::available() {
+                    check_run(
+                        (&u, &ul, &v, &segs),
+                        |r, row| tri_run_with(k.selected(), &levels, (wq as i32, 0), r, row),
+                        at,
+                        &format!("{w}x{h} {k:?}"),
+                    );
+                }
             }
         }
     }

@@ -12,6 +12,7 @@ use super::sink::Sink;
 use super::steps::STEP_REGIONS;
 use super::walk::{read_at, span_step, wrap_u, Half, HalfBuf, Nodes};
 use crate::geom::fixed::{Fx, FX_BITS};
+use crate::geom::mapping::atan2_fast;
 use crate::lut::LutTable;
 
 /// Room for a run's blended table nodes (a run that reads more blends per read).
@@ -134,6 +135,21 @@ fn exact_run<S: Sink>(scan: &Scan, fr: &Setup, x0: i64, x1: i64, sink: &mut S) {
     let c2 = scan.ca * scan.ca;
     for x in x0.max(0)..=x1 {
         let t = (x as f64 + 0.5 - half_w) * scan.t_per_x;
+        if let Some(k) = sink.exact_level(x as usize) {
+            // Read on level k ≥ 1 (with a level per region), the position may be off by
+            // far less than a pixel of the level: `atan2_fast`, within 1e-9 rad.
+            let (lambda, phi) = if k >= 1 {
+                let lambda = atan2_fast(t, scan.ca) + fr.yaw;
+                (lambda, atan2_fast(scan.sa, (t * t + c2).sqrt()))
+            } else {
+                (
+                    t.atan2(scan.ca) + fr.yaw,
+                    scan.sa.atan2((t * t + c2).sqrt()),
+                )
+            };
+            sink.exact_on(x as usize, fr.proj.uv(lambda, phi, fr.mw, fr.mh), k);
+            continue;
+        }
         let lambda = t.atan2(scan.ca) + fr.yaw;
         let phi = scan.sa.atan2((t * t + c2).sqrt());
         sink.exact(x as usize, fr.proj.uv(lambda, phi, fr.mw, fr.mh));

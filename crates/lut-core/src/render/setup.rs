@@ -13,6 +13,7 @@ use crate::geom::fixed::{to_fx, Fx, FX_BITS, FX_ONE};
 use crate::geom::projection::Projection;
 use crate::lut::{LutTable, Surface, TableKind};
 use crate::map::envmap::EnvMap;
+use crate::map::pyramid::nearest_level_of;
 use crate::map::sample::Sampler;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -139,6 +140,12 @@ pub(crate) struct Scan {
     pub(crate) ca: f64,
     /// log2 of the index step per region of |X| (see [`STEP_REGIONS`]).
     pub(crate) shifts: [u8; STEP_REGIONS],
+    /// log2 of the index step the row pass walks each region with: `shifts`, or with a
+    /// level per region (`Renderer::set_region_lod`) at least that, from the budget of
+    /// the level the region's spans read at least (`steps::lod_budget`). The regions'
+    /// first reads (`walk::Half::of`) stay those of `shifts`, so a region's pixels do not
+    /// depend on the steps of the regions before it.
+    pub(crate) lod_shifts: [u8; STEP_REGIONS],
     /// Angle between this scanline and the next at the centre column (radians).
     pub(crate) row_angle: f64,
     /// Vertical pixel footprint per region (level-0 map pixels; trilinear only): the
@@ -219,6 +226,7 @@ pub(crate) fn prepare(
     scans: &mut Vec<Scan>,
     cam: &Camera,
     opts: &RenderOptions,
+    lod_cap: Option<u32>,
 ) -> (Setup, RenderReport) {
     let (view, width, height) = (cam.view(), cam.width, cam.height);
     let f = cam.focal;
@@ -237,7 +245,17 @@ pub(crate) fn prepare(
         v1,
         v2,
         coupling,
+        lod_cap: None,
     };
+    // Steps on the level read (adaptive steps of the row pass's maps only).
+    let lod_bounds =
+        (opts.index_step == IndexStep::Adaptive && !proj.scaled_rows() && proj.full_sphere())
+            .then_some(lod_cap)
+            .flatten()
+            .map(|cap| StepBounds {
+                lod_cap: Some(cap),
+                ..bounds
+            });
     let pitch = view.pitch();
     let half_w = width as f64 * 0.5;
     // One scanline's setup (independent of the others: the rows are set up in parallel).
@@ -314,6 +332,7 @@ pub(crate) fn prepare(
                 c: a.cos().abs(),
                 t_min,
                 dt: scan.t_per_x,
+                k_floor: 0,
             };
             let reg_x = half_w / STEP_REGIONS as f64;
             for (r, shift) in scan.shifts.iter_mut().enumerate() {
@@ -324,6 +343,9 @@ pub(crate) fn prepare(
                 let n = step_for(&bounds, line, xs, nominal, 1 << hint[r]);
                 *shift = n.trailing_zeros() as u8;
             }
+            // (Longer with a level per region: `lod_steps`, once the vertical footprints
+            // are known.)
+            scan.lod_shifts = scan.shifts;
         }
         scan
     };
@@ -367,6 +389,21 @@ pub(crate) fn prepare(
     if opts.sampler == Sampler::Trilinear {
         vertical_footprints(scans, table, &frame, opts.threads);
     }
+    if let Some(lb) = &lod_bounds {
+        let steps = LodSteps {
+            bounds: lb,
+            table,
+            nominal,
+            half_w,
+        };
+        if opts.threads && scans.len() >= PARALLEL_SETUP_ROWS {
+            let mid = scans.len() / 2;
+            let (a, b) = scans.split_at_mut(mid);
+            rayon::join(|| steps.fill(a), || steps.fill(b));
+        } else {
+            steps.fill(scans);
+        }
+    }
     let report = RenderReport {
         path: match kind {
             TableKind::Wide => RenderPath::LutWide,
@@ -379,6 +416,47 @@ pub(crate) fn prepare(
         min_step,
     };
     (frame, report)
+}
+
+/// The steps of a frame drawn with a level per region (`Renderer::set_region_lod`): each
+/// region's [`Scan::lod_shifts`], the longest step within the budget of the level its
+/// spans read at least (`steps::lod_budget`: from the step's own Λ footprint and the
+/// region's vertical footprint [`Scan::fy`], which every span's level includes).
+struct LodSteps<'a> {
+    bounds: &'a StepBounds,
+    table: &'a LutTable,
+    nominal: u32,
+    half_w: f64,
+}
+
+impl LodSteps<'_> {
+    fn fill(&self, scans: &mut [Scan]) {
+        let reg_x = self.half_w / STEP_REGIONS as f64;
+        for scan in scans.iter_mut().filter(|s| s.lut) {
+            let zone = self.table.zone(scan.band);
+            let t_min = if zone >= 0.0 {
+                zone / scan.col_per_x * scan.t_per_x
+            } else {
+                0.0
+            };
+            for r in 0..STEP_REGIONS {
+                let line = StepLine {
+                    s: scan.sa.abs(),
+                    c: scan.ca.abs(),
+                    t_min,
+                    dt: scan.t_per_x,
+                    k_floor: nearest_level_of(scan.fy[r] as f64),
+                };
+                let xs = XRange {
+                    lo: r as f64 * reg_x,
+                    hi: (r + 1) as f64 * reg_x,
+                };
+                let hint = 1 << scan.shifts[r];
+                let n = step_for(self.bounds, line, xs, self.nominal, hint);
+                scan.lod_shifts[r] = n.trailing_zeros() as u8;
+            }
+        }
+    }
 }
 
 /// The vertical footprint of every scanline per region (see [`Scan::fy`]): table positions

@@ -3,7 +3,7 @@
 //! never per pixel; a trilinear sink that sets its level of detail once per span; and a
 //! sink of sampling positions, for measuring them against the exact mapping.
 
-use super::exact::{sample_at, sample_at_lod, ExactFootprint};
+use super::exact::{sample_at, sample_at_level, sample_at_lod, ExactFootprint};
 use super::kernel::{
     nearest_span_direct, sample_span_cropped, sample_spans, texels, trilinear_spans, SpanJob,
     Texels, MAX_JOBS,
@@ -13,7 +13,7 @@ use super::steps::STEP_REGIONS;
 use super::walk::wrap_u;
 use crate::geom::fixed::{from_fx, Fx, FX_ONE};
 use crate::map::envmap::EnvMap;
-use crate::map::pyramid::lod_q8;
+use crate::map::pyramid::{lod_q8, nearest_level_of};
 use crate::map::sample::Sampler;
 
 /// Where a renderer writes: pixels, or (for measurement) sampling positions.
@@ -27,6 +27,18 @@ pub(crate) trait Sink {
     }
     fn background(&mut self, x: usize);
     fn exact(&mut self, x: usize, uv: Option<(f64, f64)>);
+    /// The pyramid level pixel `x` (evaluated exactly) reads, known before its position
+    /// (bilinear with a level per region: from the mapping's derivative); `None`: the
+    /// sink takes positions through [`Sink::exact`].
+    #[inline(always)]
+    fn exact_level(&mut self, _x: usize) -> Option<u32> {
+        None
+    }
+    /// Pixel `x` at `uv` on level `k` (as [`Sink::exact_level`] gave it).
+    #[inline(always)]
+    fn exact_on(&mut self, x: usize, uv: Option<(f64, f64)>, _k: u32) {
+        self.exact(x, uv);
+    }
     /// The per-pixel step (dΛ, dV) of the span about to be emitted (its horizontal
     /// footprint): the trilinear sink picks its pyramid level from it.
     #[inline(always)]
@@ -232,6 +244,18 @@ impl TriSink<'_> {
             lod
         };
     }
+
+    /// Set the level of detail for a footprint of `f` level-0 map pixels per screen
+    /// pixel: in `nearest` mode the whole level [`nearest_level_of`] (no logarithm: this
+    /// runs once per span), else [`lod_q8`].
+    #[inline(always)]
+    fn set_footprint_of(&mut self, f: f64) {
+        if self.nearest {
+            self.lod = (nearest_level_of(f) as i32) << 8;
+        } else {
+            self.lod = lod_q8(f);
+        }
+    }
 }
 
 /// The pyramid level nearest to the footprint whose trilinear level of detail is `lod`
@@ -277,13 +301,41 @@ impl Sink for TriSink<'_> {
         // Pole zones, pixels beyond the table: their own exact footprint, as the exact
         // renderer (a span's or the scanline's footprint can be far off there: at hfov
         // 170 the edge columns beyond the wide table see a fraction of the centre's).
+        if self.nearest {
+            // Bilinear with a level per region: one level, from the footprint's
+            // derivative (no further exact positions: `ExactFootprint::derivative`).
+            self.row[x] = match uv {
+                Some(at) => {
+                    let f = self.fp.derivative(x as f64 + 0.5, self.y as f64 + 0.5, at);
+                    let last = self.levels.len() as u32 - 1;
+                    sample_at_level(self.map, at, nearest_level_of(f).min(last))
+                }
+                None => self.map.background(),
+            };
+            return;
+        }
         let lod = self.fp.lod(x, self.y, uv);
         self.row[x] = sample_at_lod(self.map, uv, lod);
+    }
+    #[inline]
+    fn exact_level(&mut self, x: usize) -> Option<u32> {
+        if !self.nearest {
+            return None;
+        }
+        let f = self.fp.derivative_of(x as f64 + 0.5, self.y as f64 + 0.5)?;
+        Some(nearest_level_of(f).min(self.levels.len() as u32 - 1))
+    }
+    #[inline]
+    fn exact_on(&mut self, x: usize, uv: Option<(f64, f64)>, k: u32) {
+        self.row[x] = match uv {
+            Some(at) => sample_at_level(self.map, at, k),
+            None => self.map.background(),
+        };
     }
     #[inline(always)]
     fn footprint(&mut self, step: LvStep, region: usize) {
         let fx = step.dl.unsigned_abs().max(step.dv.unsigned_abs()) as f64 / FX_ONE as f64;
-        self.set_lod(lod_q8(fx.max(self.fy[region] as f64)));
+        self.set_footprint_of(fx.max(self.fy[region] as f64));
     }
     const LOD: bool = true;
     #[inline(always)]

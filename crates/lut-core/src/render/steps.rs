@@ -16,6 +16,7 @@ pub const ADAPTIVE_MAX_STEP: u32 = 64;
 pub(crate) const STEP_REGIONS: usize = 8;
 
 /// Factors of the second-derivative bound of the map coordinates along a scanline.
+#[derive(Debug, Clone, Copy)]
 pub(crate) struct StepBounds {
     /// W / 2π: Λ pixels per radian of longitude.
     pub(crate) lam_px: f64,
@@ -24,6 +25,37 @@ pub(crate) struct StepBounds {
     pub(crate) v2: f64,
     /// How a V error turns into a u error through the row scale.
     pub(crate) coupling: f64,
+    /// Bilinear with a level per region (`Renderer::set_region_lod`): the deepest
+    /// pyramid level (`Some`), so that the budget is that of the level a region's spans
+    /// are sure to read ([`lod_budget`]); `None`: level 0's.
+    pub(crate) lod_cap: Option<u32>,
+}
+
+/// The span error budget, in level-0 map pixels, of spans of `reach` pixels starting
+/// at |X| ≤ `xs.hi` on `line` ([`step_fits`]), when each span reads the pyramid level
+/// nearest its footprint (`Renderer::set_region_lod`, capped at level `cap`):
+/// [`SPAN_ERROR_BUDGET`] · 2^k, k the level such a span reads at least, so the budget is
+/// [`SPAN_ERROR_BUDGET`] pixels of the level read.
+///
+/// Why k is a floor: along the scanline Λ = (W/2π)·atan2(t, c) + const, whose slope
+/// (W/2π)·c/(t² + c²) per unit t falls with |t|, so every span of the region (|t| up to
+/// t_far = (|X| + reach)·dt) steps at least f = (W/2π)·c·dt/(t_far² + c²) map pixels per
+/// pixel in Λ (its chord is the mean of the slope over it), and a span's level is chosen
+/// from the larger of its |dΛ|, |dV| and the vertical footprint
+/// (`map::pyramid::nearest_level_of`): at least the level of f, and at least
+/// `line.k_floor`, the level of the vertical footprint (near a pole the larger: there Λ
+/// turns from one scanline to the next). 3 % is taken off f for the table's own error in
+/// the chord's ends.
+pub(crate) fn lod_budget(b: &StepBounds, line: StepLine, xs: XRange, reach: f64) -> f64 {
+    let Some(cap) = b.lod_cap else {
+        return SPAN_ERROR_BUDGET;
+    };
+    let t_far = (xs.hi + reach) * line.dt;
+    let f = 0.97 * b.lam_px * line.c * line.dt / (t_far * t_far + line.c * line.c);
+    let k = crate::map::pyramid::nearest_level_of(f)
+        .max(line.k_floor)
+        .min(cap);
+    SPAN_ERROR_BUDGET * (1u64 << k) as f64
 }
 
 /// A scanline as the step bounds see it (see [`step_for`]): its folded angle a as
@@ -35,6 +67,10 @@ pub(crate) struct StepLine {
     pub(crate) c: f64,
     pub(crate) t_min: f64,
     pub(crate) dt: f64,
+    /// With a level per region ([`lod_budget`]): a level the region's spans read at
+    /// least whatever their step (from the scanline's vertical footprint there, which
+    /// the level of every span of the region includes); 0 otherwise.
+    pub(crate) k_floor: u32,
 }
 
 /// Where a region's spans start: |X| ∈ [`lo`, `hi`], pixels from the screen's centre
@@ -95,7 +131,7 @@ fn step_fits(b: &StepBounds, line: StepLine, xs: XRange, n: u32) -> bool {
     let t_hi = ((xs.hi + reach) * dt).max(t_lo);
     let bound = span_bound(b, line, t_lo, t_hi);
     let len = reach * dt;
-    n == 1 || (bound.is_finite() && len * len / 8.0 * bound <= SPAN_ERROR_BUDGET)
+    n == 1 || (bound.is_finite() && len * len / 8.0 * bound <= lod_budget(b, line, xs, reach))
 }
 
 /// [`step_for`] searched from the top, as it was before the hint (the reference the
@@ -144,7 +180,9 @@ mod tests {
 
         /// The search from any hint finds what the search from the top finds, over
         /// scanline angles, regions, pole zones, map factors and steps (log-uniform
-        /// over the ranges frames have, and beyond).
+        /// over the ranges frames have, and beyond), with the budget of level 0 and of
+        /// the level read (`lod_cap`: a shorter step's level is never finer, so the
+        /// search stays monotone).
         #[test]
         fn hinted_step_equals_the_search_from_the_top(
             a in 0.0f64..std::f64::consts::FRAC_PI_2,
@@ -154,14 +192,17 @@ mod tests {
             (lam, v1, v2, cpl) in (8.0f64..16.0, 7.0f64..16.0, 0.0f64..14.0, 0.0f64..2.0),
             nominal in prop::sample::select(vec![1u32, 2, 4, 8, 16, 64]),
             hint_log in 0u32..8,
+            lod_cap in prop_oneof![Just(None), (0u32..14).prop_map(Some)],
+            k_floor in 0u32..6,
         ) {
             let b = StepBounds {
                 lam_px: lam.exp2(),
                 v1: v1.exp2(),
                 v2: v2.exp2() - 1.0,
                 coupling: cpl,
+                lod_cap,
             };
-            let line = StepLine { s: a.sin(), c: a.cos(), t_min, dt };
+            let line = StepLine { s: a.sin(), c: a.cos(), t_min, dt, k_floor };
             let xs = XRange { lo: x_lo, hi: x_lo + w };
             let want = step_from_top(&b, line, xs, nominal);
             let got = step_for(&b, line, xs, nominal, 1 << hint_log);
