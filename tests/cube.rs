@@ -396,6 +396,83 @@ fn trilinear_minified_is_closer_to_the_supersampled_truth() {
     }
 }
 
+/// A bilinear frame of `cube` with the level per region on (`Panorama::set_region_lod`).
+fn render_region(cube: &CubeMap, view: View, r: CubeRenderer, w: u32, h: u32) -> Vec<u32> {
+    let mut out = vec![0u32; (w * h) as usize];
+    let mut pano = Panorama::cube(cube.clone());
+    pano.set_region_lod(true);
+    let opts = RenderOptions {
+        sampler: Sampler::Bilinear,
+        cube: r,
+        ..RenderOptions::default()
+    };
+    pano.render(view, &opts, &mut Frame::new(&mut out, w, h).unwrap())
+        .unwrap();
+    out
+}
+
+#[test]
+fn region_lod_is_bilinear_where_magnified_and_closer_to_the_truth_where_minified() {
+    // Magnified (far below one texel per pixel): the level per region reads the faces
+    // themselves, byte for byte the bilinear frame, with either renderer.
+    let small = noise_cube(24);
+    for &(yaw, pitch) in EDGE_VIEWS {
+        let view = View::new(yaw, pitch, 30.0).unwrap();
+        let want = render(
+            &small,
+            view,
+            Sampler::Bilinear,
+            CubeRenderer::Basic,
+            96,
+            72,
+            false,
+        );
+        for r in [CubeRenderer::Basic, CubeRenderer::Accelerated] {
+            assert!(
+                render_region(&small, view, r, 96, 72) == want,
+                "({yaw}, {pitch}) {r:?}: the region level differs where magnified"
+            );
+        }
+    }
+    // Minified (the trilinear test's views): each region's nearest level is much closer
+    // to the 8×8 supersampled truth than bilinear on the faces, and the two renderers
+    // agree closely (per pixel against per 16 pixels).
+    let cube = noise_cube(512);
+    let (w, h) = (160, 120);
+    for &(yaw, pitch) in &[(10.0, 5.0), (45.0, 35.26), (0.0, 90.0), (-135.0, -60.0)] {
+        let view = View::new(yaw, pitch, 120.0).unwrap();
+        let truth = supersampled(&cube, view, w, h, 8);
+        let bil = render(
+            &cube,
+            view,
+            Sampler::Bilinear,
+            CubeRenderer::Accelerated,
+            w,
+            h,
+            false,
+        );
+        let scan = render_region(&cube, view, CubeRenderer::Accelerated, w, h);
+        let basic = render_region(&cube, view, CubeRenderer::Basic, w, h);
+        let (p_bil, p_scan, p_basic) = (
+            psnr(&bil, &truth),
+            psnr(&scan, &truth),
+            psnr(&basic, &truth),
+        );
+        eprintln!(
+            "region lod ({yaw}, {pitch}): bilinear {p_bil:.1} dB, region scanline {p_scan:.1}, \
+             basic {p_basic:.1}"
+        );
+        assert!(
+            p_scan >= p_bil + 4.0,
+            "({yaw}, {pitch}): {p_scan:.1} vs {p_bil:.1}"
+        );
+        assert!(
+            p_basic >= p_bil + 4.0,
+            "({yaw}, {pitch}): {p_basic:.1} vs {p_bil:.1}"
+        );
+    }
+}
+
 #[test]
 fn edges_and_corners_show_no_seam_nan_or_bad_read() {
     const TOL: u32 = 8;

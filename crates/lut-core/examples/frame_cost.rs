@@ -17,7 +17,9 @@
 //! gather = a plain gather along the frame's precomputed nearest indices, the floor the
 //! nearest kernel is compared with; cube = the cube scanline renderer on a cube of faces a
 //! quarter of the map's width, converted from the map as `viewer bench` does; cube-basic =
-//! the per-pixel cube renderer), `cache` PATH (keep the generated map's pixels there, and
+//! the per-pixel cube renderer), `face` N (the cube's face side; default a quarter of the
+//! map's width, `pi` for the map's width / π rounded: the face whose centre has the
+//! map's texel density at the equator), `cache` PATH (keep the generated map's pixels there, and
 //! a cube's faces in PATH.cubeN, and read them on later runs: much faster under valgrind),
 //! `level` 0|1|2 (0: bilinear reads the map; 1: bilinear reads the pyramid level matching
 //! the footprint at the centre, `Renderer::set_bilinear_level`, as the window does while
@@ -195,6 +197,7 @@ fn run() -> Result<(), String> {
     let mut file = None;
     let mut crop: Option<(u32, u32, u32, u32)> = None;
     let mut lit = "none";
+    let mut face = None;
     for a in std::env::args().skip(1) {
         let (k, v) = a
             .split_once('=')
@@ -240,6 +243,12 @@ fn run() -> Result<(), String> {
             },
             "cache" => cache = Some(std::path::PathBuf::from(v)),
             "level" => level = num(v)? as u32,
+            "face" => {
+                face = Some(match v {
+                    "pi" => None,
+                    n => Some(num(n)? as u32),
+                })
+            }
             "rlod" => rlod = num(v)? != 0.0,
             "file" => file = Some(std::path::PathBuf::from(v)),
             "lit" => {
@@ -292,8 +301,19 @@ fn run() -> Result<(), String> {
         ..RenderOptions::default()
     };
     let cube = match cube_renderer {
-        Some(_) => Some(load_cube(&map, (map_wh.0 / 4).max(1), cache.as_deref())?),
+        Some(_) => {
+            let n = match face {
+                None => (map_wh.0 / 4).max(1),
+                Some(None) => (map_wh.0 as f64 / std::f64::consts::PI).round() as u32,
+                Some(Some(n)) => n,
+            };
+            Some(load_cube(&map, n, cache.as_deref())?)
+        }
         None => None,
+    };
+    let source = match &cube {
+        Some(c) => format!(" (cube of {0}x{0} faces)", c.face_size()),
+        None => String::new(),
     };
     let mut pano = match cube {
         Some(c) => Panorama::cube(c),
@@ -391,7 +411,7 @@ fn run() -> Result<(), String> {
         .iter()
         .fold(0u64, |a, &p| a.wrapping_mul(31).wrapping_add(p as u64));
     println!(
-        "{} | {} {}{} {}x{} from {}x{}, hfov {hfov}, {threads} thread(s): median {med:.2} ms (min {min:.2}; CPU {cpu:.2} ms per frame, all threads) over {} frame(s) (checksum {checksum:016x})",
+        "{} | {} {}{} {}x{} from {}x{}{source}, hfov {hfov}, {threads} thread(s): median {med:.2} ms (min {min:.2}; CPU {cpu:.2} ms per frame, all threads) over {} frame(s) (checksum {checksum:016x})",
         lut_core::kernel_info(),
         match (gather, cube_renderer) {
             (true, _) => "gather",

@@ -63,7 +63,7 @@ pub const LOD_BIAS: f32 = -0.5;
 /// up to 2^0.5, where log2 + [`LOD_BIAS`] ≤ 0 (and just above it, or after the f32
 /// rounding of the footprint, the Q.8 value truncates below 1/256 to 0 anyway). The LUT
 /// renderer's spans at the common zoom have footprints between 1 and 1.414.
-const LOD0_FOOTPRINT: f64 = std::f64::consts::SQRT_2;
+pub(crate) const LOD0_FOOTPRINT: f64 = std::f64::consts::SQRT_2;
 
 /// Level of detail in Q.8 (256 = one level) for a footprint of `footprint` level-0 map
 /// pixels per screen pixel: log2 of it plus [`LOD_BIAS`], and 0 (level 0, plain bilinear)

@@ -77,6 +77,9 @@ impl PanoramaKind {
 #[derive(Debug)]
 pub struct Panorama {
     repr: Repr,
+    /// A cube's bilinear frames read the face pyramid level of each region's footprint
+    /// ([`Panorama::set_region_lod`]; a map's renderer keeps its own flag).
+    cube_region_lod: bool,
 }
 
 /// The kinds, with what each owns. Private: only this file matches on it.
@@ -127,6 +130,7 @@ impl Panorama {
         let renderer = Renderer::new(&map);
         Panorama {
             repr: Repr::Map { map, renderer },
+            cube_region_lod: false,
         }
     }
 
@@ -134,6 +138,7 @@ impl Panorama {
     pub fn cube(cube: impl Into<Arc<CubeMap>>) -> Panorama {
         Panorama {
             repr: Repr::Cube(cube.into()),
+            cube_region_lod: false,
         }
     }
 
@@ -149,6 +154,7 @@ impl Panorama {
                 wait,
                 still: true,
             }),
+            cube_region_lod: false,
         }
     }
 
@@ -249,7 +255,10 @@ impl Panorama {
             Repr::Cube(cube) => Repr::Cube(cube.clone()),
             Repr::Tiled(t) => Repr::Tiled(t.clone()),
         };
-        Panorama { repr }
+        Panorama {
+            repr,
+            cube_region_lod: self.cube_region_lod,
+        }
     }
 
     /// Build now what the first frames would otherwise build: for a map both tables on
@@ -293,9 +302,11 @@ impl Panorama {
         }
     }
 
-    /// Bilinear frames of a map choose their pyramid level per region
-    /// ([`Renderer::set_region_lod`]); no effect on a cube or a tiled panorama.
+    /// Bilinear frames choose their pyramid level per region: a map's
+    /// ([`Renderer::set_region_lod`]) and a cube's (the face pyramid level nearest each
+    /// 16 pixels' footprint, `render/cube.rs`); no effect on a tiled panorama.
     pub fn set_region_lod(&mut self, on: bool) {
+        self.cube_region_lod = on;
         if let Repr::Map { renderer, .. } = &mut self.repr {
             renderer.set_region_lod(on);
         }
@@ -342,13 +353,14 @@ impl Panorama {
         frame: &mut Frame<'_>,
         hook: Option<BandHook<'_>>,
     ) -> Result<RenderReport, ViewError> {
+        let cube_region_lod = self.cube_region_lod;
         match &mut self.repr {
             Repr::Map { map, renderer } => match hook {
                 Some(hook) => renderer.render_with(map, view, opts, frame, hook),
                 None => renderer.render(map, view, opts, frame),
             },
             Repr::Cube(cube) => {
-                let report = cube_frame(cube, view, opts, frame)?;
+                let report = cube_frame(cube, view, opts, frame, cube_region_lod)?;
                 if let Some(hook) = hook {
                     crate::render::run_hook(frame, opts, hook);
                 }
@@ -431,7 +443,10 @@ impl Panorama {
             // copy is its level 1 as a cube map, lit (docs/huge.md).
             Repr::Tiled(t) => Repr::Cube(Arc::new(cube(&t.base)?)),
         };
-        Ok(Panorama { repr })
+        Ok(Panorama {
+            repr,
+            cube_region_lod: self.cube_region_lod,
+        })
     }
 
     /// `map(the map)` or `cube(the cube)`.
@@ -505,6 +520,7 @@ mod tests {
                 view,
                 &opts,
                 &mut Frame::new(&mut want, 40, 24).unwrap(),
+                false,
             )
             .unwrap();
             let mut pano = Panorama::cube(cube.clone());

@@ -42,14 +42,14 @@ use super::kernel::{active, ChunkLevels, ChunkWeights, FaceBuf, FaceRun, Texels}
 use super::rows::{rows_per_task, Loan};
 use super::setup::check_step;
 use super::{RenderOptions, RenderPath, RenderReport};
-use crate::cube::pyramid::{footprint, lod_of, TRILINEAR_RUN_CHUNK};
+use crate::cube::pyramid::{footprint, footprint_bound, lod_of, TRILINEAR_RUN_CHUNK};
 use crate::cube::{
     check_face_size, face_axes, face_of, face_uv, CubeError, CubeMap, Face, UsageProblem,
 };
 use crate::error::ViewError;
 use crate::geom::camera::View;
 use crate::map::envmap::EnvMap;
-use crate::map::pyramid::lod_q8;
+use crate::map::pyramid::{lod_q8, nearest_level_of, LOD0_FOOTPRINT};
 use crate::map::sample::Sampler;
 use crate::named::{parse_name, unknown_name, Named};
 use glam::DVec3;
@@ -233,6 +233,8 @@ struct NearestFetch;
 struct BilinearFetch;
 #[derive(Clone, Copy)]
 struct TrilinearFetch;
+#[derive(Clone, Copy)]
+struct RegionFetch;
 
 impl Fetch for NearestFetch {
     #[inline(always)]
@@ -281,54 +283,141 @@ impl Fetch for TrilinearFetch {
         out: &mut [u32],
         buf: &mut FaceBuf,
     ) {
-        const C: usize = TRILINEAR_RUN_CHUNK;
-        let n = out.len();
-        // The image's x and y steps on the face's axes (y: −R₁ per row; the sign does not
-        // change the footprint).
-        let (sx, sy) = (face_axes(face, frame.b), face_axes(face, frame.r1));
-        let (mut levels, mut fracs) = (take(&mut buf.levels), take(&mut buf.fracs));
-        levels.clear();
-        fracs.clear();
-        for c in 0..n.div_ceil(C) {
-            let mid = run.dx + (c * C + C.min(n - c * C) / 2) as f64;
-            let at = |i: usize| run.p[i] + mid * run.d[i];
-            let lod = lod_q8(footprint((at(0), at(1), at(2)), sx, sy, frame.half_face));
-            let (k, frac) = ((lod.max(0) >> 8) as usize, (lod.max(0) & 0xFF) as u32);
-            let (ka, kb) = (cube.level(k).1, cube.level(k + 1).1);
-            levels.push(ChunkLevels {
-                first: ka,
-                second: kb,
-            });
-            fracs.push(if ka == kb { 0 } else { frac });
-        }
-        // The run on level `k` from chunk `cs.start` and its pixels.
-        let on = |k: usize, cs: &Range<usize>| {
-            let (l, _) = cube.level(k);
-            let half = l.face_size() as f64 / 2.0;
-            let sub = FaceRun {
-                half,
-                dx: run.dx + (cs.start * C) as f64,
-                ..*run
-            };
-            let px = cs.start * C..(cs.end * C).min(n);
-            let t = toward_next(face_texels(l, face), frame, face, &sub, px.len());
-            (t, sub, px)
-        };
-        for (k, cs) in same_runs(levels.len(), |c| Some(levels[c].first)) {
-            let (t, sub, px) = on(k, &cs);
-            active().face_rows::<true>(&t, &sub, &mut out[px], buf);
-        }
-        let blended = |c: usize| (fracs[c] != 0).then_some(levels[c].second);
-        for (k, cs) in same_runs(levels.len(), blended) {
-            let (t, sub, px) = on(k, &cs);
-            let w = ChunkWeights {
-                chunk: C,
-                fracs: &fracs[cs],
-            };
-            active().face_rows_blend(&t, &sub, &mut out[px], w, buf);
-        }
-        (buf.levels, buf.fracs) = (levels, fracs);
+        chunked_span(cube, frame, face, run, out, buf, |f| {
+            let lod = lod_q8(f).max(0);
+            ((lod >> 8) as usize, (lod & 0xFF) as u32)
+        })
     }
+}
+
+/// Bilinear with a level per region (`Panorama::set_region_lod`): the pyramid level
+/// nearest the footprint (`nearest_level_of`: 0 up to √2, so magnified pixels read the
+/// faces as [`BilinearFetch`] does, byte for byte), per pixel or per
+/// [`TRILINEAR_RUN_CHUNK`] of a run, read bilinearly with no blend.
+impl Fetch for RegionFetch {
+    #[inline(always)]
+    fn fetch(self, cube: &CubeMap, frame: &Rays, face: Face, d: DVec3) -> u32 {
+        let (sx, sy) = (face_axes(face, frame.b), face_axes(face, frame.r1));
+        let f = footprint(face_axes(face, d), sx, sy, frame.half_face);
+        let (l, _) = cube.level(nearest_level_of(f) as usize);
+        let (u, v) = face_uv(face, d, l.face_size() as f64 / 2.0);
+        l.bilinear(face, u, v)
+    }
+
+    fn span(
+        self,
+        cube: &CubeMap,
+        frame: &Rays,
+        face: Face,
+        run: &FaceRun,
+        out: &mut [u32],
+        buf: &mut FaceBuf,
+    ) {
+        chunked_span(cube, frame, face, run, out, buf, |f| {
+            (nearest_level_of(f) as usize, 0)
+        })
+    }
+}
+
+/// A run drawn per [`TRILINEAR_RUN_CHUNK`] on the pyramid levels `level_of` gives each
+/// chunk from its middle pixel's footprint: the first level and the second's weight
+/// (0..=255; 0 for none), `(0, 0)` at footprints up to √2. The run's chunks that share
+/// their first level are drawn on it in one go, then those that share their second
+/// level (and blend it in) are blended in one go (`face_rows`, `face_rows_blend`: the
+/// positions pass and the row kernels).
+fn chunked_span(
+    cube: &CubeMap,
+    frame: &Rays,
+    face: Face,
+    run: &FaceRun,
+    out: &mut [u32],
+    buf: &mut FaceBuf,
+    level_of: impl Fn(f64) -> (usize, u32),
+) {
+    const C: usize = TRILINEAR_RUN_CHUNK;
+    let n = out.len();
+    // The image's x and y steps on the face's axes (y: −R₁ per row; the sign does not
+    // change the footprint).
+    let (sx, sy) = (face_axes(face, frame.b), face_axes(face, frame.r1));
+    let (mut levels, mut fracs) = (take(&mut buf.levels), take(&mut buf.fracs));
+    levels.clear();
+    fracs.clear();
+    let chunks = n.div_ceil(C);
+    levels.reserve(chunks);
+    fracs.reserve(chunks);
+    // The levels of the last `k` seen (a run's chunks mostly share theirs): the
+    // pyramid is looked up when `k` changes, not per chunk.
+    let resolve = |k: usize| ChunkLevels {
+        first: cube.level(k).1,
+        second: cube.level(k + 1).1,
+    };
+    let (mut last_k, mut last) = (0, resolve(0));
+    // Chunk c's middle pixel is c·C + C/2 (the last chunk's: its own middle), a
+    // whole number below 2^53 stepped in f64: exact, the same `mid` as
+    // `(c * C + C / 2) as f64`.
+    let mut off = (C / 2) as f64;
+    // Blocks of chunks whose footprint is bounded by √2 (`footprint_bound`) have
+    // level of detail 0 at every middle pixel without computing it (a bounded block
+    // gets what the exact footprint would give it, so the bytes are the same).
+    let mut skip_to = 0;
+    for c in 0..chunks {
+        if c % LOD_BLOCK == 0 && c + LOD_BLOCK < chunks {
+            let ends = (run.dx + off, run.dx + off + ((LOD_BLOCK - 1) * C) as f64);
+            let bound = footprint_bound((run.p, run.d), ends, sx, sy, frame.half_face);
+            if bound <= LOD0_FOOTPRINT {
+                skip_to = c + LOD_BLOCK;
+            }
+        }
+        if c < skip_to {
+            off += C as f64;
+            if last_k != 0 {
+                (last_k, last) = (0, resolve(0));
+            }
+            levels.push(last);
+            fracs.push(0);
+            continue;
+        }
+        let mid = if c + 1 < chunks {
+            run.dx + off
+        } else {
+            run.dx + (c * C + (n - c * C) / 2) as f64
+        };
+        off += C as f64;
+        let at = |i: usize| run.p[i] + mid * run.d[i];
+        let (k, frac) = level_of(footprint((at(0), at(1), at(2)), sx, sy, frame.half_face));
+        if k != last_k {
+            (last_k, last) = (k, resolve(k));
+        }
+        levels.push(last);
+        fracs.push(if last.first == last.second { 0 } else { frac });
+    }
+    // The run on level `k` from chunk `cs.start` and its pixels.
+    let on = |k: usize, cs: &Range<usize>| {
+        let (l, _) = cube.level(k);
+        let half = l.face_size() as f64 / 2.0;
+        let sub = FaceRun {
+            half,
+            dx: run.dx + (cs.start * C) as f64,
+            ..*run
+        };
+        let px = cs.start * C..(cs.end * C).min(n);
+        let t = toward_next(face_texels(l, face), frame, face, &sub, px.len());
+        (t, sub, px)
+    };
+    for (k, cs) in same_runs(levels.len(), |c| Some(levels[c].first)) {
+        let (t, sub, px) = on(k, &cs);
+        active().face_rows::<true>(&t, &sub, &mut out[px], buf);
+    }
+    let blended = |c: usize| (fracs[c] != 0).then_some(levels[c].second);
+    for (k, cs) in same_runs(levels.len(), blended) {
+        let (t, sub, px) = on(k, &cs);
+        let w = ChunkWeights {
+            chunk: C,
+            fracs: &fracs[cs],
+        };
+        active().face_rows_blend(&t, &sub, &mut out[px], w, buf);
+    }
+    (buf.levels, buf.fracs) = (levels, fracs);
 }
 
 /// A frame of `view` of `cube` with `opts` (the entry is [`crate::Panorama::render`] of a
@@ -343,11 +432,16 @@ pub(crate) fn cube_frame(
     view: View,
     opts: &RenderOptions,
     frame: &mut Frame<'_>,
+    region_lod: bool,
 ) -> Result<RenderReport, ViewError> {
     check_step(opts.index_step)?;
     let pixels = frame.width() as u64 * frame.height() as u64;
     let path = if view.projection().is_rectilinear() {
-        render_cube(cube, view, opts.sampler, opts.cube, frame, opts.threads);
+        let sampler = match (opts.sampler, region_lod) {
+            (Sampler::Bilinear, true) => CubeSampler::Region,
+            (s, _) => CubeSampler::Plain(s),
+        };
+        render_cube(cube, view, sampler, opts.cube, frame, opts.threads);
         RenderPath::Cube(opts.cube)
     } else {
         super::projected::render_cube(cube, view, opts.sampler, frame, opts.threads);
@@ -370,20 +464,42 @@ pub(crate) fn cube_frame(
 pub(crate) fn render_cube(
     cube: &CubeMap,
     view: View,
-    sampler: Sampler,
+    sampler: impl Into<CubeSampler>,
     renderer: CubeRenderer,
     frame: &mut Frame<'_>,
     threads: bool,
 ) {
     let rays = Rays::new(view, frame.width(), frame.height(), cube.face_size());
     let out = frame.pixels_mut();
-    match sampler {
-        Sampler::Nearest => render_with(cube, &rays, NearestFetch, renderer, out, threads),
-        Sampler::Bilinear => render_with(cube, &rays, BilinearFetch, renderer, out, threads),
-        Sampler::Trilinear => {
+    match sampler.into() {
+        CubeSampler::Plain(Sampler::Nearest) => {
+            render_with(cube, &rays, NearestFetch, renderer, out, threads)
+        }
+        CubeSampler::Plain(Sampler::Bilinear) => {
+            render_with(cube, &rays, BilinearFetch, renderer, out, threads)
+        }
+        CubeSampler::Plain(Sampler::Trilinear) => {
             cube.pyramid(); // built here, not inside a row band
             render_with(cube, &rays, TrilinearFetch, renderer, out, threads)
         }
+        CubeSampler::Region => {
+            cube.pyramid();
+            render_with(cube, &rays, RegionFetch, renderer, out, threads)
+        }
+    }
+}
+
+/// How a cube frame samples: a [`Sampler`], or bilinear on the pyramid level of each
+/// region's footprint (`Panorama::set_region_lod`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum CubeSampler {
+    Plain(Sampler),
+    Region,
+}
+
+impl From<Sampler> for CubeSampler {
+    fn from(s: Sampler) -> CubeSampler {
+        CubeSampler::Plain(s)
     }
 }
 
@@ -410,6 +526,10 @@ fn same_runs(
         None
     })
 }
+
+/// Chunks of a trilinear face run whose level of detail is bounded together
+/// (`footprint_bound`) before any is computed.
+const LOD_BLOCK: usize = 8;
 
 /// A cube band task's scratch: a scanline's face segments and its runs' position buffers.
 type BandScratch = (Vec<Seg>, FaceBuf);
@@ -680,7 +800,118 @@ impl CubeMap {
 
 #[cfg(test)]
 mod tests {
-    use super::same_runs;
+    use super::*;
+
+    /// A cube of `n`² faces of hashed noise.
+    fn noise_cube(n: u32) -> CubeMap {
+        let faces: Vec<Vec<u32>> = (0..6u32)
+            .map(|k| {
+                (0..n * n)
+                    .map(|i| {
+                        let mut h = (i + 1).wrapping_mul(2_654_435_761) ^ ((k + 7) * 40_503);
+                        h ^= h >> 15;
+                        h = h.wrapping_mul(2_246_822_519);
+                        (h ^ (h >> 13)) & 0x00FF_FFFF
+                    })
+                    .collect()
+            })
+            .collect();
+        let refs: [&[u32]; 6] = std::array::from_fn(|k| faces[k].as_slice());
+        CubeMap::from_faces(n, refs).unwrap()
+    }
+
+    #[test]
+    fn trilinear_runs_take_each_chunks_exact_level_of_detail() {
+        // Every pixel of a scanline trilinear frame is `trilinear_dir` with the level of
+        // detail of its chunk's middle pixel computed exactly (verified runs; the
+        // per-pixel one elsewhere), whether or not the renderer skipped the chunk's
+        // level in a block bounded below √2: the bytes the renderer gave before blocks
+        // were skipped. The views mix blocks that are skipped and chunks that blend.
+        // The level per region likewise: bilinear on the level nearest that footprint.
+        const C: usize = TRILINEAR_RUN_CHUNK;
+        let cube = noise_cube(256);
+        cube.pyramid();
+        let (w, h) = (400u32, 160u32);
+        let (mut skipped, mut blended) = (0, 0);
+        let views = [
+            (37.3, 0.0, 90.0),
+            (10.0, 30.0, 120.0),
+            (-140.0, -50.0, 100.0),
+        ];
+        for (yaw, pitch, hfov) in views {
+            let view = View::new(yaw, pitch, hfov).unwrap();
+            let mut px = vec![0u32; (w * h) as usize];
+            let mut frame = Frame::new(&mut px, w, h).unwrap();
+            render_cube(
+                &cube,
+                view,
+                Sampler::Trilinear,
+                CubeRenderer::Accelerated,
+                &mut frame,
+                false,
+            );
+            // The level per region: bilinear on the nearest level of the same footprint.
+            let mut region = vec![0u32; (w * h) as usize];
+            let mut rf = Frame::new(&mut region, w, h).unwrap();
+            let (r, a) = (CubeSampler::Region, CubeRenderer::Accelerated);
+            render_cube(&cube, view, r, a, &mut rf, false);
+            let rays = Rays::new(view, w, h, cube.face_size());
+            let half = rays.half_face;
+            for y in 0..h as usize {
+                let p = rays.row(rays.dy(y));
+                for r in scanline_runs(view, w, h, cube.face_size(), y as u32) {
+                    let face = r.face;
+                    let (sx, sy) = (face_axes(face, rays.b), face_axes(face, rays.r1));
+                    let (s, n) = (r.start as usize, (r.end - r.start) as usize);
+                    for x in s..s + n {
+                        let d = ray(p, rays.b, rays.dx(x));
+                        let f = if r.verified {
+                            let c = (x - s) / C;
+                            let mid = rays.dx(s) + (c * C + C.min(n - c * C) / 2) as f64;
+                            footprint(face_axes(face, ray(p, rays.b, mid)), sx, sy, half)
+                        } else {
+                            footprint(face_axes(face, d), sx, sy, half)
+                        };
+                        let lod = lod_q8(f);
+                        let want = cube.trilinear_dir(face, d, lod);
+                        let got = px[y * w as usize + x];
+                        assert_eq!(got, want, "{view:?} ({x}, {y}) lod {lod}");
+                        let (l, _) = cube.level(nearest_level_of(f) as usize);
+                        let (u, v) = face_uv(face, d, l.face_size() as f64 / 2.0);
+                        let want = l.bilinear(face, u, v);
+                        let got = region[y * w as usize + x];
+                        assert_eq!(got, want, "region {view:?} ({x}, {y}) footprint {f}");
+                    }
+                    // What the renderer's blocks did on this run.
+                    let chunks = n.div_ceil(C);
+                    for c0 in (0..chunks).step_by(super::LOD_BLOCK) {
+                        if !r.verified || c0 + super::LOD_BLOCK >= chunks {
+                            continue;
+                        }
+                        let mid = |c: usize| rays.dx(s) + (c * C + C / 2) as f64;
+                        let (pa, pb, pm) = face_axes(face, p);
+                        let (ba, bb, bm) = face_axes(face, rays.b);
+                        let ends = (mid(c0), mid(c0 + super::LOD_BLOCK - 1));
+                        let run = ([pa, pb, pm], [ba, bb, bm]);
+                        if footprint_bound(run, ends, sx, sy, half) <= LOD0_FOOTPRINT {
+                            skipped += 1;
+                        }
+                    }
+                    blended += (0..chunks)
+                        .filter(|&c| {
+                            let mid = rays.dx(s) + (c * C + C.min(n - c * C) / 2) as f64;
+                            let at = face_axes(face, ray(p, rays.b, mid));
+                            r.verified && lod_q8(footprint(at, sx, sy, half)) > 0
+                        })
+                        .count();
+                }
+            }
+        }
+        assert!(
+            skipped > 100 && blended > 100,
+            "{skipped} blocks skipped, {blended} chunks blended"
+        );
+    }
 
     #[test]
     fn same_runs_groups_consecutive_keys_and_skips_none() {

@@ -275,6 +275,11 @@ fn run_in_pool(a: &BenchArgs, threads: usize) -> Result<()> {
     let cube_map = if a.no_cube || a.only_default {
         None
     } else {
+        // Faces of a quarter of the map's width: as many texels per degree along the
+        // equator and the meridians through the face centres as the map has there (the
+        // same texel density: the comparison with the LUT frames is fair; wider faces,
+        // e.g. width / π, read up to 1.6x the texels, docs/performance.md, "Cube against
+        // the LUT per view").
         let size = (map.width() / 4).clamp(16, 4096);
         let t = Instant::now();
         let c = CubeMap::from_envmap(&map, size, Sampler::Bilinear)

@@ -493,7 +493,8 @@ impl App {
         // (`Renderer::set_still_level`): the map itself unless the view is zoomed out, and
         // then the cost of the level, not of a 32k map. Bilinear frames drawn from the map
         // (or a level) read, span by span, the pyramid level nearest the footprint there
-        // (`Renderer::set_region_lod`): looking at a pole or across a wide view costs
+        // (`Renderer::set_region_lod`; a cube's bilinear frames the face pyramid level
+        // nearest each 16 pixels' footprint): looking at a pole or across a wide view costs
         // about 0.65-0.75x the CPU time of the map itself there and aliases less; where
         // pixels magnify the frame is the same, byte for byte (docs/performance.md,
         // issue 34).

@@ -203,8 +203,15 @@ fn run_blend(
         "a weight per chunk"
     );
     let low = positions::<true>(k, t, r, len, buf);
+    // Each chunk's weight repeated over its pixels (no division per pixel).
     buf.w.clear();
-    buf.w.extend((0..len).map(|j| fracs[j / chunk]));
+    for &f in fracs {
+        let k = chunk.min(len - buf.w.len());
+        buf.w.resize(buf.w.len() + k, f);
+        if buf.w.len() == len {
+            break;
+        }
+    }
     if low {
         buf.under.clear();
         buf.under.extend_from_slice(out);
