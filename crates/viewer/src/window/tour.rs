@@ -653,6 +653,12 @@ mod tests {
         nav
     }
 
+    /// `nav`'s current scene arrived (its panorama shown), as the window reports it.
+    pub fn shown(nav: &mut TourNav) {
+        let src = scene_source(&nav.tour, nav.current()).unwrap();
+        nav.arrived(&src, None, 0.0).unwrap();
+    }
+
     fn arrive(nav: &mut TourNav, a: &TourAction, t: f64) -> Angles {
         let TourAction::Load(src) = a else {
             panic!("not a load: {a:?}");

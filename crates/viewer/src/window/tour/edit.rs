@@ -564,16 +564,11 @@ pub fn edit_panel(ctx: &egui::Context, scene: egui::Rect, nav: &mut TourNav) -> 
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::sample;
+    use super::super::tests::{sample, shown};
     use super::*;
     use crate::tour::HotspotKind;
     use crate::window::input::steer_rect;
     use crate::window::loader::Source;
-
-    fn shown(nav: &mut TourNav) {
-        let src = scene_source(&nav.tour, nav.current()).unwrap();
-        nav.arrived(&src, None, 0.0).unwrap();
-    }
 
     #[test]
     fn a_click_picks_a_spot_or_selects_a_marker_and_the_panel_edits_there() {

@@ -286,15 +286,10 @@ fn dot(out: &mut [u32], w: u32, h: u32, cx: f64, cy: f64, r: f64, color: u32) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::sample;
-    use super::super::{scene_source, EditRequest};
+    use super::super::tests::{sample, shown};
+    use super::super::EditRequest;
     use super::*;
     use crate::window::input::steer_rect;
-
-    fn shown(nav: &mut TourNav) {
-        let src = scene_source(&nav.tour, nav.current()).unwrap();
-        nav.arrived(&src, None, 0.0).unwrap();
-    }
 
     #[test]
     fn the_preview_shows_each_pixel_from_where_the_rotation_sends_it() {
